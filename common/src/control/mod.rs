@@ -1,0 +1,1 @@
+//! The successive-loop-closure autopilot of the thesis (chapter 3).

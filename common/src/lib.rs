@@ -1,0 +1,27 @@
+//! Everything that flies, once, for the MCU and for the host.
+//!
+//! `common` is `#![no_std]` and never allocates. Its folders follow the data flow of one
+//! autopilot tick:
+//!
+//! ```text
+//! sensors -> estimator -> (navigation, guidance) -> control -> actuator outputs
+//! ```
+//!
+//! - [`math`]: the one definition of every frame change, rotation, geodetic conversion and
+//!   the standard atmosphere, generic over the float type so the f64 plant and the f32
+//!   firmware share it.
+//! - [`params`]: how each stage declares its parameters (name, default, bounds, unit).
+//! - [`sensors`]: the raw sensor samples the estimator consumes.
+//! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
+//! - [`control`]: the successive-loop-closure autopilot of the thesis.
+//!
+//! Every stage is a plain struct with an explicit `step`/`update` taking its inputs and time
+//! step: no globals, no I/O, no clock reads.
+#![no_std]
+#![forbid(unsafe_code)]
+
+pub mod control;
+pub mod estimator;
+pub mod math;
+pub mod params;
+pub mod sensors;

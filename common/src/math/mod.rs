@@ -1,0 +1,16 @@
+//! Frames, rotations, geodetic conversions and the standard atmosphere.
+//!
+//! Every function here is generic over the float type (`nalgebra::RealField`): the plant
+//! calls them in `f64`, the firmware in `f32`, and both therefore agree on every convention.
+//!
+//! Conventions (fixed for the whole project):
+//! - inertial frame NED (north, east, down), flat earth about a home point;
+//! - body frame x forward, y right, z down;
+//! - attitude as 3-2-1 Euler angles (yaw psi, pitch theta, roll phi) or the equivalent unit
+//!   quaternion that rotates body vectors into NED.
+
+pub mod atmosphere;
+pub mod frames;
+pub mod geodetic;
+
+pub use frames::*;

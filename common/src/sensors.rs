@@ -1,0 +1,57 @@
+//! Raw sensor samples, as the estimator consumes them.
+//!
+//! On the MCU they come from drivers; in SITL from the simulator's `HIL_SENSOR` and `HIL_GPS`
+//! frames. Units are SI: specific force in m/s^2 (level flight reads z = -g), rates in rad/s,
+//! magnetic field in gauss, pressures in Pa, temperatures in deg C.
+
+use crate::math::geodetic::GeoPoint;
+use nalgebra::Vector3;
+
+/// One IMU sample in the body frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImuSample {
+    /// Specific force (accelerometer), m/s^2.
+    pub accel: Vector3<f32>,
+    /// Angular rate (gyro), rad/s.
+    pub gyro: Vector3<f32>,
+}
+
+/// One magnetometer sample in the body frame, gauss.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MagSample {
+    /// Field vector, gauss.
+    pub field: Vector3<f32>,
+}
+
+/// One barometer sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BaroSample {
+    /// Static pressure, Pa.
+    pub pressure_pa: f32,
+    /// Temperature, deg C.
+    pub temperature_c: f32,
+}
+
+/// One differential-pressure (pitot-static) sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PitotSample {
+    /// Total minus static pressure, Pa.
+    pub diff_pressure_pa: f32,
+}
+
+/// One GPS fix.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GpsFix {
+    /// Horizontal position.
+    pub position: GeoPoint,
+    /// Altitude above mean sea level, m.
+    pub alt_amsl_m: f32,
+    /// Velocity in NED, m/s.
+    pub vel_ned: Vector3<f32>,
+    /// 0-1: no fix, 2: 2D, 3: 3D (MAVLink `GPS_FIX_TYPE`).
+    pub fix_type: u8,
+    /// Satellites used.
+    pub satellites: u8,
+    /// Horizontal dilution of precision.
+    pub hdop: f32,
+}

@@ -1,0 +1,1 @@
+//! The Ultra Stick 25e simulator: plant, analysis and the simulator side of the MAVLink link.
