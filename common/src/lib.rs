@@ -14,12 +14,14 @@
 //! - [`sensors`]: the raw sensor samples the estimator consumes.
 //! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
 //! - [`control`]: the successive-loop-closure autopilot of the thesis.
+//! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
 //!
 //! Every stage is a plain struct with an explicit `step`/`update` taking its inputs and time
 //! step: no globals, no I/O, no clock reads.
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod actuators;
 pub mod control;
 pub mod estimator;
 pub mod math;
