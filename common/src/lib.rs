@@ -14,6 +14,7 @@
 //! - [`sensors`]: the raw sensor samples the estimator consumes.
 //! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
 //! - [`control`]: the successive-loop-closure autopilot of the thesis.
+//! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
 //!
 //! Every stage is a plain struct with an explicit `step`/`update` taking its inputs and time
@@ -24,6 +25,7 @@
 pub mod actuators;
 pub mod control;
 pub mod estimator;
+pub mod link;
 pub mod math;
 pub mod params;
 pub mod sensors;

@@ -1,0 +1,421 @@
+//! MAVLink byte-stream framing with counted rejections.
+//!
+//! The `mavlink` crate's own reader skips corrupt frames silently; an autopilot must count
+//! them (bad CRC, unknown message, undecodable payload) and report them, so this parser does
+//! the frame synchronisation itself and leaves every check of substance to the crate:
+//! [`MAVLinkV2MessageRaw::has_valid_crc`] for the checksum and [`Message::parse`] for the
+//! payload. It takes bytes in whatever chunks a UART, a socket or a pipe delivers them, never
+//! allocates and never panics.
+
+use mavlink::dialects::common::MavMessage;
+use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message};
+
+const STX_V1: u8 = 0xFE;
+const STX_V2: u8 = 0xFD;
+const V1_HEADER: usize = 5;
+const V2_HEADER: usize = 9;
+const V2_IFLAG_SIGNED: u8 = 0x01;
+const V2_SIGNATURE: usize = 13;
+const CHECKSUM: usize = 2;
+const MAX_FRAME: usize = 1 + V2_HEADER + 255 + CHECKSUM + V2_SIGNATURE;
+
+/// Counters of everything the parser saw.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LinkStats {
+    /// Frames decoded and delivered.
+    pub frames_ok: u32,
+    /// Frames whose checksum did not match.
+    pub crc_errors: u32,
+    /// Frames of a message id this dialect does not know.
+    pub unknown_ids: u32,
+    /// Frames with a valid checksum whose payload did not decode (bad enum value, ...).
+    pub parse_errors: u32,
+    /// Frames with incompatibility flags this parser does not support.
+    pub unsupported: u32,
+    /// Bytes skipped while looking for a start-of-frame marker.
+    pub bytes_skipped: u32,
+    /// Lost frames, from gaps in each sender's sequence numbers.
+    pub seq_gaps: u32,
+}
+
+/// A decoded frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Sender, sequence and component.
+    pub header: MavHeader,
+    /// Protocol version the frame arrived in.
+    pub version: MavlinkVersion,
+    /// The message.
+    pub message: MavMessage,
+}
+
+/// Incremental MAVLink 1 and 2 frame parser.
+pub struct FrameParser {
+    buf: [u8; MAX_FRAME],
+    len: usize,
+    stats: LinkStats,
+    last_seq: Option<(u32, u8)>,
+}
+
+impl Default for FrameParser {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+// Lives for one check on the stack; boxing is not available without a heap.
+#[allow(clippy::large_enum_variant)]
+enum Check {
+    NeedMore,
+    Bad,
+    /// Skip a whole frame of this length (its id is unknown, so its checksum cannot be checked).
+    Skip(usize),
+    Done(Frame, usize),
+}
+
+impl FrameParser {
+    /// An empty parser.
+    pub const fn new() -> Self {
+        Self {
+            buf: [0; MAX_FRAME],
+            len: 0,
+            stats: LinkStats {
+                frames_ok: 0,
+                crc_errors: 0,
+                unknown_ids: 0,
+                parse_errors: 0,
+                unsupported: 0,
+                bytes_skipped: 0,
+                seq_gaps: 0,
+            },
+            last_seq: None,
+        }
+    }
+
+    /// What the parser has counted so far.
+    pub fn stats(&self) -> LinkStats {
+        self.stats
+    }
+
+    /// Feeds bytes; calls `on_frame` for every complete, valid frame in order.
+    pub fn push(&mut self, bytes: &[u8], mut on_frame: impl FnMut(Frame)) {
+        for &b in bytes {
+            if self.len == 0 && b != STX_V1 && b != STX_V2 {
+                self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(1);
+                continue;
+            }
+            if self.len < self.buf.len() {
+                self.buf[self.len] = b;
+                self.len += 1;
+            }
+            self.drain(&mut on_frame);
+        }
+    }
+
+    /// Checks the buffer until it needs more bytes.
+    fn drain(&mut self, on_frame: &mut impl FnMut(Frame)) {
+        loop {
+            match self.check() {
+                Check::NeedMore => return,
+                Check::Done(frame, n) => {
+                    self.note_sequence(&frame.header);
+                    self.stats.frames_ok = self.stats.frames_ok.wrapping_add(1);
+                    on_frame(frame);
+                    self.consume(n);
+                }
+                Check::Skip(n) => self.consume(n),
+                // A corrupt candidate: the real frame may start inside it, so resynchronise
+                // on the next marker after its first byte.
+                Check::Bad => self.resync(),
+            }
+            if self.len == 0 {
+                return;
+            }
+        }
+    }
+
+    fn consume(&mut self, n: usize) {
+        let n = n.min(self.len);
+        self.buf.copy_within(n..self.len, 0);
+        self.len -= n;
+        self.skip_to_marker(0);
+    }
+
+    fn resync(&mut self) {
+        self.skip_to_marker(1);
+    }
+
+    fn skip_to_marker(&mut self, from: usize) {
+        let start = self.buf[..self.len]
+            .iter()
+            .enumerate()
+            .skip(from)
+            .find(|(_, &b)| b == STX_V1 || b == STX_V2)
+            .map_or(self.len, |(i, _)| i);
+        self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(start as u32);
+        self.buf.copy_within(start..self.len, 0);
+        self.len -= start;
+    }
+
+    fn note_sequence(&mut self, h: &MavHeader) {
+        if let Some((sys, seq)) = self.last_seq {
+            if sys == h.system_id {
+                let gap = h.sequence.wrapping_sub(seq).wrapping_sub(1);
+                // A large jump is a restarted sender, not 200 lost frames.
+                if gap > 0 && gap < 128 {
+                    self.stats.seq_gaps = self.stats.seq_gaps.wrapping_add(u32::from(gap));
+                }
+            }
+        }
+        self.last_seq = Some((h.system_id, h.sequence));
+    }
+
+    fn check(&mut self) -> Check {
+        let Some(&stx) = self.buf.first().filter(|_| self.len > 0) else {
+            return Check::NeedMore;
+        };
+        if self.len < 3 {
+            return Check::NeedMore;
+        }
+        let payload_len = usize::from(self.buf[1]);
+        if stx == STX_V2 {
+            let iflags = self.buf[2];
+            if iflags & !V2_IFLAG_SIGNED != 0 {
+                self.stats.unsupported = self.stats.unsupported.wrapping_add(1);
+                return Check::Bad;
+            }
+            let sig = if iflags & V2_IFLAG_SIGNED != 0 {
+                V2_SIGNATURE
+            } else {
+                0
+            };
+            let total = 1 + V2_HEADER + payload_len + CHECKSUM + sig;
+            if self.len < total {
+                return Check::NeedMore;
+            }
+            let mut raw = MAVLinkV2MessageRaw::new();
+            raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
+            let id = raw.message_id();
+            if !raw.has_valid_crc::<MavMessage>() {
+                return self.classify_failure(id, total);
+            }
+            let header = MavHeader {
+                system_id: raw.system_id(),
+                component_id: raw.component_id(),
+                sequence: raw.sequence(),
+            };
+            self.finish(header, MavlinkVersion::V2, id, raw.payload(), total)
+        } else {
+            let total = 1 + V1_HEADER + payload_len + CHECKSUM;
+            if self.len < total {
+                return Check::NeedMore;
+            }
+            let mut raw = MAVLinkV1MessageRaw::new();
+            raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
+            let id = u32::from(raw.message_id());
+            if !raw.has_valid_crc::<MavMessage>() {
+                return self.classify_failure(id, total);
+            }
+            let header = MavHeader {
+                system_id: u32::from(raw.system_id()),
+                component_id: raw.component_id(),
+                sequence: raw.sequence(),
+            };
+            self.finish(header, MavlinkVersion::V1, id, raw.payload(), total)
+        }
+    }
+
+    fn classify_failure(&mut self, id: u32, total: usize) -> Check {
+        if MavMessage::default_message_from_id(id).is_none() {
+            self.stats.unknown_ids = self.stats.unknown_ids.wrapping_add(1);
+            Check::Skip(total)
+        } else {
+            self.stats.crc_errors = self.stats.crc_errors.wrapping_add(1);
+            Check::Bad
+        }
+    }
+
+    fn finish(
+        &mut self,
+        header: MavHeader,
+        version: MavlinkVersion,
+        id: u32,
+        payload: &[u8],
+        total: usize,
+    ) -> Check {
+        match MavMessage::parse(version, id, payload) {
+            Ok(message) => Check::Done(
+                Frame {
+                    header,
+                    version,
+                    message,
+                },
+                total,
+            ),
+            Err(_) => {
+                self.stats.parse_errors = self.stats.parse_errors.wrapping_add(1);
+                Check::Skip(total)
+            }
+        }
+    }
+}
+
+/// Encodes one MAVLink 2 frame; returns the buffer holding it (`raw_bytes()` is the frame).
+pub fn encode_v2(header: MavHeader, message: &MavMessage) -> MAVLinkV2MessageRaw {
+    let mut raw = MAVLinkV2MessageRaw::new();
+    raw.serialize_message(header, message);
+    raw
+}
+
+/// Hands out the sequence numbers of one sender on one link.
+#[derive(Clone, Copy, Debug)]
+pub struct Sender {
+    system_id: u8,
+    component_id: u8,
+    sequence: u8,
+}
+
+impl Sender {
+    /// A sender with the given identity.
+    pub const fn new(system_id: u8, component_id: u8) -> Self {
+        Self {
+            system_id,
+            component_id,
+            sequence: 0,
+        }
+    }
+
+    /// The header for the next frame.
+    pub fn next_header(&mut self) -> MavHeader {
+        let h = MavHeader {
+            system_id: u32::from(self.system_id),
+            component_id: self.component_id,
+            sequence: self.sequence,
+        };
+        self.sequence = self.sequence.wrapping_add(1);
+        h
+    }
+
+    /// Encodes `message` as the next MAVLink 2 frame of this sender.
+    pub fn encode(&mut self, message: &MavMessage) -> MAVLinkV2MessageRaw {
+        encode_v2(self.next_header(), message)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use mavlink::dialects::common::{HEARTBEAT_DATA, PARAM_VALUE_DATA};
+    use std::vec::Vec;
+
+    fn frames(bytes: &[u8], chunk: usize) -> (Vec<Frame>, LinkStats) {
+        let mut p = FrameParser::new();
+        let mut out = Vec::new();
+        for c in bytes.chunks(chunk.max(1)) {
+            p.push(c, |f| out.push(f));
+        }
+        (out, p.stats())
+    }
+
+    fn heartbeat(seq: u8) -> Vec<u8> {
+        let h = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: seq,
+        };
+        encode_v2(h, &MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()))
+            .raw_bytes()
+            .to_vec()
+    }
+
+    #[test]
+    fn decodes_frames_in_any_chunking() {
+        let mut s = Vec::new();
+        for i in 0..5 {
+            s.extend(heartbeat(i));
+        }
+        for chunk in [1, 3, 7, 1000] {
+            let (f, st) = frames(&s, chunk);
+            assert_eq!(f.len(), 5);
+            assert_eq!(st.crc_errors + st.bytes_skipped + st.seq_gaps, 0);
+            assert_eq!(f[4].header.sequence, 4);
+        }
+    }
+
+    #[test]
+    fn counts_and_survives_garbage_bad_crc_truncation_and_unknown_ids() {
+        let mut s = Vec::new();
+        s.extend(b"\x00garbage\x01\x02");
+        let mut bad = heartbeat(0);
+        let n = bad.len();
+        bad[n - 1] ^= 0xFF; // corrupt checksum
+        s.extend(&bad);
+        let trunc = heartbeat(1);
+        s.extend(&trunc[..trunc.len() - 4]); // truncated: swallowed by the next frame's bytes
+                                             // An unknown message id 0xABCDE with a plausible header.
+        s.extend([STX_V2, 2, 0, 0, 9, 1, 1, 0xDE, 0xBC, 0x0A, 1, 2, 0x55, 0x66]);
+        s.extend(heartbeat(2));
+        s.extend(heartbeat(3));
+        let (f, st) = frames(&s, 5);
+        // Both heartbeats after the debris still arrive.
+        assert!(f.len() >= 2, "{st:?}");
+        assert_eq!(f.last().map(|f| f.header.sequence), Some(3));
+        assert!(st.crc_errors >= 1, "{st:?}");
+        assert!(st.bytes_skipped >= 10, "{st:?}");
+    }
+
+    #[test]
+    fn unknown_id_with_good_length_is_skipped_whole() {
+        let mut s = Vec::new();
+        s.extend([STX_V2, 2, 0, 0, 9, 1, 1, 0xDE, 0xBC, 0x0A, 1, 2, 0x55, 0x66]);
+        s.extend(heartbeat(7));
+        let (f, st) = frames(&s, 64);
+        assert_eq!(f.len(), 1);
+        assert_eq!(st.unknown_ids, 1);
+    }
+
+    #[test]
+    fn mavlink1_frames_decode_and_sequence_gaps_count() {
+        let h = MavHeader {
+            system_id: 255,
+            component_id: 190,
+            sequence: 10,
+        };
+        let mut v1 = MAVLinkV1MessageRaw::new();
+        let msg = MavMessage::PARAM_VALUE(PARAM_VALUE_DATA::default());
+        v1.serialize_message(h, &msg);
+        let mut s = v1.raw_bytes().to_vec();
+        let h2 = MavHeader { sequence: 13, ..h };
+        s.extend(encode_v2(h2, &msg).raw_bytes());
+        let (f, st) = frames(&s, 2);
+        assert_eq!(f.len(), 2);
+        assert_eq!(f[0].version, MavlinkVersion::V1);
+        assert_eq!(st.seq_gaps, 2);
+    }
+
+    #[test]
+    fn random_bytes_never_panic() {
+        // xorshift: deterministic noise, including many 0xFD/0xFE markers.
+        let mut x: u32 = 0x1234_5678;
+        let mut s = Vec::new();
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let b = (x & 0xFF) as u8;
+            s.push(if b < 16 { STX_V2 } else { b });
+        }
+        // A garbage marker just before the end can claim up to 280 bytes as its frame, so
+        // enough real frames must follow for the parser to resynchronise.
+        for i in 0..15 {
+            s.extend(heartbeat(i));
+        }
+        let (f, _) = frames(&s, 97);
+        assert!(matches!(
+            f.last().map(|f| &f.message),
+            Some(MavMessage::HEARTBEAT(_))
+        ));
+    }
+}

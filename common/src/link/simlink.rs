@@ -1,0 +1,413 @@
+//! PX4's simulator interface: `HIL_SENSOR` and `HIL_GPS` from the simulator,
+//! `HIL_ACTUATOR_CONTROLS` back.
+//!
+//! Both sides of the link use these functions, so units and flag bits are defined once:
+//! `HIL_SENSOR` carries specific force in m/s^2 (level flight z = -g), rates in rad/s, field in
+//! gauss, pressures in hPa and temperature in deg C, with `fields_updated` bits saying which
+//! groups are new (a barometer update sets bits 9, 11 and 12 together). `HIL_GPS` carries
+//! 1e-7 deg, mm and cm/s. The autopilot answers every sensor frame with
+//! `HIL_ACTUATOR_CONTROLS`: roll, pitch, yaw in -1..1 and throttle 0..1, `mode` bit 128 when
+//! armed and `flags` bit 0 (lock-step).
+//!
+//! The decoders are the autopilot's first line of defence: a group whose values are not
+//! finite or not physically plausible is dropped and counted, never passed on.
+
+use crate::actuators::Surfaces;
+use crate::math::geodetic::GeoPoint;
+use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use mavlink::dialects::common::{
+    HilActuatorControlsFlags, HilSensorUpdatedFlags, MavModeFlag, HIL_ACTUATOR_CONTROLS_DATA,
+    HIL_GPS_DATA, HIL_SENSOR_DATA,
+};
+use nalgebra::Vector3;
+
+const PA_PER_HPA: f32 = 100.0;
+
+/// `fields_updated` bits of one complete IMU update (accelerometer and gyro, all axes).
+pub const BITS_IMU: u32 = 0x3F;
+/// `fields_updated` bits of one magnetometer update.
+pub const BITS_MAG: u32 = 0x1C0;
+/// `fields_updated` bits of one barometer update: absolute pressure, pressure altitude,
+/// temperature.
+pub const BITS_BARO: u32 = (1 << 9) | (1 << 11) | (1 << 12);
+/// `fields_updated` bit of a differential-pressure update.
+pub const BITS_DIFF_PRESSURE: u32 = 1 << 10;
+
+/// Plausibility limits: beyond these a value is a fault, not a measurement.
+mod limits {
+    /// 16 g, the range of common MEMS accelerometers.
+    pub const ACCEL_MPS2: f32 = 16.0 * 9.81;
+    /// 2000 deg/s.
+    pub const GYRO_RADPS: f32 = 34.9;
+    /// The earth's field is below 0.7 gauss; allow local disturbance.
+    pub const MAG_GAUSS: f32 = 4.0;
+    /// 10 km above sea level to below the Dead Sea.
+    pub const BARO_HPA: (f32, f32) = (260.0, 1100.0);
+    /// About 130 m/s of airspeed; small negative readings are sensor offset.
+    pub const DIFF_HPA: (f32, f32) = (-5.0, 100.0);
+    pub const TEMP_C: (f32, f32) = (-60.0, 90.0);
+}
+
+/// One `HIL_SENSOR` frame as typed samples; `None` where the group was not updated.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SensorFrame {
+    /// Simulation time, us: the autopilot's clock in lock-step.
+    pub time_us: u64,
+    /// Accelerometer and gyro.
+    pub imu: Option<ImuSample>,
+    /// Magnetometer.
+    pub mag: Option<MagSample>,
+    /// Barometer.
+    pub baro: Option<BaroSample>,
+    /// Differential pressure.
+    pub pitot: Option<PitotSample>,
+    /// The simulator reset its state (bit 31).
+    pub reset: bool,
+}
+
+/// Which groups of one frame were dropped as implausible or incomplete.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Rejected {
+    /// IMU values missing an axis, non-finite or beyond range.
+    pub imu: bool,
+    /// Magnetometer.
+    pub mag: bool,
+    /// Barometer.
+    pub baro: bool,
+    /// Differential pressure.
+    pub pitot: bool,
+}
+
+impl Rejected {
+    /// True when nothing was dropped.
+    pub fn none(&self) -> bool {
+        !(self.imu || self.mag || self.baro || self.pitot)
+    }
+}
+
+fn finite_within(v: &[f32], limit: f32) -> bool {
+    v.iter().all(|x| x.is_finite() && x.abs() <= limit)
+}
+
+fn in_range(x: f32, (lo, hi): (f32, f32)) -> bool {
+    x.is_finite() && x >= lo && x <= hi
+}
+
+/// Encodes a sensor frame (simulator side).
+pub fn encode_hil_sensor(f: &SensorFrame, pressure_alt_m: f32) -> HIL_SENSOR_DATA {
+    let mut d = HIL_SENSOR_DATA {
+        time_usec: f.time_us,
+        ..Default::default()
+    };
+    let mut bits = 0u32;
+    if let Some(imu) = f.imu {
+        (d.xacc, d.yacc, d.zacc) = (imu.accel.x, imu.accel.y, imu.accel.z);
+        (d.xgyro, d.ygyro, d.zgyro) = (imu.gyro.x, imu.gyro.y, imu.gyro.z);
+        bits |= BITS_IMU;
+    }
+    if let Some(mag) = f.mag {
+        (d.xmag, d.ymag, d.zmag) = (mag.field.x, mag.field.y, mag.field.z);
+        bits |= BITS_MAG;
+    }
+    if let Some(b) = f.baro {
+        d.abs_pressure = b.pressure_pa / PA_PER_HPA;
+        d.temperature = b.temperature_c;
+        d.pressure_alt = pressure_alt_m;
+        bits |= BITS_BARO;
+    }
+    if let Some(p) = f.pitot {
+        d.diff_pressure = p.diff_pressure_pa / PA_PER_HPA;
+        bits |= BITS_DIFF_PRESSURE;
+    }
+    if f.reset {
+        bits |= 1 << 31;
+    }
+    d.fields_updated = HilSensorUpdatedFlags::from_bits_truncate(bits);
+    d
+}
+
+/// Decodes a `HIL_SENSOR` frame (autopilot side), dropping implausible groups.
+pub fn decode_hil_sensor(d: &HIL_SENSOR_DATA) -> (SensorFrame, Rejected) {
+    let bits = d.fields_updated.bits();
+    let mut f = SensorFrame {
+        time_us: d.time_usec,
+        reset: bits & (1 << 31) != 0,
+        ..Default::default()
+    };
+    let mut r = Rejected::default();
+    let group = |mask: u32| bits & mask;
+    match group(BITS_IMU) {
+        0 => {}
+        BITS_IMU => {
+            let a = [d.xacc, d.yacc, d.zacc];
+            let g = [d.xgyro, d.ygyro, d.zgyro];
+            if finite_within(&a, limits::ACCEL_MPS2) && finite_within(&g, limits::GYRO_RADPS) {
+                f.imu = Some(ImuSample {
+                    accel: Vector3::from(a),
+                    gyro: Vector3::from(g),
+                });
+            } else {
+                r.imu = true;
+            }
+        }
+        _ => r.imu = true,
+    }
+    match group(BITS_MAG) {
+        0 => {}
+        BITS_MAG => {
+            let m = [d.xmag, d.ymag, d.zmag];
+            if finite_within(&m, limits::MAG_GAUSS) {
+                f.mag = Some(MagSample {
+                    field: Vector3::from(m),
+                });
+            } else {
+                r.mag = true;
+            }
+        }
+        _ => r.mag = true,
+    }
+    // Pressure is what matters; a frame may carry it without altitude or temperature.
+    if group(1 << 9) != 0 {
+        let temp_ok = group(1 << 12) == 0 || in_range(d.temperature, limits::TEMP_C);
+        if in_range(d.abs_pressure, limits::BARO_HPA) && temp_ok {
+            f.baro = Some(BaroSample {
+                pressure_pa: d.abs_pressure * PA_PER_HPA,
+                temperature_c: if group(1 << 12) != 0 {
+                    d.temperature
+                } else {
+                    15.0
+                },
+            });
+        } else {
+            r.baro = true;
+        }
+    }
+    if group(BITS_DIFF_PRESSURE) != 0 {
+        if in_range(d.diff_pressure, limits::DIFF_HPA) {
+            f.pitot = Some(PitotSample {
+                diff_pressure_pa: d.diff_pressure * PA_PER_HPA,
+            });
+        } else {
+            r.pitot = true;
+        }
+    }
+    (f, r)
+}
+
+fn clamp_i16(x: f32) -> i16 {
+    if x.is_finite() {
+        x.clamp(i16::MIN as f32, i16::MAX as f32) as i16
+    } else {
+        0
+    }
+}
+
+/// Encodes a GPS fix (simulator side). `time_us` is the time the fix is valid for.
+pub fn encode_hil_gps(time_us: u64, fix: &GpsFix) -> HIL_GPS_DATA {
+    let (course, speed) = crate::math::course_and_speed(&fix.vel_ned);
+    let cog_cdeg = crate::math::wrap_two_pi(course).to_degrees() * 100.0;
+    HIL_GPS_DATA {
+        time_usec: time_us,
+        fix_type: fix.fix_type,
+        lat: fix.position.lat_e7,
+        lon: fix.position.lon_e7,
+        alt: (fix.alt_amsl_m * 1000.0) as i32,
+        eph: (fix.hdop * 100.0).clamp(0.0, 65534.0) as u16,
+        epv: (fix.hdop * 150.0).clamp(0.0, 65534.0) as u16,
+        vel: (speed * 100.0).clamp(0.0, 65534.0) as u16,
+        vn: clamp_i16(fix.vel_ned.x * 100.0),
+        ve: clamp_i16(fix.vel_ned.y * 100.0),
+        vd: clamp_i16(fix.vel_ned.z * 100.0),
+        cog: if speed > 0.5 {
+            (cog_cdeg as u16).min(35999)
+        } else {
+            u16::MAX
+        },
+        satellites_visible: fix.satellites,
+        id: 0,
+        yaw: 0,
+    }
+}
+
+/// Decodes a `HIL_GPS` frame (autopilot side); `None` for an implausible fix.
+pub fn decode_hil_gps(d: &HIL_GPS_DATA) -> Option<GpsFix> {
+    let position = GeoPoint {
+        lat_e7: d.lat,
+        lon_e7: d.lon,
+    };
+    let alt_amsl_m = d.alt as f32 / 1000.0;
+    if d.fix_type >= 2 && (!position.is_valid() || !(-1000.0..=20_000.0).contains(&alt_amsl_m)) {
+        return None;
+    }
+    Some(GpsFix {
+        position,
+        alt_amsl_m,
+        vel_ned: Vector3::new(
+            f32::from(d.vn) / 100.0,
+            f32::from(d.ve) / 100.0,
+            f32::from(d.vd) / 100.0,
+        ),
+        fix_type: d.fix_type,
+        satellites: d.satellites_visible,
+        hdop: if d.eph == u16::MAX {
+            99.99
+        } else {
+            f32::from(d.eph) / 100.0
+        },
+    })
+}
+
+/// What the autopilot commands for one sensor frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ActuatorFrame {
+    /// Time of the sensor frame this answers, us.
+    pub time_us: u64,
+    /// Surface and throttle commands.
+    pub surfaces: Surfaces,
+    /// Armed (throttle live).
+    pub armed: bool,
+}
+
+/// Encodes the autopilot's answer.
+pub fn encode_actuators(a: &ActuatorFrame) -> HIL_ACTUATOR_CONTROLS_DATA {
+    let mut controls = [0.0_f32; 16];
+    let c = a.surfaces.to_px4_controls();
+    controls[..4].copy_from_slice(&c);
+    if !a.armed {
+        controls[3] = 0.0;
+    }
+    let mut mode = MavModeFlag::empty();
+    if a.armed {
+        mode |= MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED;
+    }
+    HIL_ACTUATOR_CONTROLS_DATA {
+        time_usec: a.time_us,
+        flags: HilActuatorControlsFlags::HIL_ACTUATOR_CONTROLS_FLAGS_LOCKSTEP,
+        controls,
+        mode,
+    }
+}
+
+/// Decodes the autopilot's answer (simulator side). Out-of-range or non-finite controls are
+/// clamped or neutralised; throttle is zero unless armed.
+pub fn decode_actuators(d: &HIL_ACTUATOR_CONTROLS_DATA) -> ActuatorFrame {
+    let armed = d.mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
+    let mut surfaces =
+        Surfaces::from_px4_controls([d.controls[0], d.controls[1], d.controls[2], d.controls[3]]);
+    if !armed {
+        surfaces.throttle = 0.0;
+    }
+    ActuatorFrame {
+        time_us: d.time_usec,
+        surfaces,
+        armed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame() -> SensorFrame {
+        SensorFrame {
+            time_us: 123_456,
+            imu: Some(ImuSample {
+                accel: Vector3::new(0.54, 0.017, -9.79),
+                gyro: Vector3::new(0.01, -0.02, 0.03),
+            }),
+            mag: Some(MagSample {
+                field: Vector3::new(0.18, -0.01, 0.52),
+            }),
+            baro: Some(BaroSample {
+                pressure_pa: 100_129.4,
+                temperature_c: 14.35,
+            }),
+            pitot: Some(PitotSample {
+                diff_pressure_pa: 175.3,
+            }),
+            reset: false,
+        }
+    }
+
+    #[test]
+    fn sensor_round_trip_and_bits() {
+        let d = encode_hil_sensor(&frame(), 100.0);
+        // DESIGN.md: a barometer update sets bits 9, 11 and 12 together.
+        assert_eq!(d.fields_updated.bits() & BITS_BARO, BITS_BARO);
+        assert_eq!(d.fields_updated.bits(), 0x1FFF);
+        assert!((d.abs_pressure - 1001.294).abs() < 1e-3, "hPa on the wire");
+        let (back, rej) = decode_hil_sensor(&d);
+        assert!(rej.none());
+        let b = back.baro.map(|b| b.pressure_pa).unwrap_or(0.0);
+        assert!((b - 100_129.4).abs() < 0.01);
+        assert_eq!(back.imu, frame().imu);
+        assert_eq!(back.mag, frame().mag);
+    }
+
+    #[test]
+    fn implausible_groups_are_dropped_and_flagged() {
+        let mut d = encode_hil_sensor(&frame(), 100.0);
+        d.xgyro = f32::NAN;
+        d.abs_pressure = 5000.0;
+        d.diff_pressure = f32::INFINITY;
+        let (f, r) = decode_hil_sensor(&d);
+        assert!(f.imu.is_none() && r.imu);
+        assert!(f.baro.is_none() && r.baro);
+        assert!(f.pitot.is_none() && r.pitot);
+        assert!(f.mag.is_some() && !r.mag);
+        // Half an IMU update is no update.
+        let mut d = encode_hil_sensor(&frame(), 100.0);
+        d.fields_updated = HilSensorUpdatedFlags::from_bits_truncate(0x7);
+        let (f, r) = decode_hil_sensor(&d);
+        assert!(f.imu.is_none() && r.imu);
+    }
+
+    #[test]
+    fn gps_round_trip_in_wire_units() {
+        let fix = GpsFix {
+            position: GeoPoint::from_deg(44.7258357, -93.07501316),
+            alt_amsl_m: 100.25,
+            vel_ned: Vector3::new(-15.0, 8.0, 0.5),
+            fix_type: 3,
+            satellites: 12,
+            hdop: 0.9,
+        };
+        let d = encode_hil_gps(5_000, &fix);
+        assert_eq!(d.alt, 100_250);
+        assert_eq!((d.vn, d.ve, d.vd), (-1500, 800, 50));
+        assert_eq!(d.vel, 1700);
+        // Course of (-15, 8): 151.93 deg.
+        assert_eq!(d.cog / 100, 151);
+        let back = decode_hil_gps(&d).unwrap_or_default();
+        assert_eq!(back.position, fix.position);
+        assert!((back.vel_ned - fix.vel_ned).norm() < 1e-6);
+        let mut bad = d;
+        bad.lat = 950_000_000;
+        assert!(decode_hil_gps(&bad).is_none());
+    }
+
+    #[test]
+    fn actuators_carry_armed_and_lockstep_bits() {
+        let a = ActuatorFrame {
+            time_us: 42,
+            surfaces: Surfaces {
+                elevator: -0.0972,
+                aileron: 0.01,
+                rudder: 0.003,
+                throttle: 0.57,
+            },
+            armed: true,
+        };
+        let d = encode_actuators(&a);
+        assert_eq!(d.mode.bits() & 128, 128);
+        assert_eq!(d.flags.bits() & 1, 1);
+        // Negative elevator (trailing edge up) is nose-up: positive PX4 pitch.
+        assert!(d.controls[1] > 0.0);
+        let back = decode_actuators(&d);
+        assert!((back.surfaces.elevator - a.surfaces.elevator).abs() < 1e-6);
+        let mut disarmed = d;
+        disarmed.mode = MavModeFlag::empty();
+        assert_eq!(decode_actuators(&disarmed).surfaces.throttle, 0.0);
+    }
+}
