@@ -13,9 +13,6 @@
 #[cfg(target_os = "none")]
 mod mcu;
 #[cfg(not(target_os = "none"))]
-mod sitl;
-
-#[cfg(not(target_os = "none"))]
 fn main() -> std::process::ExitCode {
-    sitl::main()
+    firmware::sitl::main()
 }

@@ -1,1 +1,3 @@
 //! The Ultra Stick 25e simulator: plant, analysis and the simulator side of the MAVLink link.
+
+pub mod link;

@@ -1,0 +1,144 @@
+//! Lock-step exchange: one sensor frame out, one actuator frame back, then the plant moves.
+
+use super::tlog::TlogWriter;
+use super::transport::Transport;
+use common::link::framing::{FrameParser, LinkStats, Sender};
+use common::link::simlink::{self, ActuatorFrame};
+use mavlink::dialects::common::MavMessage;
+use std::io;
+use std::time::{Duration, Instant};
+
+/// The simulator speaks for the vehicle's sensors: system 1 (the autopilot's own system, so
+/// it accepts the frames), and a component id of its own.
+pub const SIM_SYSTEM_ID: u8 = 1;
+/// Component id of the simulator (MAV_COMP_ID_USER27, unused by real vehicles' components).
+pub const SIM_COMPONENT_ID: u8 = 51;
+
+/// Why an exchange failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LinkError {
+    /// The autopilot did not answer a sensor frame in time.
+    #[error("the autopilot is silent: no HIL_ACTUATOR_CONTROLS for the frame at t = {time_s:.3} s within {waited:?} ({frames} frames answered before)")]
+    Silent {
+        /// Simulation time of the unanswered frame, s.
+        time_s: f64,
+        /// How long we waited.
+        waited: Duration,
+        /// Frames answered before this one.
+        frames: u64,
+    },
+    /// The transport failed.
+    #[error("simulator link: {0}")]
+    Io(#[from] io::Error),
+}
+
+/// The simulator end of a lock-step link.
+pub struct Lockstep<T: Transport> {
+    transport: T,
+    parser: FrameParser,
+    sender: Sender,
+    tlog: Option<TlogWriter>,
+    timeout: Duration,
+    answered: u64,
+    buf: Vec<u8>,
+    rx: Vec<u8>,
+}
+
+impl<T: Transport> Lockstep<T> {
+    /// Wraps a transport; an exchange fails after `timeout` without an answer.
+    pub fn new(transport: T, timeout: Duration) -> Self {
+        Self {
+            transport,
+            parser: FrameParser::new(),
+            sender: Sender::new(SIM_SYSTEM_ID, SIM_COMPONENT_ID),
+            tlog: None,
+            timeout,
+            answered: 0,
+            buf: Vec::with_capacity(512),
+            rx: vec![0; 4096],
+        }
+    }
+
+    /// Records every frame, both ways, into `tlog`.
+    pub fn with_tlog(mut self, tlog: TlogWriter) -> Self {
+        self.tlog = Some(tlog);
+        self
+    }
+
+    /// The transport.
+    pub fn transport(&self) -> &T {
+        &self.transport
+    }
+
+    /// Framing counters of what the autopilot sent.
+    pub fn stats(&self) -> LinkStats {
+        self.parser.stats()
+    }
+
+    /// Frames answered so far.
+    pub fn answered(&self) -> u64 {
+        self.answered
+    }
+
+    /// Flushes and returns the log, if any.
+    pub fn finish(mut self) -> io::Result<Option<TlogWriter>> {
+        if let Some(t) = self.tlog.as_mut() {
+            t.flush()?;
+        }
+        Ok(self.tlog)
+    }
+
+    /// Sends `messages` (stamped `time_us`) in one write and waits for the autopilot's
+    /// `HIL_ACTUATOR_CONTROLS` for that time. Other frames from the autopilot are logged and
+    /// passed over.
+    pub fn exchange(
+        &mut self,
+        time_us: u64,
+        messages: &[MavMessage],
+    ) -> Result<ActuatorFrame, LinkError> {
+        self.buf.clear();
+        for m in messages {
+            let raw = self.sender.encode(m);
+            if let Some(t) = self.tlog.as_mut() {
+                t.write(time_us, raw.raw_bytes())?;
+            }
+            self.buf.extend_from_slice(raw.raw_bytes());
+        }
+        self.transport.send(&self.buf)?;
+
+        let start = Instant::now();
+        loop {
+            let n = self
+                .transport
+                .recv(&mut self.rx, Duration::from_millis(50))?;
+            let mut answer = None;
+            let tlog = &mut self.tlog;
+            let mut log_err = Ok(());
+            self.parser.push(&self.rx[..n], |f| {
+                if let Some(t) = tlog.as_mut() {
+                    let raw = common::link::framing::encode_v2(f.header, &f.message);
+                    if let Err(e) = t.write(time_us, raw.raw_bytes()) {
+                        log_err = Err(e);
+                    }
+                }
+                if let MavMessage::HIL_ACTUATOR_CONTROLS(d) = &f.message {
+                    if d.time_usec == time_us {
+                        answer = Some(simlink::decode_actuators(d));
+                    }
+                }
+            });
+            log_err?;
+            if let Some(a) = answer {
+                self.answered += 1;
+                return Ok(a);
+            }
+            if n == 0 && start.elapsed() > self.timeout {
+                return Err(LinkError::Silent {
+                    time_s: time_us as f64 * 1e-6,
+                    waited: self.timeout,
+                    frames: self.answered,
+                });
+            }
+        }
+    }
+}

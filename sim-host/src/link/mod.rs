@@ -1,0 +1,11 @@
+//! The simulator side of PX4's simulator MAVLink interface.
+//!
+//! [`transport`] moves bytes (TCP, UDP, a pty, or an in-process pipe into the firmware's own
+//! loop); [`lockstep::Lockstep`] sends each sensor frame and waits for the autopilot's answer
+//! before the plant may advance, so a run is deterministic and as fast as the CPU allows;
+//! [`tlog`] records every frame both ways in the `.tlog` format pymavlink and QGroundControl
+//! read.
+
+pub mod lockstep;
+pub mod tlog;
+pub mod transport;
