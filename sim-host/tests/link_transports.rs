@@ -20,7 +20,7 @@ fn frames(k: u64) -> (u64, Vec<MavMessage>) {
             accel: Vector3::new(0.5, 0.0, -9.79 + k as f32 * 1e-3),
             gyro: Vector3::new(0.0, 0.01, 0.0),
         }),
-        baro: (k % 2 == 0).then_some(BaroSample {
+        baro: k.is_multiple_of(2).then_some(BaroSample {
             pressure_pa: 100_129.0,
             temperature_c: 14.4,
         }),
@@ -30,7 +30,7 @@ fn frames(k: u64) -> (u64, Vec<MavMessage>) {
         ..Default::default()
     };
     let mut m = vec![MavMessage::HIL_SENSOR(encode_hil_sensor(&s, 100.0))];
-    if k % 20 == 0 {
+    if k.is_multiple_of(20) {
         let fix = GpsFix {
             position: GeoPoint::from_deg(44.7258357, -93.07501316),
             alt_amsl_m: 100.0,
