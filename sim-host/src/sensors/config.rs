@@ -1,0 +1,157 @@
+//! Sensor rates and noise, read from the `[sensors]` table of the aircraft file.
+
+use serde::{Deserialize, Serialize};
+
+/// GPS receiver model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GpsConfig {
+    /// Fix rate, Hz.
+    pub rate_hz: f64,
+    /// Horizontal position noise (1 sigma), m.
+    pub horiz_m: f64,
+    /// Vertical position noise (1 sigma), m.
+    pub vert_m: f64,
+    /// Velocity noise (1 sigma, each axis), m/s.
+    pub vel_mps: f64,
+    /// Time from measurement to delivery, s.
+    pub latency_s: f64,
+    /// Satellites reported.
+    pub satellites: u8,
+    /// Horizontal dilution of precision reported.
+    pub hdop: f64,
+}
+
+impl Default for GpsConfig {
+    fn default() -> Self {
+        // The UMN legacy library has no GPS; these are the bolderflight re-hosting's values
+        // (aircraft file, `gps_secondary_bolderflight`), with a typical u-blox latency.
+        Self {
+            rate_hz: 5.0,
+            horiz_m: 1.5,
+            vert_m: 5.5,
+            vel_mps: 0.05,
+            latency_s: 0.12,
+            satellites: 12,
+            hdop: 0.8,
+        }
+    }
+}
+
+/// Every sensor's rate and noise.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorConfig {
+    /// IMU (and lock-step frame) rate, Hz.
+    pub imu_rate_hz: f64,
+    /// Gyro noise power per axis, (rad/s)^2 s (UMN `gyro_noise_power`).
+    pub gyro_noise_power: [f64; 3],
+    /// Accelerometer noise power per axis, (m/s^2)^2 s (UMN `accel_noise_power`).
+    pub accel_noise_power: [f64; 3],
+    /// Gyro turn-on bias per axis, rad/s.
+    pub gyro_bias_radps: [f64; 3],
+    /// Gyro bias random walk, rad/s per sqrt(s).
+    pub gyro_bias_walk: f64,
+    /// Accelerometer turn-on bias per axis, m/s^2.
+    pub accel_bias_mps2: [f64; 3],
+    /// Magnetometer rate, Hz.
+    pub mag_rate_hz: f64,
+    /// Earth field at home in NED, gauss.
+    pub mag_field_ned_gauss: [f64; 3],
+    /// Magnetometer noise power per axis, nT^2 s (UMN `mag_noise_power_nT`).
+    pub mag_noise_power_nt: [f64; 3],
+    /// Barometer rate, Hz.
+    pub baro_rate_hz: f64,
+    /// Static-pressure noise power, kPa^2 s (UMN `ps_noise_power_kPa`).
+    pub ps_noise_power_kpa: f64,
+    /// Differential-pressure rate, Hz.
+    pub pitot_rate_hz: f64,
+    /// Differential-pressure noise power, kPa^2 s (UMN `pd_noise_power_kPa`).
+    pub pd_noise_power_kpa: f64,
+    /// GPS receiver.
+    pub gps: GpsConfig,
+}
+
+impl Default for SensorConfig {
+    fn default() -> Self {
+        Self {
+            imu_rate_hz: 100.0,
+            gyro_noise_power: [1e-6; 3],
+            accel_noise_power: [0.0008, 0.004, 0.004],
+            gyro_bias_radps: [0.003, -0.002, 0.0015],
+            gyro_bias_walk: 1e-5,
+            accel_bias_mps2: [0.02, -0.015, 0.03],
+            mag_rate_hz: 50.0,
+            // IGRF at the UMN home (44.73 N, 93.08 W): 18 uT north, -0.2 uT east, 52 uT down.
+            mag_field_ned_gauss: [0.18, -0.002, 0.52],
+            mag_noise_power_nt: [150.0, 150.0, 80_000.0],
+            baro_rate_hz: 50.0,
+            ps_noise_power_kpa: 8e-7,
+            pitot_rate_hz: 50.0,
+            pd_noise_power_kpa: 1.5e-7,
+            gps: GpsConfig::default(),
+        }
+    }
+}
+
+impl SensorConfig {
+    /// Checks every rate positive and every noise finite and non-negative; the error names the
+    /// key and its value.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.imu_rate_hz.is_finite() || self.imu_rate_hz <= 0.0 {
+            return Err(format!(
+                "sensors.imu_rate_hz = {}: must be positive",
+                self.imu_rate_hz
+            ));
+        }
+        let rates = [
+            ("mag_rate_hz", self.mag_rate_hz),
+            ("baro_rate_hz", self.baro_rate_hz),
+            ("pitot_rate_hz", self.pitot_rate_hz),
+            ("gps.rate_hz", self.gps.rate_hz),
+        ];
+        for (k, v) in rates {
+            if !v.is_finite() || v <= 0.0 || v > self.imu_rate_hz {
+                return Err(format!(
+                    "sensors.{k} = {v}: must be positive and at most imu_rate_hz"
+                ));
+            }
+        }
+        let scalars = [
+            ("gyro_bias_walk", self.gyro_bias_walk),
+            ("ps_noise_power_kpa", self.ps_noise_power_kpa),
+            ("pd_noise_power_kpa", self.pd_noise_power_kpa),
+            ("gps.horiz_m", self.gps.horiz_m),
+            ("gps.vert_m", self.gps.vert_m),
+            ("gps.vel_mps", self.gps.vel_mps),
+            ("gps.latency_s", self.gps.latency_s),
+            ("gps.hdop", self.gps.hdop),
+        ];
+        for (k, v) in scalars {
+            if !v.is_finite() || v < 0.0 {
+                return Err(format!("sensors.{k} = {v}: must be finite and >= 0"));
+            }
+        }
+        let vectors = [
+            ("gyro_noise_power", self.gyro_noise_power),
+            ("accel_noise_power", self.accel_noise_power),
+            ("mag_noise_power_nt", self.mag_noise_power_nt),
+        ];
+        for (k, v) in vectors {
+            if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+                return Err(format!("sensors.{k} = {v:?}: must be finite and >= 0"));
+            }
+        }
+        let finite = [
+            ("gyro_bias_radps", self.gyro_bias_radps),
+            ("accel_bias_mps2", self.accel_bias_mps2),
+            ("mag_field_ned_gauss", self.mag_field_ned_gauss),
+        ];
+        for (k, v) in finite {
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(format!("sensors.{k} = {v:?}: must be finite"));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,296 @@
+//! The sensor suite, sampled at the lock-step frame rate.
+
+use super::SensorConfig;
+use common::link::simlink::SensorFrame;
+use common::math::atmosphere::standard_atmosphere;
+use common::math::geodetic::{offset_point, GeoPoint};
+use common::math::ned_to_body;
+use common::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use nalgebra::{UnitQuaternion, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use std::collections::VecDeque;
+
+/// What the sensors see of the plant at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Truth {
+    /// Position from home, NED, m.
+    pub pos_ned: Vector3<f64>,
+    /// Inertial velocity, NED, m/s.
+    pub vel_ned: Vector3<f64>,
+    /// Body-to-NED rotation.
+    pub attitude: UnitQuaternion<f64>,
+    /// Body rates, rad/s.
+    pub omega_body: Vector3<f64>,
+    /// Specific force (non-gravitational acceleration) in body axes, m/s^2.
+    pub specific_force_body: Vector3<f64>,
+    /// True airspeed, m/s.
+    pub airspeed_mps: f64,
+}
+
+fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+    StandardNormal.sample(rng)
+}
+
+fn gauss3(rng: &mut ChaCha8Rng, sigma: [f64; 3]) -> Vector3<f64> {
+    Vector3::new(
+        sigma[0] * gauss(rng),
+        sigma[1] * gauss(rng),
+        sigma[2] * gauss(rng),
+    )
+}
+
+/// Standard deviation of Simulink band-limited white noise of power `p` sampled every `ts`.
+fn sigma(p: f64, ts: f64) -> f64 {
+    (p / ts).sqrt()
+}
+
+fn decimation(frame_hz: f64, rate_hz: f64) -> u64 {
+    ((frame_hz / rate_hz).round() as u64).max(1)
+}
+
+/// Faults a test or a user can inject.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SensorFaults {
+    /// No GPS fixes.
+    pub gps_lost: bool,
+    /// No differential pressure.
+    pub pitot_failed: bool,
+    /// No magnetometer.
+    pub mag_failed: bool,
+    /// No barometer.
+    pub baro_failed: bool,
+}
+
+/// Every sensor of the airplane.
+pub struct SensorSuite {
+    cfg: SensorConfig,
+    home: GeoPoint,
+    home_alt_amsl_m: f64,
+    frame: u64,
+    period_us: u64,
+    gyro_bias: Vector3<f64>,
+    rng_imu: ChaCha8Rng,
+    rng_mag: ChaCha8Rng,
+    rng_baro: ChaCha8Rng,
+    rng_pitot: ChaCha8Rng,
+    rng_gps: ChaCha8Rng,
+    gps_queue: VecDeque<(u64, GpsFix)>,
+    /// Injected faults.
+    pub faults: SensorFaults,
+}
+
+impl SensorSuite {
+    /// A suite at `home` (ground level `home_alt_amsl_m` above mean sea level), seeded.
+    pub fn new(cfg: SensorConfig, home: GeoPoint, home_alt_amsl_m: f64, seed: u64) -> Self {
+        let stream =
+            |k: u64| ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ k);
+        let period_us = (1e6 / cfg.imu_rate_hz).round() as u64;
+        Self {
+            gyro_bias: Vector3::from(cfg.gyro_bias_radps),
+            cfg,
+            home,
+            home_alt_amsl_m,
+            frame: 0,
+            period_us,
+            rng_imu: stream(1),
+            rng_mag: stream(2),
+            rng_baro: stream(3),
+            rng_pitot: stream(4),
+            rng_gps: stream(5),
+            gps_queue: VecDeque::new(),
+            faults: SensorFaults::default(),
+        }
+    }
+
+    /// Time between frames, us.
+    pub fn period_us(&self) -> u64 {
+        self.period_us
+    }
+
+    /// The current gyro bias, rad/s (truth for judging the estimator).
+    pub fn gyro_bias(&self) -> Vector3<f64> {
+        self.gyro_bias
+    }
+
+    /// The next frame's time, us.
+    pub fn next_time_us(&self) -> u64 {
+        self.frame * self.period_us
+    }
+
+    /// Samples every sensor due at the next frame time; returns the frame and a GPS fix if one
+    /// is delivered now.
+    pub fn sample(&mut self, t: &Truth) -> (SensorFrame, Option<GpsFix>) {
+        let time_us = self.next_time_us();
+        let frame = self.frame;
+        self.frame += 1;
+        let cfg = &self.cfg;
+        let fr = cfg.imu_rate_hz;
+        let ts = 1.0 / fr;
+
+        // IMU every frame, with a bias that wanders.
+        let walk = cfg.gyro_bias_walk * ts.sqrt();
+        self.gyro_bias += gauss3(&mut self.rng_imu, [walk; 3]);
+        let gyro_sigma = cfg.gyro_noise_power.map(|p| sigma(p, ts));
+        let accel_sigma = cfg.accel_noise_power.map(|p| sigma(p, ts));
+        let gyro = t.omega_body + self.gyro_bias + gauss3(&mut self.rng_imu, gyro_sigma);
+        let accel = t.specific_force_body
+            + Vector3::from(cfg.accel_bias_mps2)
+            + gauss3(&mut self.rng_imu, accel_sigma);
+        let mut out = SensorFrame {
+            time_us,
+            imu: Some(ImuSample {
+                accel: accel.cast(),
+                gyro: gyro.cast(),
+            }),
+            ..Default::default()
+        };
+
+        let alt_amsl = self.home_alt_amsl_m - t.pos_ned.z;
+        let air = standard_atmosphere(alt_amsl);
+
+        let n = decimation(fr, cfg.mag_rate_hz);
+        if frame.is_multiple_of(n) && !self.faults.mag_failed {
+            let ts = n as f64 / fr;
+            let s = cfg.mag_noise_power_nt.map(|p| sigma(p, ts) * 1e-5);
+            let field = ned_to_body(&t.attitude, &Vector3::from(cfg.mag_field_ned_gauss))
+                + gauss3(&mut self.rng_mag, s);
+            out.mag = Some(MagSample {
+                field: field.cast(),
+            });
+        }
+        let n = decimation(fr, cfg.baro_rate_hz);
+        if frame.is_multiple_of(n) && !self.faults.baro_failed {
+            let ts = n as f64 / fr;
+            let noise_pa = sigma(cfg.ps_noise_power_kpa, ts) * 1e3 * gauss(&mut self.rng_baro);
+            out.baro = Some(BaroSample {
+                pressure_pa: (air.pressure_pa + noise_pa) as f32,
+                temperature_c: (air.temperature_k - 273.15) as f32,
+            });
+        }
+        let n = decimation(fr, cfg.pitot_rate_hz);
+        if frame.is_multiple_of(n) && !self.faults.pitot_failed {
+            let ts = n as f64 / fr;
+            let noise_pa = sigma(cfg.pd_noise_power_kpa, ts) * 1e3 * gauss(&mut self.rng_pitot);
+            let q = 0.5 * air.density * t.airspeed_mps * t.airspeed_mps;
+            out.pitot = Some(PitotSample {
+                diff_pressure_pa: (q + noise_pa) as f32,
+            });
+        }
+
+        // GPS: measured now, delivered after its latency.
+        let g = &cfg.gps;
+        let n = decimation(fr, g.rate_hz);
+        if frame.is_multiple_of(n) {
+            let p = t.pos_ned + gauss3(&mut self.rng_gps, [g.horiz_m, g.horiz_m, g.vert_m]);
+            let v = t.vel_ned + gauss3(&mut self.rng_gps, [g.vel_mps; 3]);
+            let fix = GpsFix {
+                position: offset_point(self.home, p.x, p.y),
+                alt_amsl_m: (self.home_alt_amsl_m - p.z) as f32,
+                vel_ned: v.cast(),
+                fix_type: 3,
+                satellites: g.satellites,
+                hdop: g.hdop as f32,
+            };
+            let release = time_us + (g.latency_s * 1e6).round() as u64;
+            if !self.faults.gps_lost {
+                self.gps_queue.push_back((release, fix));
+            }
+        }
+        let gps = match self.gps_queue.front() {
+            Some((release, _)) if *release <= time_us => self.gps_queue.pop_front().map(|(_, f)| f),
+            _ => None,
+        };
+        (out, gps)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn level_truth() -> Truth {
+        Truth {
+            pos_ned: Vector3::new(0.0, 0.0, -100.0),
+            vel_ned: Vector3::new(17.0, 0.0, 0.0),
+            attitude: UnitQuaternion::identity(),
+            omega_body: Vector3::zeros(),
+            specific_force_body: Vector3::new(0.0, 0.0, -9.8056),
+            airspeed_mps: 17.0,
+        }
+    }
+
+    #[test]
+    fn noise_statistics_follow_the_umn_noise_power() {
+        let cfg = SensorConfig::default();
+        let mut s = SensorSuite::new(cfg.clone(), GeoPoint::from_deg(44.7, -93.0), 0.0, 7);
+        let t = level_truth();
+        let n = 20_000;
+        let mut sum = 0.0;
+        let mut sum2 = 0.0;
+        let mut dp = Vec::new();
+        for _ in 0..n {
+            let (f, _) = s.sample(&t);
+            let gz = f64::from(f.imu.map(|i| i.gyro.z).unwrap_or(f32::NAN));
+            sum += gz;
+            sum2 += gz * gz;
+            if let Some(p) = f.pitot {
+                dp.push(f64::from(p.diff_pressure_pa));
+            }
+        }
+        let mean = sum / n as f64;
+        let sd = (sum2 / n as f64 - mean * mean).sqrt();
+        // Power 1e-6 at 100 Hz: sigma = sqrt(1e-6 / 0.01) = 0.01 rad/s.
+        assert!((sd - 0.01).abs() < 0.0005, "gyro sigma {sd}");
+        // The mean is the bias (0.0015 rad/s) plus a small random walk.
+        assert!((mean - 0.0015).abs() < 0.001, "gyro mean {mean}");
+        // Dynamic pressure at 17 m/s and 100 m: 0.5 * 1.21328 * 17^2 = 175.32 Pa.
+        let m = dp.iter().sum::<f64>() / dp.len() as f64;
+        assert!((m - 175.32).abs() < 0.2, "pitot mean {m}");
+        assert_eq!(dp.len(), n / 2, "pitot at 50 Hz");
+    }
+
+    #[test]
+    fn gps_arrives_at_5hz_after_its_latency() {
+        let mut s = SensorSuite::new(
+            SensorConfig::default(),
+            GeoPoint::from_deg(44.7, -93.0),
+            250.0,
+            1,
+        );
+        let t = level_truth();
+        let mut times = Vec::new();
+        let mut alts = Vec::new();
+        for _ in 0..500 {
+            let time = s.next_time_us();
+            if let (_, Some(fix)) = s.sample(&t) {
+                times.push(time);
+                alts.push(fix.alt_amsl_m);
+            }
+        }
+        // 5 s at 5 Hz, the first one delivered 0.12 s after it was measured at t = 0.
+        assert_eq!(times[0], 120_000);
+        assert_eq!(times[1] - times[0], 200_000);
+        assert!(times.len() >= 24);
+        let mean = alts.iter().sum::<f32>() / alts.len() as f32;
+        assert!((mean - 350.0).abs() < 3.0, "GPS altitude {mean}");
+    }
+
+    #[test]
+    fn the_same_seed_gives_the_same_readings_and_faults_silence_a_sensor() {
+        let mk = || SensorSuite::new(SensorConfig::default(), GeoPoint::default(), 0.0, 42);
+        let (mut a, mut b) = (mk(), mk());
+        for _ in 0..100 {
+            assert_eq!(a.sample(&level_truth()), b.sample(&level_truth()));
+        }
+        b.faults.gps_lost = true;
+        b.faults.pitot_failed = true;
+        for k in 0..200 {
+            let (f, g) = b.sample(&level_truth());
+            assert!(f.pitot.is_none());
+            // A fix measured before the loss may still be in flight for one latency.
+            assert!(g.is_none() || k < 12, "GPS fix {k} frames after the loss");
+        }
+    }
+}
