@@ -1,6 +1,7 @@
 //! Shared helpers of the system tests in `tests/tests/`.
 
 use std::path::PathBuf;
+use std::process::Command;
 
 /// The workspace root.
 pub fn workspace_root() -> PathBuf {
@@ -8,4 +9,51 @@ pub fn workspace_root() -> PathBuf {
         .parent()
         .map(PathBuf::from)
         .unwrap_or_default()
+}
+
+/// Builds the MCU image (release, thumbv7em-none-eabihf) and returns the ELF's path.
+///
+/// It builds into `target/cross`, apart from the host build that runs the tests, so the two
+/// never wait on each other's lock. A fresh toolchain lacks the target; adding it is
+/// idempotent and quick once present.
+pub fn build_mcu_firmware() -> PathBuf {
+    let root = workspace_root();
+    let _ = Command::new("rustup")
+        .args(["target", "add", "thumbv7em-none-eabihf"])
+        .status();
+    let target_dir = root.join("target").join("cross");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(&root)
+        .args([
+            "build",
+            "-p",
+            "firmware",
+            "--release",
+            "--target",
+            "thumbv7em-none-eabihf",
+        ])
+        .env("CARGO_TARGET_DIR", &target_dir)
+        .status()
+        .expect("cargo runs");
+    assert!(status.success(), "thumbv7em build of firmware failed");
+    target_dir.join("thumbv7em-none-eabihf/release/firmware")
+}
+
+/// Whether an external tool is installed. Under CI (`CI` set) a missing tool is an error, so a
+/// test that needs it can never pass by being skipped there.
+pub fn tool_available(name: &str) -> bool {
+    let found = Command::new(name)
+        .arg("--version")
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !found {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "{name} is required under CI (.ci/run installs it)"
+        );
+        eprintln!("SKIPPED: {name} is not installed");
+    }
+    found
 }

@@ -1,37 +1,14 @@
 //! The MCU image builds for the STM32F405 and fits its memory map.
 
 use object::{Object, ObjectSection, ObjectSegment};
-use std::process::Command;
-use system_tests::workspace_root;
+use system_tests::build_mcu_firmware;
 
 const FLASH: (u64, u64) = (0x0800_0000, 1024 * 1024);
 const RAM: (u64, u64) = (0x2000_0000, 128 * 1024);
 
 #[test]
 fn firmware_links_for_thumbv7em_and_fits_the_stm32f405() {
-    let root = workspace_root();
-    // A fresh toolchain lacks the target; adding it is idempotent and quick once present.
-    let _ = Command::new("rustup")
-        .args(["target", "add", "thumbv7em-none-eabihf"])
-        .status();
-    let target_dir = root.join("target").join("cross");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "-p",
-            "firmware",
-            "--release",
-            "--target",
-            "thumbv7em-none-eabihf",
-        ])
-        .env("CARGO_TARGET_DIR", &target_dir)
-        .status()
-        .expect("cargo runs");
-    assert!(status.success(), "thumbv7em build of firmware failed");
-
-    let elf = target_dir.join("thumbv7em-none-eabihf/release/firmware");
+    let elf = build_mcu_firmware();
     let bytes = std::fs::read(&elf).expect("firmware ELF exists");
     let file = object::File::parse(&*bytes).expect("a valid ELF");
     assert_eq!(file.architecture(), object::Architecture::Arm);
