@@ -1736,3 +1736,23 @@ fn malformed_input_never_panics() {
     poll(&mut l, &v, 100_000_000);
     assert!(l.dropped() > 0, "overflow counted");
 }
+
+#[test]
+fn ram_footprint_within_budget() {
+    use core::mem::size_of;
+    let sizes = [
+        ("GroundLink", size_of::<GroundLink>()),
+        ("ParamStore", size_of::<param_store::ParamStore>()),
+        ("MissionManager", size_of::<mission::MissionManager>()),
+        ("MissionStore", size_of::<mission::MissionStore>()),
+        ("VehicleSnapshot", size_of::<VehicleSnapshot>()),
+        ("MavMessage", size_of::<MavMessage>()),
+        ("ParamImage", size_of::<param_store::ParamImage>()),
+    ];
+    for (n, s) in sizes {
+        std::println!("{n}: {s} bytes");
+    }
+    // The MCU has 128 KiB of SRAM; the link (with 240 stored plan items and a staging list
+    // for uploads) must leave most of it to the rest of the autopilot.
+    assert!(size_of::<GroundLink>() <= 20 * 1024, "{}", size_of::<GroundLink>());
+}
