@@ -6,7 +6,8 @@
 //! `f32`; integer parameters hold whole numbers, exact up to 2^24.
 
 use heapless::{String, Vec};
-use serde::{Deserialize, Serialize};
+use serde::ser::SerializeSeq;
+use serde::{Deserialize, Serialize, Serializer};
 
 use crate::params::{ParamDef, ParamError, ParamKind, MAX_NAME_LEN};
 
@@ -208,6 +209,30 @@ impl ParamStore {
         }
         self.saved_changes = self.changes;
         report
+    }
+}
+
+/// Serialises the values [`ParamStore::export`] would return, in the same encoding as a
+/// [`ParamImage`], without building one (the image is 8 KiB: too much for the stack of a
+/// flying MCU when it saves).
+pub struct ParamExport<'a>(pub &'a ParamStore);
+
+impl Serialize for ParamExport<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let store = self.0;
+        let changed = || {
+            (0..store.len()).filter_map(move |i| {
+                let d = store.def(i)?;
+                let v = store.value(i)?;
+                (v.to_bits() != d.default.to_bits()).then_some((d.name, v))
+            })
+        };
+        let mut seq = serializer.serialize_seq(Some(changed().count()))?;
+        for rec in changed() {
+            // (name, value) encodes exactly as a ParamRecord.
+            seq.serialize_element(&rec)?;
+        }
+        seq.end()
     }
 }
 

@@ -1754,5 +1754,9 @@ fn ram_footprint_within_budget() {
     }
     // The MCU has 128 KiB of SRAM; the link (with 240 stored plan items and a staging list
     // for uploads) must leave most of it to the rest of the autopilot.
-    assert!(size_of::<GroundLink>() <= 20 * 1024, "{}", size_of::<GroundLink>());
+    assert!(
+        size_of::<GroundLink>() <= 20 * 1024,
+        "{}",
+        size_of::<GroundLink>()
+    );
 }

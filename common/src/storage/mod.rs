@@ -22,7 +22,7 @@
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::gcs::mission::MissionStore;
-use crate::gcs::param_store::{ImportReport, ParamImage, ParamStore};
+use crate::gcs::param_store::{ImportReport, ParamExport, ParamImage, ParamStore};
 
 /// A flash device (or a model of one). Erased bytes read 0xFF; a write can only clear bits.
 pub trait Flash {
@@ -215,18 +215,21 @@ pub fn load<F: Flash, T: DeserializeOwned>(
 }
 
 /// Saves the parameters that differ from their defaults, by name, and marks the store saved.
+/// Streams from the store: no [`ParamImage`] is built.
 pub fn save_params<F: Flash>(
     flash: &mut F,
     region: &AbRegion,
     store: &mut ParamStore,
     scratch: &mut [u8],
 ) -> Result<u32, StorageError<F::Error>> {
-    let seq = save(flash, region, &store.export(), scratch)?;
+    let seq = save(flash, region, &ParamExport(store), scratch)?;
     store.mark_saved();
     Ok(seq)
 }
 
-/// Loads saved parameters into `store` by name; `None` when nothing is saved.
+/// Loads saved parameters into `store` by name; `None` when nothing is saved. Decodes into
+/// a [`ParamImage`] first (8 KiB of stack: meant for start-up), so a copy that does not
+/// decode changes nothing.
 pub fn load_params<F: Flash>(
     flash: &mut F,
     region: &AbRegion,

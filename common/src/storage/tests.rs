@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::*;
 use crate::gcs::mission::{MissionItem, MissionStore};
+use crate::gcs::param_store::ParamExport;
 use crate::params::ParamDef;
 
 const SECTOR: u32 = 1024;
@@ -181,6 +182,14 @@ fn params_load_by_name_into_a_reordered_table() {
     assert!(old.is_dirty());
     save_params(&mut f, &REGION, &mut old, &mut scratch).unwrap();
     assert!(!old.is_dirty());
+    // The streamed encoding is the one a ParamImage has.
+    let mut direct = [0u8; 1024];
+    let image = postcard::to_slice(&old.export(), &mut direct)
+        .unwrap()
+        .to_vec();
+    let mut streamed = [0u8; 1024];
+    let streamed = postcard::to_slice(&ParamExport(&old), &mut streamed).unwrap();
+    assert_eq!(image, streamed);
 
     let mut new = ParamStore::new(&[NEW_TABLE]).unwrap();
     let report = load_params(&mut f, &REGION, &mut new, &mut scratch)
