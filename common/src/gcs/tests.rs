@@ -1760,3 +1760,101 @@ fn ram_footprint_within_budget() {
         size_of::<GroundLink>()
     );
 }
+
+#[test]
+fn heartbeat_reports_truth_not_requests_and_tracks_gcs() {
+    let mut l = link();
+    let v = healthy();
+    assert_eq!(l.gcs_last_seen_us(), None);
+    l.handle(
+        &hdr(),
+        &MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            mavtype: MavType::MAV_TYPE_GCS,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+            ..Default::default()
+        }),
+        42,
+        &v,
+    );
+    assert_eq!(l.gcs_last_seen_us(), Some(42));
+    // Loiter accepted, but the vehicle has not switched: the heartbeat still says Manual and
+    // CURRENT_MODE shows the intention.
+    let out = exchange(
+        &mut l,
+        &v,
+        100,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            [1.0, 4.0, 3.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(heartbeat_of(&out).unwrap().custom_mode, px4(1, 0));
+    let out = exchange(
+        &mut l,
+        &v,
+        200,
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [436.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    let cm = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::CURRENT_MODE(c) => Some(c.clone()),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!(
+        (cm.custom_mode, cm.intended_custom_mode),
+        (px4(1, 0), px4(4, 3))
+    );
+}
+
+#[test]
+fn preflight_storage_requests_save_and_resets_defaults() {
+    let mut l = link();
+    let mut v = healthy();
+    exchange(
+        &mut l,
+        &v,
+        0,
+        param_set("RLL_KP", 2.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    let out = exchange(
+        &mut l,
+        &v,
+        1,
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert!(l.take_requests().save_params);
+    v.armed = true;
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(l.params().get("RLL_KP"), Some(2.0));
+    v.armed = false;
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(l.params().get("RLL_KP"), Some(0.8));
+}
