@@ -16,6 +16,9 @@
 //! - [`control`]: the successive-loop-closure autopilot of the thesis.
 //! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
+//! - [`gcs`]: the ground-station link logic (heartbeat, parameters, missions, commands,
+//!   telemetry), transport-agnostic.
+//! - [`storage`]: power-cut-safe persistence of parameters and missions in flash.
 //!
 //! Every stage is a plain struct with an explicit `step`/`update` taking its inputs and time
 //! step: no globals, no I/O, no clock reads.
@@ -25,7 +28,9 @@
 pub mod actuators;
 pub mod control;
 pub mod estimator;
+pub mod gcs;
 pub mod link;
 pub mod math;
 pub mod params;
 pub mod sensors;
+pub mod storage;

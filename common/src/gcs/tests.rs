@@ -1,0 +1,1860 @@
+//! Protocol tests: the link driven with MavMessage values, outputs inspected. Expected values
+//! come from the MAVLink specification and PX4's published encodings, not from this code.
+
+extern crate std;
+
+use std::string::ToString;
+use std::vec::Vec;
+
+use mavlink::dialects::common::*;
+use mavlink::MavHeader;
+
+use super::mission::{MISSION_CAPACITY, UPLOAD_MAX_RETRIES, UPLOAD_RETRY_US};
+use super::modes::{FlightMode, ModeSet};
+use super::snapshot::*;
+use super::*;
+use crate::params::ParamDef;
+
+const STAGE_A: &[ParamDef] = &[
+    ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", "roll gain"),
+    ParamDef::real("RLL_KI", 0.1, 0.0, 1.0, "", "roll integral gain"),
+    ParamDef::int("NAV_MODE", 2, 0, 5, "", "an enumeration"),
+];
+const STAGE_B: &[ParamDef] = &[
+    ParamDef::real("ASPD_TRIM", 17.0, 10.0, 30.0, "m/s", "trim airspeed"),
+    ParamDef::int("SYS_COUNT", 100000, -5, 1_000_000, "", "a large integer"),
+    ParamDef::real("ALT_KP", 0.05, 0.0, 1.0, "", "altitude gain"),
+];
+const REGISTRY: Registry = &[STAGE_A, STAGE_B];
+
+const GCS: (u8, u8) = (255, 190);
+
+fn hdr() -> MavHeader {
+    MavHeader {
+        system_id: GCS.0 as u32,
+        component_id: GCS.1,
+        sequence: 0,
+    }
+}
+
+fn link() -> GroundLink {
+    GroundLink::new(REGISTRY).unwrap()
+}
+
+/// A vehicle on the ground, booted, every sensor healthy, 3D fix, home set.
+fn healthy() -> VehicleSnapshot {
+    VehicleSnapshot {
+        boot_complete: true,
+        modes_available: ModeSet::ALL,
+        landed: LandedState::OnGround,
+        health: SensorHealth {
+            gyro_ok: true,
+            accel_ok: true,
+            mag_ok: true,
+            baro_ok: true,
+            airspeed_ok: true,
+            gps_ok: true,
+            attitude_converged: true,
+            position_valid: true,
+        },
+        gps: GpsRaw {
+            fix_type: 3,
+            satellites: 10,
+            ..Default::default()
+        },
+        home: Home {
+            valid: true,
+            lat_e7: 449_000_000,
+            lon_e7: -932_000_000,
+            alt_amsl_m: 290.0,
+        },
+        ..Default::default()
+    }
+}
+
+/// Handles `msg` at `now` and returns what the next poll emits.
+fn exchange(l: &mut GroundLink, v: &VehicleSnapshot, now: u64, msg: MavMessage) -> Vec<MavMessage> {
+    l.handle(&hdr(), &msg, now, v);
+    poll(l, v, now)
+}
+
+fn poll(l: &mut GroundLink, v: &VehicleSnapshot, now: u64) -> Vec<MavMessage> {
+    let mut out = Vec::new();
+    l.poll(now, v, |m| out.push(m));
+    out
+}
+
+fn cmd_long(command: MavCmd, p: [f32; 7]) -> MavMessage {
+    MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
+        param1: p[0],
+        param2: p[1],
+        param3: p[2],
+        param4: p[3],
+        param5: p[4],
+        param6: p[5],
+        param7: p[6],
+        command,
+        target_system: 1,
+        target_component: 1,
+        confirmation: 0,
+    })
+}
+
+fn acks(out: &[MavMessage]) -> Vec<(MavCmd, MavResult)> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::COMMAND_ACK(a) => Some((a.command, a.result)),
+            _ => None,
+        })
+        .collect()
+}
+
+fn texts(out: &[MavMessage]) -> Vec<std::string::String> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::STATUSTEXT(t) => Some(t.text.to_str().unwrap().to_string()),
+            _ => None,
+        })
+        .collect()
+}
+
+fn param_values(out: &[MavMessage]) -> Vec<PARAM_VALUE_DATA> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::PARAM_VALUE(p) => Some(p.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+fn heartbeat_of(out: &[MavMessage]) -> Option<HEARTBEAT_DATA> {
+    out.iter().find_map(|m| match m {
+        MavMessage::HEARTBEAT(h) => Some(h.clone()),
+        _ => None,
+    })
+}
+
+// ---------------------------------------------------------------- parameters
+
+#[test]
+fn full_parameter_download_every_index_once() {
+    let mut l = link();
+    let v = healthy();
+    let mut got = Vec::new();
+    let mut now = 0;
+    got.extend(param_values(&exchange(
+        &mut l,
+        &v,
+        now,
+        MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+            target_system: 1,
+            target_component: 1,
+        }),
+    )));
+    for _ in 0..20 {
+        now += 20_000;
+        got.extend(param_values(&poll(&mut l, &v, now)));
+    }
+    assert_eq!(got.len(), 6, "six parameters, each sent once");
+    let mut seen = [false; 6];
+    for (k, p) in got.iter().enumerate() {
+        assert_eq!(p.param_count, 6);
+        assert_eq!(usize::from(p.param_index), k, "index order is stable");
+        assert!(!seen[usize::from(p.param_index)]);
+        seen[usize::from(p.param_index)] = true;
+    }
+    let names: Vec<_> = got
+        .iter()
+        .map(|p| p.param_id.to_str().unwrap().to_string())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "RLL_KP",
+            "RLL_KI",
+            "NAV_MODE",
+            "ASPD_TRIM",
+            "SYS_COUNT",
+            "ALT_KP"
+        ]
+    );
+    // INT32 values travel bytewise: 100000's bytes, not the float 100000.0.
+    assert_eq!(got[4].param_type, MavParamType::MAV_PARAM_TYPE_INT32);
+    assert_eq!(got[4].param_value.to_bits(), 100_000);
+    assert_eq!(got[0].param_type, MavParamType::MAV_PARAM_TYPE_REAL32);
+    assert_eq!(got[0].param_value, 0.8);
+    // Paced: 4 per poll by default.
+    let mut l2 = link();
+    let first = param_values(&exchange(
+        &mut l2,
+        &v,
+        0,
+        MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA::default()),
+    ));
+    assert_eq!(first.len(), 4);
+}
+
+fn param_set(name: &str, value: f32, t: MavParamType) -> MavMessage {
+    MavMessage::PARAM_SET(PARAM_SET_DATA {
+        param_value: value,
+        target_system: 1,
+        target_component: 1,
+        param_id: name.into(),
+        param_type: t,
+    })
+}
+
+#[test]
+fn set_and_read_back() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        param_set("RLL_KP", 1.25, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    let pv = param_values(&out);
+    assert_eq!(pv.len(), 1);
+    assert_eq!(pv[0].param_value, 1.25);
+    assert_eq!(pv[0].param_index, 0);
+    assert!(texts(&out).is_empty());
+    assert_eq!(l.params().get("RLL_KP"), Some(1.25));
+    assert!(l.params().is_dirty());
+
+    // Integer set bytewise.
+    let out = exchange(
+        &mut l,
+        &v,
+        1,
+        param_set(
+            "SYS_COUNT",
+            f32::from_bits(-3i32 as u32),
+            MavParamType::MAV_PARAM_TYPE_INT32,
+        ),
+    );
+    assert_eq!(param_values(&out)[0].param_value.to_bits(), -3i32 as u32);
+    assert_eq!(l.params().get("SYS_COUNT"), Some(-3.0));
+
+    // Read by name (index -1) and by index.
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: -1,
+            target_system: 1,
+            target_component: 1,
+            param_id: "RLL_KP".into(),
+        }),
+    );
+    assert_eq!(param_values(&out)[0].param_value, 1.25);
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: 4,
+            target_system: 1,
+            target_component: 1,
+            param_id: "".into(),
+        }),
+    );
+    let pv = param_values(&out);
+    assert_eq!(pv[0].param_id.to_str().unwrap(), "SYS_COUNT");
+    assert_eq!(pv[0].param_value.to_bits(), -3i32 as u32);
+    // An index past the end gets no answer.
+    let out = exchange(
+        &mut l,
+        &v,
+        4,
+        MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: 6,
+            target_system: 1,
+            target_component: 1,
+            param_id: "".into(),
+        }),
+    );
+    assert!(param_values(&out).is_empty());
+}
+
+#[test]
+fn bad_values_refused_with_echo_and_reason() {
+    let mut l = link();
+    let v = healthy();
+    let cases: [(&str, f32, MavParamType, &str); 5] = [
+        (
+            "RLL_KP",
+            f32::NAN,
+            MavParamType::MAV_PARAM_TYPE_REAL32,
+            "not a finite number",
+        ),
+        (
+            "RLL_KP",
+            7.0,
+            MavParamType::MAV_PARAM_TYPE_REAL32,
+            "out of bounds",
+        ),
+        (
+            "NAV_MODE",
+            1.5,
+            MavParamType::MAV_PARAM_TYPE_REAL32,
+            "not an integer",
+        ),
+        (
+            "NAV_MODE",
+            f32::from_bits(9),
+            MavParamType::MAV_PARAM_TYPE_INT32,
+            "out of bounds",
+        ),
+        (
+            "RLL_KI",
+            f32::from_bits(1),
+            MavParamType::MAV_PARAM_TYPE_INT32,
+            "wrong type",
+        ),
+    ];
+    for (k, (name, value, t, why)) in cases.into_iter().enumerate() {
+        let before = l.params().get(name).unwrap();
+        let changes = l.params().change_count();
+        let out = exchange(&mut l, &v, k as u64, param_set(name, value, t));
+        let pv = param_values(&out);
+        assert_eq!(pv.len(), 1, "{name}: one echo");
+        let echoed = if pv[0].param_type == MavParamType::MAV_PARAM_TYPE_INT32 {
+            pv[0].param_value.to_bits() as i32 as f32
+        } else {
+            pv[0].param_value
+        };
+        assert_eq!(echoed, before, "{name}: echo carries the unchanged value");
+        assert_eq!(l.params().get(name), Some(before));
+        assert_eq!(l.params().change_count(), changes);
+        let t = texts(&out);
+        assert_eq!(t.len(), 1, "{name}: one STATUSTEXT");
+        assert!(t[0].contains(name) && t[0].contains(why), "{:?}", t[0]);
+    }
+    // A whole number sent as REAL32 to an integer parameter is accepted (pymavlink default).
+    let out = exchange(
+        &mut l,
+        &v,
+        10,
+        param_set("NAV_MODE", 4.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(param_values(&out)[0].param_value.to_bits(), 4);
+    // Unknown name: no echo, a reason.
+    let out = exchange(
+        &mut l,
+        &v,
+        11,
+        param_set("NOPE", 1.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert!(param_values(&out).is_empty());
+    assert!(texts(&out)[0].contains("unknown"));
+}
+
+// ---------------------------------------------------------------- identity, commands
+
+#[test]
+fn heartbeat_one_hertz_identity_and_status() {
+    let mut l = link();
+    let mut v = VehicleSnapshot::default();
+    let mut beats = Vec::new();
+    for k in 0..5000u64 {
+        // 5 s polled at 1 kHz.
+        for m in poll(&mut l, &v, k * 1000) {
+            if let MavMessage::HEARTBEAT(h) = m {
+                beats.push(h);
+            }
+        }
+    }
+    assert_eq!(beats.len(), 5);
+    let h = &beats[0];
+    assert_eq!(h.mavtype, MavType::MAV_TYPE_FIXED_WING);
+    assert_eq!(h.autopilot, MavAutopilot::MAV_AUTOPILOT_GENERIC);
+    assert_eq!(h.system_status, MavState::MAV_STATE_BOOT);
+    assert_eq!(h.mavlink_version, 3);
+    assert!(h
+        .base_mode
+        .contains(MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED));
+
+    v = healthy();
+    let st =
+        |l: &mut GroundLink, v: &VehicleSnapshot, t: u64| heartbeat_of(&poll(l, v, t)).unwrap();
+    assert_eq!(
+        st(&mut l, &v, 6_000_000).system_status,
+        MavState::MAV_STATE_STANDBY
+    );
+    v.armed = true;
+    let h = st(&mut l, &v, 7_000_000);
+    assert_eq!(h.system_status, MavState::MAV_STATE_ACTIVE);
+    assert!(h
+        .base_mode
+        .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED));
+    assert!(h
+        .base_mode
+        .contains(MavModeFlag::MAV_MODE_FLAG_MANUAL_INPUT_ENABLED));
+    v.failsafe = true;
+    assert_eq!(
+        st(&mut l, &v, 8_000_000).system_status,
+        MavState::MAV_STATE_CRITICAL
+    );
+    v.failsafe = false;
+    v.mode = FlightMode::Mission;
+    let h = st(&mut l, &v, 9_000_000);
+    assert!(h
+        .base_mode
+        .contains(MavModeFlag::MAV_MODE_FLAG_AUTO_ENABLED));
+    assert!(!h
+        .base_mode
+        .contains(MavModeFlag::MAV_MODE_FLAG_MANUAL_INPUT_ENABLED));
+}
+
+#[allow(deprecated)]
+#[test]
+fn autopilot_version_on_request_and_legacy_command() {
+    let v = healthy();
+    for (k, msg) in [
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [148.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut l = link();
+        let out = exchange(&mut l, &v, k as u64, msg);
+        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+        let av = out
+            .iter()
+            .find_map(|m| match m {
+                MavMessage::AUTOPILOT_VERSION(a) => Some(a.clone()),
+                _ => None,
+            })
+            .expect("AUTOPILOT_VERSION sent");
+        // Bits from the MAVLink MAV_PROTOCOL_CAPABILITY enum.
+        let bits = av.capabilities.bits();
+        for b in [8192u64, 4, 8, 2, 16] {
+            assert_ne!(bits & b, 0, "capability {b}");
+        }
+        assert_eq!(bits & 64, 0, "SET_ATTITUDE_TARGET not claimed");
+        assert_eq!(bits & 32, 0, "FTP not claimed");
+        assert_eq!(av.flight_sw_version & 0xff, 255);
+    }
+}
+
+#[test]
+fn unknown_command_unsupported_and_ack_addressed_to_sender() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        cmd_long(MavCmd::MAV_CMD_DO_DIGICAM_CONTROL, [0.0; 7]),
+    );
+    let ack = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::COMMAND_ACK(a) => Some(a.clone()),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!(ack.result, MavResult::MAV_RESULT_UNSUPPORTED);
+    assert_eq!(ack.command, MavCmd::MAV_CMD_DO_DIGICAM_CONTROL);
+    assert_eq!((ack.target_system, ack.target_component), GCS);
+    // REQUEST_MESSAGE for a message we do not produce.
+    let out = exchange(
+        &mut l,
+        &v,
+        1,
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [397.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(
+        acks(&out),
+        [(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            MavResult::MAV_RESULT_UNSUPPORTED
+        )]
+    );
+}
+
+#[test]
+fn messages_for_other_systems_ignored() {
+    let mut l = link();
+    let v = healthy();
+    // Drain the first heartbeat and streams so only answers remain.
+    poll(&mut l, &v, 0);
+    let other_sys = MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
+        command: MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
+        param1: 1.0,
+        target_system: 2,
+        target_component: 1,
+        ..Default::default()
+    });
+    assert!(acks(&exchange(&mut l, &v, 1, other_sys)).is_empty());
+    let other_comp = MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+        target_system: 1,
+        target_component: 154,
+    });
+    assert!(param_values(&exchange(&mut l, &v, 2, other_comp)).is_empty());
+    assert_eq!(l.take_requests(), VehicleRequests::default());
+    // Broadcast (0) is ours.
+    let bcast = MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+        param_index: 0,
+        target_system: 0,
+        target_component: 0,
+        param_id: "".into(),
+    });
+    assert_eq!(param_values(&exchange(&mut l, &v, 3, bcast)).len(), 1);
+    // Our own echo (system 1, component 1) is ignored.
+    let echo = MavHeader {
+        system_id: 1,
+        component_id: 1,
+        sequence: 0,
+    };
+    l.handle(
+        &echo,
+        &cmd_long(MavCmd::MAV_CMD_DO_DIGICAM_CONTROL, [0.0; 7]),
+        4,
+        &v,
+    );
+    assert!(acks(&poll(&mut l, &v, 4)).is_empty());
+}
+
+// ---------------------------------------------------------------- arming and modes
+
+fn arm_cmd(arm: bool, force: bool) -> MavMessage {
+    let p2 = if force { 21196.0 } else { 0.0 };
+    cmd_long(
+        MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
+        [if arm { 1.0 } else { 0.0 }, p2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    )
+}
+
+#[test]
+fn arming_with_and_without_prearm_conditions() {
+    let v = healthy();
+    let mut l = link();
+    let out = exchange(&mut l, &v, 0, arm_cmd(true, false));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(
+        l.take_requests().arm,
+        Some(ArmRequest {
+            arm: true,
+            forced: false
+        })
+    );
+
+    type Breaker = fn(&mut VehicleSnapshot);
+    let breakers: [(Breaker, &str); 6] = [
+        (|v| v.health.gyro_ok = false, "gyro"),
+        (|v| v.health.baro_ok = false, "barometer"),
+        (|v| v.health.attitude_converged = false, "attitude estimate"),
+        (|v| v.gps.fix_type = 2, "GPS fix"),
+        (|v| v.health.position_valid = false, "position estimate"),
+        (
+            |v| {
+                v.battery.present = true;
+                v.battery.remaining = 0.03
+            },
+            "battery",
+        ),
+    ];
+    for (k, (brk, why)) in breakers.iter().enumerate() {
+        let mut bad = healthy();
+        brk(&mut bad);
+        let mut l = link();
+        let out = exchange(&mut l, &bad, k as u64, arm_cmd(true, false));
+        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED, "{why}");
+        let t = texts(&out);
+        assert!(
+            t[0].starts_with("Arming denied") && t[0].contains(why),
+            "{t:?}"
+        );
+        assert_eq!(l.take_requests().arm, None);
+        // Forced arming skips the checks.
+        let out = exchange(&mut l, &bad, 100, arm_cmd(true, true));
+        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+        assert!(l.take_requests().arm.unwrap().forced);
+    }
+    // Still booting: try again later.
+    let mut booting = healthy();
+    booting.boot_complete = false;
+    let out = exchange(&mut link(), &booting, 0, arm_cmd(true, false));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+
+    // Disarm in the air refused unless forced.
+    let mut flying = healthy();
+    flying.armed = true;
+    flying.landed = LandedState::InAir;
+    let mut l = link();
+    let out = exchange(&mut l, &flying, 0, arm_cmd(false, false));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+    assert!(texts(&out)[0].contains("not landed"));
+    let out = exchange(&mut l, &flying, 1, arm_cmd(false, true));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(
+        l.take_requests().arm,
+        Some(ArmRequest {
+            arm: false,
+            forced: true
+        })
+    );
+}
+
+/// PX4's custom_mode numbers, written out independently of `FlightMode`.
+fn px4(main: u32, sub: u32) -> u32 {
+    (main << 16) | (sub << 24)
+}
+
+#[allow(deprecated)]
+#[test]
+fn mode_changes_by_every_path_reach_the_heartbeat() {
+    let mut v = healthy();
+    let mut l = link();
+    // A one-item mission so Mission mode can be entered.
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            0,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &waypoints(1, 0)
+        ),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    let cases: Vec<(MavMessage, MavCmd, u32)> = std::vec![
+        (
+            cmd_long(
+                MavCmd::MAV_CMD_DO_SET_MODE,
+                [1.0, 7.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+            ),
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            px4(7, 0)
+        ),
+        (
+            MavMessage::COMMAND_INT(COMMAND_INT_DATA {
+                param1: 129.0,
+                param2: 2.0,
+                command: MavCmd::MAV_CMD_DO_SET_MODE,
+                target_system: 1,
+                target_component: 1,
+                ..Default::default()
+            }),
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            px4(2, 0)
+        ),
+        (
+            MavMessage::SET_MODE(SET_MODE_DATA {
+                custom_mode: px4(3, 0),
+                target_system: 1,
+                base_mode: MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+            }),
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            px4(3, 0)
+        ),
+        (
+            cmd_long(
+                MavCmd::MAV_CMD_DO_SET_MODE,
+                [1.0, 4.0, 3.0, 0.0, 0.0, 0.0, 0.0]
+            ),
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            px4(4, 3)
+        ),
+        (
+            cmd_long(
+                MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
+                [8.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+            ),
+            MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
+            px4(4, 2)
+        ),
+        (
+            cmd_long(
+                MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
+                [7.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+            ),
+            MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
+            px4(4, 6)
+        ),
+        (
+            cmd_long(MavCmd::MAV_CMD_MISSION_START, [0.0; 7]),
+            MavCmd::MAV_CMD_MISSION_START,
+            px4(4, 4)
+        ),
+        (
+            cmd_long(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7]),
+            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH,
+            px4(4, 5)
+        ),
+        (
+            cmd_long(
+                MavCmd::MAV_CMD_DO_SET_MODE,
+                [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+            ),
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            px4(1, 0)
+        ),
+    ];
+    let mut now = 1_000_000;
+    for (msg, cmd, expect) in cases {
+        now += 1_000_000;
+        let out = exchange(&mut l, &v, now, msg);
+        assert_eq!(
+            acks(&out),
+            [(cmd, MavResult::MAV_RESULT_ACCEPTED)],
+            "{expect:#x}"
+        );
+        // The vehicle applies the request; the next heartbeat tells the truth.
+        let mode = l.take_requests().mode.expect("mode requested");
+        v.mode = mode;
+        now += 1_000_000;
+        let hb = heartbeat_of(&poll(&mut l, &v, now)).unwrap();
+        assert_eq!(hb.custom_mode, expect);
+    }
+}
+
+#[test]
+fn modes_refused_with_reasons() {
+    let mut v = healthy();
+    v.health.position_valid = false;
+    v.modes_available = ModeSet::WITHOUT_POSITION;
+    let mut l = link();
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            0,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &waypoints(2, 0)
+        ),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    let out = exchange(
+        &mut l,
+        &v,
+        10,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            [1.0, 4.0, 3.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert!(texts(&out)[0].contains("Loiter refused: no position estimate"));
+    assert_eq!(l.take_requests().mode, None);
+    // Altitude mode needs no position.
+    let out = exchange(
+        &mut l,
+        &v,
+        11,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            [1.0, 2.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    // Modes this autopilot does not fly.
+    let out = exchange(
+        &mut l,
+        &v,
+        12,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            [1.0, 6.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_FAILED);
+    let out = exchange(
+        &mut l,
+        &v,
+        13,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_FAILED);
+    // Mission with nothing uploaded, Return without home.
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        cmd_long(MavCmd::MAV_CMD_MISSION_START, [0.0; 7]),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+    assert!(texts(&out)[0].contains("no mission"));
+    let mut nohome = healthy();
+    nohome.home.valid = false;
+    let out = exchange(
+        &mut l,
+        &nohome,
+        1,
+        cmd_long(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 7]),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert!(texts(&out)[0].contains("no home"));
+}
+
+#[test]
+fn available_and_current_modes() {
+    let mut l = link();
+    let mut v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [435.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert!(matches!(out[0], MavMessage::COMMAND_ACK(_)), "ACK first");
+    let modes: Vec<_> = out
+        .iter()
+        .filter_map(|m| match m {
+            MavMessage::AVAILABLE_MODES(a) => Some(a.clone()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(modes.len(), 9);
+    let mut idx: Vec<u8> = modes.iter().map(|m| m.mode_index).collect();
+    idx.sort();
+    assert_eq!(idx, (1..=9).collect::<Vec<u8>>());
+    assert!(modes.iter().all(|m| m.number_modes == 9));
+    let mission = modes
+        .iter()
+        .find(|m| m.mode_name.to_str().unwrap() == "Mission")
+        .unwrap();
+    assert_eq!(mission.custom_mode, px4(4, 4));
+    assert_eq!(
+        mission.standard_mode,
+        MavStandardMode::MAV_STANDARD_MODE_MISSION
+    );
+    // One by index.
+    let out = exchange(
+        &mut l,
+        &v,
+        1,
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [435.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    let one: Vec<_> = out
+        .iter()
+        .filter(|m| matches!(m, MavMessage::AVAILABLE_MODES(_)))
+        .collect();
+    assert_eq!(one.len(), 1);
+    // CURRENT_MODE on request and on change.
+    v.mode = FlightMode::Loiter;
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [436.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    let cm = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::CURRENT_MODE(c) => Some(c.clone()),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!(cm.custom_mode, px4(4, 3));
+    assert_eq!(cm.standard_mode, MavStandardMode::MAV_STANDARD_MODE_ORBIT);
+}
+
+// ---------------------------------------------------------------- telemetry scheduler
+
+fn count_over(l: &mut GroundLink, v: &VehicleSnapshot, from_us: u64, secs: u64, id: u32) -> usize {
+    let mut n = 0;
+    // Polled at 1 kHz, like a fast SITL loop.
+    for k in 0..secs * 1000 {
+        for m in poll(l, v, from_us + k * 1000) {
+            if mavlink::Message::message_id(&m) == id {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+#[test]
+fn default_stream_rates() {
+    let mut l = link();
+    let v = healthy();
+    // 10 s: PX4-like defaults.
+    let mut counts = std::collections::BTreeMap::new();
+    for k in 0..10_000u64 {
+        for m in poll(&mut l, &v, k * 1000) {
+            *counts
+                .entry(mavlink::Message::message_id(&m))
+                .or_insert(0usize) += 1;
+        }
+    }
+    let expect = [
+        (0u32, 10usize), // HEARTBEAT 1 Hz
+        (1, 10),         // SYS_STATUS 1 Hz
+        (24, 10),        // GPS_RAW_INT 1 Hz
+        (30, 150),       // ATTITUDE 15 Hz
+        (33, 50),        // GLOBAL_POSITION_INT 5 Hz
+        (42, 10),        // MISSION_CURRENT 1 Hz
+        (62, 10),        // NAV_CONTROLLER_OUTPUT 1 Hz
+        (74, 40),        // VFR_HUD 4 Hz
+        (147, 5),        // BATTERY_STATUS 0.5 Hz
+        (242, 5),        // HOME_POSITION 0.5 Hz
+        (245, 10),       // EXTENDED_SYS_STATE 1 Hz
+    ];
+    for (id, n) in expect {
+        let got = counts.get(&id).copied().unwrap_or(0);
+        assert!(
+            got.abs_diff(n) <= 1,
+            "message {id}: {got} in 10 s, expected {n}"
+        );
+    }
+}
+
+#[test]
+fn set_message_interval_changes_a_stream() {
+    let mut l = link();
+    let v = healthy();
+    let set = |iv: f32| {
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [30.0, iv, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+    };
+    assert_eq!(
+        acks(&exchange(&mut l, &v, 0, set(20_000.0)))[0].1,
+        MavResult::MAV_RESULT_ACCEPTED
+    );
+    let n = count_over(&mut l, &v, 1_000, 10, 30);
+    assert!(n.abs_diff(500) <= 1, "50 Hz for 10 s gave {n}");
+    // GET_MESSAGE_INTERVAL reports it.
+    #[allow(deprecated)]
+    let out = exchange(
+        &mut l,
+        &v,
+        11_000_000,
+        cmd_long(
+            MavCmd::MAV_CMD_GET_MESSAGE_INTERVAL,
+            [30.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    let mi = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::MESSAGE_INTERVAL(i) => Some(i.clone()),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!((mi.message_id, mi.interval_us), (30, 20_000));
+    // -1 stops it.
+    exchange(&mut l, &v, 11_000_001, set(-1.0));
+    assert_eq!(count_over(&mut l, &v, 11_001_000, 3, 30), 0);
+    // 0 restores the default 15 Hz.
+    exchange(&mut l, &v, 14_001_000, set(0.0));
+    let n = count_over(&mut l, &v, 14_002_000, 10, 30);
+    assert!(n.abs_diff(150) <= 1, "default gave {n}");
+    // Unknown stream, heartbeat.
+    let out = exchange(
+        &mut l,
+        &v,
+        30_000_000,
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [9999.0, 1e5, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    let out = exchange(
+        &mut l,
+        &v,
+        30_000_001,
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [0.0, 1e5, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+}
+
+#[test]
+fn statustext_queue_from_vehicle() {
+    let mut l = link();
+    let v = healthy();
+    l.send_statustext(MavSeverity::MAV_SEVERITY_CRITICAL, "Failsafe: link lost");
+    let out = poll(&mut l, &v, 0);
+    assert_eq!(texts(&out), ["Failsafe: link lost"]);
+    // More than fit: the rest counted as dropped, never a panic.
+    for _ in 0..20 {
+        l.send_statustext(MavSeverity::MAV_SEVERITY_INFO, "x");
+    }
+    assert_eq!(texts(&poll(&mut l, &v, 1)).len(), 8);
+    assert_eq!(l.dropped(), 12);
+}
+
+// ---------------------------------------------------------------- missions
+
+/// `n` waypoints; each carries awkward floats: NaN with a payload, -0.0, infinities.
+fn waypoints(n: usize, salt: u32) -> Vec<MISSION_ITEM_INT_DATA> {
+    (0..n)
+        .map(|i| MISSION_ITEM_INT_DATA {
+            param1: i as f32 * 0.5,
+            param2: f32::from_bits(0x7fc0_0000 | (i as u32 + salt)), // NaN, payload i
+            param3: -0.0,
+            param4: if i % 2 == 0 { f32::NAN } else { f32::INFINITY },
+            x: 449_000_000 + i as i32 * 1000,
+            y: -932_000_000 - i as i32 * 1000,
+            z: 100.0 + i as f32,
+            seq: i as u16,
+            command: if i == 0 {
+                MavCmd::MAV_CMD_NAV_TAKEOFF
+            } else {
+                MavCmd::MAV_CMD_NAV_WAYPOINT
+            },
+            target_system: 1,
+            target_component: 1,
+            frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+            current: 0,
+            autocontinue: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        })
+        .collect()
+}
+
+/// A ground station uploading `items`, answering each request; returns the final ACK.
+fn upload(
+    l: &mut GroundLink,
+    v: &VehicleSnapshot,
+    start_us: u64,
+    t: MavMissionType,
+    items: &[MISSION_ITEM_INT_DATA],
+) -> MavMissionResult {
+    let mut now = start_us;
+    let mut out = exchange(
+        l,
+        v,
+        now,
+        MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+            count: items.len() as u16,
+            target_system: 1,
+            target_component: 1,
+            mission_type: t,
+            opaque_id: 0,
+        }),
+    );
+    for _ in 0..10_000 {
+        let mut next = None;
+        for m in &out {
+            match m {
+                MavMessage::MISSION_ACK(a) => return a.mavtype,
+                MavMessage::MISSION_REQUEST_INT(r) => {
+                    assert_eq!(r.mission_type, t);
+                    assert_eq!((r.target_system, r.target_component), GCS);
+                    next = Some(r.seq);
+                }
+                _ => {}
+            }
+        }
+        now += 1000;
+        out = match next {
+            Some(seq) => {
+                let mut it = items[usize::from(seq)].clone();
+                it.mission_type = t;
+                exchange(l, v, now, MavMessage::MISSION_ITEM_INT(it))
+            }
+            None => poll(l, v, now),
+        };
+    }
+    panic!("upload never finished");
+}
+
+/// A ground station downloading a list.
+fn download(
+    l: &mut GroundLink,
+    v: &VehicleSnapshot,
+    start_us: u64,
+    t: MavMissionType,
+) -> Vec<MISSION_ITEM_INT_DATA> {
+    let out = exchange(
+        l,
+        v,
+        start_us,
+        MavMessage::MISSION_REQUEST_LIST(MISSION_REQUEST_LIST_DATA {
+            target_system: 1,
+            target_component: 1,
+            mission_type: t,
+        }),
+    );
+    let count = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::MISSION_COUNT(c) => Some(c.clone()),
+            _ => None,
+        })
+        .expect("MISSION_COUNT");
+    assert_eq!(count.mission_type, t);
+    let mut items = Vec::new();
+    for seq in 0..count.count {
+        let out = exchange(
+            l,
+            v,
+            start_us + 1 + u64::from(seq),
+            MavMessage::MISSION_REQUEST_INT(MISSION_REQUEST_INT_DATA {
+                seq,
+                target_system: 1,
+                target_component: 1,
+                mission_type: t,
+            }),
+        );
+        let it = out
+            .iter()
+            .find_map(|m| match m {
+                MavMessage::MISSION_ITEM_INT(i) => Some(i.clone()),
+                _ => None,
+            })
+            .expect("MISSION_ITEM_INT");
+        assert_eq!(it.seq, seq);
+        items.push(it);
+    }
+    l.handle(
+        &hdr(),
+        &MavMessage::MISSION_ACK(MISSION_ACK_DATA {
+            target_system: 1,
+            target_component: 1,
+            mavtype: MavMissionResult::MAV_MISSION_ACCEPTED,
+            mission_type: t,
+            opaque_id: 0,
+        }),
+        start_us + 100_000,
+        v,
+    );
+    assert!(!l.missions().busy(), "download closed by the GCS ACK");
+    items
+}
+
+fn same_bits(a: &MISSION_ITEM_INT_DATA, b: &MISSION_ITEM_INT_DATA) -> bool {
+    a.param1.to_bits() == b.param1.to_bits()
+        && a.param2.to_bits() == b.param2.to_bits()
+        && a.param3.to_bits() == b.param3.to_bits()
+        && a.param4.to_bits() == b.param4.to_bits()
+        && a.x == b.x
+        && a.y == b.y
+        && a.z.to_bits() == b.z.to_bits()
+        && a.seq == b.seq
+        && a.command == b.command
+        && a.frame == b.frame
+        && a.autocontinue == b.autocontinue
+        && a.mission_type == b.mission_type
+}
+
+#[test]
+fn mission_round_trip_bit_exact_130_items() {
+    let mut l = link();
+    let v = healthy();
+    let items = waypoints(130, 7);
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            0,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &items
+        ),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    assert_eq!(l.missions().store().mission.len(), 130);
+    let back = download(
+        &mut l,
+        &v,
+        10_000_000,
+        MavMissionType::MAV_MISSION_TYPE_MISSION,
+    );
+    assert_eq!(back.len(), 130);
+    for (a, b) in items.iter().zip(&back) {
+        assert!(same_bits(a, b), "item {} differs:\n{a:?}\n{b:?}", a.seq);
+        assert_eq!((b.target_system, b.target_component), GCS);
+    }
+    // Item 0 is the first to fly (take-off), not home.
+    assert_eq!(back[0].command, MavCmd::MAV_CMD_NAV_TAKEOFF);
+    // The full capacity fits; one more does not.
+    let mut l = link();
+    let full = waypoints(MISSION_CAPACITY, 0);
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            0,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &full
+        ),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    let over = waypoints(MISSION_CAPACITY + 1, 0);
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            0,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &over
+        ),
+        MavMissionResult::MAV_MISSION_NO_SPACE
+    );
+    assert_eq!(
+        l.missions().store().mission.len(),
+        MISSION_CAPACITY,
+        "old mission kept"
+    );
+}
+
+#[test]
+fn fence_and_rally_stored_beside_the_mission() {
+    let mut l = link();
+    let v = healthy();
+    let mission = waypoints(3, 0);
+    let fence: Vec<_> = (0..4)
+        .map(|i| MISSION_ITEM_INT_DATA {
+            param1: 4.0, // vertices in the polygon
+            x: 449_000_000 + (i & 1) * 10_000,
+            y: -932_000_000 + (i >> 1) * 10_000,
+            seq: i as u16,
+            command: MavCmd::MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION,
+            frame: MavFrame::MAV_FRAME_GLOBAL,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_FENCE,
+            ..Default::default()
+        })
+        .collect();
+    let rally = [MISSION_ITEM_INT_DATA {
+        x: 449_100_000,
+        y: -932_100_000,
+        z: 50.0,
+        command: MavCmd::MAV_CMD_NAV_RALLY_POINT,
+        frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        mission_type: MavMissionType::MAV_MISSION_TYPE_RALLY,
+        ..Default::default()
+    }];
+    let m = MavMissionType::MAV_MISSION_TYPE_MISSION;
+    let f = MavMissionType::MAV_MISSION_TYPE_FENCE;
+    let r = MavMissionType::MAV_MISSION_TYPE_RALLY;
+    assert_eq!(
+        upload(&mut l, &v, 0, m, &mission),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    assert_eq!(
+        upload(&mut l, &v, 1_000_000, f, &fence),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    assert_eq!(
+        upload(&mut l, &v, 2_000_000, r, &rally),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    assert_eq!(download(&mut l, &v, 3_000_000, m).len(), 3);
+    let fb = download(&mut l, &v, 4_000_000, f);
+    assert!(fence.iter().zip(&fb).all(|(a, b)| same_bits(a, b)));
+    let rb = download(&mut l, &v, 5_000_000, r);
+    assert!(same_bits(&rally[0], &rb[0]));
+    // A waypoint is not a fence item.
+    assert_eq!(
+        upload(&mut l, &v, 6_000_000, f, &waypoints(1, 0)),
+        MavMissionResult::MAV_MISSION_UNSUPPORTED
+    );
+    assert_eq!(l.missions().store().fence.len(), 4);
+    // Clearing the fence leaves the others.
+    let out = exchange(
+        &mut l,
+        &v,
+        7_000_000,
+        MavMessage::MISSION_CLEAR_ALL(MISSION_CLEAR_ALL_DATA {
+            target_system: 1,
+            target_component: 1,
+            mission_type: f,
+        }),
+    );
+    assert!(out.iter().any(|m| matches!(m, MavMessage::MISSION_ACK(a) if a.mavtype == MavMissionResult::MAV_MISSION_ACCEPTED && a.mission_type == f)));
+    assert_eq!(l.missions().store().fence.len(), 0);
+    assert_eq!(l.missions().store().mission.len(), 3);
+    assert_eq!(l.missions().store().rally.len(), 1);
+    // ALL clears everything.
+    exchange(
+        &mut l,
+        &v,
+        7_100_000,
+        MavMessage::MISSION_CLEAR_ALL(MISSION_CLEAR_ALL_DATA {
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_ALL,
+        }),
+    );
+    assert!(l.missions().store().mission.is_empty() && l.missions().store().rally.is_empty());
+}
+
+fn mission_acks(out: &[MavMessage]) -> Vec<MavMissionResult> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::MISSION_ACK(a) => Some(a.mavtype),
+            _ => None,
+        })
+        .collect()
+}
+
+fn requests(out: &[MavMessage]) -> Vec<u16> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::MISSION_REQUEST_INT(r) => Some(r.seq),
+            _ => None,
+        })
+        .collect()
+}
+
+fn count_msg(n: u16) -> MavMessage {
+    MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+        count: n,
+        target_system: 1,
+        target_component: 1,
+        mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        opaque_id: 0,
+    })
+}
+
+#[test]
+fn erroneous_uploads_get_the_right_ack() {
+    let v = healthy();
+    let items = waypoints(5, 0);
+    // Out of sequence: item 3 when 1 is expected.
+    let mut l = link();
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            0,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &items[..2]
+        ),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    assert_eq!(requests(&exchange(&mut l, &v, 1, count_msg(5))), [0]);
+    assert_eq!(
+        requests(&exchange(
+            &mut l,
+            &v,
+            2,
+            MavMessage::MISSION_ITEM_INT(items[0].clone())
+        )),
+        [1]
+    );
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        MavMessage::MISSION_ITEM_INT(items[3].clone()),
+    );
+    assert_eq!(
+        mission_acks(&out),
+        [MavMissionResult::MAV_MISSION_INVALID_SEQUENCE]
+    );
+    assert_eq!(l.missions().store().mission.len(), 2, "old mission kept");
+    assert!(!l.missions().busy());
+    // A repeated earlier item is answered by asking again for the expected one.
+    exchange(&mut l, &v, 4, count_msg(5));
+    exchange(
+        &mut l,
+        &v,
+        5,
+        MavMessage::MISSION_ITEM_INT(items[0].clone()),
+    );
+    assert_eq!(
+        requests(&exchange(
+            &mut l,
+            &v,
+            6,
+            MavMessage::MISSION_ITEM_INT(items[0].clone())
+        )),
+        [1]
+    );
+    // Local frame, latitude out of range.
+    let mut local = items[0].clone();
+    local.frame = MavFrame::MAV_FRAME_LOCAL_NED;
+    let mut badlat = items[0].clone();
+    badlat.x = 950_000_000;
+    for (it, want) in [
+        (local, MavMissionResult::MAV_MISSION_UNSUPPORTED_FRAME),
+        (badlat, MavMissionResult::MAV_MISSION_INVALID_PARAM5_X),
+    ] {
+        let mut l = link();
+        exchange(&mut l, &v, 0, count_msg(1));
+        assert_eq!(
+            mission_acks(&exchange(&mut l, &v, 1, MavMessage::MISSION_ITEM_INT(it))),
+            [want]
+        );
+    }
+    // Busy: an upload while a download runs is denied; from another GCS while uploading too.
+    let mut l = link();
+    upload(
+        &mut l,
+        &v,
+        0,
+        MavMissionType::MAV_MISSION_TYPE_MISSION,
+        &items,
+    );
+    exchange(
+        &mut l,
+        &v,
+        1_000_000,
+        MavMessage::MISSION_REQUEST_LIST(MISSION_REQUEST_LIST_DATA {
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        }),
+    );
+    assert_eq!(
+        mission_acks(&exchange(&mut l, &v, 1_000_001, count_msg(2))),
+        [MavMissionResult::MAV_MISSION_DENIED]
+    );
+    let mut l = link();
+    exchange(&mut l, &v, 0, count_msg(3));
+    let other = MavHeader {
+        system_id: 254,
+        component_id: 190,
+        sequence: 0,
+    };
+    l.handle(&other, &count_msg(2), 1, &v);
+    assert_eq!(
+        mission_acks(&poll(&mut l, &v, 1)),
+        [MavMissionResult::MAV_MISSION_DENIED]
+    );
+    // The GCS cancels its upload.
+    l.handle(
+        &hdr(),
+        &MavMessage::MISSION_ACK(MISSION_ACK_DATA {
+            target_system: 1,
+            target_component: 1,
+            mavtype: MavMissionResult::MAV_MISSION_OPERATION_CANCELLED,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+            opaque_id: 0,
+        }),
+        2,
+        &v,
+    );
+    assert!(!l.missions().busy());
+    // Requesting an item that does not exist.
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        MavMessage::MISSION_REQUEST_INT(MISSION_REQUEST_INT_DATA {
+            seq: 9,
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        }),
+    );
+    assert_eq!(
+        mission_acks(&out),
+        [MavMissionResult::MAV_MISSION_INVALID_SEQUENCE]
+    );
+    // mission_type ALL cannot be uploaded.
+    let out = exchange(
+        &mut l,
+        &v,
+        4,
+        MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+            count: 1,
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_ALL,
+            opaque_id: 0,
+        }),
+    );
+    assert_eq!(
+        mission_acks(&out),
+        [MavMissionResult::MAV_MISSION_UNSUPPORTED]
+    );
+}
+
+#[test]
+fn upload_timeouts_retries_and_restart() {
+    let v = healthy();
+    let items = waypoints(4, 0);
+    let mut l = link();
+    upload(
+        &mut l,
+        &v,
+        0,
+        MavMissionType::MAV_MISSION_TYPE_MISSION,
+        &items[..1],
+    );
+    let t0 = 10_000_000;
+    assert_eq!(requests(&exchange(&mut l, &v, t0, count_msg(4))), [0]);
+    assert_eq!(
+        requests(&exchange(
+            &mut l,
+            &v,
+            t0 + 1000,
+            MavMessage::MISSION_ITEM_INT(items[0].clone())
+        )),
+        [1]
+    );
+    // Silence: item 1 requested again every retry interval, then an error ACK.
+    let mut rerequests = Vec::new();
+    let mut final_ack = Vec::new();
+    let mut now = t0 + 1000;
+    while now < t0 + 1000 + UPLOAD_RETRY_US * (u64::from(UPLOAD_MAX_RETRIES) + 2) {
+        now += 10_000;
+        let out = poll(&mut l, &v, now);
+        for s in requests(&out) {
+            rerequests.push((s, now));
+        }
+        final_ack.extend(mission_acks(&out));
+    }
+    assert_eq!(rerequests.len(), usize::from(UPLOAD_MAX_RETRIES));
+    assert!(rerequests.iter().all(|(s, _)| *s == 1));
+    let gaps: Vec<u64> = rerequests.windows(2).map(|w| w[1].1 - w[0].1).collect();
+    assert!(
+        gaps.iter().all(|&g| g.abs_diff(UPLOAD_RETRY_US) <= 10_000),
+        "{gaps:?}"
+    );
+    assert_eq!(final_ack, [MavMissionResult::MAV_MISSION_ERROR]);
+    assert!(!l.missions().busy());
+    assert_eq!(l.missions().store().mission.len(), 1, "old mission kept");
+
+    // A retry answered resumes the upload.
+    let mut l = link();
+    exchange(&mut l, &v, 0, count_msg(2));
+    exchange(
+        &mut l,
+        &v,
+        1000,
+        MavMessage::MISSION_ITEM_INT(items[0].clone()),
+    );
+    assert_eq!(requests(&poll(&mut l, &v, 1000 + UPLOAD_RETRY_US)), [1]);
+    let out = exchange(
+        &mut l,
+        &v,
+        2000 + UPLOAD_RETRY_US,
+        MavMessage::MISSION_ITEM_INT(items[1].clone()),
+    );
+    assert_eq!(mission_acks(&out), [MavMissionResult::MAV_MISSION_ACCEPTED]);
+    // The ACK was lost and the GCS repeats its last item: the same ACK again.
+    let out = exchange(
+        &mut l,
+        &v,
+        3000 + UPLOAD_RETRY_US,
+        MavMessage::MISSION_ITEM_INT(items[1].clone()),
+    );
+    assert_eq!(mission_acks(&out), [MavMissionResult::MAV_MISSION_ACCEPTED]);
+
+    // A new count mid-upload restarts it from item 0.
+    let mut l = link();
+    exchange(&mut l, &v, 0, count_msg(4));
+    exchange(
+        &mut l,
+        &v,
+        1,
+        MavMessage::MISSION_ITEM_INT(items[0].clone()),
+    );
+    exchange(
+        &mut l,
+        &v,
+        2,
+        MavMessage::MISSION_ITEM_INT(items[1].clone()),
+    );
+    assert_eq!(requests(&exchange(&mut l, &v, 3, count_msg(3))), [0]);
+    assert_eq!(
+        upload(
+            &mut l,
+            &v,
+            4,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+            &items[..3]
+        ),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    assert_eq!(l.missions().store().mission.len(), 3);
+}
+
+#[allow(deprecated)]
+#[test]
+fn legacy_request_answered_with_item_int_and_set_current() {
+    let v = healthy();
+    let mut l = link();
+    let items = waypoints(3, 0);
+    upload(
+        &mut l,
+        &v,
+        0,
+        MavMissionType::MAV_MISSION_TYPE_MISSION,
+        &items,
+    );
+    let out = exchange(
+        &mut l,
+        &v,
+        1_000_000,
+        MavMessage::MISSION_REQUEST(MISSION_REQUEST_DATA {
+            seq: 2,
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        }),
+    );
+    let it = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::MISSION_ITEM_INT(i) => Some(i.clone()),
+            _ => None,
+        })
+        .expect("MISSION_ITEM_INT");
+    assert!(same_bits(&it, &items[2]));
+    // Set current via the command and via the message: MISSION_CURRENT confirms.
+    let out = exchange(
+        &mut l,
+        &v,
+        1_000_001,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MISSION_CURRENT,
+            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    let mc = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::MISSION_CURRENT(c) => Some(c.clone()),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!((mc.seq, mc.total), (2, 3));
+    assert_eq!(l.take_requests().mission_seq, Some(2));
+    let out = exchange(
+        &mut l,
+        &v,
+        1_000_002,
+        MavMessage::MISSION_SET_CURRENT(MISSION_SET_CURRENT_DATA {
+            seq: 7,
+            target_system: 1,
+            target_component: 1,
+        }),
+    );
+    assert!(texts(&out)[0].contains("does not exist"));
+    assert_eq!(l.take_requests().mission_seq, None);
+}
+
+#[test]
+fn malformed_input_never_panics() {
+    // Every message kind with extreme field values: the link must answer or ignore, not panic.
+    let mut l = link();
+    let mut v = healthy();
+    v.yaw = f32::NAN;
+    v.alt_amsl_m = f32::INFINITY;
+    v.battery.present = true;
+    v.battery.voltage_v = -1e30;
+    let msgs = [
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [f32::NAN, f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [30.0, 1e30, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [435.0, 1e9, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [-5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            [f32::NAN, 1e9, -1e9, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MISSION_CURRENT,
+            [1e12, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
+            [f32::INFINITY, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        MavMessage::PARAM_SET(PARAM_SET_DATA {
+            param_value: 1.0,
+            param_id: [0xffu8; 16].into(),
+            ..Default::default()
+        }),
+        MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: i16::MAX,
+            ..Default::default()
+        }),
+        MavMessage::MISSION_ITEM_INT(MISSION_ITEM_INT_DATA {
+            seq: u16::MAX,
+            ..Default::default()
+        }),
+        MavMessage::MISSION_REQUEST_INT(MISSION_REQUEST_INT_DATA {
+            seq: u16::MAX,
+            ..Default::default()
+        }),
+        MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+            count: u16::MAX,
+            ..Default::default()
+        }),
+    ];
+    let big = MavHeader {
+        system_id: 70_000,
+        component_id: 1,
+        sequence: 0,
+    };
+    for (k, m) in msgs.iter().enumerate() {
+        l.handle(&hdr(), m, k as u64, &v);
+        l.handle(&big, m, k as u64, &v);
+        poll(&mut l, &v, k as u64 * 1_000_000);
+    }
+    for _ in 0..100 {
+        l.handle(
+            &hdr(),
+            &cmd_long(
+                MavCmd::MAV_CMD_REQUEST_MESSAGE,
+                [435.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            ),
+            0,
+            &v,
+        );
+    }
+    poll(&mut l, &v, 100_000_000);
+    assert!(l.dropped() > 0, "overflow counted");
+}
+
+#[test]
+fn ram_footprint_within_budget() {
+    use core::mem::size_of;
+    let sizes = [
+        ("GroundLink", size_of::<GroundLink>()),
+        ("ParamStore", size_of::<param_store::ParamStore>()),
+        ("MissionManager", size_of::<mission::MissionManager>()),
+        ("MissionStore", size_of::<mission::MissionStore>()),
+        ("VehicleSnapshot", size_of::<VehicleSnapshot>()),
+        ("MavMessage", size_of::<MavMessage>()),
+        ("ParamImage", size_of::<param_store::ParamImage>()),
+    ];
+    for (n, s) in sizes {
+        std::println!("{n}: {s} bytes");
+    }
+    // The MCU has 128 KiB of SRAM; the link (with 240 stored plan items and a staging list
+    // for uploads) must leave most of it to the rest of the autopilot.
+    assert!(
+        size_of::<GroundLink>() <= 20 * 1024,
+        "{}",
+        size_of::<GroundLink>()
+    );
+}
+
+#[test]
+fn heartbeat_reports_truth_not_requests_and_tracks_gcs() {
+    let mut l = link();
+    let v = healthy();
+    assert_eq!(l.gcs_last_seen_us(), None);
+    l.handle(
+        &hdr(),
+        &MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            mavtype: MavType::MAV_TYPE_GCS,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+            ..Default::default()
+        }),
+        42,
+        &v,
+    );
+    assert_eq!(l.gcs_last_seen_us(), Some(42));
+    // Loiter accepted, but the vehicle has not switched: the heartbeat still says Manual and
+    // CURRENT_MODE shows the intention.
+    let out = exchange(
+        &mut l,
+        &v,
+        100,
+        cmd_long(
+            MavCmd::MAV_CMD_DO_SET_MODE,
+            [1.0, 4.0, 3.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(heartbeat_of(&out).unwrap().custom_mode, px4(1, 0));
+    let out = exchange(
+        &mut l,
+        &v,
+        200,
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [436.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    let cm = out
+        .iter()
+        .find_map(|m| match m {
+            MavMessage::CURRENT_MODE(c) => Some(c.clone()),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!(
+        (cm.custom_mode, cm.intended_custom_mode),
+        (px4(1, 0), px4(4, 3))
+    );
+}
+
+#[test]
+fn preflight_storage_requests_save_and_resets_defaults() {
+    let mut l = link();
+    let mut v = healthy();
+    exchange(
+        &mut l,
+        &v,
+        0,
+        param_set("RLL_KP", 2.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    let out = exchange(
+        &mut l,
+        &v,
+        1,
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert!(l.take_requests().save_params);
+    v.armed = true;
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(l.params().get("RLL_KP"), Some(2.0));
+    v.armed = false;
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    );
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(l.params().get("RLL_KP"), Some(0.8));
+}

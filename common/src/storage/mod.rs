@@ -1,0 +1,388 @@
+//! Power-cut-safe persistence of parameters and missions in flash.
+//!
+//! Each record (the parameters, the mission lists) lives in an [`AbRegion`]: two slots of one
+//! flash sector each. A save goes to the slot that does *not* hold the newest good copy, so the
+//! newest good copy is never touched while it is the only one. A slot is
+//!
+//! ```text
+//! offset 0   magic   u32 LE   which record this is (and the format version)
+//!        4   seq     u32 LE   save counter; the higher (wrapping) valid one wins
+//!        8   len     u32 LE   payload length
+//!       12   crc     u32 LE   CRC-32 of seq, len and payload
+//!       16   payload          postcard encoding of the record
+//! ```
+//!
+//! and is written in this order: erase, payload, header. Until the last header byte is
+//! written the slot fails its magic or CRC check, so a power cut at any point loses at most
+//! the save in progress: loading yields the old record or the new one, never a mixture.
+//!
+//! Parameters are stored by name ([`ParamImage`]), so a firmware whose table is reordered or
+//! extended still loads them; only values that differ from their default are stored.
+
+use serde::{de::DeserializeOwned, Serialize};
+
+use crate::gcs::mission::MissionStore;
+use crate::gcs::param_store::{ImportReport, ParamExport, ParamImage, ParamStore};
+
+/// A flash device (or a model of one). Erased bytes read 0xFF; a write can only clear bits.
+pub trait Flash {
+    /// Error of the device.
+    type Error: core::fmt::Debug;
+    /// Erases the whole sector that starts at `addr`.
+    fn erase_sector(&mut self, addr: u32) -> Result<(), Self::Error>;
+    /// Programs `data` at `addr` (already erased).
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), Self::Error>;
+    /// Reads `buf.len()` bytes at `addr`.
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), Self::Error>;
+}
+
+/// Two slots holding one record. Each slot is one whole sector of `slot_len` bytes (on the
+/// STM32F405, for example, two of its 16 KiB sectors 1..3 for the parameters and the 16 KiB
+/// sector 3 with the 64 KiB sector 4, using its first 16 KiB, for the missions).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AbRegion {
+    /// Tells the records apart (and their format version): a slot with another magic is
+    /// never loaded.
+    pub magic: u32,
+    /// Start of slot A (a sector start).
+    pub slot_a: u32,
+    /// Start of slot B (a sector start).
+    pub slot_b: u32,
+    /// Usable bytes of each slot, header included.
+    pub slot_len: u32,
+}
+
+/// Magic of the parameter record, format 1.
+pub const PARAMS_MAGIC: u32 = 0x5052_4d31; // "PRM1"
+/// Magic of the mission record, format 1.
+pub const MISSION_MAGIC: u32 = 0x4d53_4e31; // "MSN1"
+
+const HEADER_LEN: u32 = 16;
+
+/// Why a save or load failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StorageError<E> {
+    /// The device failed.
+    Flash(E),
+    /// The record does not fit the scratch buffer or the slot.
+    TooLarge,
+    /// Both copies are intact but neither decodes as this record (format changed).
+    Decode,
+}
+
+/// A record loaded from flash.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Loaded<T> {
+    /// The record.
+    pub value: T,
+    /// Its save counter.
+    pub seq: u32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Header {
+    seq: u32,
+    len: u32,
+}
+
+fn crc_of<F: Flash>(
+    flash: &mut F,
+    addr: u32,
+    seq: u32,
+    len: u32,
+) -> Result<u32, StorageError<F::Error>> {
+    let mut crc = crc_any::CRCu32::crc32();
+    crc.digest(&seq.to_le_bytes());
+    crc.digest(&len.to_le_bytes());
+    let mut chunk = [0u8; 64];
+    let mut done = 0u32;
+    while done < len {
+        let n = (len - done).min(chunk.len() as u32) as usize;
+        let buf = chunk.get_mut(..n).ok_or(StorageError::TooLarge)?;
+        flash
+            .read(addr + HEADER_LEN + done, buf)
+            .map_err(StorageError::Flash)?;
+        crc.digest(buf);
+        done += n as u32;
+    }
+    Ok(crc.get_crc())
+}
+
+/// The header of a slot if the slot holds a complete, intact record of this region.
+fn check_slot<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    addr: u32,
+) -> Result<Option<Header>, StorageError<F::Error>> {
+    let mut h = [0u8; HEADER_LEN as usize];
+    flash.read(addr, &mut h).map_err(StorageError::Flash)?;
+    let word = |i: usize| u32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]);
+    let (magic, seq, len, crc) = (word(0), word(4), word(8), word(12));
+    if magic != region.magic || len > region.slot_len.saturating_sub(HEADER_LEN) {
+        return Ok(None);
+    }
+    if crc_of(flash, addr, seq, len)? != crc {
+        return Ok(None);
+    }
+    Ok(Some(Header { seq, len }))
+}
+
+/// Whether save counter `a` is newer than `b` (wrapping).
+fn newer(a: u32, b: u32) -> bool {
+    (a.wrapping_sub(b) as i32) > 0
+}
+
+/// The intact slots, newest first.
+type Candidates = [Option<(u32, Header)>; 2];
+
+fn candidates<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+) -> Result<Candidates, StorageError<F::Error>> {
+    let a = check_slot(flash, region, region.slot_a)?.map(|h| (region.slot_a, h));
+    let b = check_slot(flash, region, region.slot_b)?.map(|h| (region.slot_b, h));
+    Ok(match (a, b) {
+        (Some(x), Some(y)) if newer(y.1.seq, x.1.seq) => [Some(y), Some(x)],
+        (Some(x), Some(y)) => [Some(x), Some(y)],
+        (Some(x), None) | (None, Some(x)) => [Some(x), None],
+        (None, None) => [None, None],
+    })
+}
+
+/// Saves `value` into the slot not holding the newest intact copy; `scratch` must hold the
+/// encoded record. Returns the new save counter.
+pub fn save<F: Flash, T: Serialize>(
+    flash: &mut F,
+    region: &AbRegion,
+    value: &T,
+    scratch: &mut [u8],
+) -> Result<u32, StorageError<F::Error>> {
+    let payload = postcard::to_slice(value, scratch).map_err(|_| StorageError::TooLarge)?;
+    let len = payload.len() as u32;
+    if len > region.slot_len.saturating_sub(HEADER_LEN) {
+        return Err(StorageError::TooLarge);
+    }
+    let [newest, _] = candidates(flash, region)?;
+    let (target, seq) = match newest {
+        Some((addr, h)) if addr == region.slot_a => (region.slot_b, h.seq.wrapping_add(1)),
+        Some((_, h)) => (region.slot_a, h.seq.wrapping_add(1)),
+        None => (region.slot_a, 1),
+    };
+    let mut crc = crc_any::CRCu32::crc32();
+    crc.digest(&seq.to_le_bytes());
+    crc.digest(&len.to_le_bytes());
+    crc.digest(payload);
+    let mut header = [0u8; HEADER_LEN as usize];
+    for (i, w) in [region.magic, seq, len, crc.get_crc()].iter().enumerate() {
+        if let Some(dst) = header.get_mut(i * 4..i * 4 + 4) {
+            dst.copy_from_slice(&w.to_le_bytes());
+        }
+    }
+    flash.erase_sector(target).map_err(StorageError::Flash)?;
+    flash
+        .write(target + HEADER_LEN, payload)
+        .map_err(StorageError::Flash)?;
+    // The header last: until it is complete the slot is not valid.
+    flash.write(target, &header).map_err(StorageError::Flash)?;
+    Ok(seq)
+}
+
+/// Loads the newest intact copy that decodes (falling back to the older one), `None` when
+/// neither slot holds one.
+pub fn load<F: Flash, T: DeserializeOwned>(
+    flash: &mut F,
+    region: &AbRegion,
+    scratch: &mut [u8],
+) -> Result<Option<Loaded<T>>, StorageError<F::Error>> {
+    let mut any = false;
+    for (addr, h) in candidates(flash, region)?.into_iter().flatten() {
+        any = true;
+        let Some(buf) = scratch.get_mut(..h.len as usize) else {
+            continue;
+        };
+        flash
+            .read(addr + HEADER_LEN, buf)
+            .map_err(StorageError::Flash)?;
+        if let Ok(value) = postcard::from_bytes::<T>(buf) {
+            return Ok(Some(Loaded { value, seq: h.seq }));
+        }
+    }
+    if any {
+        Err(StorageError::Decode)
+    } else {
+        Ok(None)
+    }
+}
+
+/// Saves the parameters that differ from their defaults, by name, and marks the store saved.
+/// Streams from the store: no [`ParamImage`] is built.
+pub fn save_params<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    store: &mut ParamStore,
+    scratch: &mut [u8],
+) -> Result<u32, StorageError<F::Error>> {
+    let seq = save(flash, region, &ParamExport(store), scratch)?;
+    store.mark_saved();
+    Ok(seq)
+}
+
+/// Loads saved parameters into `store` by name; `None` when nothing is saved. Decodes into
+/// a [`ParamImage`] first (8 KiB of stack: meant for start-up), so a copy that does not
+/// decode changes nothing.
+pub fn load_params<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    store: &mut ParamStore,
+    scratch: &mut [u8],
+) -> Result<Option<ImportReport>, StorageError<F::Error>> {
+    Ok(load::<F, ParamImage>(flash, region, scratch)?.map(|l| store.import(&l.value)))
+}
+
+/// Saves the mission, fence and rally lists.
+pub fn save_missions<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    store: &MissionStore,
+    scratch: &mut [u8],
+) -> Result<u32, StorageError<F::Error>> {
+    save(flash, region, store, scratch)
+}
+
+/// Loads the mission, fence and rally lists; `None` when nothing is saved.
+pub fn load_missions<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    scratch: &mut [u8],
+) -> Result<Option<MissionStore>, StorageError<F::Error>> {
+    Ok(load::<F, MissionStore>(flash, region, scratch)?.map(|l| l.value))
+}
+
+/// Error of [`RamFlash`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RamFlashError {
+    /// Address outside the device or not a sector start.
+    Address,
+    /// The simulated power is off.
+    PowerLost,
+}
+
+/// Flash in RAM with NOR semantics (erase to 0xFF, writes clear bits), for SITL and tests.
+/// It can lose power after a given number of operations (each erase and each byte written is
+/// one): the operation hit by the cut is torn (half a sector erased, a byte half programmed)
+/// and nothing after it happens.
+#[derive(Clone, Debug)]
+pub struct RamFlash<const N: usize> {
+    mem: [u8; N],
+    sector: u32,
+    budget: Option<usize>,
+    ops: usize,
+}
+
+impl<const N: usize> RamFlash<N> {
+    /// Erased flash of `N` bytes in sectors of `sector` bytes.
+    pub fn new(sector: u32) -> Self {
+        Self {
+            mem: [0xff; N],
+            sector: sector.max(1),
+            budget: None,
+            ops: 0,
+        }
+    }
+
+    /// Cuts the power during the `ops`-th operation from now: `ops - 1` complete, that one is
+    /// torn, none after it happens (`Some(0)`: already off; `None`: power stays on).
+    pub fn cut_after(&mut self, ops: Option<usize>) {
+        self.budget = ops;
+    }
+
+    /// Operations done since creation.
+    pub fn ops(&self) -> usize {
+        self.ops
+    }
+
+    /// The raw contents.
+    pub fn bytes(&self) -> &[u8] {
+        &self.mem
+    }
+
+    /// Consumes one operation; `Ok(true)` if it completes, `Ok(false)` if the cut tears it.
+    fn spend(&mut self) -> Result<bool, RamFlashError> {
+        self_spend(&mut self.budget, &mut self.ops)
+    }
+}
+
+impl<const N: usize> Flash for RamFlash<N> {
+    type Error = RamFlashError;
+
+    fn erase_sector(&mut self, addr: u32) -> Result<(), RamFlashError> {
+        if !addr.is_multiple_of(self.sector) {
+            return Err(RamFlashError::Address);
+        }
+        let (start, len) = (addr as usize, self.sector as usize);
+        let range = self
+            .mem
+            .get_mut(start..start + len)
+            .ok_or(RamFlashError::Address)?;
+        let whole = self_spend(&mut self.budget, &mut self.ops)?;
+        let end = if whole { len } else { len / 2 };
+        range.iter_mut().take(end).for_each(|b| *b = 0xff);
+        if whole {
+            Ok(())
+        } else {
+            Err(RamFlashError::PowerLost)
+        }
+    }
+
+    fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), RamFlashError> {
+        let start = addr as usize;
+        if self.mem.get(start..start + data.len()).is_none() {
+            return Err(RamFlashError::Address);
+        }
+        for (i, d) in data.iter().enumerate() {
+            let whole = self.spend()?;
+            if let Some(b) = self.mem.get_mut(start + i) {
+                // A torn byte gets only its upper nibble programmed.
+                *b &= if whole { *d } else { *d | 0x0f };
+            }
+            if !whole {
+                return Err(RamFlashError::PowerLost);
+            }
+        }
+        Ok(())
+    }
+
+    fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), RamFlashError> {
+        let start = addr as usize;
+        let src = self
+            .mem
+            .get(start..start + buf.len())
+            .ok_or(RamFlashError::Address)?;
+        buf.copy_from_slice(src);
+        Ok(())
+    }
+}
+
+/// [`RamFlash::spend`] on split borrows (the erase holds a borrow of the memory).
+fn self_spend(budget: &mut Option<usize>, ops: &mut usize) -> Result<bool, RamFlashError> {
+    match *budget {
+        Some(0) => Err(RamFlashError::PowerLost),
+        Some(1) => {
+            *budget = Some(0);
+            *ops += 1;
+            Ok(false)
+        }
+        Some(n) => {
+            *budget = Some(n - 1);
+            *ops += 1;
+            Ok(true)
+        }
+        None => {
+            *ops += 1;
+            Ok(true)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,287 @@
+//! Persistence tests, including a power cut at every operation of a save.
+
+extern crate std;
+
+use serde::{Deserialize, Serialize};
+
+use super::*;
+use crate::gcs::mission::{MissionItem, MissionStore};
+use crate::gcs::param_store::ParamExport;
+use crate::params::ParamDef;
+
+const SECTOR: u32 = 1024;
+type Dev = RamFlash<4096>;
+
+const REGION: AbRegion = AbRegion {
+    magic: 0x5445_5354,
+    slot_a: 0,
+    slot_b: SECTOR,
+    slot_len: SECTOR,
+};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct Rec {
+    gen: u32,
+    data: heapless::Vec<u8, 200>,
+}
+
+fn rec(gen: u32, len: usize) -> Rec {
+    let mut data = heapless::Vec::new();
+    for i in 0..len {
+        data.push((i as u32 * 7 + gen * 13) as u8).unwrap();
+    }
+    Rec { gen, data }
+}
+
+#[test]
+fn empty_flash_loads_nothing() {
+    let mut f = Dev::new(SECTOR);
+    let mut scratch = [0u8; 512];
+    assert_eq!(load::<_, Rec>(&mut f, &REGION, &mut scratch).unwrap(), None);
+}
+
+#[test]
+fn saves_alternate_slots_and_newest_wins() {
+    let mut f = Dev::new(SECTOR);
+    let mut scratch = [0u8; 512];
+    for g in 1..=5 {
+        assert_eq!(save(&mut f, &REGION, &rec(g, 50), &mut scratch).unwrap(), g);
+        let l = load::<_, Rec>(&mut f, &REGION, &mut scratch)
+            .unwrap()
+            .unwrap();
+        assert_eq!(l.value, rec(g, 50));
+        assert_eq!(l.seq, g);
+    }
+    // Both slots hold a record (the two newest).
+    assert_eq!(&f.bytes()[0..4], &REGION.magic.to_le_bytes());
+    assert_eq!(
+        &f.bytes()[SECTOR as usize..SECTOR as usize + 4],
+        &REGION.magic.to_le_bytes()
+    );
+}
+
+#[test]
+fn power_cut_at_every_operation_keeps_old_or_new() {
+    let mut scratch = [0u8; 512];
+    // Two complete generations, then the third cut at every erase and byte.
+    let mut base = Dev::new(SECTOR);
+    save(&mut base, &REGION, &rec(1, 120), &mut scratch).unwrap();
+    save(&mut base, &REGION, &rec(2, 80), &mut scratch).unwrap();
+    let new = rec(3, 150);
+    let mut probe = base.clone();
+    let before = probe.ops();
+    save(&mut probe, &REGION, &new, &mut scratch).unwrap();
+    let total = probe.ops() - before;
+    assert!(total > 150, "erase + payload + header");
+    let (mut old_seen, mut new_seen) = (0, 0);
+    // `cut` = k: k - 1 operations complete, the k-th is torn (k = 0: no power at all); k =
+    // total + 1 lets the save finish.
+    for cut in 0..=total + 1 {
+        let mut f = base.clone();
+        f.cut_after(Some(cut));
+        let r = save(&mut f, &REGION, &new, &mut scratch);
+        assert_eq!(r.is_ok(), cut > total, "cut {cut}");
+        // Power back: load must give a complete record, the old one unless the save finished.
+        f.cut_after(None);
+        let got = load::<_, Rec>(&mut f, &REGION, &mut scratch)
+            .unwrap()
+            .unwrap();
+        if cut > total {
+            assert_eq!(got.value, new, "cut {cut}");
+            new_seen += 1;
+        } else {
+            assert_eq!(got.value, rec(2, 80), "cut {cut}");
+            old_seen += 1;
+        }
+        // A later save recovers.
+        save(&mut f, &REGION, &rec(4, 10), &mut scratch).unwrap();
+        assert_eq!(
+            load::<_, Rec>(&mut f, &REGION, &mut scratch)
+                .unwrap()
+                .unwrap()
+                .value,
+            rec(4, 10)
+        );
+    }
+    assert_eq!((old_seen, new_seen), (total + 1, 1));
+}
+
+#[test]
+fn power_cut_on_first_save_loads_nothing_or_new() {
+    let mut scratch = [0u8; 512];
+    let new = rec(1, 30);
+    for cut in 0..=60 {
+        let mut f = Dev::new(SECTOR);
+        f.cut_after(Some(cut));
+        let done = save(&mut f, &REGION, &new, &mut scratch).is_ok();
+        f.cut_after(None);
+        let got = load::<_, Rec>(&mut f, &REGION, &mut scratch).unwrap();
+        assert_eq!(
+            got.map(|l| l.value),
+            if done { Some(new.clone()) } else { None }
+        );
+    }
+}
+
+#[test]
+fn corrupted_newest_falls_back_and_other_magic_ignored() {
+    let mut scratch = [0u8; 512];
+    let mut f = Dev::new(SECTOR);
+    save(&mut f, &REGION, &rec(1, 40), &mut scratch).unwrap();
+    save(&mut f, &REGION, &rec(2, 40), &mut scratch).unwrap(); // in slot B
+                                                               // Flip a payload bit of slot B (a write can clear bits).
+    f.write(SECTOR + 20, &[0x00]).unwrap();
+    assert_eq!(
+        load::<_, Rec>(&mut f, &REGION, &mut scratch)
+            .unwrap()
+            .unwrap()
+            .value,
+        rec(1, 40)
+    );
+    let other = AbRegion { magic: 1, ..REGION };
+    assert_eq!(load::<_, Rec>(&mut f, &other, &mut scratch).unwrap(), None);
+    // Too large for the slot is refused before anything is erased.
+    let mut big = [0u8; 4096];
+    let huge: heapless::Vec<u8, 2048> = (0..2000).map(|i| i as u8).collect();
+    assert_eq!(
+        save(&mut f, &REGION, &huge, &mut big),
+        Err(StorageError::TooLarge)
+    );
+    assert_eq!(
+        load::<_, Rec>(&mut f, &REGION, &mut scratch)
+            .unwrap()
+            .unwrap()
+            .value,
+        rec(1, 40)
+    );
+}
+
+const OLD_TABLE: &[ParamDef] = &[
+    ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", ""),
+    ParamDef::int("NAV_MODE", 2, 0, 5, "", ""),
+    ParamDef::real("GONE", 1.0, 0.0, 5.0, "", ""),
+    ParamDef::real("NARROWED", 1.0, 0.0, 5.0, "", ""),
+];
+// The next firmware: reordered, one removed, one added, one with tighter bounds.
+const NEW_TABLE: &[ParamDef] = &[
+    ParamDef::real("ADDED", 3.0, 0.0, 5.0, "", ""),
+    ParamDef::real("NARROWED", 1.0, 0.0, 2.0, "", ""),
+    ParamDef::int("NAV_MODE", 2, 0, 5, "", ""),
+    ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", ""),
+];
+
+#[test]
+fn params_load_by_name_into_a_reordered_table() {
+    let mut f = Dev::new(SECTOR);
+    let mut scratch = [0u8; 1024];
+    let mut old = ParamStore::new(&[OLD_TABLE]).unwrap();
+    old.set("RLL_KP", 1.5).unwrap();
+    old.set("NAV_MODE", 4.0).unwrap();
+    old.set("GONE", 2.0).unwrap();
+    old.set("NARROWED", 4.0).unwrap();
+    assert!(old.is_dirty());
+    save_params(&mut f, &REGION, &mut old, &mut scratch).unwrap();
+    assert!(!old.is_dirty());
+    // The streamed encoding is the one a ParamImage has.
+    let mut direct = [0u8; 1024];
+    let image = postcard::to_slice(&old.export(), &mut direct)
+        .unwrap()
+        .to_vec();
+    let mut streamed = [0u8; 1024];
+    let streamed = postcard::to_slice(&ParamExport(&old), &mut streamed).unwrap();
+    assert_eq!(image, streamed);
+
+    let mut new = ParamStore::new(&[NEW_TABLE]).unwrap();
+    let report = load_params(&mut f, &REGION, &mut new, &mut scratch)
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        report,
+        ImportReport {
+            loaded: 2,
+            unknown: 1,
+            rejected: 1
+        }
+    );
+    assert_eq!(new.get("RLL_KP"), Some(1.5));
+    assert_eq!(new.get("NAV_MODE"), Some(4.0));
+    assert_eq!(
+        new.get("NARROWED"),
+        Some(1.0),
+        "out of new bounds: default kept"
+    );
+    assert_eq!(new.get("ADDED"), Some(3.0));
+    assert!(!new.is_dirty(), "a load is not a change to persist");
+}
+
+#[test]
+fn missions_persist_bit_exact() {
+    let mut f = Dev::new(SECTOR);
+    let mut scratch = [0u8; 2048];
+    let mut store = MissionStore::default();
+    for i in 0..20u32 {
+        store
+            .mission
+            .push(MissionItem {
+                params: [0x7fc0_0001 + i, (-0.0f32).to_bits(), 0xffff_ffff, i],
+                x: 449_000_000 + i as i32,
+                y: -932_000_000,
+                z: f32::NAN.to_bits(),
+                command: 16,
+                frame: 3,
+                autocontinue: true,
+            })
+            .unwrap();
+    }
+    store
+        .rally
+        .push(MissionItem {
+            command: 5100,
+            ..Default::default()
+        })
+        .unwrap();
+    save_missions(&mut f, &REGION, &store, &mut scratch).unwrap();
+    let back = load_missions(&mut f, &REGION, &mut scratch)
+        .unwrap()
+        .unwrap();
+    assert_eq!(back, store);
+}
+
+#[test]
+fn full_records_fit_their_sectors() {
+    // The largest parameter image and mission store encode within one 16 KiB sector.
+    use crate::gcs::mission::{FENCE_CAPACITY, MISSION_CAPACITY, RALLY_CAPACITY};
+    use crate::gcs::param_store::{ParamRecord, MAX_PARAMS};
+    let worst = MissionItem {
+        params: [u32::MAX; 4],
+        x: i32::MIN,
+        y: i32::MIN,
+        z: u32::MAX,
+        command: u16::MAX,
+        frame: u8::MAX,
+        autocontinue: true,
+    };
+    let mut m = MissionStore::default();
+    for _ in 0..MISSION_CAPACITY {
+        m.mission.push(worst).unwrap();
+    }
+    for _ in 0..FENCE_CAPACITY {
+        m.fence.push(worst).unwrap();
+    }
+    for _ in 0..RALLY_CAPACITY {
+        m.rally.push(worst).unwrap();
+    }
+    let mut buf = std::vec![0u8; 64 * 1024];
+    let n = postcard::to_slice(&m, &mut buf).unwrap().len();
+    assert!(n + 16 <= 16 * 1024, "missions: {n} bytes");
+    let mut img = ParamImage::new();
+    for _ in 0..MAX_PARAMS {
+        img.push(ParamRecord {
+            name: heapless::String::try_from("ABCDEFGHIJKLMNOP").unwrap(),
+            value: f32::MAX,
+        })
+        .unwrap();
+    }
+    let n = postcard::to_slice(&img, &mut buf).unwrap().len();
+    assert!(n + 16 <= 16 * 1024, "params: {n} bytes");
+}
