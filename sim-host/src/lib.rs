@@ -9,5 +9,6 @@
 
 pub mod aircraft;
 pub mod analysis;
+pub mod commands;
 pub mod plant;
 pub mod report;

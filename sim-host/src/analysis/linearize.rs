@@ -142,7 +142,12 @@ pub fn controls_of(u: &U5, base: &Controls) -> Controls {
 /// Derivative of the Euler-angle state (calm air).
 pub fn f13(p: &ModelParams, x: &X13, u: &U5, base: &Controls) -> X13 {
     let s = state_of(x);
-    let d = derivatives(p, &s.to_vector(), &controls_of(u, base), &Environment::default());
+    let d = derivatives(
+        p,
+        &s.to_vector(),
+        &controls_of(u, base),
+        &Environment::default(),
+    );
     let e = Euler::new(x[6], x[7], x[8]);
     let euler_dot = e.rates_from_body(&s.omega_body);
     let mut out = X13::zeros();
@@ -280,8 +285,22 @@ pub fn linearize(p: &ModelParams, trim: &TrimResult) -> Linearization {
         xm[j] -= h;
         c_air.set_column(j, &((air_outputs(&xp) - air_outputs(&xm)) / (2.0 * h)));
     }
-    let lon = StateSpace::select(&a, &b, &LON_STATES, &LON_STATE_NAMES, &LON_INPUTS, &LON_INPUT_NAMES);
-    let lat = StateSpace::select(&a, &b, &LAT_STATES, &LAT_STATE_NAMES, &LAT_INPUTS, &LAT_INPUT_NAMES);
+    let lon = StateSpace::select(
+        &a,
+        &b,
+        &LON_STATES,
+        &LON_STATE_NAMES,
+        &LON_INPUTS,
+        &LON_INPUT_NAMES,
+    );
+    let lat = StateSpace::select(
+        &a,
+        &b,
+        &LAT_STATES,
+        &LAT_STATE_NAMES,
+        &LAT_INPUTS,
+        &LAT_INPUT_NAMES,
+    );
     Linearization {
         x0,
         u0,

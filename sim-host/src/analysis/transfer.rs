@@ -35,7 +35,12 @@ impl TransferFunction {
     pub fn from_state_space(a: &DMatrix<f64>, b: &DVector<f64>, c: &DVector<f64>) -> Self {
         let den = char_poly(a);
         let closed = char_poly(&(a - b * c.transpose()));
-        let num: Vec<f64> = closed.iter().zip(&den).skip(1).map(|(x, y)| x - y).collect();
+        let num: Vec<f64> = closed
+            .iter()
+            .zip(&den)
+            .skip(1)
+            .map(|(x, y)| x - y)
+            .collect();
         Self { num, den }
     }
 
@@ -117,5 +122,43 @@ mod tests {
         for (x, y) in p.iter().zip([1.0, 2.0, 3.0, 4.0]) {
             assert!((x - y).abs() < 1e-12);
         }
+    }
+}
+
+/// The three transfer functions the thesis prints, from a linearisation.
+#[derive(Clone, Debug, Serialize)]
+pub struct ThesisTransferFunctions {
+    /// p / combined aileron, roll-only (one state p).
+    pub p_over_da: TransferFunction,
+    /// q / elevator, two-state short period (w, q).
+    pub q_over_de: TransferFunction,
+    /// r / rudder, four-state lateral model (v, p, r, phi).
+    pub r_over_dr: TransferFunction,
+}
+
+/// Forms p/da, q/de and r/dr from the decoupled models.
+pub fn thesis_transfer_functions(lin: &super::linearize::Linearization) -> ThesisTransferFunctions {
+    let lat = &lin.lat;
+    let lon = &lin.lon;
+    // Lateral order v, p, r, phi, psi; inputs left, right aileron, rudder. Combined aileron
+    // da moves the left surface by -da and the right by +da.
+    let b_da = |i: usize| lat.b[(i, 1)] - lat.b[(i, 0)];
+    let p_over_da = TransferFunction {
+        num: vec![b_da(1)],
+        den: vec![1.0, -lat.a[(1, 1)]],
+    };
+    // Longitudinal order u, w, q, theta, Ze, Omega; short period keeps w, q.
+    let a_sp = DMatrix::from_fn(2, 2, |i, j| lon.a[(i + 1, j + 1)]);
+    let b_sp = DVector::from_fn(2, |i, _| lon.b[(i + 1, 0)]);
+    let q_over_de =
+        TransferFunction::from_state_space(&a_sp, &b_sp, &DVector::from_vec(vec![0.0, 1.0]));
+    let a4 = DMatrix::from_fn(4, 4, |i, j| lat.a[(i, j)]);
+    let b4 = DVector::from_fn(4, |i, _| lat.b[(i, 2)]);
+    let r_over_dr =
+        TransferFunction::from_state_space(&a4, &b4, &DVector::from_vec(vec![0.0, 0.0, 1.0, 0.0]));
+    ThesisTransferFunctions {
+        p_over_da,
+        q_over_de,
+        r_over_dr,
     }
 }
