@@ -124,7 +124,7 @@ mod tests {
         for _ in 0..100 {
             s.step(1.0, 0.001);
         }
-        assert!((s.position - 15f64.to_radians()).abs() < 1e-9);
+        assert!((s.position - 15f64.to_radians()).abs() < 1e-8);
         for _ in 0..1000 {
             s.step(1.0, 0.001);
         }
