@@ -38,7 +38,10 @@ fn malformed_toml() {
     let e = Aircraft::from_file(&p).unwrap_err();
     assert!(matches!(e, AircraftError::Syntax { .. }), "{e}");
     let msg = e.to_string();
-    assert!(msg.contains("plane.toml") && msg.contains("line 2"), "{msg}");
+    assert!(
+        msg.contains("plane.toml") && msg.contains("line 2"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -48,14 +51,19 @@ fn unknown_key() {
     let e = Aircraft::from_file(&write(&dir, &text)).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, AircraftError::Shape { .. }), "{msg}");
-    assert!(msg.contains("aero.lift") && msg.contains("CL_stall"), "{msg}");
+    assert!(
+        msg.contains("aero.lift") && msg.contains("CL_stall"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn missing_key() {
     let dir = tempfile::tempdir().unwrap();
     let text = replace("Cm_q = ", "");
-    let msg = Aircraft::from_file(&write(&dir, &text)).unwrap_err().to_string();
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("aero.pitch") && msg.contains("Cm_q"), "{msg}");
 }
 
@@ -81,13 +89,23 @@ fn non_finite_value() {
     ] {
         let prefix = line.split(" = ").next().unwrap().to_string() + " = ";
         let text = replace(&prefix, line);
-        let msg = Aircraft::from_file(&write(&dir, &text)).unwrap_err().to_string();
+        let msg = Aircraft::from_file(&write(&dir, &text))
+            .unwrap_err()
+            .to_string();
         assert!(msg.contains(key) && msg.contains("finite"), "{msg}");
     }
     // Inside an array the index is named too.
-    let text = replace("CT_poly_J = ", "CT_poly_J = [-0.4314, 1.08, -inf, 0.1089, 0.0604]");
-    let msg = Aircraft::from_file(&write(&dir, &text)).unwrap_err().to_string();
-    assert!(msg.contains("propulsion.CT_poly_J[2]") && msg.contains("-inf"), "{msg}");
+    let text = replace(
+        "CT_poly_J = ",
+        "CT_poly_J = [-0.4314, 1.08, -inf, 0.1089, 0.0604]",
+    );
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("propulsion.CT_poly_J[2]") && msg.contains("-inf"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -95,25 +113,40 @@ fn thesis_inertia_typo_is_rejected() {
     // The thesis prints Jxz = 0.14: Jx Jz - Jxz^2 = 0.011 - 0.0196 < 0.
     let dir = tempfile::tempdir().unwrap();
     let text = replace("Jxz_kgm2 = ", "Jxz_kgm2 = 0.14");
-    let msg = Aircraft::from_file(&write(&dir, &text)).unwrap_err().to_string();
-    assert!(msg.contains("mass.Jxz_kgm2") && msg.contains("0.14"), "{msg}");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("mass.Jxz_kgm2") && msg.contains("0.14"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn wrong_type_and_bad_limits() {
     let dir = tempfile::tempdir().unwrap();
     let text = replace("b_m = ", "b_m = \"wide\"");
-    let msg = Aircraft::from_file(&write(&dir, &text)).unwrap_err().to_string();
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("geometry.b_m"), "{msg}");
     let text = replace("J_clamp = ", "J_clamp = [0.7, 0.0]");
-    let msg = Aircraft::from_file(&write(&dir, &text)).unwrap_err().to_string();
-    assert!(msg.contains("propulsion.J_clamp") && msg.contains("0.7"), "{msg}");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("propulsion.J_clamp") && msg.contains("0.7"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn shipped_file_equals_embedded_and_loads_from_disk() {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("aircraft/ultrastick25e.toml");
-    assert_eq!(Aircraft::from_file(&p).unwrap(), Aircraft::ultrastick25e().unwrap());
+    assert_eq!(
+        Aircraft::from_file(&p).unwrap(),
+        Aircraft::ultrastick25e().unwrap()
+    );
 }
 
 #[test]

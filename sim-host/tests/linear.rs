@@ -11,7 +11,12 @@ use sim_host::plant::ModelParams;
 fn within_1pct(m: &Mode, (re, im): (f64, f64), name: &str) {
     let d = ((m.re - re).powi(2) + (m.im - im).powi(2)).sqrt();
     let mag = (re * re + im * im).sqrt();
-    assert!(d / mag < 0.01, "{name}: ours {} ± {}i, UMN {re} ± {im}i", m.re, m.im);
+    assert!(
+        d / mag < 0.01,
+        "{name}: ours {} ± {}i, UMN {re} ± {im}i",
+        m.re,
+        m.im
+    );
 }
 
 fn close(ours: f64, reference: f64, rel_tol: f64, what: &str) {
@@ -35,7 +40,11 @@ fn poles_tfs_and_matrices_at_level_trim() {
     within_1pct(&lm.engine_speed, (-6.18, 0.0), "engine speed");
     within_1pct(&am.roll, (-16.1, 0.0), "roll");
     within_1pct(&am.dutch_roll, (-1.84, 5.29), "dutch roll");
-    assert!((am.spiral.re - (-0.0090)).abs() < 0.005, "spiral {}", am.spiral.re);
+    assert!(
+        (am.spiral.re - (-0.0090)).abs() < 0.005,
+        "spiral {}",
+        am.spiral.re
+    );
     assert!(am.heading.re.abs() < 1e-9);
     // Thesis damping and frequency (Tables 2.4, 2.5).
     assert!((lm.phugoid.damping - 0.241).abs() < 0.005);
@@ -67,7 +76,12 @@ fn poles_tfs_and_matrices_at_level_trim() {
     }
     close(r.num[3], -2351.0, 0.05, "r/dr numerator constant");
     // Denominator constant = product of the poles; with the UMN spiral it is ~4.5, not 6.89.
-    close(r.den[4], 16.05 * 0.0090 * (1.840f64.powi(2) + 5.286f64.powi(2)), 0.02, "r/dr den constant");
+    close(
+        r.den[4],
+        16.05 * 0.0090 * (1.840f64.powi(2) + 5.286f64.powi(2)),
+        0.02,
+        "r/dr den constant",
+    );
 
     // Entry by entry against ValidatedDynamics.txt (printed to 4 significant digits).
     let check = |ours: &nalgebra::DMatrix<f64>, umn: &[&[f64]], what: &str| {
@@ -83,8 +97,24 @@ fn poles_tfs_and_matrices_at_level_trim() {
     };
     let rows = |m: &[[f64; 6]]| m.iter().map(|r| r.to_vec()).collect::<Vec<_>>();
     let a_lon = rows(&refs::UMN_A_LON);
-    check(&lin.lon.a, &a_lon.iter().map(|r| &r[..]).collect::<Vec<_>>(), "A_lon");
-    check(&lin.lon.b, &refs::UMN_B_LON.iter().map(|r| &r[..]).collect::<Vec<_>>(), "B_lon");
-    check(&lin.lat.a, &refs::UMN_A_LAT.iter().map(|r| &r[..]).collect::<Vec<_>>(), "A_lat");
-    check(&lin.lat.b, &refs::UMN_B_LAT.iter().map(|r| &r[..]).collect::<Vec<_>>(), "B_lat");
+    check(
+        &lin.lon.a,
+        &a_lon.iter().map(|r| &r[..]).collect::<Vec<_>>(),
+        "A_lon",
+    );
+    check(
+        &lin.lon.b,
+        &refs::UMN_B_LON.iter().map(|r| &r[..]).collect::<Vec<_>>(),
+        "B_lon",
+    );
+    check(
+        &lin.lat.a,
+        &refs::UMN_A_LAT.iter().map(|r| &r[..]).collect::<Vec<_>>(),
+        "A_lat",
+    );
+    check(
+        &lin.lat.b,
+        &refs::UMN_B_LAT.iter().map(|r| &r[..]).collect::<Vec<_>>(),
+        "B_lat",
+    );
 }

@@ -18,10 +18,19 @@ fn trimmed_flight_stays_trimmed() {
         // 10 s later: same airspeed, angle of attack, bank, rates; the altitude changed by
         // gamma * V * t only (zero here).
         let air = plant.air_data();
-        assert!((air.va - 17.0).abs() < 1e-3, "{} Va {}", target.name, air.va);
+        assert!(
+            (air.va - 17.0).abs() < 1e-3,
+            "{} Va {}",
+            target.name,
+            air.va
+        );
         assert!((air.alpha - t.alpha).abs() < 1e-4);
         assert!((plant.euler().phi - t.phi).abs() < 1e-3);
-        assert!((plant.alt_msl_m() - 100.0).abs() < 0.05, "alt {}", plant.alt_msl_m());
+        assert!(
+            (plant.alt_msl_m() - 100.0).abs() < 0.05,
+            "alt {}",
+            plant.alt_msl_m()
+        );
         assert!((plant.body_rates() - t.state.omega_body).norm() < 1e-4);
         assert!((plant.attitude().quaternion().norm() - 1.0).abs() < 1e-12);
         if target.name == "turn" {

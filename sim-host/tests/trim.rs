@@ -13,13 +13,33 @@ fn level_trim_matches_the_umn_committed_trim_within_0_1_percent() {
     let a = Aircraft::ultrastick25e().unwrap();
     let t = trim(&a, &TrimTarget::level());
     assert!(t.converged, "residual {}", t.residual_norm);
-    assert!(rel(t.throttle, umn_trim::THROTTLE) < 1e-3, "throttle {}", t.throttle);
-    assert!(rel(t.elevator, umn_trim::ELEVATOR) < 1e-3, "elevator {}", t.elevator);
+    assert!(
+        rel(t.throttle, umn_trim::THROTTLE) < 1e-3,
+        "throttle {}",
+        t.throttle
+    );
+    assert!(
+        rel(t.elevator, umn_trim::ELEVATOR) < 1e-3,
+        "elevator {}",
+        t.elevator
+    );
     assert!(rel(t.alpha, umn_trim::ALPHA) < 1e-3, "alpha {}", t.alpha);
-    assert!(rel(t.engine_speed, umn_trim::ENGINE_SPEED) < 1e-3, "Omega {}", t.engine_speed);
+    assert!(
+        rel(t.engine_speed, umn_trim::ENGINE_SPEED) < 1e-3,
+        "Omega {}",
+        t.engine_speed
+    );
     // The lateral trim of the UMN file too (aileron balances the propeller torque).
-    assert!(rel(t.aileron, umn_trim::AILERON) < 1e-3, "aileron {}", t.aileron);
-    assert!(rel(t.rudder, umn_trim::RUDDER) < 1e-3, "rudder {}", t.rudder);
+    assert!(
+        rel(t.aileron, umn_trim::AILERON) < 1e-3,
+        "aileron {}",
+        t.aileron
+    );
+    assert!(
+        rel(t.rudder, umn_trim::RUDDER) < 1e-3,
+        "rudder {}",
+        t.rudder
+    );
     assert!(rel(t.phi, umn_trim::PHI) < 1e-3, "phi {}", t.phi);
     // Accelerometer reading at trim: the UMN file's specific force.
     for i in 0..3 {
@@ -65,14 +85,24 @@ fn thesis_table_2_3() {
             );
         }
         // Documented offsets: alpha 2-5 % above the thesis, elevator 1-2 % more negative.
-        assert!(t.alpha > th.alpha && rel(t.alpha, th.alpha) < 0.05, "{} alpha {}", th.name, t.alpha);
+        assert!(
+            t.alpha > th.alpha && rel(t.alpha, th.alpha) < 0.05,
+            "{} alpha {}",
+            th.name,
+            t.alpha
+        );
         assert!(
             t.elevator < th.elevator && rel(t.elevator, th.elevator) < 0.02,
             "{} elevator {}",
             th.name,
             t.elevator
         );
-        assert!((t.theta - th.theta).abs() < 0.003, "{} theta {}", th.name, t.theta);
+        assert!(
+            (t.theta - th.theta).abs() < 0.003,
+            "{} theta {}",
+            th.name,
+            t.theta
+        );
     }
 }
 

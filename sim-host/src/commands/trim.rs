@@ -58,6 +58,9 @@ fn diff_cells(ours: f64, reference: Option<f64>, digits: usize) -> [String; 2] {
     }
 }
 
+/// One table row: quantity, unit, ours, thesis, UMN.
+type Row<'a> = (&'a str, &'a str, f64, Option<f64>, Option<f64>);
+
 /// Builds the table of one trim.
 pub fn trim_table(e: &TrimEntry) -> Table {
     let r = &e.result;
@@ -89,7 +92,7 @@ pub fn trim_table(e: &TrimEntry) -> Table {
     );
     let th = e.thesis;
     let umn = e.umn_level;
-    let rows: [(&str, &str, f64, Option<f64>, Option<f64>); 14] = [
+    let rows: [Row; 14] = [
         (
             "throttle",
             "0..1",

@@ -21,6 +21,29 @@ pub fn validation_markdown(aircraft: &Aircraft, out_dir: Option<&Path>) -> anyho
     s.push_str(include_str!("validation_intro.md"));
     s.push_str("\n## 1. Trim (thesis Table 2.3)\n\n");
     s.push_str(include_str!("validation_trim.md"));
+    let worst = trims
+        .trims
+        .iter()
+        .map(|e| e.result.residual_norm)
+        .fold(0.0, f64::max);
+    let most = trims
+        .trims
+        .iter()
+        .map(|e| e.result.iterations)
+        .max()
+        .unwrap_or(0);
+    let converged = trims.trims.iter().filter(|e| e.result.converged).count();
+    s.push_str(&format!(
+        "\nConvergence: {converged} of {} targets converged; largest residual {worst:.1e}, at most \
+         {most} iterations.\n",
+        trims.trims.len()
+    ));
+    if let Some(turn) = trims.get("turn") {
+        s.push_str(&format!(
+            "Level-turn rudder: {:.6} rad here, -0.00748 in the thesis.\n",
+            turn.result.rudder
+        ));
+    }
     if let Some(l) = &level {
         let th = THESIS_TRIM[0];
         s.push_str(&format!(
@@ -103,6 +126,17 @@ pub fn validation_markdown(aircraft: &Aircraft, out_dir: Option<&Path>) -> anyho
         g(Surface::Rudder, "beta"),
         g(Surface::Rudder, "p"),
         g(Surface::Rudder, "r"),
+    ));
+    let mut ratios = Vec::new();
+    for run in dbl.runs.iter().filter(|r| r.surface != Surface::Elevator) {
+        for i in [2, 6, 8] {
+            ratios.push(100.0 * run.max_abs_diff[i] / run.max_abs_response[i].max(1e-12));
+        }
+    }
+    let lo = ratios.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = ratios.iter().copied().fold(0.0, f64::max);
+    s.push_str(&format!(
+        "Lateral differences in beta, p and r: {lo:.1} % to {hi:.1} % of their response peaks.\n\n"
     ));
     s.push_str(&render(&dbl.tables, Format::Markdown));
     if out_dir.is_some() {
