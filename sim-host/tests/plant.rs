@@ -46,7 +46,7 @@ fn specific_force_in_level_flight_is_minus_g_along_z() {
     let a = Aircraft::ultrastick25e().unwrap();
     let t = trim(&a, &TrimTarget::level());
     let mut plant = Plant::new(&a, t.state);
-    plant.step(&t.controls, &Environment::default(), 1e-4);
+    plant.set_inputs(&t.controls, &Environment::default());
     let f = plant.specific_force_body();
     // Unaccelerated flight: the specific force is minus gravity in body axes.
     let g = a.environment.g_mps2;

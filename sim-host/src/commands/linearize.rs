@@ -157,11 +157,19 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
     ];
     for (name, m) in ours_modes {
         let r = refs::POLES.iter().find(|x| x.mode == name);
+        // Reference values keep at least one decimal, as printed in their sources.
+        let num = |x: f64| {
+            if x.fract() == 0.0 {
+                format!("{x:.1}")
+            } else {
+                format!("{x}")
+            }
+        };
         let fmt = |(re, im): (f64, f64)| {
             if im > 0.0 {
-                format!("{re} ± {im}i")
+                format!("{} ± {}i", num(re), num(im))
             } else {
-                format!("{re}")
+                num(re)
             }
         };
         let (umn, cmp, thesis) = match (level, r) {
@@ -179,7 +187,12 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
         let (zeta, wn) = if m.wn_radps > 1e-9 && m.im > 0.0 {
             (format!("{:.3}", m.damping), format!("{:.3}", m.wn_radps))
         } else {
-            ("1 (real)".into(), sig(m.wn_radps, 3))
+            let kind = if m.re < 0.0 {
+                "1 (real)"
+            } else {
+                "-1 (real, unstable)"
+            };
+            (kind.into(), sig(m.wn_radps, 3))
         };
         poles.row([name.to_string(), pole(m), zeta, wn, umn, cmp, thesis]);
     }

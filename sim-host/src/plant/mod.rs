@@ -278,6 +278,13 @@ impl Plant {
         self.time_s += dt;
     }
 
+    /// Sets the controls and environment the accessors evaluate with (e.g. the trim, before
+    /// the first step), without stepping.
+    pub fn set_inputs(&mut self, controls: &Controls, env: &Environment) {
+        self.controls = *controls;
+        self.env = *env;
+    }
+
     /// Replaces the state (time unchanged).
     pub fn set_state(&mut self, state: State) {
         self.x = state.to_vector();
