@@ -107,9 +107,9 @@ fn run() -> anyhow::Result<ExitCode> {
         Some(Command::Trim { out }) => {
             let r = commands::trim::trim_report(&aircraft);
             if out.json {
-                println!("{}", to_json(&r.trims)?);
+                emit(&to_json(&r.trims)?)?;
             } else {
-                print!("{}", render(&r.tables, out.format()));
+                emit(&render(&r.tables, out.format()))?;
             }
             let failed = r.failures();
             for (name, res) in &failed {
@@ -124,9 +124,9 @@ fn run() -> anyhow::Result<ExitCode> {
         Some(Command::Linearize { trim, out }) => {
             let r = commands::linearize::linearize_report(&aircraft, &trim)?;
             if out.json {
-                println!("{}", to_json(&r)?);
+                emit(&to_json(&r)?)?;
             } else {
-                print!("{}", render(&r.tables, out.format()));
+                emit(&render(&r.tables, out.format()))?;
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -151,11 +151,11 @@ fn run() -> anyhow::Result<ExitCode> {
             );
             let r = commands::doublet::doublet_report(&aircraft, &cfg, Some(&out))?;
             if fmt.json {
-                println!("{}", to_json(&r)?);
+                emit(&to_json(&r)?)?;
             } else {
-                print!("{}", render(&r.tables, fmt.format()));
+                emit(&render(&r.tables, fmt.format()))?;
                 for f in &r.files {
-                    println!("wrote {}", f.display());
+                    emit(&format!("wrote {}\n", f.display()))?;
                 }
             }
             Ok(ExitCode::SUCCESS)
@@ -168,9 +168,24 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             std::fs::write(&out, md)
                 .with_context(|| format!("cannot write `{}`", out.display()))?;
-            println!("wrote {}", out.display());
+            emit(&format!("wrote {}\n", out.display()))?;
             Ok(ExitCode::SUCCESS)
         }
+    }
+}
+
+/// Writes to standard output; a closed pipe (`sim-host trim | head`) ends quietly.
+fn emit(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let text = if text.ends_with('\n') {
+        text.to_string()
+    } else {
+        format!("{text}\n")
+    };
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        other => Ok(other?),
     }
 }
 
@@ -178,11 +193,10 @@ fn run() -> anyhow::Result<ExitCode> {
 fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
     let trims = commands::trim::trim_report(aircraft);
     if let Some(level) = trims.tables.first() {
-        print!("{}", level.render_text());
+        emit(&level.render_text())?;
     }
-    println!();
     let r = commands::doublet::doublet_report(aircraft, &DoubletConfig::default(), None)?;
-    print!("{}", render(&r.tables, Format::Text));
-    println!("\n(see `sim-host --help` for trim, linearize, doublet and validation)");
+    emit(&format!("\n{}", render(&r.tables, Format::Text)))?;
+    emit("\n(see `sim-host --help` for trim, linearize, doublet and validation)\n")?;
     Ok(ExitCode::SUCCESS)
 }

@@ -130,6 +130,8 @@ pub struct DoubletRun {
     pub surface: Surface,
     /// Set-up.
     pub config: DoubletConfig,
+    /// Output names with units, in [`OUTPUT_INFO`] order.
+    pub outputs: Vec<String>,
     /// Largest |nonlinear - linear| per output, in user units ([`OUTPUT_INFO`] order).
     pub max_abs_diff: Vec<f64>,
     /// Largest |nonlinear - trim| per output, in user units (the size of the response).
@@ -258,6 +260,10 @@ pub fn run(
     DoubletRun {
         surface,
         config: *cfg,
+        outputs: OUTPUT_INFO
+            .iter()
+            .map(|(n, u, _)| format!("{n} ({u})"))
+            .collect(),
         max_abs_diff,
         max_abs_response,
         samples,
