@@ -1,6 +1,20 @@
 //! The Ultra Stick 25e simulator: plant, analysis and the simulator side of the MAVLink link.
+//!
+//! - [`aircraft`]: the aircraft file (model parameters), read and validated;
+//! - [`plant`]: the nonlinear 6-DOF model (aero, propulsion, rigid body, servos, RK4);
+//! - [`environment`]: steady wind and Dryden turbulence;
+//! - [`sensors`]: IMU, magnetometer, barometer, pitot and GPS models;
+//! - [`link`]: the simulator end of PX4's simulator MAVLink interface, in lock-step;
+//! - [`analysis`]: trim, linearisation, transfer functions, the linear-versus-nonlinear
+//!   doublet check of the thesis, and linear-systems tools;
+//! - [`report`]: tables, JSON, CSV and plots shared by every command.
+#![warn(missing_docs)]
 
+pub mod aircraft;
 pub mod analysis;
+pub mod commands;
 pub mod environment;
 pub mod link;
+pub mod plant;
+pub mod report;
 pub mod sensors;

@@ -1,4 +1,10 @@
-//! The thesis's analysis: linear-systems tools and response figures.
+//! The thesis's analysis: trim, linearisation, transfer functions, the doublet check, and the
+//! linear-systems tools and response figures the loop design and the scenarios use.
 
+pub mod doublet;
+pub mod linearize;
 pub mod lti;
 pub mod metrics;
+pub mod references;
+pub mod transfer;
+pub mod trim;

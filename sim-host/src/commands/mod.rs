@@ -1,0 +1,30 @@
+//! The analysis commands as library functions: each returns its results (for `--json` and for
+//! tests) and the tables it prints, so the CLI only chooses the output form.
+
+pub mod doublet;
+pub mod linearize;
+pub mod trim;
+pub mod validation;
+
+use crate::report::Table;
+
+/// How a command prints its tables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Aligned plain text.
+    Text,
+    /// Markdown.
+    Markdown,
+}
+
+/// Renders tables one after another.
+pub fn render(tables: &[Table], format: Format) -> String {
+    tables
+        .iter()
+        .map(|t| match format {
+            Format::Text => t.render_text(),
+            Format::Markdown => t.render_markdown(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}

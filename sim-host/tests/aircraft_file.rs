@@ -1,0 +1,172 @@
+//! The aircraft file: bad input is rejected with the file, the key and the value named.
+
+use sim_host::aircraft::{Aircraft, AircraftError, DEFAULT_AIRCRAFT_TOML};
+use std::path::Path;
+use std::process::Command;
+
+fn write(dir: &tempfile::TempDir, text: &str) -> std::path::PathBuf {
+    let p = dir.path().join("plane.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn replace(key_line_start: &str, new_line: &str) -> String {
+    DEFAULT_AIRCRAFT_TOML
+        .lines()
+        .map(|l| {
+            if l.starts_with(key_line_start) {
+                new_line.to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn missing_file() {
+    let e = Aircraft::from_file(Path::new("/nonexistent/plane.toml")).unwrap_err();
+    assert!(matches!(e, AircraftError::Read { .. }));
+    assert!(e.to_string().contains("/nonexistent/plane.toml"), "{e}");
+}
+
+#[test]
+fn malformed_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(&dir, "[mass]\nmass_kg = = 1.9\n");
+    let e = Aircraft::from_file(&p).unwrap_err();
+    assert!(matches!(e, AircraftError::Syntax { .. }), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("plane.toml") && msg.contains("line 2"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn unknown_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = replace("CL_q = ", "CL_q = 6.1639\nCL_stall = 1.2");
+    let e = Aircraft::from_file(&write(&dir, &text)).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, AircraftError::Shape { .. }), "{msg}");
+    assert!(
+        msg.contains("aero.lift") && msg.contains("CL_stall"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn missing_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = replace("Cm_q = ", "");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("aero.pitch") && msg.contains("Cm_q"), "{msg}");
+}
+
+#[test]
+fn negative_mass() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = replace("mass_kg = ", "mass_kg = -1.959");
+    let e = Aircraft::from_file(&write(&dir, &text)).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, AircraftError::Value { .. }), "{msg}");
+    assert!(
+        msg.contains("plane.toml") && msg.contains("mass.mass_kg") && msg.contains("-1.959"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn non_finite_value() {
+    let dir = tempfile::tempdir().unwrap();
+    for (line, key) in [
+        ("CL_alpha = nan", "aero.lift.CL_alpha"),
+        ("Jy_kgm2 = inf", "mass.Jy_kgm2"),
+    ] {
+        let prefix = line.split(" = ").next().unwrap().to_string() + " = ";
+        let text = replace(&prefix, line);
+        let msg = Aircraft::from_file(&write(&dir, &text))
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains(key) && msg.contains("finite"), "{msg}");
+    }
+    // Inside an array the index is named too.
+    let text = replace(
+        "CT_poly_J = ",
+        "CT_poly_J = [-0.4314, 1.08, -inf, 0.1089, 0.0604]",
+    );
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("propulsion.CT_poly_J[2]") && msg.contains("-inf"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn thesis_inertia_typo_is_rejected() {
+    // The thesis prints Jxz = 0.14: Jx Jz - Jxz^2 = 0.011 - 0.0196 < 0.
+    let dir = tempfile::tempdir().unwrap();
+    let text = replace("Jxz_kgm2 = ", "Jxz_kgm2 = 0.14");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("mass.Jxz_kgm2") && msg.contains("0.14"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn wrong_type_and_bad_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = replace("b_m = ", "b_m = \"wide\"");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("geometry.b_m"), "{msg}");
+    let text = replace("J_clamp = ", "J_clamp = [0.7, 0.0]");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("propulsion.J_clamp") && msg.contains("0.7"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn shipped_file_equals_embedded_and_loads_from_disk() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("aircraft/ultrastick25e.toml");
+    assert_eq!(
+        Aircraft::from_file(&p).unwrap(),
+        Aircraft::ultrastick25e().unwrap()
+    );
+}
+
+#[test]
+fn cli_exits_non_zero_and_names_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(&dir, &replace("mass_kg = ", "mass_kg = -2.5"));
+    let out = Command::new(env!("CARGO_BIN_EXE_sim-host"))
+        .args(["--aircraft", p.to_str().unwrap(), "trim"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("plane.toml") && err.contains("mass.mass_kg") && err.contains("-2.5"),
+        "{err}"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_sim-host"))
+        .args(["--aircraft", "/nonexistent.toml", "linearize"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent.toml"));
+}
