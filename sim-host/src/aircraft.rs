@@ -251,30 +251,6 @@ pub struct Actuators {
     pub position_limit_rad: [f64; 2],
 }
 
-/// Noise powers of the legacy sensor model, kept for the sensor models.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Sensors {
-    /// Gyro noise power per axis ((rad/s)^2 s).
-    pub gyro_noise_power: [f64; 3],
-    /// Accelerometer noise power per axis ((m/s^2)^2 s).
-    pub accel_noise_power: [f64; 3],
-    /// Magnetometer noise power per axis (nT^2 s).
-    pub mag_noise_power_nT: [f64; 3],
-    /// Indicated airspeed noise power ((m/s)^2 s).
-    pub ias_noise_power: f64,
-    /// Altitude noise power (m^2 s).
-    pub alt_noise_power: f64,
-    /// Angle-of-attack and sideslip vane noise power (rad^2 s).
-    pub alpha_beta_noise_power: f64,
-    /// Differential pressure noise power (kPa^2 s).
-    pub pd_noise_power_kPa: f64,
-    /// Static pressure noise power (kPa^2 s).
-    pub ps_noise_power_kPa: f64,
-    /// Sample time the noise powers refer to, s.
-    pub sample_time_s: f64,
-}
-
 /// Gravity and the home point.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -303,8 +279,8 @@ pub struct Aircraft {
     pub propulsion: Propulsion,
     /// Servos.
     pub actuators: Actuators,
-    /// Sensor noise powers.
-    pub sensors: Sensors,
+    /// Sensor rates, noise, biases and the GPS receiver.
+    pub sensors: crate::sensors::SensorConfig,
     /// Environment.
     pub environment: Environment,
 }
@@ -424,25 +400,9 @@ impl Aircraft {
         positive("actuators.bandwidth_Hz", a.bandwidth_Hz)?;
         positive("actuators.rate_limit_radps", a.rate_limit_radps)?;
         ordered("actuators.position_limit_rad", a.position_limit_rad)?;
-        let s = &self.sensors;
-        for (k, v) in [
-            ("sensors.gyro_noise_power", &s.gyro_noise_power[..]),
-            ("sensors.accel_noise_power", &s.accel_noise_power[..]),
-            ("sensors.mag_noise_power_nT", &s.mag_noise_power_nT[..]),
-            ("sensors.ias_noise_power", &[s.ias_noise_power][..]),
-            ("sensors.alt_noise_power", &[s.alt_noise_power][..]),
-            (
-                "sensors.alpha_beta_noise_power",
-                &[s.alpha_beta_noise_power][..],
-            ),
-            ("sensors.pd_noise_power_kPa", &[s.pd_noise_power_kPa][..]),
-            ("sensors.ps_noise_power_kPa", &[s.ps_noise_power_kPa][..]),
-        ] {
-            for x in v {
-                non_negative(k, *x)?;
-            }
+        if let Err((key, value, reason)) = self.sensors.validate() {
+            return Err(bad(&key, value, reason));
         }
-        positive("sensors.sample_time_s", s.sample_time_s)?;
         let e = &self.environment;
         positive("environment.g_mps2", e.g_mps2)?;
         if !(-90.0..=90.0).contains(&e.home_lat_deg) {

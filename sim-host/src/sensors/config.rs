@@ -1,4 +1,4 @@
-//! Sensor rates and noise, read from the `[sensors]` table of the aircraft file.
+//! Sensor rates and noise: the `[sensors]` table of the aircraft file.
 
 use serde::{Deserialize, Serialize};
 
@@ -59,14 +59,17 @@ pub struct SensorConfig {
     /// Earth field at home in NED, gauss.
     pub mag_field_ned_gauss: [f64; 3],
     /// Magnetometer noise power per axis, nT^2 s (UMN `mag_noise_power_nT`).
+    #[serde(rename = "mag_noise_power_nT")]
     pub mag_noise_power_nt: [f64; 3],
     /// Barometer rate, Hz.
     pub baro_rate_hz: f64,
     /// Static-pressure noise power, kPa^2 s (UMN `ps_noise_power_kPa`).
+    #[serde(rename = "ps_noise_power_kPa")]
     pub ps_noise_power_kpa: f64,
     /// Differential-pressure rate, Hz.
     pub pitot_rate_hz: f64,
     /// Differential-pressure noise power, kPa^2 s (UMN `pd_noise_power_kPa`).
+    #[serde(rename = "pd_noise_power_kPa")]
     pub pd_noise_power_kpa: f64,
     /// GPS receiver.
     pub gps: GpsConfig,
@@ -95,13 +98,14 @@ impl Default for SensorConfig {
 }
 
 impl SensorConfig {
-    /// Checks every rate positive and every noise finite and non-negative; the error names the
-    /// key and its value.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks every rate positive and every noise finite and non-negative; the error is the
+    /// dotted key, its value and the reason.
+    pub fn validate(&self) -> Result<(), (String, String, &'static str)> {
         if !self.imu_rate_hz.is_finite() || self.imu_rate_hz <= 0.0 {
-            return Err(format!(
-                "sensors.imu_rate_hz = {}: must be positive",
-                self.imu_rate_hz
+            return Err((
+                "sensors.imu_rate_hz".into(),
+                self.imu_rate_hz.to_string(),
+                "must be positive",
             ));
         }
         let rates = [
@@ -112,15 +116,17 @@ impl SensorConfig {
         ];
         for (k, v) in rates {
             if !v.is_finite() || v <= 0.0 || v > self.imu_rate_hz {
-                return Err(format!(
-                    "sensors.{k} = {v}: must be positive and at most imu_rate_hz"
+                return Err((
+                    format!("sensors.{k}"),
+                    v.to_string(),
+                    "must be positive and at most imu_rate_hz",
                 ));
             }
         }
         let scalars = [
             ("gyro_bias_walk", self.gyro_bias_walk),
-            ("ps_noise_power_kpa", self.ps_noise_power_kpa),
-            ("pd_noise_power_kpa", self.pd_noise_power_kpa),
+            ("ps_noise_power_kPa", self.ps_noise_power_kpa),
+            ("pd_noise_power_kPa", self.pd_noise_power_kpa),
             ("gps.horiz_m", self.gps.horiz_m),
             ("gps.vert_m", self.gps.vert_m),
             ("gps.vel_mps", self.gps.vel_mps),
@@ -129,17 +135,25 @@ impl SensorConfig {
         ];
         for (k, v) in scalars {
             if !v.is_finite() || v < 0.0 {
-                return Err(format!("sensors.{k} = {v}: must be finite and >= 0"));
+                return Err((
+                    format!("sensors.{k}"),
+                    v.to_string(),
+                    "must not be negative",
+                ));
             }
         }
         let vectors = [
             ("gyro_noise_power", self.gyro_noise_power),
             ("accel_noise_power", self.accel_noise_power),
-            ("mag_noise_power_nt", self.mag_noise_power_nt),
+            ("mag_noise_power_nT", self.mag_noise_power_nt),
         ];
         for (k, v) in vectors {
             if v.iter().any(|x| !x.is_finite() || *x < 0.0) {
-                return Err(format!("sensors.{k} = {v:?}: must be finite and >= 0"));
+                return Err((
+                    format!("sensors.{k}"),
+                    format!("{v:?}"),
+                    "must not be negative",
+                ));
             }
         }
         let finite = [
@@ -149,7 +163,7 @@ impl SensorConfig {
         ];
         for (k, v) in finite {
             if v.iter().any(|x| !x.is_finite()) {
-                return Err(format!("sensors.{k} = {v:?}: must be finite"));
+                return Err((format!("sensors.{k}"), format!("{v:?}"), "must be finite"));
             }
         }
         Ok(())
