@@ -374,7 +374,8 @@ mod tests {
         let mut ap = Autopilot::new(&MINNESOTA).unwrap();
         let c = engaged();
         ap.step(&flying(), &c, DT);
-        let fields: [(fn(&mut Measurements) -> &mut f32, InputFlags); 9] = [
+        type Field = fn(&mut Measurements) -> &mut f32;
+        let fields: [(Field, InputFlags); 9] = [
             (|m| &mut m.roll, InputFlags::ROLL),
             (|m| &mut m.pitch, InputFlags::PITCH),
             (|m| &mut m.course, InputFlags::COURSE),
@@ -498,7 +499,10 @@ mod tests {
     fn refuses_invalid_gains_and_keeps_old_ones() {
         let mut bad = DESIGNED;
         bad.lateral.course_kp = f32::NAN;
-        assert_eq!(Autopilot::new(&bad).err(), Some(GainError::NotFinite("CRS_KP")));
+        assert_eq!(
+            Autopilot::new(&bad).err(),
+            Some(GainError::NotFinite("CRS_KP"))
+        );
         let mut ap = Autopilot::new(&DESIGNED).unwrap();
         assert!(ap.set_gains(&bad).is_err());
         assert_eq!(ap.gains(), &DESIGNED);

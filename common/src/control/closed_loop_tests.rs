@@ -93,7 +93,11 @@ fn roll_plant(x: &[f64; 3], da: f64) -> [f64; 3] {
     [-16.09 * x[0] - 156.5 * da, x[0], G0 / VA * x[1].tan()]
 }
 
-fn fly_lateral(g: &GainSet, mode: impl Fn(f64) -> RollMode, secs: f64) -> (Vec<f64>, Vec<[f64; 3]>) {
+fn fly_lateral(
+    g: &GainSet,
+    mode: impl Fn(f64) -> RollMode,
+    secs: f64,
+) -> (Vec<f64>, Vec<[f64; 3]>) {
     let g = no_trim(*g);
     let mut lat = Lateral::new(&g.lateral, g.transfer_tc);
     let mut x = [0.0f64; 3];
@@ -133,7 +137,10 @@ fn designed_roll_loop_meets_thesis_requirements() {
         let s = roll_step(&g);
         std::println!("{name} roll 10 deg: {s:?}");
         assert!(s.rise_10_90 < 1.0, "{name}: {s:?}");
-        assert!(s.rise_10_90 > 0.15 && s.rise_10_90 < 0.4, "{name}: against the PD prediction {s:?}");
+        assert!(
+            s.rise_10_90 > 0.15 && s.rise_10_90 < 0.4,
+            "{name}: against the PD prediction {s:?}"
+        );
         assert!(s.overshoot < 0.05, "{name}: {s:?}");
         assert!(s.final_error < 0.01, "{name}: {s:?}");
     }
@@ -145,7 +152,10 @@ fn designed_roll_is_faster_than_minnesota() {
     let d = roll_step(&DESIGNED);
     let m = roll_step(&MINNESOTA);
     std::println!("minnesota roll 10 deg: {m:?}");
-    assert!(d.rise_10_90 < m.rise_10_90, "designed {d:?} minnesota {m:?}");
+    assert!(
+        d.rise_10_90 < m.rise_10_90,
+        "designed {d:?} minnesota {m:?}"
+    );
 }
 
 /// Course hold over the roll loop. With the roll loop as unity gain (successive loop closure),
@@ -162,7 +172,11 @@ fn course_hold_follows_successive_loop_closure_prediction() {
         let (t, x) = fly_lateral(g, cmd, 16.0);
         let chi: Vec<f64> = x.iter().map(|x| x[2]).collect();
         let s = step_after(&t, &chi, 1.0, 0.0, 5.0 * D);
-        std::println!("course 5 deg, kp {}: {s:?} (tau {:.3})", g.lateral.course_kp, tau(g));
+        std::println!(
+            "course 5 deg, kp {}: {s:?} (tau {:.3})",
+            g.lateral.course_kp,
+            tau(g)
+        );
         // The inner roll loop adds a lag of roughly its own time constant (~0.15 s); an inner
         // loop that overshoots (Minnesota's roll, ~9 %) can instead make the response a few per
         // cent faster than the unity-inner-loop prediction.
@@ -171,7 +185,10 @@ fn course_hold_follows_successive_loop_closure_prediction() {
         assert!(s.final_error < 0.01, "{s:?}");
         t63[i] = s.t_63;
     }
-    assert!(t63[0] < t63[1], "designed heading faster than Minnesota (thesis claim)");
+    assert!(
+        t63[0] < t63[1],
+        "designed heading faster than Minnesota (thesis claim)"
+    );
     // Across +-180 deg: from 175 deg to -175 deg is a 10 deg right turn, not a 350 deg left one.
     let g = no_trim(DESIGNED);
     let mut lat = Lateral::new(&g.lateral, g.transfer_tc);
@@ -189,7 +206,11 @@ fn course_hold_follows_successive_loop_closure_prediction() {
         rk4(&mut x, o.aileron as f64, roll_plant);
         min_roll = min_roll.min(x[1]);
     }
-    assert!((crate::math::wrap_pi(x[2]) + 175.0 * D).abs() < 0.2 * D, "{}", x[2] / D);
+    assert!(
+        (crate::math::wrap_pi(x[2]) + 175.0 * D).abs() < 0.2 * D,
+        "{}",
+        x[2] / D
+    );
     assert!(min_roll > -0.5 * D, "never banked left");
 }
 
@@ -247,7 +268,13 @@ struct LonRun {
 
 /// Flies the longitudinal model from (theta0, h0) on trim airspeed. Elevator trim is zeroed
 /// (deviation model); the throttle trim stays, the model subtracts it.
-fn fly_longitudinal(g: &GainSet, mode: impl Fn(f64) -> LonMode, theta0: f64, h0: f64, secs: f64) -> LonRun {
+fn fly_longitudinal(
+    g: &GainSet,
+    mode: impl Fn(f64) -> LonMode,
+    theta0: f64,
+    h0: f64,
+    secs: f64,
+) -> LonRun {
     let mut g = no_trim(*g);
     g.longitudinal.trim_throttle = THR_TRIM as f32;
     let mut ap = Autopilot::new(&g).unwrap();
@@ -272,7 +299,10 @@ fn fly_longitudinal(g: &GainSet, mode: impl Fn(f64) -> LonMode, theta0: f64, h0:
             ..Commands::OFF
         };
         let o = ap.step(&m, &c, DT);
-        rk4_lon(&mut x, (o.surfaces.elevator as f64, o.surfaces.throttle as f64));
+        rk4_lon(
+            &mut x,
+            (o.surfaces.elevator as f64, o.surfaces.throttle as f64),
+        );
         if run.regimes.last() != Some(&o.status.regime) {
             run.regimes.push(o.status.regime);
         }
@@ -367,7 +397,10 @@ fn altitude_hold_follows_successive_loop_closure_prediction() {
     // 10-90 % rise of this overdamped loop is set by its slow pole at -0.23 rad/s and moves
     // by 10 % with any small change of the loop; the 63 % time does not.)
     assert!((s.t_63 / pred.t_63 - 1.0).abs() < 0.05, "{s:?} vs {pred:?}");
-    assert!((s.overshoot - pred.overshoot).abs() < 0.02, "{s:?} vs {pred:?}");
+    assert!(
+        (s.overshoot - pred.overshoot).abs() < 0.02,
+        "{s:?} vs {pred:?}"
+    );
     assert!(s.final_error < 0.005, "{s:?}");
 }
 
@@ -411,7 +444,9 @@ fn climb_then_hold_sequence() {
         let t_band = r.t[r.x.iter().position(|x| x[3] > 120.0).unwrap()];
         std::println!(
             "{name}: regimes {:?}, h {:.2}, dV {:.3}, max h {max_h:.2}, 120 m at {t_band:.1} s",
-            r.regimes, last[3], last[4]
+            r.regimes,
+            last[3],
+            last[4]
         );
         assert_eq!(r.regimes, [Some(Climb), Some(AltitudeHold)], "{name}");
         assert!((last[3] - 130.0).abs() < 0.2, "{name}: h {}", last[3]);
@@ -430,7 +465,11 @@ fn climb_then_hold_sequence() {
 #[test]
 fn table_3_9_throttle_gains_are_unstable_behind_the_feedback_filter() {
     let routh_ok = |kp: f64, ki: f64| {
-        let (a2, a1, a0) = (0.5944 + 2.0, 2.0 * 0.5944 + 2.0 * X_DT * kp, 2.0 * X_DT * ki);
+        let (a2, a1, a0) = (
+            0.5944 + 2.0,
+            2.0 * 0.5944 + 2.0 * X_DT * kp,
+            2.0 * X_DT * ki,
+        );
         a2 > 0.0 && a1 > 0.0 && a0 > 0.0 && a2 * a1 > a0
     };
     assert!(!routh_ok(1.0, 24.0));
@@ -452,7 +491,10 @@ fn table_3_9_throttle_gains_are_unstable_behind_the_feedback_filter() {
     let (lo, hi) = spread(&DESIGNED);
     assert!(hi - lo > 0.5, "Table 3.9 gains settled: {lo} .. {hi}");
     let (lo, hi) = spread(&super::gains::DESIGNED_APPE);
-    assert!(hi - lo < 0.05 && (lo - 1.0).abs() < 0.1, "Appendix E gains: {lo} .. {hi}");
+    assert!(
+        hi - lo < 0.05 && (lo - 1.0).abs() < 0.1,
+        "Appendix E gains: {lo} .. {hi}"
+    );
 }
 
 /// Lateral model for the yaw damper: r/dr (eq. 26) in controllable canonical form. Its dutch
@@ -478,7 +520,11 @@ fn dutch_roll_activity(damper: bool) -> f64 {
     let mut x = [0.0f64; 4];
     let mut r = Vec::new();
     for k in 0..400 {
-        let mode = if damper { YawMode::Damper } else { YawMode::Off };
+        let mode = if damper {
+            YawMode::Damper
+        } else {
+            YawMode::Off
+        };
         let m = Measurements {
             yaw_rate: yaw_r(&x) as f32,
             ..Measurements::level(VA as f32, 100.0)
@@ -523,8 +569,13 @@ fn yaw_damper_raises_dutch_roll_damping() {
     let open = dutch_roll_zeta(0.0, 2.0);
     let closed = dutch_roll_zeta(0.065, 2.0);
     let wrong_sign = dutch_roll_zeta(-0.065, 2.0);
-    std::println!("dutch roll zeta: open {open:.3}, damped {closed:.3}, wrong sign {wrong_sign:.3}");
-    assert!((open - 0.329).abs() < 0.005, "model reproduces Table 2.5: {open}");
+    std::println!(
+        "dutch roll zeta: open {open:.3}, damped {closed:.3}, wrong sign {wrong_sign:.3}"
+    );
+    assert!(
+        (open - 0.329).abs() < 0.005,
+        "model reproduces Table 2.5: {open}"
+    );
     assert!(closed > open + 0.1, "{closed}");
     assert!(wrong_sign < open);
     let (a_open, a_closed) = (dutch_roll_activity(false), dutch_roll_activity(true));

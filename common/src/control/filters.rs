@@ -152,7 +152,10 @@ mod tests {
         for k in 1..200 {
             let y = f.step(1.0, 0.02).unwrap();
             let t = (k - 1) as f32 * 0.02;
-            assert!((y - (1.0 - libm::expf(-2.0 * t))).abs() < 1e-5, "k={k} y={y}");
+            assert!(
+                (y - (1.0 - libm::expf(-2.0 * t))).abs() < 1e-5,
+                "k={k} y={y}"
+            );
         }
         // First input initialises: no transient when engaged at 100 m.
         let mut g = LowPass::new(2.0);

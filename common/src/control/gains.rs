@@ -383,11 +383,8 @@ pub const BINDINGS: &[Binding] = &[
 ];
 
 /// The parameter lists of the control stages, in the order of [`BINDINGS`].
-pub const STAGE_PARAMS: &[&[ParamDef]] = &[
-    lateral::PARAMS,
-    longitudinal::PARAMS,
-    autopilot::PARAMS,
-];
+pub const STAGE_PARAMS: &[&[ParamDef]] =
+    &[lateral::PARAMS, longitudinal::PARAMS, autopilot::PARAMS];
 
 /// Finds the definition of a control parameter by name.
 pub fn param_def(name: &str) -> Option<&'static ParamDef> {
@@ -474,7 +471,9 @@ impl GainSet {
 
     /// The set as parameter values `(name, value)` in parameter units, in [`BINDINGS`] order.
     pub fn params(&self) -> impl Iterator<Item = (&'static str, f32)> + '_ {
-        BINDINGS.iter().map(move |b| (b.name, to_param(b, (b.get)(self))))
+        BINDINGS
+            .iter()
+            .map(move |b| (b.name, to_param(b, (b.get)(self))))
     }
 
     /// The value of one parameter, in parameter units.
@@ -606,16 +605,25 @@ mod tests {
     fn params_round_trip_and_missing_is_named() {
         for (_, g, _) in NAMED {
             let values: heapless::Vec<(&str, f32), 64> = g.params().collect();
-            let back = GainSet::from_params(|n| {
-                values.iter().find(|(m, _)| *m == n).map(|(_, v)| *v)
-            })
-            .unwrap();
+            let back =
+                GainSet::from_params(|n| values.iter().find(|(m, _)| *m == n).map(|(_, v)| *v))
+                    .unwrap();
             for b in BINDINGS {
                 let (x, y) = ((b.get)(g), (b.get)(&back));
-                assert!((x - y).abs() <= 1e-6 * x.abs().max(1e-3), "{} {x} {y}", b.name);
+                assert!(
+                    (x - y).abs() <= 1e-6 * x.abs().max(1e-3),
+                    "{} {x} {y}",
+                    b.name
+                );
             }
         }
-        let err = GainSet::from_params(|n| if n == "PTCH_KI" { None } else { DESIGNED.param(n) });
+        let err = GainSet::from_params(|n| {
+            if n == "PTCH_KI" {
+                None
+            } else {
+                DESIGNED.param(n)
+            }
+        });
         assert_eq!(err, Err(GainError::Missing("PTCH_KI")));
         let err = GainSet::from_params(|n| {
             if n == "CRS_KP" {
@@ -628,7 +636,10 @@ mod tests {
         let mut g = DESIGNED;
         assert_eq!(g.set_param("LIM_ROLL_DEG", 30.0), Ok(()));
         assert!((g.lateral.roll_max - 30.0 * DEG).abs() < 1e-6);
-        assert_eq!(g.set_param("LIM_ROLL_DEG", 95.0), Err(GainError::OutOfBounds("LIM_ROLL_DEG")));
+        assert_eq!(
+            g.set_param("LIM_ROLL_DEG", 95.0),
+            Err(GainError::OutOfBounds("LIM_ROLL_DEG"))
+        );
         assert_eq!(g.set_param("NOPE", 1.0), Err(GainError::Unknown));
     }
 

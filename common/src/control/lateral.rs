@@ -26,20 +26,118 @@ const L: LateralGains = DESIGNED.lateral;
 /// Parameters of the lateral autopilot; defaults are the thesis's designed set. The bounds of
 /// the loop gains admit only the sign that stabilises the loop in the UMN convention.
 pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real("RLL_KP", L.roll_kp, -10.0, 0.0, "rad/rad", "Roll attitude P gain, aileron per roll error (UMN sign: negative)"),
-    ParamDef::real("RLL_KI", L.roll_ki, -10.0, 0.0, "1/s", "Roll attitude I gain, aileron per integrated roll error"),
-    ParamDef::real("RLL_RATE_KD", L.roll_rate_kd, -2.0, 0.0, "s", "Roll-rate damper, aileron per roll rate, applied as -kd*p"),
-    ParamDef::real("CRS_KP", L.course_kp, 0.0, 20.0, "rad/rad", "Course hold P gain, commanded roll per course error"),
-    ParamDef::real("CRS_KI", L.course_ki, 0.0, 20.0, "1/s", "Course hold I gain, commanded roll per integrated course error"),
-    ParamDef::real("SLIP_KP", L.slip_kp, 0.0, 20.0, "rad/rad", "Sideslip hold P gain, rudder per sideslip error (positive)"),
-    ParamDef::real("SLIP_KI", L.slip_ki, 0.0, 20.0, "1/s", "Sideslip hold I gain, rudder per integrated sideslip error"),
-    ParamDef::real("YAW_DAMP_K", L.yaw_damper_k, 0.0, 2.0, "s", "Yaw damper, rudder per washed-out yaw rate (+k*r)"),
-    ParamDef::real("YAW_WO_POLE", L.washout_pole, 0.1, 20.0, "rad/s", "Pole of the yaw-damper washout s/(s+a)"),
-    ParamDef::real("LIM_ROLL_DEG", L.roll_max * RAD2DEG, 5.0, 80.0, "deg", "Largest commanded roll angle"),
-    ParamDef::real("LIM_AIL_DEG", 25.0, 1.0, 25.0, "deg", "Aileron travel the autopilot may use"),
-    ParamDef::real("LIM_RUD_DEG", 25.0, 1.0, 25.0, "deg", "Rudder travel the autopilot may use"),
-    ParamDef::real("TRIM_AIL_DEG", L.trim_aileron * RAD2DEG, -25.0, 25.0, "deg", "Aileron trim, feed-forward of the roll loop (trim I)"),
-    ParamDef::real("TRIM_RUD_DEG", L.trim_rudder * RAD2DEG, -25.0, 25.0, "deg", "Rudder trim, feed-forward of the rudder loops (trim I)"),
+    ParamDef::real(
+        "RLL_KP",
+        L.roll_kp,
+        -10.0,
+        0.0,
+        "rad/rad",
+        "Roll attitude P gain, aileron per roll error (UMN sign: negative)",
+    ),
+    ParamDef::real(
+        "RLL_KI",
+        L.roll_ki,
+        -10.0,
+        0.0,
+        "1/s",
+        "Roll attitude I gain, aileron per integrated roll error",
+    ),
+    ParamDef::real(
+        "RLL_RATE_KD",
+        L.roll_rate_kd,
+        -2.0,
+        0.0,
+        "s",
+        "Roll-rate damper, aileron per roll rate, applied as -kd*p",
+    ),
+    ParamDef::real(
+        "CRS_KP",
+        L.course_kp,
+        0.0,
+        20.0,
+        "rad/rad",
+        "Course hold P gain, commanded roll per course error",
+    ),
+    ParamDef::real(
+        "CRS_KI",
+        L.course_ki,
+        0.0,
+        20.0,
+        "1/s",
+        "Course hold I gain, commanded roll per integrated course error",
+    ),
+    ParamDef::real(
+        "SLIP_KP",
+        L.slip_kp,
+        0.0,
+        20.0,
+        "rad/rad",
+        "Sideslip hold P gain, rudder per sideslip error (positive)",
+    ),
+    ParamDef::real(
+        "SLIP_KI",
+        L.slip_ki,
+        0.0,
+        20.0,
+        "1/s",
+        "Sideslip hold I gain, rudder per integrated sideslip error",
+    ),
+    ParamDef::real(
+        "YAW_DAMP_K",
+        L.yaw_damper_k,
+        0.0,
+        2.0,
+        "s",
+        "Yaw damper, rudder per washed-out yaw rate (+k*r)",
+    ),
+    ParamDef::real(
+        "YAW_WO_POLE",
+        L.washout_pole,
+        0.1,
+        20.0,
+        "rad/s",
+        "Pole of the yaw-damper washout s/(s+a)",
+    ),
+    ParamDef::real(
+        "LIM_ROLL_DEG",
+        L.roll_max * RAD2DEG,
+        5.0,
+        80.0,
+        "deg",
+        "Largest commanded roll angle",
+    ),
+    ParamDef::real(
+        "LIM_AIL_DEG",
+        25.0,
+        1.0,
+        25.0,
+        "deg",
+        "Aileron travel the autopilot may use",
+    ),
+    ParamDef::real(
+        "LIM_RUD_DEG",
+        25.0,
+        1.0,
+        25.0,
+        "deg",
+        "Rudder travel the autopilot may use",
+    ),
+    ParamDef::real(
+        "TRIM_AIL_DEG",
+        L.trim_aileron * RAD2DEG,
+        -25.0,
+        25.0,
+        "deg",
+        "Aileron trim, feed-forward of the roll loop (trim I)",
+    ),
+    ParamDef::real(
+        "TRIM_RUD_DEG",
+        L.trim_rudder * RAD2DEG,
+        -25.0,
+        25.0,
+        "deg",
+        "Rudder trim, feed-forward of the rudder loops (trim I)",
+    ),
 ];
 
 /// What the ailerons do.
@@ -187,7 +285,13 @@ impl Lateral {
     /// One step. Measurements a mode needs that are not finite (or a non-finite setpoint, or a
     /// bad `dt`) hold that surface at its last good value; the loops resume bumplessly when the
     /// inputs are good again.
-    pub fn step(&mut self, m: &Measurements, roll: RollMode, yaw: YawMode, dt: f32) -> LateralOutput {
+    pub fn step(
+        &mut self,
+        m: &Measurements,
+        roll: RollMode,
+        yaw: YawMode,
+        dt: f32,
+    ) -> LateralOutput {
         let mut rejected = InputFlags::empty();
         let aileron_held = self.step_roll(m, roll, dt, &mut rejected);
         let rudder_held = self.step_yaw(m, yaw, dt, &mut rejected);
@@ -205,7 +309,13 @@ impl Lateral {
         }
     }
 
-    fn step_roll(&mut self, m: &Measurements, mode: RollMode, dt: f32, rejected: &mut InputFlags) -> bool {
+    fn step_roll(
+        &mut self,
+        m: &Measurements,
+        mode: RollMode,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> bool {
         let g = &self.gains;
         let (kind, setpoint) = match mode {
             RollMode::Off => {
@@ -222,7 +332,10 @@ impl Lateral {
         let mut bad = InputFlags::empty();
         bad.set(InputFlags::ROLL, !m.roll.is_finite());
         bad.set(InputFlags::ROLL_RATE, !m.roll_rate.is_finite());
-        bad.set(InputFlags::COURSE, kind == RollKind::Course && !m.course.is_finite());
+        bad.set(
+            InputFlags::COURSE,
+            kind == RollKind::Course && !m.course.is_finite(),
+        );
         bad.set(InputFlags::COMMAND, !setpoint.is_finite());
         bad.set(InputFlags::DT, !dt_ok(dt));
         if !bad.is_empty() {
@@ -266,7 +379,13 @@ impl Lateral {
         false
     }
 
-    fn step_yaw(&mut self, m: &Measurements, mode: YawMode, dt: f32, rejected: &mut InputFlags) -> bool {
+    fn step_yaw(
+        &mut self,
+        m: &Measurements,
+        mode: YawMode,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> bool {
         let g = &self.gains;
         let (kind, beta_c) = match mode {
             YawMode::Off => {
@@ -282,7 +401,10 @@ impl Lateral {
         };
         let mut bad = InputFlags::empty();
         bad.set(InputFlags::YAW_RATE, !m.yaw_rate.is_finite());
-        bad.set(InputFlags::SIDESLIP, kind == YawKind::Sideslip && !m.sideslip.is_finite());
+        bad.set(
+            InputFlags::SIDESLIP,
+            kind == YawKind::Sideslip && !m.sideslip.is_finite(),
+        );
         bad.set(InputFlags::COMMAND, !beta_c.is_finite());
         bad.set(InputFlags::DT, !dt_ok(dt));
         if !bad.is_empty() {
@@ -356,12 +478,25 @@ mod tests {
         // Yawing right (r > 0): the damper deflects the rudder positive (nose left).
         let mut lat = Lateral::new(&zero_trim(), 1.0);
         lat.step(&m, RollMode::Off, YawMode::Damper, DT);
-        let o = lat.step(&Measurements { yaw_rate: 0.2, ..m }, RollMode::Off, YawMode::Damper, DT);
+        let o = lat.step(
+            &Measurements { yaw_rate: 0.2, ..m },
+            RollMode::Off,
+            YawMode::Damper,
+            DT,
+        );
         assert!((o.rudder - 0.065 * 0.2).abs() < 1e-6, "{o:?}");
         // Positive sideslip: negative rudder (yaw the nose right, into the wind).
         let mut lat = Lateral::new(&zero_trim(), 1.0);
         lat.step(&m, RollMode::Off, YawMode::Sideslip(0.0), DT);
-        let o = lat.step(&Measurements { sideslip: 0.05, ..m }, RollMode::Off, YawMode::Sideslip(0.0), DT);
+        let o = lat.step(
+            &Measurements {
+                sideslip: 0.05,
+                ..m
+            },
+            RollMode::Off,
+            YawMode::Sideslip(0.0),
+            DT,
+        );
         assert!(o.rudder < 0.0, "{o:?}");
         // Course to the right of the present one: bank right.
         let mut lat = Lateral::new(&zero_trim(), 1.0);
@@ -382,7 +517,11 @@ mod tests {
         lat.step(&m, RollMode::Course(179.0 * D), YawMode::Off, DT);
         let o = lat.step(&m, RollMode::Course(-179.0 * D), YawMode::Off, DT);
         let expected = g.course_kp * 2.0 * D + g.course_ki * 2.0 * D * DT;
-        assert!((o.roll_cmd - expected).abs() < 1e-4, "{} vs {expected}", o.roll_cmd);
+        assert!(
+            (o.roll_cmd - expected).abs() < 1e-4,
+            "{} vs {expected}",
+            o.roll_cmd
+        );
         // And the other way round.
         let m = Measurements {
             course: -179.0 * D,
@@ -395,7 +534,12 @@ mod tests {
         // Commands beyond +-pi are the same course.
         let mut lat = Lateral::new(&g, 1.0);
         lat.step(&m, RollMode::Course(-179.0 * D), YawMode::Off, DT);
-        let o2 = lat.step(&m, RollMode::Course(179.0 * D + 4.0 * core::f32::consts::PI), YawMode::Off, DT);
+        let o2 = lat.step(
+            &m,
+            RollMode::Course(179.0 * D + 4.0 * core::f32::consts::PI),
+            YawMode::Off,
+            DT,
+        );
         assert!((o2.roll_cmd - o.roll_cmd).abs() < 1e-3);
     }
 

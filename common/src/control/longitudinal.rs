@@ -33,25 +33,158 @@ const G: LongitudinalGains = DESIGNED.longitudinal;
 /// Table 2.3 trim I; take-off pitch, band and hysteresis: not in the thesis, chosen here). The
 /// bounds of the loop gains admit only the sign that stabilises the loop in the UMN convention.
 pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real("PTCH_KP", G.pitch_kp, -10.0, 0.0, "rad/rad", "Pitch attitude P gain, elevator per pitch error (UMN sign: negative)"),
-    ParamDef::real("PTCH_KI", G.pitch_ki, -10.0, 0.0, "1/s", "Pitch attitude I gain, elevator per integrated pitch error"),
-    ParamDef::real("PTCH_RATE_KD", G.pitch_rate_kd, -2.0, 0.0, "s", "Pitch-rate damper, elevator per pitch rate, applied as -kd*q"),
-    ParamDef::real("ALT_KP", G.alt_kp, 0.0, 1.0, "rad/m", "Altitude hold P gain, commanded pitch per altitude error"),
-    ParamDef::real("ALT_KI", G.alt_ki, 0.0, 1.0, "rad/(m s)", "Altitude hold I gain, commanded pitch per integrated altitude error"),
-    ParamDef::real("ASPD_PTCH_KP", G.aspd_pitch_kp, -5.0, 0.0, "rad s/m", "Airspeed-by-pitch P gain, commanded pitch per airspeed error"),
-    ParamDef::real("ASPD_PTCH_KI", G.aspd_pitch_ki, -5.0, 0.0, "rad/m", "Airspeed-by-pitch I gain, per integrated airspeed error"),
-    ParamDef::real("ASPD_THR_KP", G.aspd_thr_kp, 0.0, 5.0, "s/m", "Airspeed-by-throttle P gain, throttle per airspeed error"),
-    ParamDef::real("ASPD_THR_KI", G.aspd_thr_ki, 0.0, 50.0, "1/m", "Airspeed-by-throttle I gain, throttle per integrated airspeed error"),
-    ParamDef::real("LIM_PTCH_DEG", G.pitch_max * RAD2DEG, 5.0, 45.0, "deg", "Largest commanded pitch angle (either sign)"),
-    ParamDef::real("LIM_ELEV_DEG", 25.0, 1.0, 25.0, "deg", "Elevator travel the autopilot may use"),
-    ParamDef::real("THR_MIN", G.throttle_min, 0.0, 1.0, "", "Throttle in the descent regime and lowest throttle"),
-    ParamDef::real("THR_MAX", G.throttle_max, 0.0, 1.0, "", "Throttle in take-off and climb and highest throttle"),
-    ParamDef::real("TRIM_ELEV_DEG", G.trim_elevator * RAD2DEG, -25.0, 25.0, "deg", "Elevator trim, feed-forward of the pitch loop (trim I)"),
-    ParamDef::real("TRIM_THR", G.trim_throttle, 0.0, 1.0, "", "Throttle trim, feed-forward of the airspeed-by-throttle loop"),
-    ParamDef::real("FB_LPF_POLE", G.feedback_lpf_pole, 0.1, 50.0, "rad/s", "Pole of the low-pass on altitude and airspeed feedback"),
-    ParamDef::real("TKO_PTCH_DEG", G.takeoff_pitch * RAD2DEG, 0.0, 30.0, "deg", "Pitch held in the take-off regime"),
-    ParamDef::real("ALT_BAND_M", G.alt_band, 1.0, 500.0, "m", "Altitude-hold band: hold regime entered inside +-band"),
-    ParamDef::real("ALT_HYST_M", G.alt_hysteresis, 0.0, 100.0, "m", "Hold regime left only beyond +-(band + hysteresis)"),
+    ParamDef::real(
+        "PTCH_KP",
+        G.pitch_kp,
+        -10.0,
+        0.0,
+        "rad/rad",
+        "Pitch attitude P gain, elevator per pitch error (UMN sign: negative)",
+    ),
+    ParamDef::real(
+        "PTCH_KI",
+        G.pitch_ki,
+        -10.0,
+        0.0,
+        "1/s",
+        "Pitch attitude I gain, elevator per integrated pitch error",
+    ),
+    ParamDef::real(
+        "PTCH_RATE_KD",
+        G.pitch_rate_kd,
+        -2.0,
+        0.0,
+        "s",
+        "Pitch-rate damper, elevator per pitch rate, applied as -kd*q",
+    ),
+    ParamDef::real(
+        "ALT_KP",
+        G.alt_kp,
+        0.0,
+        1.0,
+        "rad/m",
+        "Altitude hold P gain, commanded pitch per altitude error",
+    ),
+    ParamDef::real(
+        "ALT_KI",
+        G.alt_ki,
+        0.0,
+        1.0,
+        "rad/(m s)",
+        "Altitude hold I gain, commanded pitch per integrated altitude error",
+    ),
+    ParamDef::real(
+        "ASPD_PTCH_KP",
+        G.aspd_pitch_kp,
+        -5.0,
+        0.0,
+        "rad s/m",
+        "Airspeed-by-pitch P gain, commanded pitch per airspeed error",
+    ),
+    ParamDef::real(
+        "ASPD_PTCH_KI",
+        G.aspd_pitch_ki,
+        -5.0,
+        0.0,
+        "rad/m",
+        "Airspeed-by-pitch I gain, per integrated airspeed error",
+    ),
+    ParamDef::real(
+        "ASPD_THR_KP",
+        G.aspd_thr_kp,
+        0.0,
+        5.0,
+        "s/m",
+        "Airspeed-by-throttle P gain, throttle per airspeed error",
+    ),
+    ParamDef::real(
+        "ASPD_THR_KI",
+        G.aspd_thr_ki,
+        0.0,
+        50.0,
+        "1/m",
+        "Airspeed-by-throttle I gain, throttle per integrated airspeed error",
+    ),
+    ParamDef::real(
+        "LIM_PTCH_DEG",
+        G.pitch_max * RAD2DEG,
+        5.0,
+        45.0,
+        "deg",
+        "Largest commanded pitch angle (either sign)",
+    ),
+    ParamDef::real(
+        "LIM_ELEV_DEG",
+        25.0,
+        1.0,
+        25.0,
+        "deg",
+        "Elevator travel the autopilot may use",
+    ),
+    ParamDef::real(
+        "THR_MIN",
+        G.throttle_min,
+        0.0,
+        1.0,
+        "",
+        "Throttle in the descent regime and lowest throttle",
+    ),
+    ParamDef::real(
+        "THR_MAX",
+        G.throttle_max,
+        0.0,
+        1.0,
+        "",
+        "Throttle in take-off and climb and highest throttle",
+    ),
+    ParamDef::real(
+        "TRIM_ELEV_DEG",
+        G.trim_elevator * RAD2DEG,
+        -25.0,
+        25.0,
+        "deg",
+        "Elevator trim, feed-forward of the pitch loop (trim I)",
+    ),
+    ParamDef::real(
+        "TRIM_THR",
+        G.trim_throttle,
+        0.0,
+        1.0,
+        "",
+        "Throttle trim, feed-forward of the airspeed-by-throttle loop",
+    ),
+    ParamDef::real(
+        "FB_LPF_POLE",
+        G.feedback_lpf_pole,
+        0.1,
+        50.0,
+        "rad/s",
+        "Pole of the low-pass on altitude and airspeed feedback",
+    ),
+    ParamDef::real(
+        "TKO_PTCH_DEG",
+        G.takeoff_pitch * RAD2DEG,
+        0.0,
+        30.0,
+        "deg",
+        "Pitch held in the take-off regime",
+    ),
+    ParamDef::real(
+        "ALT_BAND_M",
+        G.alt_band,
+        1.0,
+        500.0,
+        "m",
+        "Altitude-hold band: hold regime entered inside +-band",
+    ),
+    ParamDef::real(
+        "ALT_HYST_M",
+        G.alt_hysteresis,
+        0.0,
+        100.0,
+        "m",
+        "Hold regime left only beyond +-(band + hysteresis)",
+    ),
 ];
 
 /// What the elevator and throttle do. Angles rad, altitudes m, airspeeds m/s.
@@ -323,7 +456,8 @@ impl Longitudinal {
         self.gains = *gains;
         self.pitch.set_gains(pitch_gains(gains), transfer_tc);
         self.alt.set_gains(alt_gains(gains), transfer_tc);
-        self.aspd_pitch.set_gains(aspd_pitch_gains(gains), transfer_tc);
+        self.aspd_pitch
+            .set_gains(aspd_pitch_gains(gains), transfer_tc);
         self.aspd_thr.set_gains(aspd_thr_gains(gains), transfer_tc);
         self.alt_lpf.set_pole(gains.feedback_lpf_pole);
         self.aspd_lpf.set_pole(gains.feedback_lpf_pole);
@@ -403,22 +537,22 @@ impl Longitudinal {
             LonMode::Pitch { pitch, throttle } => {
                 Some((PitchSource::Fixed(pitch), ThrottleSource::Fixed(throttle)))
             }
-            LonMode::AirspeedPitch { airspeed, throttle } => {
-                Some((PitchSource::Airspeed(airspeed), ThrottleSource::Fixed(throttle)))
-            }
+            LonMode::AirspeedPitch { airspeed, throttle } => Some((
+                PitchSource::Airspeed(airspeed),
+                ThrottleSource::Fixed(throttle),
+            )),
             _ => {
                 let cmd_ok =
                     alt_c.is_finite() && aspd_c.is_finite() && clear.is_none_or(f32::is_finite);
                 rejected.set(InputFlags::COMMAND, !cmd_ok);
                 rejected.set(InputFlags::ALTITUDE, !alt_good);
                 let regime = match alt_f {
-                    Some(h) if cmd_ok && alt_good && dt_good => Some(self.machine.update(
-                        alt_c - h,
-                        h,
-                        clear,
-                        g.alt_band,
-                        g.alt_hysteresis,
-                    )),
+                    Some(h) if cmd_ok && alt_good && dt_good => {
+                        Some(
+                            self.machine
+                                .update(alt_c - h, h, clear, g.alt_band, g.alt_hysteresis),
+                        )
+                    }
                     // Without a good altitude the regime stays as it was.
                     _ if cmd_ok => self.machine.regime(),
                     _ => None,
@@ -599,13 +733,22 @@ mod tests {
     fn regime_zones_and_sequence() {
         let mut rm = RegimeMachine::new();
         // Starting on the ground with a take-off request.
-        assert_eq!(rm.update(100.0, 0.0, Some(20.0), 10.0, 2.0), Regime::TakeOff);
-        assert_eq!(rm.update(85.0, 15.0, Some(20.0), 10.0, 2.0), Regime::TakeOff);
+        assert_eq!(
+            rm.update(100.0, 0.0, Some(20.0), 10.0, 2.0),
+            Regime::TakeOff
+        );
+        assert_eq!(
+            rm.update(85.0, 15.0, Some(20.0), 10.0, 2.0),
+            Regime::TakeOff
+        );
         assert_eq!(rm.update(79.0, 21.0, Some(20.0), 10.0, 2.0), Regime::Climb);
         // Sinking below the clear altitude again does not go back to take-off.
         assert_eq!(rm.update(81.0, 19.0, Some(20.0), 10.0, 2.0), Regime::Climb);
         assert_eq!(rm.update(10.5, 89.5, Some(20.0), 10.0, 2.0), Regime::Climb);
-        assert_eq!(rm.update(9.5, 90.5, Some(20.0), 10.0, 2.0), Regime::AltitudeHold);
+        assert_eq!(
+            rm.update(9.5, 90.5, Some(20.0), 10.0, 2.0),
+            Regime::AltitudeHold
+        );
         // New, lower setpoint: straight to descent, then hold inside the band.
         assert_eq!(rm.update(-50.0, 100.0, None, 10.0, 2.0), Regime::Descent);
         assert_eq!(rm.update(-10.5, 60.5, None, 10.0, 2.0), Regime::Descent);
@@ -641,7 +784,10 @@ mod tests {
             switches
         };
         assert_eq!(count_switches(2.0), 1, "one entry into hold, then nothing");
-        assert!(count_switches(0.0) > 20, "the same signal chatters without hysteresis");
+        assert!(
+            count_switches(0.0) > 20,
+            "the same signal chatters without hysteresis"
+        );
     }
 
     fn meas(pitch: f32, alt: f32, va: f32) -> Measurements {
@@ -673,10 +819,16 @@ mod tests {
             h += 0.05;
             let o = lon.step(&meas(0.1, h, 17.5), mode, DT);
             // The pitch command never jumps, whatever the regime does.
-            assert!((o.pitch_cmd - last.pitch_cmd).abs() < 0.5 * D, "{last:?} -> {o:?}");
+            assert!(
+                (o.pitch_cmd - last.pitch_cmd).abs() < 0.5 * D,
+                "{last:?} -> {o:?}"
+            );
             if o.regime == Some(Regime::AltitudeHold) && last.regime == Some(Regime::Climb) {
                 // The throttle loop takes over from full throttle without a jump.
-                assert!((o.throttle - last.throttle).abs() < 0.05, "{last:?} -> {o:?}");
+                assert!(
+                    (o.throttle - last.throttle).abs() < 0.05,
+                    "{last:?} -> {o:?}"
+                );
                 saw_hold = true;
             }
             last = o;
@@ -737,23 +889,50 @@ mod tests {
         g.trim_elevator = 0.0;
         let mut lon = Longitudinal::new(&g, 1.0);
         let m = meas(0.0, 100.0, 17.0);
-        let level = LonMode::Pitch { pitch: 0.0, throttle: 0.5 };
+        let level = LonMode::Pitch {
+            pitch: 0.0,
+            throttle: 0.5,
+        };
         // Engaged first (bumpless: output = trim), then asked for nose up: negative elevator.
         lon.step(&m, level, DT);
-        let o = lon.step(&m, LonMode::Pitch { pitch: 5.0 * D, throttle: 0.5 }, DT);
+        let o = lon.step(
+            &m,
+            LonMode::Pitch {
+                pitch: 5.0 * D,
+                throttle: 0.5,
+            },
+            DT,
+        );
         assert!(o.elevator < 0.0);
         // Pitching up with no error: positive elevator against it.
         let mut lon = Longitudinal::new(&g, 1.0);
-        let m2 = Measurements { pitch_rate: 0.3, ..m };
+        let m2 = Measurements {
+            pitch_rate: 0.3,
+            ..m
+        };
         lon.step(&m, level, DT);
         let o = lon.step(&m2, level, DT);
         assert!((o.elevator - 0.072 * 0.3).abs() < 1e-6, "{o:?}");
         // Too slow, airspeed by pitch: nose down.
         let mut lon = Longitudinal::new(&g, 1.0);
-        lon.step(&m, LonMode::AirspeedPitch { airspeed: 17.0, throttle: 0.5 }, DT);
+        lon.step(
+            &m,
+            LonMode::AirspeedPitch {
+                airspeed: 17.0,
+                throttle: 0.5,
+            },
+            DT,
+        );
         let mut o = LongitudinalOutput::default();
         for _ in 0..50 {
-            o = lon.step(&meas(0.0, 100.0, 16.0), LonMode::AirspeedPitch { airspeed: 17.0, throttle: 0.5 }, DT);
+            o = lon.step(
+                &meas(0.0, 100.0, 16.0),
+                LonMode::AirspeedPitch {
+                    airspeed: 17.0,
+                    throttle: 0.5,
+                },
+                DT,
+            );
         }
         assert!(o.pitch_cmd < 0.0, "{o:?}");
     }

@@ -196,12 +196,13 @@ impl Pid {
             Derivative::None => true,
             Derivative::Measurement(y) | Derivative::Rate(y) => y.is_finite(),
         };
-        if !(dt > 0.0 && dt.is_finite())
-            || !error.is_finite()
-            || !ff.is_finite()
-            || !deriv_ok
-            || !self.gains.is_finite()
-        {
+        let inputs_ok = dt > 0.0
+            && dt.is_finite()
+            && error.is_finite()
+            && ff.is_finite()
+            && deriv_ok
+            && self.gains.is_finite();
+        if !inputs_ok {
             return self.last.output;
         }
         let g = self.gains;
@@ -288,10 +289,7 @@ mod tests {
     #[test]
     fn pd_on_double_integrator_matches_second_order_prediction() {
         let (wn, zeta) = (2.0f32, 0.5f32);
-        let mut pid = Pid::new(
-            PidGains::symmetric(wn * wn, 0.0, 2.0 * zeta * wn, 1e6),
-            1.0,
-        );
+        let mut pid = Pid::new(PidGains::symmetric(wn * wn, 0.0, 2.0 * zeta * wn, 1e6), 1.0);
         let (mut y, mut v) = (0.0f32, 0.0f32);
         let (mut peak, mut t_peak) = (0.0f32, 0.0f32);
         for k in 0..10_000 {
@@ -304,9 +302,14 @@ mod tests {
                 t_peak = (k + 1) as f32 * DT;
             }
         }
-        let os_expected = libm::expf(-core::f32::consts::PI * zeta / libm::sqrtf(1.0 - zeta * zeta));
+        let os_expected =
+            libm::expf(-core::f32::consts::PI * zeta / libm::sqrtf(1.0 - zeta * zeta));
         let tp_expected = core::f32::consts::PI / (wn * libm::sqrtf(1.0 - zeta * zeta));
-        assert!((peak - 1.0 - os_expected).abs() < 0.005, "overshoot {}", peak - 1.0);
+        assert!(
+            (peak - 1.0 - os_expected).abs() < 0.005,
+            "overshoot {}",
+            peak - 1.0
+        );
         assert!((t_peak - tp_expected).abs() < 0.01, "peak time {t_peak}");
         assert!((y - 1.0).abs() < 1e-3);
     }
@@ -404,7 +407,10 @@ mod tests {
         let (os_naive, integ_naive, settle_naive) = run(false);
         // While saturated the clamped integrator never exceeds the output span.
         assert!(integ_clamped <= lim + 1e-6, "integrator {integ_clamped}");
-        assert!(integ_naive > 3.0 * lim, "naive integrator only {integ_naive}");
+        assert!(
+            integ_naive > 3.0 * lim,
+            "naive integrator only {integ_naive}"
+        );
         // Linear-region overshoot of this loop (zeta = 0.707 with a zero) is about 20 %
         // of the last, unsaturated part of the step; the naive loop overshoots by metres.
         assert!(os_clamped < 0.3, "clamped overshoot {os_clamped}");
