@@ -582,3 +582,55 @@ fn yaw_damper_raises_dutch_roll_damping() {
     std::println!("r total variation after a rudder pulse: open {a_open:.4}, damped {a_closed:.4}");
     assert!(a_closed < 0.6 * a_open, "open {a_open} damped {a_closed}");
 }
+
+/// Sideslip on the thesis's own design model for it (Appendix C, Beard and McLain):
+/// beta' = -a_b1 beta + a_b2 dr, a_b1 = -rho Va S CY_beta / (2 m), a_b2 = rho Va S CY_dr / (2 m),
+/// with the UMN data (aircraft/ultrastick25e.toml: CY_beta = -0.4889, CY_dr = 0.1913, S = 0.3097
+/// m^2, m = 1.959 kg, rho = 1.2133 kg/m^3 at 100 m). The closed loop is s^2 + (a_b1 + a_b2 kp) s +
+/// a_b2 ki: with the designed gains (3, 0.8) both coefficients are positive (stable); with Table
+/// 3.5's printed signs (-3, -0.8) they are negative (unstable). That is why the sideslip gains
+/// are stored positive (see `gains`).
+#[test]
+fn sideslip_hold_sign_on_the_design_model() {
+    let k = 1.2133 * VA * 0.3097 / (2.0 * 1.959);
+    let (a1, a2) = (-k * -0.4889, k * 0.1913);
+    let fly = |kp: f32, ki: f32| {
+        let mut g = no_trim(DESIGNED);
+        g.lateral.slip_kp = kp;
+        g.lateral.slip_ki = ki;
+        g.lateral.yaw_damper_k = 0.0;
+        // Built directly, bypassing validation, so the printed signs can be flown too.
+        let mut lat = Lateral::new(&g.lateral, g.transfer_tc);
+        let mut x = [2.0 * D];
+        let mut max = 0.0f64;
+        for _ in 0..(30.0 / DT) as usize {
+            let m = Measurements {
+                sideslip: x[0] as f32,
+                ..Measurements::level(VA as f32, 100.0)
+            };
+            let o = lat.step(&m, RollMode::Off, YawMode::Sideslip(0.0), DT);
+            rk4(&mut x, o.rudder as f64, |x: &[f64; 1], dr| {
+                [-a1 * x[0] + a2 * dr]
+            });
+            max = max.max(x[0].abs());
+        }
+        (x[0], max)
+    };
+    let (end, _) = fly(3.0, 0.8);
+    std::println!(
+        "sideslip from 2 deg, designed: {:.4} deg after 30 s",
+        end / D
+    );
+    assert!(end.abs() < 0.02 * D, "{}", end / D);
+    // With the printed signs the sideslip runs away until the rudder sits on its 25 deg stop,
+    // which holds beta at a_b2 / a_b1 * 25 deg = 9.8 deg.
+    let (end, max) = fly(-3.0, -0.8);
+    let stop = a2 / a1 * 25.0 * D;
+    assert!(max > 4.0 * 2.0 * D, "printed signs: max {}", max / D);
+    assert!(
+        (end.abs() - stop).abs() < 0.1 * D,
+        "{} vs {}",
+        end / D,
+        stop / D
+    );
+}

@@ -214,6 +214,10 @@ impl Pid {
             } else {
                 0.0
             };
+            // Far below any servo resolution: stop paying for the exp().
+            if libm::fabsf(self.transfer) < 1e-7 {
+                self.transfer = 0.0;
+            }
         }
 
         let p = g.kp * error;
