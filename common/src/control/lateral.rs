@@ -1,0 +1,588 @@
+//! Lateral-directional autopilot (thesis section 3.4, Figures 3-7 to 3-15): ailerons and rudder.
+//!
+//! ```text
+//! chi_c --(+)-- PI course --[+-roll_max]-- phi_c --(+)-- PI roll --(+)-- trim --[+-ail_max]--> aileron
+//!        wrap(chi_c - chi)                        phi          -kd p
+//! beta_c --(+)-- PI sideslip --(+)-- trim --(+)-- k * s/(s+a) * r --[+-rud_max]--> rudder
+//!          beta
+//! ```
+//!
+//! Signs (UMN): positive aileron rolls left, so the roll gains are negative and `-kd p` with
+//! `kd < 0` adds aileron against the roll rate (the thesis's pole shift -16.09 -> -25.76 with
+//! `kd = -0.0618` on `p/da = -156.5/(s + 16.09)`). Positive rudder yaws the nose left and raises
+//! sideslip: the yaw damper adds `+k r` (right yaw -> rudder that yaws left) and the sideslip PI
+//! has positive gains (see [`super::gains`] for the Table 3.5 sign).
+
+use super::autopilot::{InputFlags, Measurements};
+use super::filters::Washout;
+use super::gains::{LateralGains, DESIGNED, RAD2DEG};
+use super::pid::{Bumpless, Derivative, Pid, PidGains};
+use crate::actuators::SURFACE_LIMIT_RAD;
+use crate::math::wrap_pi;
+use crate::params::ParamDef;
+
+const L: LateralGains = DESIGNED.lateral;
+
+/// Parameters of the lateral autopilot; defaults are the thesis's designed set. The bounds of
+/// the loop gains admit only the sign that stabilises the loop in the UMN convention.
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef::real(
+        "RLL_KP",
+        L.roll_kp,
+        -10.0,
+        0.0,
+        "rad/rad",
+        "Roll attitude P gain, aileron per roll error (UMN sign: negative)",
+    ),
+    ParamDef::real(
+        "RLL_KI",
+        L.roll_ki,
+        -10.0,
+        0.0,
+        "1/s",
+        "Roll attitude I gain, aileron per integrated roll error",
+    ),
+    ParamDef::real(
+        "RLL_RATE_KD",
+        L.roll_rate_kd,
+        -2.0,
+        0.0,
+        "s",
+        "Roll-rate damper, aileron per roll rate, applied as -kd*p",
+    ),
+    ParamDef::real(
+        "CRS_KP",
+        L.course_kp,
+        0.0,
+        20.0,
+        "rad/rad",
+        "Course hold P gain, commanded roll per course error",
+    ),
+    ParamDef::real(
+        "CRS_KI",
+        L.course_ki,
+        0.0,
+        20.0,
+        "1/s",
+        "Course hold I gain, commanded roll per integrated course error",
+    ),
+    ParamDef::real(
+        "SLIP_KP",
+        L.slip_kp,
+        0.0,
+        20.0,
+        "rad/rad",
+        "Sideslip hold P gain, rudder per sideslip error (positive)",
+    ),
+    ParamDef::real(
+        "SLIP_KI",
+        L.slip_ki,
+        0.0,
+        20.0,
+        "1/s",
+        "Sideslip hold I gain, rudder per integrated sideslip error",
+    ),
+    ParamDef::real(
+        "YAW_DAMP_K",
+        L.yaw_damper_k,
+        0.0,
+        2.0,
+        "s",
+        "Yaw damper, rudder per washed-out yaw rate (+k*r)",
+    ),
+    ParamDef::real(
+        "YAW_WO_POLE",
+        L.washout_pole,
+        0.1,
+        20.0,
+        "rad/s",
+        "Pole of the yaw-damper washout s/(s+a)",
+    ),
+    ParamDef::real(
+        "LIM_ROLL_DEG",
+        L.roll_max * RAD2DEG,
+        5.0,
+        80.0,
+        "deg",
+        "Largest commanded roll angle",
+    ),
+    ParamDef::real(
+        "LIM_AIL_DEG",
+        25.0,
+        1.0,
+        25.0,
+        "deg",
+        "Aileron travel the autopilot may use",
+    ),
+    ParamDef::real(
+        "LIM_RUD_DEG",
+        25.0,
+        1.0,
+        25.0,
+        "deg",
+        "Rudder travel the autopilot may use",
+    ),
+    ParamDef::real(
+        "TRIM_AIL_DEG",
+        L.trim_aileron * RAD2DEG,
+        -25.0,
+        25.0,
+        "deg",
+        "Aileron trim, feed-forward of the roll loop (trim I)",
+    ),
+    ParamDef::real(
+        "TRIM_RUD_DEG",
+        L.trim_rudder * RAD2DEG,
+        -25.0,
+        25.0,
+        "deg",
+        "Rudder trim, feed-forward of the rudder loops (trim I)",
+    ),
+];
+
+/// What the ailerons do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RollMode {
+    /// Not engaged: aileron at trim, loops at rest.
+    Off,
+    /// Hold this roll angle, rad (limited to the roll limit).
+    Roll(f32),
+    /// Hold this course over ground, rad (any value; the error is wrapped to +-pi).
+    Course(f32),
+}
+
+/// What the rudder does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum YawMode {
+    /// Not engaged: rudder at trim.
+    Off,
+    /// Yaw damper only.
+    Damper,
+    /// Hold this sideslip angle, rad (normally 0), with the yaw damper.
+    Sideslip(f32),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum RollKind {
+    Off,
+    Roll,
+    Course,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum YawKind {
+    Off,
+    Damper,
+    Sideslip,
+}
+
+/// Output of one lateral step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LateralOutput {
+    /// Aileron, rad (UMN sign).
+    pub aileron: f32,
+    /// Rudder, rad (UMN sign).
+    pub rudder: f32,
+    /// Roll angle the roll loop was asked for, rad (NaN when the roll axis is off).
+    pub roll_cmd: f32,
+    /// The aileron was held at its last good value this step.
+    pub aileron_held: bool,
+    /// The rudder was held at its last good value this step.
+    pub rudder_held: bool,
+    /// Inputs refused this step.
+    pub rejected: InputFlags,
+}
+
+/// The lateral autopilot: roll-rate damper inside PI roll inside PI course; PI sideslip plus
+/// washed-out yaw damper on the rudder.
+#[derive(Clone, Copy, Debug)]
+pub struct Lateral {
+    gains: LateralGains,
+    roll: Pid,
+    course: Pid,
+    slip: Pid,
+    washout: Washout,
+    roll_kind: RollKind,
+    yaw_kind: YawKind,
+    aileron: f32,
+    rudder: f32,
+    roll_cmd: f32,
+    roll_resume: bool,
+    yaw_resume: bool,
+}
+
+fn roll_gains(g: &LateralGains) -> PidGains {
+    PidGains::symmetric(
+        g.roll_kp,
+        g.roll_ki,
+        g.roll_rate_kd,
+        g.aileron_max.min(SURFACE_LIMIT_RAD),
+    )
+}
+
+fn course_gains(g: &LateralGains) -> PidGains {
+    PidGains::symmetric(g.course_kp, g.course_ki, 0.0, g.roll_max)
+}
+
+fn slip_gains(g: &LateralGains) -> PidGains {
+    PidGains::symmetric(
+        g.slip_kp,
+        g.slip_ki,
+        0.0,
+        g.rudder_max.min(SURFACE_LIMIT_RAD),
+    )
+}
+
+fn dt_ok(dt: f32) -> bool {
+    dt.is_finite() && dt > 0.0
+}
+
+impl Lateral {
+    /// A disengaged lateral autopilot with these gains; `transfer_tc` is the bumpless fade time
+    /// constant, s. Gains are expected to have passed [`super::GainSet::validate`].
+    pub fn new(gains: &LateralGains, transfer_tc: f32) -> Self {
+        Self {
+            gains: *gains,
+            roll: Pid::new(roll_gains(gains), transfer_tc),
+            course: Pid::new(course_gains(gains), transfer_tc),
+            slip: Pid::new(slip_gains(gains), transfer_tc),
+            washout: Washout::new(gains.washout_pole),
+            roll_kind: RollKind::Off,
+            yaw_kind: YawKind::Off,
+            aileron: gains.trim_aileron,
+            rudder: gains.trim_rudder,
+            roll_cmd: f32::NAN,
+            roll_resume: false,
+            yaw_resume: false,
+        }
+    }
+
+    /// Replaces the gains in flight; engaged loops re-initialise bumplessly on the next step.
+    pub fn set_gains(&mut self, gains: &LateralGains, transfer_tc: f32) {
+        self.gains = *gains;
+        self.roll.set_gains(roll_gains(gains), transfer_tc);
+        self.course.set_gains(course_gains(gains), transfer_tc);
+        self.slip.set_gains(slip_gains(gains), transfer_tc);
+        self.washout.set_pole(gains.washout_pole);
+        self.roll_resume = true;
+        self.yaw_resume = true;
+    }
+
+    /// Makes the next engagement start from these surface positions (e.g. where the pilot held
+    /// them) instead of the trim.
+    pub fn handover(&mut self, aileron: f32, rudder: f32) {
+        if self.roll_kind == RollKind::Off && aileron.is_finite() {
+            self.aileron = aileron;
+        }
+        if self.yaw_kind == YawKind::Off && rudder.is_finite() {
+            self.rudder = rudder;
+        }
+    }
+
+    /// One step. Measurements a mode needs that are not finite (or a non-finite setpoint, or a
+    /// bad `dt`) hold that surface at its last good value; the loops resume bumplessly when the
+    /// inputs are good again.
+    pub fn step(
+        &mut self,
+        m: &Measurements,
+        roll: RollMode,
+        yaw: YawMode,
+        dt: f32,
+    ) -> LateralOutput {
+        let mut rejected = InputFlags::empty();
+        let aileron_held = self.step_roll(m, roll, dt, &mut rejected);
+        let rudder_held = self.step_yaw(m, yaw, dt, &mut rejected);
+        LateralOutput {
+            aileron: self.aileron,
+            rudder: self.rudder,
+            roll_cmd: if self.roll_kind == RollKind::Off {
+                f32::NAN
+            } else {
+                self.roll_cmd
+            },
+            aileron_held,
+            rudder_held,
+            rejected,
+        }
+    }
+
+    fn step_roll(
+        &mut self,
+        m: &Measurements,
+        mode: RollMode,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> bool {
+        let g = &self.gains;
+        let (kind, setpoint) = match mode {
+            RollMode::Off => {
+                self.roll.reset();
+                self.course.reset();
+                self.roll_kind = RollKind::Off;
+                self.roll_resume = false;
+                self.aileron = g.trim_aileron;
+                return false;
+            }
+            RollMode::Roll(phi_c) => (RollKind::Roll, phi_c),
+            RollMode::Course(chi_c) => (RollKind::Course, chi_c),
+        };
+        let mut bad = InputFlags::empty();
+        bad.set(InputFlags::ROLL, !m.roll.is_finite());
+        bad.set(InputFlags::ROLL_RATE, !m.roll_rate.is_finite());
+        bad.set(
+            InputFlags::COURSE,
+            kind == RollKind::Course && !m.course.is_finite(),
+        );
+        bad.set(InputFlags::COMMAND, !setpoint.is_finite());
+        bad.set(InputFlags::DT, !dt_ok(dt));
+        if !bad.is_empty() {
+            *rejected |= bad;
+            self.roll_resume = true;
+            return true;
+        }
+
+        let prev = self.roll_kind;
+        let restart = prev != kind || self.roll_resume;
+        if prev == RollKind::Off || self.roll_resume {
+            self.roll.reset_to(self.aileron, Bumpless::Integrator);
+        }
+        let phi_c = match kind {
+            RollKind::Course => {
+                if restart {
+                    // From Off the course loop starts at the present bank; from Roll (or after a
+                    // hold) at the roll command it replaces.
+                    let from = if prev == RollKind::Off {
+                        m.roll
+                    } else {
+                        self.roll_cmd
+                    };
+                    self.course.reset_to(from, Bumpless::Fade);
+                }
+                let e = wrap_pi(setpoint - m.course);
+                self.course.step(e, Derivative::None, 0.0, dt)
+            }
+            _ => {
+                self.course.reset();
+                setpoint.clamp(-g.roll_max, g.roll_max)
+            }
+        };
+        let e = wrap_pi(phi_c - m.roll);
+        self.aileron = self
+            .roll
+            .step(e, Derivative::Rate(m.roll_rate), g.trim_aileron, dt);
+        self.roll_cmd = phi_c;
+        self.roll_kind = kind;
+        self.roll_resume = false;
+        false
+    }
+
+    fn step_yaw(
+        &mut self,
+        m: &Measurements,
+        mode: YawMode,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> bool {
+        let g = &self.gains;
+        let (kind, beta_c) = match mode {
+            YawMode::Off => {
+                self.slip.reset();
+                self.washout.reset();
+                self.yaw_kind = YawKind::Off;
+                self.yaw_resume = false;
+                self.rudder = g.trim_rudder;
+                return false;
+            }
+            YawMode::Damper => (YawKind::Damper, 0.0),
+            YawMode::Sideslip(b) => (YawKind::Sideslip, b),
+        };
+        let mut bad = InputFlags::empty();
+        bad.set(InputFlags::YAW_RATE, !m.yaw_rate.is_finite());
+        bad.set(
+            InputFlags::SIDESLIP,
+            kind == YawKind::Sideslip && !m.sideslip.is_finite(),
+        );
+        bad.set(InputFlags::COMMAND, !beta_c.is_finite());
+        bad.set(InputFlags::DT, !dt_ok(dt));
+        if !bad.is_empty() {
+            *rejected |= bad;
+            self.yaw_resume = true;
+            return true;
+        }
+
+        let prev = self.yaw_kind;
+        if prev == YawKind::Off || self.yaw_resume {
+            // Restart the washout from the present yaw rate: a steady turn gives no kick.
+            self.washout.reset();
+        }
+        if prev != kind || self.yaw_resume {
+            // Damper only: whatever the sideslip integrator held fades out. Sideslip hold: the
+            // integrator takes over the present rudder.
+            let how = if kind == YawKind::Damper {
+                Bumpless::Fade
+            } else {
+                Bumpless::Integrator
+            };
+            self.slip.reset_to(self.rudder, how);
+        }
+        let damper = g.yaw_damper_k * self.washout.step(m.yaw_rate, dt);
+        let e = if kind == YawKind::Sideslip {
+            beta_c - m.sideslip
+        } else {
+            0.0
+        };
+        self.rudder = self
+            .slip
+            .step(e, Derivative::None, g.trim_rudder + damper, dt);
+        self.yaw_kind = kind;
+        self.yaw_resume = false;
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f32 = 0.02;
+    const D: f32 = core::f32::consts::PI / 180.0;
+
+    fn zero_trim() -> LateralGains {
+        let mut g = DESIGNED.lateral;
+        g.trim_aileron = 0.0;
+        g.trim_rudder = 0.0;
+        g
+    }
+
+    #[test]
+    fn signs_follow_umn_convention() {
+        // Each loop is engaged first (bumpless: output = trim), then disturbed.
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        let m = Measurements::level(17.0, 100.0);
+        lat.step(&m, RollMode::Roll(0.0), YawMode::Off, DT);
+        // Asked to bank right: aileron negative (positive aileron rolls left).
+        let o = lat.step(&m, RollMode::Roll(10.0 * D), YawMode::Off, DT);
+        assert!(o.aileron < 0.0, "{o:?}");
+        // Rolling right with no error: the damper adds positive aileron against it.
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        let m2 = Measurements {
+            roll_rate: 0.5,
+            ..m
+        };
+        lat.step(&m, RollMode::Roll(0.0), YawMode::Off, DT);
+        let o = lat.step(&m2, RollMode::Roll(0.0), YawMode::Off, DT);
+        assert!((o.aileron - 0.0618 * 0.5).abs() < 1e-6, "{o:?}");
+        // Yawing right (r > 0): the damper deflects the rudder positive (nose left).
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        lat.step(&m, RollMode::Off, YawMode::Damper, DT);
+        let o = lat.step(
+            &Measurements { yaw_rate: 0.2, ..m },
+            RollMode::Off,
+            YawMode::Damper,
+            DT,
+        );
+        assert!((o.rudder - 0.065 * 0.2).abs() < 1e-6, "{o:?}");
+        // Positive sideslip: negative rudder (yaw the nose right, into the wind).
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        lat.step(&m, RollMode::Off, YawMode::Sideslip(0.0), DT);
+        let o = lat.step(
+            &Measurements {
+                sideslip: 0.05,
+                ..m
+            },
+            RollMode::Off,
+            YawMode::Sideslip(0.0),
+            DT,
+        );
+        assert!(o.rudder < 0.0, "{o:?}");
+        // Course to the right of the present one: bank right.
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        lat.step(&m, RollMode::Course(0.0), YawMode::Off, DT);
+        let o = lat.step(&m, RollMode::Course(5.0 * D), YawMode::Off, DT);
+        assert!(o.roll_cmd > 0.0 && o.aileron < 0.0, "{o:?}");
+    }
+
+    #[test]
+    fn course_error_wraps_across_180_deg() {
+        let g = zero_trim();
+        let m = Measurements {
+            course: 179.0 * D,
+            ..Measurements::level(17.0, 100.0)
+        };
+        // Command -179 deg from 179 deg: 2 deg to the right, not 358 to the left.
+        let mut lat = Lateral::new(&g, 1.0);
+        lat.step(&m, RollMode::Course(179.0 * D), YawMode::Off, DT);
+        let o = lat.step(&m, RollMode::Course(-179.0 * D), YawMode::Off, DT);
+        let expected = g.course_kp * 2.0 * D + g.course_ki * 2.0 * D * DT;
+        assert!(
+            (o.roll_cmd - expected).abs() < 1e-4,
+            "{} vs {expected}",
+            o.roll_cmd
+        );
+        // And the other way round.
+        let m = Measurements {
+            course: -179.0 * D,
+            ..m
+        };
+        let mut lat = Lateral::new(&g, 1.0);
+        lat.step(&m, RollMode::Course(-179.0 * D), YawMode::Off, DT);
+        let o = lat.step(&m, RollMode::Course(179.0 * D), YawMode::Off, DT);
+        assert!((o.roll_cmd + expected).abs() < 1e-4, "{}", o.roll_cmd);
+        // Commands beyond +-pi are the same course.
+        let mut lat = Lateral::new(&g, 1.0);
+        lat.step(&m, RollMode::Course(-179.0 * D), YawMode::Off, DT);
+        let o2 = lat.step(
+            &m,
+            RollMode::Course(179.0 * D + 4.0 * core::f32::consts::PI),
+            YawMode::Off,
+            DT,
+        );
+        assert!((o2.roll_cmd - o.roll_cmd).abs() < 1e-3);
+    }
+
+    #[test]
+    fn roll_command_limited_to_45_deg() {
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        let m = Measurements::level(17.0, 100.0);
+        let o = lat.step(&m, RollMode::Course(0.0), YawMode::Off, DT);
+        assert_eq!(o.roll_cmd, 0.0);
+        let o = lat.step(&m, RollMode::Course(150.0 * D), YawMode::Off, DT);
+        assert!((o.roll_cmd - 45.0 * D).abs() < 1e-6, "{}", o.roll_cmd / D);
+        let o = lat.step(&m, RollMode::Roll(-80.0 * D), YawMode::Off, DT);
+        assert!((o.roll_cmd + 45.0 * D).abs() < 1e-6);
+        // Aileron inside the servo limit whatever the error.
+        let wild = Measurements { roll: 3.0, ..m };
+        let o = lat.step(&wild, RollMode::Roll(-80.0 * D), YawMode::Off, DT);
+        assert!(o.aileron.abs() <= SURFACE_LIMIT_RAD + 1e-6);
+    }
+
+    #[test]
+    fn engaging_and_mode_changes_are_bumpless() {
+        let g = DESIGNED.lateral;
+        let mut lat = Lateral::new(&g, 1.0);
+        let m = Measurements {
+            roll: 12.0 * D,
+            roll_rate: 0.1,
+            yaw_rate: 0.05,
+            sideslip: 0.02,
+            ..Measurements::level(17.0, 100.0)
+        };
+        // Pilot held some aileron and rudder; engaging starts from there.
+        lat.handover(0.07, -0.03);
+        let o = lat.step(&m, RollMode::Course(1.0), YawMode::Sideslip(0.0), DT);
+        assert!((o.aileron - 0.07).abs() < 1e-6, "{o:?}");
+        assert!((o.rudder + 0.03).abs() < 1e-6, "{o:?}");
+        // Course loop started at the present bank.
+        assert!((o.roll_cmd - 12.0 * D).abs() < 1e-6);
+        // Course -> roll -> course: the course loop picks up the roll command it replaces.
+        let o = lat.step(&m, RollMode::Roll(20.0 * D), YawMode::Damper, DT);
+        let rudder_before = o.rudder;
+        let o = lat.step(&m, RollMode::Course(1.0), YawMode::Damper, DT);
+        assert!((o.roll_cmd - 20.0 * D).abs() < 1e-6, "{}", o.roll_cmd / D);
+        // Damper-only rudder: continuous at the switch, then the sideslip loop's share fades.
+        assert!((o.rudder - rudder_before).abs() < 0.01);
+    }
+}

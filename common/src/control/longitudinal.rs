@@ -1,0 +1,939 @@
+//! Longitudinal autopilot (thesis section 3.5, Figures 3-16 to 3-21): elevator and throttle.
+//!
+//! ```text
+//! theta_c source (by regime) --[+-pitch_max]-- theta_c --(+)-- PI pitch --(+)-- trim --[+-elev_max]--> elevator
+//!   altitude:  PI on (h_c - LPF(h))                       theta        -kd q
+//!   airspeed:  PI on (Va_c - LPF(Va))   (negative gain: too slow -> nose down)
+//!   take-off:  fixed takeoff pitch
+//! throttle source (by regime): full | zero | PI on (Va_c - LPF(Va)) + trim --[min..max]--> throttle
+//! ```
+//!
+//! Regimes of Figure 3-16 ([`Regime`]), chosen from the altitude error `e = h_c - LPF(h)` by
+//! [`RegimeMachine`]: take-off (full throttle, fixed pitch) until the clear altitude; climb (full
+//! throttle, airspeed by pitch) while `e` is above the band; altitude hold (altitude by pitch,
+//! airspeed by throttle) inside it; descent (zero throttle, airspeed by pitch) below it. The band
+//! is entered at `|e| < band` and left only at `|e| > band + hysteresis`, so altitude noise at the
+//! edge does not make the regime chatter. When a regime changes the source of the pitch or
+//! throttle command, the new source starts from the command the old one gave (bumpless).
+//!
+//! Signs (UMN): positive elevator pitches the nose down, so the pitch gains are negative and
+//! `-kd q` with `kd < 0` adds elevator against the pitch rate.
+
+use super::autopilot::{InputFlags, Measurements};
+use super::filters::LowPass;
+use super::gains::{LongitudinalGains, DESIGNED, RAD2DEG};
+use super::pid::{Bumpless, Derivative, Pid, PidGains};
+use crate::actuators::SURFACE_LIMIT_RAD;
+use crate::math::wrap_pi;
+use crate::params::ParamDef;
+
+const G: LongitudinalGains = DESIGNED.longitudinal;
+
+/// Parameters of the longitudinal autopilot; defaults are the thesis's designed set (trims:
+/// Table 2.3 trim I; take-off pitch, band and hysteresis: not in the thesis, chosen here). The
+/// bounds of the loop gains admit only the sign that stabilises the loop in the UMN convention.
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef::real(
+        "PTCH_KP",
+        G.pitch_kp,
+        -10.0,
+        0.0,
+        "rad/rad",
+        "Pitch attitude P gain, elevator per pitch error (UMN sign: negative)",
+    ),
+    ParamDef::real(
+        "PTCH_KI",
+        G.pitch_ki,
+        -10.0,
+        0.0,
+        "1/s",
+        "Pitch attitude I gain, elevator per integrated pitch error",
+    ),
+    ParamDef::real(
+        "PTCH_RATE_KD",
+        G.pitch_rate_kd,
+        -2.0,
+        0.0,
+        "s",
+        "Pitch-rate damper, elevator per pitch rate, applied as -kd*q",
+    ),
+    ParamDef::real(
+        "ALT_KP",
+        G.alt_kp,
+        0.0,
+        1.0,
+        "rad/m",
+        "Altitude hold P gain, commanded pitch per altitude error",
+    ),
+    ParamDef::real(
+        "ALT_KI",
+        G.alt_ki,
+        0.0,
+        1.0,
+        "rad/(m s)",
+        "Altitude hold I gain, commanded pitch per integrated altitude error",
+    ),
+    ParamDef::real(
+        "ASPD_PTCH_KP",
+        G.aspd_pitch_kp,
+        -5.0,
+        0.0,
+        "rad s/m",
+        "Airspeed-by-pitch P gain, commanded pitch per airspeed error",
+    ),
+    ParamDef::real(
+        "ASPD_PTCH_KI",
+        G.aspd_pitch_ki,
+        -5.0,
+        0.0,
+        "rad/m",
+        "Airspeed-by-pitch I gain, per integrated airspeed error",
+    ),
+    ParamDef::real(
+        "ASPD_THR_KP",
+        G.aspd_thr_kp,
+        0.0,
+        5.0,
+        "s/m",
+        "Airspeed-by-throttle P gain, throttle per airspeed error",
+    ),
+    ParamDef::real(
+        "ASPD_THR_KI",
+        G.aspd_thr_ki,
+        0.0,
+        50.0,
+        "1/m",
+        "Airspeed-by-throttle I gain, throttle per integrated airspeed error",
+    ),
+    ParamDef::real(
+        "LIM_PTCH_DEG",
+        G.pitch_max * RAD2DEG,
+        5.0,
+        45.0,
+        "deg",
+        "Largest commanded pitch angle (either sign)",
+    ),
+    ParamDef::real(
+        "LIM_ELEV_DEG",
+        25.0,
+        1.0,
+        25.0,
+        "deg",
+        "Elevator travel the autopilot may use",
+    ),
+    ParamDef::real(
+        "THR_MIN",
+        G.throttle_min,
+        0.0,
+        1.0,
+        "",
+        "Throttle in the descent regime and lowest throttle",
+    ),
+    ParamDef::real(
+        "THR_MAX",
+        G.throttle_max,
+        0.0,
+        1.0,
+        "",
+        "Throttle in take-off and climb and highest throttle",
+    ),
+    ParamDef::real(
+        "TRIM_ELEV_DEG",
+        G.trim_elevator * RAD2DEG,
+        -25.0,
+        25.0,
+        "deg",
+        "Elevator trim, feed-forward of the pitch loop (trim I)",
+    ),
+    ParamDef::real(
+        "TRIM_THR",
+        G.trim_throttle,
+        0.0,
+        1.0,
+        "",
+        "Throttle trim, feed-forward of the airspeed-by-throttle loop",
+    ),
+    ParamDef::real(
+        "FB_LPF_POLE",
+        G.feedback_lpf_pole,
+        0.1,
+        50.0,
+        "rad/s",
+        "Pole of the low-pass on altitude and airspeed feedback",
+    ),
+    ParamDef::real(
+        "TKO_PTCH_DEG",
+        G.takeoff_pitch * RAD2DEG,
+        0.0,
+        30.0,
+        "deg",
+        "Pitch held in the take-off regime",
+    ),
+    ParamDef::real(
+        "ALT_BAND_M",
+        G.alt_band,
+        1.0,
+        500.0,
+        "m",
+        "Altitude-hold band: hold regime entered inside +-band",
+    ),
+    ParamDef::real(
+        "ALT_HYST_M",
+        G.alt_hysteresis,
+        0.0,
+        100.0,
+        "m",
+        "Hold regime left only beyond +-(band + hysteresis)",
+    ),
+];
+
+/// What the elevator and throttle do. Angles rad, altitudes m, airspeeds m/s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LonMode {
+    /// Not engaged: elevator and throttle at trim, loops at rest.
+    Off,
+    /// Hold this pitch angle; throttle as given (0..1).
+    Pitch {
+        /// Pitch angle, rad (limited to the pitch limit).
+        pitch: f32,
+        /// Throttle, 0..1.
+        throttle: f32,
+    },
+    /// Hold this airspeed with the elevator (by commanded pitch); throttle as given.
+    AirspeedPitch {
+        /// Airspeed, m/s.
+        airspeed: f32,
+        /// Throttle, 0..1.
+        throttle: f32,
+    },
+    /// Reach and hold this altitude and airspeed through the climb / hold / descent regimes.
+    Altitude {
+        /// Altitude, m (same datum as the measured altitude).
+        altitude: f32,
+        /// Airspeed, m/s.
+        airspeed: f32,
+    },
+    /// As [`LonMode::Altitude`], starting in the take-off regime while below `clear_altitude`.
+    TakeOff {
+        /// Altitude, m.
+        altitude: f32,
+        /// Airspeed, m/s.
+        airspeed: f32,
+        /// Altitude at which the take-off regime ends, m.
+        clear_altitude: f32,
+    },
+}
+
+/// Flight regime of Figure 3-16.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Regime {
+    /// Full throttle, fixed pitch.
+    TakeOff,
+    /// Full throttle, airspeed by pitch.
+    Climb,
+    /// Altitude by pitch, airspeed by throttle.
+    AltitudeHold,
+    /// Zero throttle, airspeed by pitch.
+    Descent,
+}
+
+/// The regime state machine with hysteresis on the altitude band.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RegimeMachine {
+    regime: Option<Regime>,
+}
+
+impl RegimeMachine {
+    /// A machine with no regime yet; the first update picks one from scratch.
+    pub fn new() -> Self {
+        Self { regime: None }
+    }
+
+    /// The present regime.
+    pub fn regime(&self) -> Option<Regime> {
+        self.regime
+    }
+
+    /// Forgets the regime.
+    pub fn reset(&mut self) {
+        self.regime = None;
+    }
+
+    /// Next regime from the altitude error `error = h_c - h` (m), the altitude `altitude` (m),
+    /// the take-off clear altitude (when taking off), the band and its hysteresis (m).
+    ///
+    /// Take-off is a phase, not a zone: it is entered only when the machine starts below the
+    /// clear altitude, and left for good once above it.
+    pub fn update(
+        &mut self,
+        error: f32,
+        altitude: f32,
+        clear_altitude: Option<f32>,
+        band: f32,
+        hysteresis: f32,
+    ) -> Regime {
+        let leave = band + hysteresis.max(0.0);
+        let fresh = if error > band {
+            Regime::Climb
+        } else if error < -band {
+            Regime::Descent
+        } else {
+            Regime::AltitudeHold
+        };
+        let below_clear = matches!(clear_altitude, Some(c) if altitude < c);
+        let next = match self.regime {
+            None if below_clear => Regime::TakeOff,
+            None => fresh,
+            Some(Regime::TakeOff) if below_clear => Regime::TakeOff,
+            Some(Regime::TakeOff) => fresh,
+            Some(Regime::Climb) => {
+                if error < -leave {
+                    Regime::Descent
+                } else if error < band {
+                    Regime::AltitudeHold
+                } else {
+                    Regime::Climb
+                }
+            }
+            Some(Regime::AltitudeHold) => {
+                if error > leave {
+                    Regime::Climb
+                } else if error < -leave {
+                    Regime::Descent
+                } else {
+                    Regime::AltitudeHold
+                }
+            }
+            Some(Regime::Descent) => {
+                if error > leave {
+                    Regime::Climb
+                } else if error > -band {
+                    Regime::AltitudeHold
+                } else {
+                    Regime::Descent
+                }
+            }
+        };
+        self.regime = Some(next);
+        next
+    }
+}
+
+/// Output of one longitudinal step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LongitudinalOutput {
+    /// Elevator, rad (UMN sign).
+    pub elevator: f32,
+    /// Throttle, 0..1.
+    pub throttle: f32,
+    /// Pitch angle the pitch loop was asked for, rad (NaN when off).
+    pub pitch_cmd: f32,
+    /// Regime, in the altitude modes.
+    pub regime: Option<Regime>,
+    /// The elevator was held at its last good value this step.
+    pub elevator_held: bool,
+    /// The throttle was held at its last good value this step.
+    pub throttle_held: bool,
+    /// Inputs refused this step.
+    pub rejected: InputFlags,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum PitchSource {
+    Fixed(f32),
+    Airspeed(f32),
+    Altitude(f32),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ThrottleSource {
+    Fixed(f32),
+    Airspeed(f32),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum SourceKind {
+    Off,
+    Fixed,
+    Airspeed,
+    Altitude,
+}
+
+impl PitchSource {
+    fn kind(self) -> SourceKind {
+        match self {
+            PitchSource::Fixed(_) => SourceKind::Fixed,
+            PitchSource::Airspeed(_) => SourceKind::Airspeed,
+            PitchSource::Altitude(_) => SourceKind::Altitude,
+        }
+    }
+}
+
+impl ThrottleSource {
+    fn kind(self) -> SourceKind {
+        match self {
+            ThrottleSource::Fixed(_) => SourceKind::Fixed,
+            ThrottleSource::Airspeed(_) => SourceKind::Airspeed,
+        }
+    }
+}
+
+/// The longitudinal autopilot.
+#[derive(Clone, Copy, Debug)]
+pub struct Longitudinal {
+    gains: LongitudinalGains,
+    pitch: Pid,
+    alt: Pid,
+    aspd_pitch: Pid,
+    aspd_thr: Pid,
+    alt_lpf: LowPass,
+    aspd_lpf: LowPass,
+    machine: RegimeMachine,
+    pitch_src: SourceKind,
+    thr_src: SourceKind,
+    elevator: f32,
+    throttle: f32,
+    pitch_cmd: f32,
+    elev_resume: bool,
+    thr_resume: bool,
+}
+
+fn pitch_gains(g: &LongitudinalGains) -> PidGains {
+    PidGains::symmetric(
+        g.pitch_kp,
+        g.pitch_ki,
+        g.pitch_rate_kd,
+        g.elevator_max.min(SURFACE_LIMIT_RAD),
+    )
+}
+
+fn alt_gains(g: &LongitudinalGains) -> PidGains {
+    PidGains::symmetric(g.alt_kp, g.alt_ki, 0.0, g.pitch_max)
+}
+
+fn aspd_pitch_gains(g: &LongitudinalGains) -> PidGains {
+    PidGains::symmetric(g.aspd_pitch_kp, g.aspd_pitch_ki, 0.0, g.pitch_max)
+}
+
+fn aspd_thr_gains(g: &LongitudinalGains) -> PidGains {
+    PidGains {
+        kp: g.aspd_thr_kp,
+        ki: g.aspd_thr_ki,
+        kd: 0.0,
+        out_min: g.throttle_min,
+        out_max: g.throttle_max,
+    }
+}
+
+impl Longitudinal {
+    /// A disengaged longitudinal autopilot; `transfer_tc` is the bumpless fade time constant, s.
+    /// Gains are expected to have passed [`super::GainSet::validate`].
+    pub fn new(gains: &LongitudinalGains, transfer_tc: f32) -> Self {
+        Self {
+            gains: *gains,
+            pitch: Pid::new(pitch_gains(gains), transfer_tc),
+            alt: Pid::new(alt_gains(gains), transfer_tc),
+            aspd_pitch: Pid::new(aspd_pitch_gains(gains), transfer_tc),
+            aspd_thr: Pid::new(aspd_thr_gains(gains), transfer_tc),
+            alt_lpf: LowPass::new(gains.feedback_lpf_pole),
+            aspd_lpf: LowPass::new(gains.feedback_lpf_pole),
+            machine: RegimeMachine::new(),
+            pitch_src: SourceKind::Off,
+            thr_src: SourceKind::Off,
+            elevator: gains.trim_elevator,
+            throttle: gains.trim_throttle,
+            pitch_cmd: f32::NAN,
+            elev_resume: false,
+            thr_resume: false,
+        }
+    }
+
+    /// Replaces the gains in flight; engaged loops re-initialise bumplessly on the next step.
+    pub fn set_gains(&mut self, gains: &LongitudinalGains, transfer_tc: f32) {
+        self.gains = *gains;
+        self.pitch.set_gains(pitch_gains(gains), transfer_tc);
+        self.alt.set_gains(alt_gains(gains), transfer_tc);
+        self.aspd_pitch
+            .set_gains(aspd_pitch_gains(gains), transfer_tc);
+        self.aspd_thr.set_gains(aspd_thr_gains(gains), transfer_tc);
+        self.alt_lpf.set_pole(gains.feedback_lpf_pole);
+        self.aspd_lpf.set_pole(gains.feedback_lpf_pole);
+        self.elev_resume = true;
+        self.thr_resume = true;
+    }
+
+    /// Makes the next engagement start from these positions instead of the trim.
+    pub fn handover(&mut self, elevator: f32, throttle: f32) {
+        if self.pitch_src == SourceKind::Off && elevator.is_finite() {
+            self.elevator = elevator;
+        }
+        if self.thr_src == SourceKind::Off && throttle.is_finite() {
+            self.throttle = throttle;
+        }
+    }
+
+    /// The present regime (altitude modes only).
+    pub fn regime(&self) -> Option<Regime> {
+        self.machine.regime()
+    }
+
+    /// One step. Measurements the active loops need that are not finite (or a non-finite
+    /// setpoint, or a bad `dt`) hold that output at its last good value; the loops resume
+    /// bumplessly when the inputs are good again. The altitude and airspeed filters run on
+    /// every good sample, whatever the mode, so they are warm when a loop engages.
+    pub fn step(&mut self, m: &Measurements, mode: LonMode, dt: f32) -> LongitudinalOutput {
+        let g = self.gains;
+        let dt_good = dt.is_finite() && dt > 0.0;
+        let alt_good = m.altitude.is_finite();
+        let aspd_good = m.airspeed.is_finite();
+        let alt_f = if dt_good && alt_good {
+            self.alt_lpf.step(m.altitude, dt)
+        } else {
+            self.alt_lpf.output()
+        };
+        let aspd_f = if dt_good && aspd_good {
+            self.aspd_lpf.step(m.airspeed, dt)
+        } else {
+            self.aspd_lpf.output()
+        };
+
+        let mut rejected = InputFlags::empty();
+        let (alt_c, aspd_c, clear) = match mode {
+            LonMode::Off => {
+                self.pitch.reset();
+                self.alt.reset();
+                self.aspd_pitch.reset();
+                self.aspd_thr.reset();
+                self.machine.reset();
+                self.pitch_src = SourceKind::Off;
+                self.thr_src = SourceKind::Off;
+                self.elev_resume = false;
+                self.thr_resume = false;
+                self.elevator = g.trim_elevator;
+                self.throttle = g.trim_throttle;
+                return LongitudinalOutput {
+                    elevator: self.elevator,
+                    throttle: self.throttle,
+                    pitch_cmd: f32::NAN,
+                    ..Default::default()
+                };
+            }
+            LonMode::Pitch { .. } | LonMode::AirspeedPitch { .. } => {
+                self.machine.reset();
+                (0.0, 0.0, None)
+            }
+            LonMode::Altitude { altitude, airspeed } => (altitude, airspeed, None),
+            LonMode::TakeOff {
+                altitude,
+                airspeed,
+                clear_altitude,
+            } => (altitude, airspeed, Some(clear_altitude)),
+        };
+
+        let sources = match mode {
+            LonMode::Pitch { pitch, throttle } => {
+                Some((PitchSource::Fixed(pitch), ThrottleSource::Fixed(throttle)))
+            }
+            LonMode::AirspeedPitch { airspeed, throttle } => Some((
+                PitchSource::Airspeed(airspeed),
+                ThrottleSource::Fixed(throttle),
+            )),
+            _ => {
+                let cmd_ok =
+                    alt_c.is_finite() && aspd_c.is_finite() && clear.is_none_or(f32::is_finite);
+                rejected.set(InputFlags::COMMAND, !cmd_ok);
+                rejected.set(InputFlags::ALTITUDE, !alt_good);
+                let regime = match alt_f {
+                    Some(h) if cmd_ok && alt_good && dt_good => {
+                        Some(
+                            self.machine
+                                .update(alt_c - h, h, clear, g.alt_band, g.alt_hysteresis),
+                        )
+                    }
+                    // Without a good altitude the regime stays as it was.
+                    _ if cmd_ok => self.machine.regime(),
+                    _ => None,
+                };
+                regime.map(|r| match r {
+                    Regime::TakeOff => (
+                        PitchSource::Fixed(g.takeoff_pitch),
+                        ThrottleSource::Fixed(g.throttle_max),
+                    ),
+                    Regime::Climb => (
+                        PitchSource::Airspeed(aspd_c),
+                        ThrottleSource::Fixed(g.throttle_max),
+                    ),
+                    Regime::AltitudeHold => (
+                        PitchSource::Altitude(alt_c),
+                        ThrottleSource::Airspeed(aspd_c),
+                    ),
+                    Regime::Descent => (
+                        PitchSource::Airspeed(aspd_c),
+                        ThrottleSource::Fixed(g.throttle_min),
+                    ),
+                })
+            }
+        };
+
+        let (elevator_held, throttle_held) = match sources {
+            None => {
+                // No regime (no good altitude yet, or a bad command): hold both.
+                rejected.set(InputFlags::DT, !dt_good);
+                self.elev_resume = true;
+                self.thr_resume = true;
+                (true, true)
+            }
+            Some((ps, ts)) => {
+                let e = self.step_elevator(m, ps, alt_f, aspd_f, dt, &mut rejected);
+                let t = self.step_throttle(m, ts, aspd_f, dt, &mut rejected);
+                (e, t)
+            }
+        };
+        LongitudinalOutput {
+            elevator: self.elevator,
+            throttle: self.throttle,
+            pitch_cmd: self.pitch_cmd,
+            regime: self.machine.regime(),
+            elevator_held,
+            throttle_held,
+            rejected,
+        }
+    }
+
+    fn step_elevator(
+        &mut self,
+        m: &Measurements,
+        src: PitchSource,
+        alt_f: Option<f32>,
+        aspd_f: Option<f32>,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> bool {
+        let g = self.gains;
+        let mut bad = InputFlags::empty();
+        bad.set(InputFlags::PITCH, !m.pitch.is_finite());
+        bad.set(InputFlags::PITCH_RATE, !m.pitch_rate.is_finite());
+        bad.set(InputFlags::DT, !(dt.is_finite() && dt > 0.0));
+        let (feedback, setpoint) = match src {
+            PitchSource::Fixed(v) => (Some(0.0), v),
+            PitchSource::Airspeed(v) => {
+                bad.set(InputFlags::AIRSPEED, !m.airspeed.is_finite());
+                (aspd_f, v)
+            }
+            PitchSource::Altitude(v) => {
+                bad.set(InputFlags::ALTITUDE, !m.altitude.is_finite());
+                (alt_f, v)
+            }
+        };
+        bad.set(InputFlags::COMMAND, !setpoint.is_finite());
+        let feedback = match feedback {
+            Some(f) if bad.is_empty() => f,
+            _ => {
+                *rejected |= bad;
+                self.elev_resume = true;
+                return true;
+            }
+        };
+
+        let prev = self.pitch_src;
+        let kind = src.kind();
+        if prev == SourceKind::Off || self.elev_resume {
+            self.pitch.reset_to(self.elevator, Bumpless::Integrator);
+        }
+        if prev != kind || self.elev_resume {
+            // The new source of the pitch command starts where the old one left it (from the
+            // present attitude when engaging).
+            let from = if prev == SourceKind::Off {
+                m.pitch
+            } else {
+                self.pitch_cmd
+            };
+            match kind {
+                SourceKind::Airspeed => self.aspd_pitch.reset_to(from, Bumpless::Fade),
+                SourceKind::Altitude => self.alt.reset_to(from, Bumpless::Fade),
+                _ => {}
+            }
+        }
+        let theta_c = match src {
+            PitchSource::Fixed(v) => v.clamp(-g.pitch_max, g.pitch_max),
+            PitchSource::Airspeed(v) => {
+                self.aspd_pitch
+                    .step(v - feedback, Derivative::None, 0.0, dt)
+            }
+            PitchSource::Altitude(v) => self.alt.step(v - feedback, Derivative::None, 0.0, dt),
+        };
+        let e = wrap_pi(theta_c - m.pitch);
+        self.elevator = self
+            .pitch
+            .step(e, Derivative::Rate(m.pitch_rate), g.trim_elevator, dt);
+        self.pitch_cmd = theta_c;
+        self.pitch_src = kind;
+        self.elev_resume = false;
+        false
+    }
+
+    fn step_throttle(
+        &mut self,
+        m: &Measurements,
+        src: ThrottleSource,
+        aspd_f: Option<f32>,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> bool {
+        let g = self.gains;
+        let mut bad = InputFlags::empty();
+        bad.set(InputFlags::DT, !(dt.is_finite() && dt > 0.0));
+        let (feedback, setpoint) = match src {
+            ThrottleSource::Fixed(v) => (Some(0.0), v),
+            ThrottleSource::Airspeed(v) => {
+                bad.set(InputFlags::AIRSPEED, !m.airspeed.is_finite());
+                (aspd_f, v)
+            }
+        };
+        bad.set(InputFlags::COMMAND, !setpoint.is_finite());
+        let feedback = match feedback {
+            Some(f) if bad.is_empty() => f,
+            _ => {
+                *rejected |= bad;
+                self.thr_resume = true;
+                return true;
+            }
+        };
+        let kind = src.kind();
+        self.throttle = match src {
+            ThrottleSource::Fixed(v) => {
+                self.aspd_thr.reset();
+                v.clamp(g.throttle_min, g.throttle_max)
+            }
+            ThrottleSource::Airspeed(v) => {
+                if self.thr_src != kind || self.thr_resume {
+                    self.aspd_thr.reset_to(self.throttle, Bumpless::Fade);
+                }
+                self.aspd_thr
+                    .step(v - feedback, Derivative::None, g.trim_throttle, dt)
+            }
+        };
+        self.thr_src = kind;
+        self.thr_resume = false;
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f32 = 0.02;
+    const D: f32 = core::f32::consts::PI / 180.0;
+
+    #[test]
+    fn regime_zones_and_sequence() {
+        let mut rm = RegimeMachine::new();
+        // Starting on the ground with a take-off request.
+        assert_eq!(
+            rm.update(100.0, 0.0, Some(20.0), 10.0, 2.0),
+            Regime::TakeOff
+        );
+        assert_eq!(
+            rm.update(85.0, 15.0, Some(20.0), 10.0, 2.0),
+            Regime::TakeOff
+        );
+        assert_eq!(rm.update(79.0, 21.0, Some(20.0), 10.0, 2.0), Regime::Climb);
+        // Sinking below the clear altitude again does not go back to take-off.
+        assert_eq!(rm.update(81.0, 19.0, Some(20.0), 10.0, 2.0), Regime::Climb);
+        assert_eq!(rm.update(10.5, 89.5, Some(20.0), 10.0, 2.0), Regime::Climb);
+        assert_eq!(
+            rm.update(9.5, 90.5, Some(20.0), 10.0, 2.0),
+            Regime::AltitudeHold
+        );
+        // New, lower setpoint: straight to descent, then hold inside the band.
+        assert_eq!(rm.update(-50.0, 100.0, None, 10.0, 2.0), Regime::Descent);
+        assert_eq!(rm.update(-10.5, 60.5, None, 10.0, 2.0), Regime::Descent);
+        assert_eq!(rm.update(-9.5, 59.5, None, 10.0, 2.0), Regime::AltitudeHold);
+        // From scratch without take-off: by zone.
+        let mut rm = RegimeMachine::new();
+        assert_eq!(rm.update(30.0, 0.0, None, 10.0, 2.0), Regime::Climb);
+        let mut rm = RegimeMachine::new();
+        assert_eq!(rm.update(-30.0, 0.0, None, 10.0, 2.0), Regime::Descent);
+        let mut rm = RegimeMachine::new();
+        assert_eq!(rm.update(3.0, 0.0, None, 10.0, 2.0), Regime::AltitudeHold);
+    }
+
+    /// The altitude error wanders across the band edge (10 m) by less than the hysteresis
+    /// (2 m): after entering the hold regime the machine stays there. Without hysteresis the
+    /// same signal would switch on nearly every crossing.
+    #[test]
+    fn hysteresis_prevents_chattering_at_the_band_edge() {
+        let count_switches = |hyst: f32| {
+            let mut rm = RegimeMachine::new();
+            let mut last = rm.update(15.0, 0.0, None, 10.0, hyst);
+            let mut switches = 0;
+            for k in 0..1000 {
+                // 10 m +- 1.5 m, a slow sine plus a fast "noise" component.
+                let t = k as f32 * DT;
+                let e = 10.0 + 1.0 * libm::sinf(0.7 * t) + 0.5 * libm::sinf(37.0 * t);
+                let r = rm.update(e, 0.0, None, 10.0, hyst);
+                if r != last {
+                    switches += 1;
+                    last = r;
+                }
+            }
+            switches
+        };
+        assert_eq!(count_switches(2.0), 1, "one entry into hold, then nothing");
+        assert!(
+            count_switches(0.0) > 20,
+            "the same signal chatters without hysteresis"
+        );
+    }
+
+    fn meas(pitch: f32, alt: f32, va: f32) -> Measurements {
+        Measurements {
+            pitch,
+            altitude: alt,
+            airspeed: va,
+            ..Measurements::level(va, alt)
+        }
+    }
+
+    #[test]
+    fn regime_transfers_are_bumpless() {
+        let g = DESIGNED.longitudinal;
+        let mut lon = Longitudinal::new(&g, 1.0);
+        let mode = LonMode::Altitude {
+            altitude: 130.0,
+            airspeed: 17.0,
+        };
+        // Climb: full throttle, pitch command from the airspeed loop, started at the attitude.
+        let o = lon.step(&meas(0.1, 100.0, 17.5), mode, DT);
+        assert_eq!(o.regime, Some(Regime::Climb));
+        assert_eq!(o.throttle, 1.0);
+        assert!((o.pitch_cmd - 0.1).abs() < 1e-6);
+        let mut h = 100.0;
+        let mut last = o;
+        let mut saw_hold = false;
+        for _ in 0..2000 {
+            h += 0.05;
+            let o = lon.step(&meas(0.1, h, 17.5), mode, DT);
+            // The pitch command never jumps, whatever the regime does.
+            assert!(
+                (o.pitch_cmd - last.pitch_cmd).abs() < 0.5 * D,
+                "{last:?} -> {o:?}"
+            );
+            if o.regime == Some(Regime::AltitudeHold) && last.regime == Some(Regime::Climb) {
+                // The throttle loop takes over from full throttle without a jump.
+                assert!(
+                    (o.throttle - last.throttle).abs() < 0.05,
+                    "{last:?} -> {o:?}"
+                );
+                saw_hold = true;
+            }
+            last = o;
+            if saw_hold {
+                break;
+            }
+        }
+        assert!(saw_hold);
+    }
+
+    #[test]
+    fn pitch_command_and_throttle_saturate() {
+        let g = DESIGNED.longitudinal;
+        let mut lon = Longitudinal::new(&g, 1.0);
+        let o = lon.step(
+            &meas(0.0, 100.0, 17.0),
+            LonMode::Pitch {
+                pitch: 40.0 * D,
+                throttle: 1.7,
+            },
+            DT,
+        );
+        assert!((o.pitch_cmd - 20.0 * D).abs() < 1e-6);
+        assert_eq!(o.throttle, 1.0);
+        let o = lon.step(
+            &meas(0.0, 100.0, 17.0),
+            LonMode::Pitch {
+                pitch: 40.0 * D,
+                throttle: 1.7,
+            },
+            DT,
+        );
+        assert!(
+            o.elevator >= -SURFACE_LIMIT_RAD && o.elevator < g.trim_elevator,
+            "nose up: {o:?}"
+        );
+        // Far below the setpoint in altitude hold (band 500 m): pitch command at +20 deg.
+        let mut g2 = g;
+        g2.alt_band = 500.0;
+        let mut lon = Longitudinal::new(&g2, 0.01);
+        let mode = LonMode::Altitude {
+            altitude: 300.0,
+            airspeed: 17.0,
+        };
+        let mut o = lon.step(&meas(0.0, 100.0, 17.0), mode, DT);
+        for _ in 0..100 {
+            o = lon.step(&meas(0.0, 100.0, 12.0), mode, DT);
+        }
+        assert_eq!(o.regime, Some(Regime::AltitudeHold));
+        assert!((o.pitch_cmd - 20.0 * D).abs() < 1e-5, "{}", o.pitch_cmd / D);
+        // Too slow by 5 m/s: throttle at its maximum, not beyond.
+        assert_eq!(o.throttle, 1.0);
+    }
+
+    #[test]
+    fn signs_follow_umn_convention() {
+        let mut g = DESIGNED.longitudinal;
+        g.trim_elevator = 0.0;
+        let mut lon = Longitudinal::new(&g, 1.0);
+        let m = meas(0.0, 100.0, 17.0);
+        let level = LonMode::Pitch {
+            pitch: 0.0,
+            throttle: 0.5,
+        };
+        // Engaged first (bumpless: output = trim), then asked for nose up: negative elevator.
+        lon.step(&m, level, DT);
+        let o = lon.step(
+            &m,
+            LonMode::Pitch {
+                pitch: 5.0 * D,
+                throttle: 0.5,
+            },
+            DT,
+        );
+        assert!(o.elevator < 0.0);
+        // Pitching up with no error: positive elevator against it.
+        let mut lon = Longitudinal::new(&g, 1.0);
+        let m2 = Measurements {
+            pitch_rate: 0.3,
+            ..m
+        };
+        lon.step(&m, level, DT);
+        let o = lon.step(&m2, level, DT);
+        assert!((o.elevator - 0.072 * 0.3).abs() < 1e-6, "{o:?}");
+        // Too slow, airspeed by pitch: nose down.
+        let mut lon = Longitudinal::new(&g, 1.0);
+        lon.step(
+            &m,
+            LonMode::AirspeedPitch {
+                airspeed: 17.0,
+                throttle: 0.5,
+            },
+            DT,
+        );
+        let mut o = LongitudinalOutput::default();
+        for _ in 0..50 {
+            o = lon.step(
+                &meas(0.0, 100.0, 16.0),
+                LonMode::AirspeedPitch {
+                    airspeed: 17.0,
+                    throttle: 0.5,
+                },
+                DT,
+            );
+        }
+        assert!(o.pitch_cmd < 0.0, "{o:?}");
+    }
+}
