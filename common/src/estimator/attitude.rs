@@ -160,14 +160,16 @@ impl AttitudeEkf {
 
     /// Fuses the accelerometer as a gravity reference.
     ///
-    /// `accel` is the measured specific force, `maneuver_body` the body acceleration the
-    /// aircraft is known to have (centripetal `omega x v_air`), `noise` the per-axis standard
-    /// deviation. The update is skipped when the compensated specific force is further than
+    /// `accel` is the measured specific force, `v_air_body` the air-relative velocity in body
+    /// axes: the aircraft's acceleration is taken as the centripetal `omega x v_air` of a turn
+    /// or pull-up, with `omega` the bias-corrected gyro rate `rates`. `noise` is the per-axis
+    /// standard deviation. The update is skipped when the compensated specific force is further than
     /// `gate_mps2` from g: then the aircraft accelerates in a way the model does not know.
     pub fn fuse_accel(
         &mut self,
         accel: &Vector3<f32>,
-        maneuver_body: &Vector3<f32>,
+        rates: &Vector3<f32>,
+        v_air_body: &Vector3<f32>,
         noise: f32,
         gate_mps2: f32,
         gate_sigma: f32,
@@ -175,12 +177,22 @@ impl AttitudeEkf {
         if !self.initialized {
             return None;
         }
+        let maneuver_body = rates.cross(v_air_body);
         let gravity_part = accel - maneuver_body;
         if libm::fabsf(gravity_part.norm() - GRAVITY) > gate_mps2 {
             return None;
         }
         let minus_g = Vector3::new(0.0, 0.0, -GRAVITY);
-        Some(self.fuse_vector(accel, maneuver_body, &minus_g, noise, gate_sigma))
+        // The centripetal term carries the bias error too: (omega - db) x v = m + [v]x db.
+        let bias_jac = v_air_body.cross_matrix();
+        Some(self.fuse_vector(
+            accel,
+            &maneuver_body,
+            &minus_g,
+            &bias_jac,
+            noise,
+            gate_sigma,
+        ))
     }
 
     /// Fuses a magnetometer sample against the earth field `earth_ned` (gauss).
@@ -194,15 +206,24 @@ impl AttitudeEkf {
         if !self.initialized {
             return None;
         }
-        Some(self.fuse_vector(mag, &Vector3::zeros(), earth_ned, noise, gate_sigma))
+        Some(self.fuse_vector(
+            mag,
+            &Vector3::zeros(),
+            earth_ned,
+            &Matrix3::zeros(),
+            noise,
+            gate_sigma,
+        ))
     }
 
-    /// Fuses `z = offset + R^T u` one component at a time, re-linearising after each.
+    /// Fuses `z = offset + R^T u` (with `d offset / d bias = bias_jac`) one component at a
+    /// time, re-linearising after each.
     fn fuse_vector(
         &mut self,
         z: &Vector3<f32>,
         offset: &Vector3<f32>,
         u_ned: &Vector3<f32>,
+        bias_jac: &Matrix3<f32>,
         noise: f32,
         gate_sigma: f32,
     ) -> VectorFusion {
@@ -216,6 +237,8 @@ impl AttitudeEkf {
             let mut h = Vec6::zeros();
             h.fixed_rows_mut::<3>(0)
                 .copy_from(&jac.row(axis).transpose());
+            h.fixed_rows_mut::<3>(3)
+                .copy_from(&bias_jac.row(axis).transpose());
             let innov = z[axis] - predicted[axis];
             let mut p = self.p;
             match scalar_update(&mut p, &h, innov, r_meas, gate_sigma) {
@@ -285,7 +308,14 @@ mod tests {
         f.q = Euler::new(0.087_f32, 0.0, 0.0).to_quaternion();
         for _ in 0..500 {
             f.predict(&Vector3::zeros(), 0.02, 0.0015, 5e-5);
-            f.fuse_accel(&accel, &Vector3::zeros(), 0.7, 2.5, 100.0);
+            f.fuse_accel(
+                &accel,
+                &Vector3::zeros(),
+                &Vector3::zeros(),
+                0.7,
+                2.5,
+                100.0,
+            );
         }
         let e = Euler::from_quaternion(&f.attitude());
         assert!(e.phi.abs() < 0.005, "roll {}", e.phi);

@@ -230,6 +230,14 @@ pub const PARAMS: &[ParamDef] = &[
         "converged: 1-sigma heading uncertainty below this",
     ),
     ParamDef::real(
+        "EST_CONV_GBIAS",
+        0.005,
+        1e-4,
+        0.1,
+        "rad/s",
+        "converged: 1-sigma gyro bias uncertainty (each axis) below this",
+    ),
+    ParamDef::real(
         "EST_CONV_POS",
         3.0,
         0.1,
@@ -310,6 +318,8 @@ pub struct EstimatorConfig {
     pub conv_tilt: f32,
     /// `EST_CONV_HDG`, rad.
     pub conv_heading: f32,
+    /// `EST_CONV_GBIAS`, rad/s.
+    pub conv_gyro_bias: f32,
     /// `EST_CONV_POS`, m.
     pub conv_pos: f32,
     /// `EST_CONV_VEL`, m/s.
@@ -348,6 +358,7 @@ impl Default for EstimatorConfig {
             max_rejections: 0,
             conv_tilt: 0.0,
             conv_heading: 0.0,
+            conv_gyro_bias: 0.0,
             conv_pos: 0.0,
             conv_vel: 0.0,
             conv_nis: 0.0,
@@ -422,6 +433,7 @@ impl EstimatorConfig {
             "EST_GPS_TOUT" => &mut self.gps_timeout,
             "EST_CONV_TILT" => &mut self.conv_tilt,
             "EST_CONV_HDG" => &mut self.conv_heading,
+            "EST_CONV_GBIAS" => &mut self.conv_gyro_bias,
             "EST_CONV_POS" => &mut self.conv_pos,
             "EST_CONV_VEL" => &mut self.conv_vel,
             "EST_CONV_NIS" => &mut self.conv_nis,

@@ -59,8 +59,12 @@ pub const MAX_GPS_SPEED_MPS: f32 = 150.0;
 /// Samples of the other sensors after which a silent IMU is declared unhealthy (the IMU is
 /// the clock, so its silence can only be seen through the others).
 pub const IMU_STALE_SAMPLES: u32 = 50;
-/// Consecutive gated GPS fixes after which the horizontal state is moved to GPS.
+/// Consecutive gated GPS fixes after which position and velocity are moved to GPS.
 pub const GPS_RESET_FIXES: u32 = 5;
+/// Consecutive gated samples of a 50 Hz sensor (about 1 s) after which the filter part it
+/// corrects is taken to be lost and restarted from the measurements: a filter whose
+/// innovations are all beyond the gate would otherwise never listen again.
+pub const LOCKOUT_SAMPLES: u32 = 50;
 /// Density used until the barometer has been read, kg/m^3 (sea-level standard).
 const DEFAULT_DENSITY: f32 = 1.225;
 /// Averaging weight of the magnetometer innovation monitor (about 1 s at 50 Hz).
@@ -77,7 +81,10 @@ pub struct SensorStatus {
     pub rejected: u32,
     /// Samples (or components) refused by the filters' innovation gates.
     pub gated: u32,
+    /// Times the filter part this sensor corrects was restarted after a lock-out.
+    pub resets: u32,
     consecutive: u32,
+    gated_streak: u32,
     last_ok_s: Option<f64>,
 }
 
@@ -90,6 +97,23 @@ impl SensorStatus {
     fn accept(&mut self, t: f64) {
         self.consecutive = 0;
         self.last_ok_s = Some(t);
+    }
+
+    /// Books `gated` refused components of a sample; `all` when none was fused. Returns true
+    /// when the sensor has been locked out for `limit` samples in a row (and starts over).
+    fn gate(&mut self, gated: u8, all: bool, limit: u32) -> bool {
+        self.gated = self.gated.saturating_add(u32::from(gated));
+        if !all {
+            self.gated_streak = 0;
+            return false;
+        }
+        self.gated_streak = self.gated_streak.saturating_add(1);
+        if self.gated_streak >= limit {
+            self.gated_streak = 0;
+            self.resets = self.resets.saturating_add(1);
+            return true;
+        }
+        false
     }
 
     fn evaluate(&mut self, t: f64, timeout: f32, max_rejections: u32) {
@@ -194,7 +218,6 @@ pub struct Estimator {
     mag_nis: f32,
     last_pitot_t: Option<f64>,
     imu_silent_samples: u32,
-    gps_gated_streak: u32,
     alpha_memory: f32,
     pending_dt: f32,
 }
@@ -233,7 +256,6 @@ impl Estimator {
             mag_nis: 0.0,
             last_pitot_t: None,
             imu_silent_samples: 0,
-            gps_gated_streak: 0,
             alpha_memory: 0.0,
             pending_dt: 0.0,
         }
@@ -286,6 +308,25 @@ impl Estimator {
 
     fn note_other_sensor(&mut self) {
         self.imu_silent_samples = self.imu_silent_samples.saturating_add(1);
+    }
+
+    /// Restarts the attitude filter from the latest accelerometer and magnetometer samples,
+    /// with the centripetal term of body-frame quantities only (the old attitude is not
+    /// trusted).
+    fn restart_attitude(&mut self) {
+        if let (Some(a), Some(m)) = (self.last_accel, self.last_mag) {
+            let va = if self.health.pitot.healthy {
+                self.airspeed.value()
+            } else {
+                0.0
+            };
+            let gravity = a - self.rates.cross(&Vector3::new(va, 0.0, 0.0));
+            let earth = self.earth_field();
+            self.att
+                .initialize(&gravity, &m, &earth, self.cfg.gyro_bias_init);
+            self.wind = WindFilter::default();
+            self.mag_nis = 0.0;
+        }
     }
 
     fn try_initialize_attitude(&mut self) {
@@ -351,15 +392,18 @@ impl Estimator {
             .predict(self.t, &acc_ned, dt, c.nav_accel_noise, c.baro_bias_rw);
         let wn = self.wind_noise();
         self.wind.predict(dt, &wn);
-        let maneuver = self.rates.cross(&self.air_velocity_body());
+        let v_air = self.air_velocity_body();
         if let Some(f) = self.att.fuse_accel(
             &sample.accel,
-            &maneuver,
+            &self.rates,
+            &v_air,
             c.accel_noise,
             c.accel_gate,
             c.gate_sigma,
         ) {
-            self.health.imu.gated = self.health.imu.gated.saturating_add(u32::from(f.gated));
+            if self.health.imu.gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES) {
+                self.restart_attitude();
+            }
         }
     }
 
@@ -385,7 +429,9 @@ impl Estimator {
             .att
             .fuse_mag(&sample.field, &earth, c.mag_noise, c.gate_sigma)
         {
-            self.health.mag.gated = self.health.mag.gated.saturating_add(u32::from(f.gated));
+            if self.health.mag.gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES) {
+                self.restart_attitude();
+            }
             // A gated component enters the monitor at the gate, so a field that no longer
             // matches the model shows up instead of vanishing.
             let nis = if f.fused > 0 {
@@ -420,7 +466,13 @@ impl Estimator {
             let f = self
                 .nav
                 .fuse_baro(home.alt_amsl_m - alt, c.baro_noise, c.gate_sigma);
-            self.health.baro.gated = self.health.baro.gated.saturating_add(u32::from(f.gated));
+            if self
+                .health
+                .baro
+                .gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES)
+            {
+                self.nav.reset_baro_offset(home.alt_amsl_m - alt);
+            }
         }
     }
 
@@ -454,7 +506,10 @@ impl Estimator {
             let wn = self.wind_noise();
             let v = self.nav.velocity();
             let gated = self.wind.update(va, &v, &x, &y, &wn, c.gate_sigma);
-            self.health.pitot.gated = self.health.pitot.gated.saturating_add(u32::from(gated));
+            if self.health.pitot.gate(gated, gated == 2, LOCKOUT_SAMPLES) {
+                // Starts again from the wind triangle at the next sample.
+                self.wind = WindFilter::default();
+            }
             if self.wind.is_initialized() {
                 let body = q.inverse_transform_vector(&(v - self.wind.wind()));
                 let ad = AirData::from_body_velocity(&body);
@@ -516,38 +571,22 @@ impl Estimator {
         };
         let (n, e): (f32, f32) = ned_offset(home.point, fix.position);
         let pos = Vector3::new(n, e, home.alt_amsl_m - fix.alt_amsl_m);
-        if !was_healthy {
-            // Back from an outage: dead reckoning may have drifted beyond the gate.
-            let t_fix = self.t - f64::from(c.gps_delay);
-            let f = self
-                .nav
-                .fuse_gps(t_fix, &pos, &fix.vel_ned, &noise, c.gate_sigma);
-            if f.gated > 0 {
-                self.nav
-                    .reset_horizontal(&pos, &fix.vel_ned, c.gps_delay, &noise);
-            }
-            self.gps_gated_streak = 0;
-            return;
-        }
         let t_fix = self.t - f64::from(c.gps_delay);
         let f = self
             .nav
             .fuse_gps(t_fix, &pos, &fix.vel_ned, &noise, c.gate_sigma);
-        self.health.gps.gated = self.health.gps.gated.saturating_add(u32::from(f.gated));
-        if f.gated > 0 {
-            self.gps_gated_streak = self.gps_gated_streak.saturating_add(1);
-            if self.gps_gated_streak >= GPS_RESET_FIXES {
-                self.nav
-                    .reset_horizontal(&pos, &fix.vel_ned, c.gps_delay, &noise);
-                self.gps_gated_streak = 0;
-            }
-        } else {
-            self.gps_gated_streak = 0;
+        let limit = if was_healthy { GPS_RESET_FIXES } else { 1 };
+        // Back from an outage, dead reckoning may have drifted beyond the gate: the first
+        // refused fix moves the state at once.
+        if self.health.gps.gate(f.gated, f.gated > 0, limit) {
+            self.nav
+                .reset_to_gps(&pos, &fix.vel_ned, c.gps_delay, &noise);
         }
     }
 
     /// True when the estimate is fit to arm on: attitude initialised with roll/pitch and
-    /// heading uncertainty below `EST_CONV_TILT` / `EST_CONV_HDG`, the averaged normalised
+    /// heading uncertainty below `EST_CONV_TILT` / `EST_CONV_HDG`, gyro bias uncertainty below
+    /// `EST_CONV_GBIAS` on every axis, the averaged normalised
     /// magnetometer innovation below `EST_CONV_NIS` (the field matches the model), home set
     /// with horizontal position and velocity uncertainty below `EST_CONV_POS` /
     /// `EST_CONV_VEL`, and every sensor healthy.
@@ -559,6 +598,7 @@ impl Estimator {
         self.att.is_initialized()
             && tilt < c.conv_tilt
             && hdg < c.conv_heading
+            && self.att.bias_sigma().max() < c.conv_gyro_bias
             && self.mag_nis < c.conv_nis
             && self.nav.is_initialized()
             && pos < c.conv_pos

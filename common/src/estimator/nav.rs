@@ -301,9 +301,9 @@ impl NavFilter {
         out
     }
 
-    /// Moves the horizontal position and velocity to a GPS fix (after a long outage the
-    /// filter may have drifted beyond its gate); height and baro offset are kept.
-    pub fn reset_horizontal(
+    /// Moves position and velocity to a GPS fix taken `delay` s ago (after a long outage or a
+    /// lock-out the filter may have drifted beyond its gate); the baro offset is kept.
+    pub fn reset_to_gps(
         &mut self,
         pos: &Vector3<f32>,
         vel: &Vector3<f32>,
@@ -312,26 +312,37 @@ impl NavFilter {
     ) {
         let now = pos + vel * delay;
         let mut shift = Vec7::zeros();
-        for i in 0..2 {
+        for i in 0..3 {
             shift[i] = now[i] - self.x[i];
             shift[IV + i] = vel[i] - self.x[IV + i];
+        }
+        if !shift.iter().all(|c| c.is_finite()) {
+            return;
         }
         // The stored past moves with the present, so the next delayed fix compares like with
         // like.
         self.apply(&shift, f64::NEG_INFINITY);
         let h2 = noise.horizontal * noise.horizontal;
+        let z2 = noise.vertical * noise.vertical;
         let v2 = (noise.velocity * noise.velocity).max(0.25);
+        let b = self.p[(IB, IB)];
+        self.p = Mat7::from_diagonal(&Vec7::from([h2, h2, z2, v2, v2, v2, b + z2]));
+    }
+
+    /// Makes the baro offset agree with one barometric altitude (`home_alt - baro_alt`) after
+    /// a lock-out, with its uncertainty back to the GPS's vertical one.
+    pub fn reset_baro_offset(&mut self, home_minus_baro: f32) {
+        let b = self.x[IPD] - home_minus_baro;
+        if !b.is_finite() {
+            return;
+        }
+        self.x[IB] = b;
         for i in 0..7 {
-            for j in [0, 1, IV, IV + 1] {
-                if i != j {
-                    self.p[(i, j)] = 0.0;
-                    self.p[(j, i)] = 0.0;
-                }
+            if i != IB {
+                self.p[(i, IB)] = 0.0;
+                self.p[(IB, i)] = 0.0;
             }
         }
-        self.p[(0, 0)] = h2;
-        self.p[(1, 1)] = h2;
-        self.p[(IV, IV)] = v2;
-        self.p[(IV + 1, IV + 1)] = v2;
+        self.p[(IB, IB)] = self.p[(IPD, IPD)] + 1.0;
     }
 }
