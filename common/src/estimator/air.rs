@@ -37,25 +37,41 @@ pub fn true_airspeed(diff_pressure_pa: f32, density: f32) -> f32 {
     libm::sqrtf(2.0 * diff_pressure_pa.max(0.0) / density)
 }
 
-/// First-order low-pass of the airspeed.
+/// First-order low-pass of the airspeed, and a low-passed rate of change of it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AirspeedFilter {
     value: f32,
+    rate: f32,
     primed: bool,
 }
 
 impl AirspeedFilter {
     /// Feeds one airspeed over `dt` with time constant `tau` (0: no filtering) and returns the
-    /// filtered value.
-    pub fn update(&mut self, va: f32, dt: f32, tau: f32) -> f32 {
+    /// filtered value. The rate of change is the difference of the filtered value, low-passed
+    /// again with `rate_tau`.
+    pub fn update(&mut self, va: f32, dt: f32, tau: f32, rate_tau: f32) -> f32 {
         if !self.primed {
             self.value = va;
+            self.rate = 0.0;
             self.primed = true;
-        } else {
+        } else if dt > 0.0 {
             let a = if tau > 0.0 { dt / (tau + dt) } else { 1.0 };
+            let before = self.value;
             self.value += a.clamp(0.0, 1.0) * (va - self.value);
+            let raw_rate = (self.value - before) / dt;
+            let b = if rate_tau > 0.0 {
+                dt / (rate_tau + dt)
+            } else {
+                1.0
+            };
+            self.rate += b.clamp(0.0, 1.0) * (raw_rate - self.rate);
         }
         self.value
+    }
+
+    /// Rate of change of the airspeed, m/s^2.
+    pub fn rate(&self) -> f32 {
+        self.rate
     }
 
     /// The filtered airspeed, m/s.

@@ -162,14 +162,16 @@ impl AttitudeEkf {
     ///
     /// `accel` is the measured specific force, `v_air_body` the air-relative velocity in body
     /// axes: the aircraft's acceleration is taken as the centripetal `omega x v_air` of a turn
-    /// or pull-up, with `omega` the bias-corrected gyro rate `rates`. `noise` is the per-axis
-    /// standard deviation. The update is skipped when the compensated specific force is further than
+    /// or pull-up, with `omega` the bias-corrected gyro rate `rates`, plus `along_body`, the
+    /// acceleration along the flight path (airspeed changes). `noise` is the per-axis standard
+    /// deviation. The update is skipped when the compensated specific force is further than
     /// `gate_mps2` from g: then the aircraft accelerates in a way the model does not know.
     pub fn fuse_accel(
         &mut self,
         accel: &Vector3<f32>,
         rates: &Vector3<f32>,
         v_air_body: &Vector3<f32>,
+        along_body: &Vector3<f32>,
         noise: f32,
         gate_mps2: f32,
         gate_sigma: f32,
@@ -177,7 +179,7 @@ impl AttitudeEkf {
         if !self.initialized {
             return None;
         }
-        let maneuver_body = rates.cross(v_air_body);
+        let maneuver_body = rates.cross(v_air_body) + along_body;
         let gravity_part = accel - maneuver_body;
         if libm::fabsf(gravity_part.norm() - GRAVITY) > gate_mps2 {
             return None;
@@ -308,14 +310,8 @@ mod tests {
         f.q = Euler::new(0.087_f32, 0.0, 0.0).to_quaternion();
         for _ in 0..500 {
             f.predict(&Vector3::zeros(), 0.02, 0.0015, 5e-5);
-            f.fuse_accel(
-                &accel,
-                &Vector3::zeros(),
-                &Vector3::zeros(),
-                0.7,
-                2.5,
-                100.0,
-            );
+            let z = Vector3::zeros();
+            f.fuse_accel(&accel, &z, &z, &z, 0.7, 2.5, 100.0);
         }
         let e = Euler::from_quaternion(&f.attitude());
         assert!(e.phi.abs() < 0.005, "roll {}", e.phi);

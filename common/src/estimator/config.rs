@@ -158,6 +158,14 @@ pub const PARAMS: &[ParamDef] = &[
         "time constant of the airspeed low-pass filter",
     ),
     ParamDef::real(
+        "ARSP_DTAU",
+        0.5,
+        0.02,
+        5.0,
+        "s",
+        "time constant of the airspeed-rate filter (along-track acceleration)",
+    ),
+    ParamDef::real(
         "ARSP_MIN",
         6.0,
         0.0,
@@ -300,6 +308,8 @@ pub struct EstimatorConfig {
     pub dead_reckon_vel_noise: f32,
     /// `ARSP_TAU`, s.
     pub airspeed_tau: f32,
+    /// `ARSP_DTAU`, s.
+    pub airspeed_rate_tau: f32,
     /// `ARSP_MIN`, m/s.
     pub airspeed_min: f32,
     /// `WIND_PNOISE`, m/s/sqrt(s).
@@ -349,6 +359,7 @@ impl Default for EstimatorConfig {
             gate_sigma: 0.0,
             dead_reckon_vel_noise: 0.0,
             airspeed_tau: 0.0,
+            airspeed_rate_tau: 0.0,
             airspeed_min: 0.0,
             wind_process_noise: 0.0,
             wind_airspeed_noise: 0.0,
@@ -425,6 +436,7 @@ impl EstimatorConfig {
             "EKF_GATE" => &mut self.gate_sigma,
             "EKF_DR_V_NOISE" => &mut self.dead_reckon_vel_noise,
             "ARSP_TAU" => &mut self.airspeed_tau,
+            "ARSP_DTAU" => &mut self.airspeed_rate_tau,
             "ARSP_MIN" => &mut self.airspeed_min,
             "WIND_PNOISE" => &mut self.wind_process_noise,
             "WIND_VA_NOISE" => &mut self.wind_airspeed_noise,

@@ -393,10 +393,18 @@ impl Estimator {
         let wn = self.wind_noise();
         self.wind.predict(dt, &wn);
         let v_air = self.air_velocity_body();
+        // Speeding up or slowing down tilts the apparent gravity nose-up or down: the
+        // airspeed's rate of change, along the air velocity, is the acceleration's other part.
+        let along = if self.health.pitot.healthy && v_air.norm() > c.airspeed_min {
+            v_air.normalize() * self.airspeed.rate()
+        } else {
+            Vector3::zeros()
+        };
         if let Some(f) = self.att.fuse_accel(
             &sample.accel,
             &self.rates,
             &v_air,
+            &along,
             c.accel_noise,
             c.accel_gate,
             c.gate_sigma,
@@ -493,9 +501,12 @@ impl Estimator {
         };
         self.last_pitot_t = Some(self.t);
         let c = self.cfg;
-        let va = self
-            .airspeed
-            .update(true_airspeed(dp, self.density), dt, c.airspeed_tau);
+        let va = self.airspeed.update(
+            true_airspeed(dp, self.density),
+            dt,
+            c.airspeed_tau,
+            c.airspeed_rate_tau,
+        );
         if !self.att.is_initialized() || !self.nav.is_initialized() || va < c.airspeed_min {
             return;
         }

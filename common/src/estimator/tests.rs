@@ -123,11 +123,7 @@ impl Rms {
 }
 
 fn level(duration: f64) -> Segment {
-    Segment {
-        duration,
-        turn_rate: 0.0,
-        gamma: 0.0,
-    }
+    turn(duration, 0.0, 0.0)
 }
 
 fn turn(duration: f64, deg_per_s: f64, gamma_deg: f64) -> Segment {
@@ -135,11 +131,16 @@ fn turn(duration: f64, deg_per_s: f64, gamma_deg: f64) -> Segment {
         duration,
         turn_rate: deg_per_s * DEG,
         gamma: gamma_deg * DEG,
+        airspeed: 17.0,
     }
 }
 
-/// Straight and level, 20 deg/s turns both ways (one while climbing), a 5 deg climb, in a
-/// steady 5 m/s wind: 240 s.
+fn at_speed(s: Segment, airspeed: f64) -> Segment {
+    Segment { airspeed, ..s }
+}
+
+/// Straight and level, 20 deg/s turns both ways (one while climbing, one at 22 m/s), a 5 deg
+/// climb, speeding up from 17 to 22 m/s and back, in a steady 5 m/s wind: 240 s.
 fn mission() -> [Segment; 8] {
     [
         level(40.0),
@@ -147,8 +148,8 @@ fn mission() -> [Segment; 8] {
         level(20.0),
         turn(20.0, 0.0, 5.0),
         turn(27.0, -20.0, 5.0),
-        level(20.0),
-        turn(36.0, 20.0, 0.0),
+        at_speed(level(20.0), 22.0),
+        at_speed(turn(36.0, 20.0, 0.0), 22.0),
         level(41.0),
     ]
 }
@@ -293,7 +294,7 @@ fn convergence_flag_waits_for_a_good_estimate() {
 #[test]
 fn converges_at_rest_on_the_ground() {
     // Pre-arm: sitting still, no wind, pitot reading noise around zero.
-    let segs = [level(30.0)];
+    let segs = [at_speed(level(30.0), 0.0)];
     let mut f = Flight {
         est: Estimator::default(),
         traj: Trajectory::new(

@@ -27,8 +27,13 @@ use std::vec::Vec;
 pub const G: f64 = 9.8056;
 /// Trim angle of attack at 17 m/s (UMN trim), rad.
 pub const ALPHA0: f64 = 0.055;
-/// Cosine blend between segments, s.
+/// Cosine blend of turn rate and flight-path angle between segments, s.
 pub const BLEND_S: f64 = 2.0;
+/// Cosine blend of airspeed between segments, s (5 m/s in 5 s peaks at 1.6 m/s^2, about what
+/// the Ultra Stick's motor gives).
+pub const SPEED_BLEND_S: f64 = 5.0;
+/// Airspeed of the UMN trim, m/s (angle of attack scales with (VA0 / Va)^2).
+pub const VA0: f64 = 17.0;
 /// UMN home (OpenFlight NL_Sim setup).
 pub const HOME_LAT: f64 = 44.7258357;
 /// UMN home longitude.
@@ -65,6 +70,8 @@ pub struct Segment {
     pub turn_rate: f64,
     /// Air-relative flight-path angle, rad (positive climbing).
     pub gamma: f64,
+    /// True airspeed, m/s.
+    pub airspeed: f64,
 }
 
 /// The true state at one instant.
@@ -101,24 +108,35 @@ impl Truth {
 pub struct Trajectory {
     segments: Vec<Segment>,
     starts: Vec<f64>,
-    va: f64,
+    va0: f64,
     wind: Vector3<f64>,
     chi: f64,
     pos: Vector3<f64>,
     t: f64,
 }
 
-fn blend(tau: f64) -> (f64, f64) {
-    if tau >= BLEND_S {
+fn blend(tau: f64, length: f64) -> (f64, f64) {
+    if tau >= length {
         (1.0, 0.0)
     } else {
-        let w = core::f64::consts::PI / BLEND_S;
+        let w = core::f64::consts::PI / length;
         (0.5 * (1.0 - (w * tau).cos()), 0.5 * w * (w * tau).sin())
     }
 }
 
+/// The commanded quantities at one instant.
+#[derive(Clone, Copy, Debug)]
+struct Sched {
+    turn: f64,
+    gamma: f64,
+    gamma_dot: f64,
+    va: f64,
+    va_dot: f64,
+}
+
 impl Trajectory {
-    /// Starts at `pos0` on air-relative course `chi0` (rad).
+    /// Starts at `pos0` on air-relative course `chi0` (rad), at airspeed `va` (each segment
+    /// then sets its own).
     pub fn new(
         segments: &[Segment],
         va: f64,
@@ -135,7 +153,7 @@ impl Trajectory {
         Self {
             segments: segments.to_vec(),
             starts,
-            va,
+            va0: va,
             wind,
             chi: chi0,
             pos: pos0,
@@ -148,35 +166,51 @@ impl Trajectory {
         self.segments.iter().map(|s| s.duration).sum()
     }
 
-    /// (turn rate, gamma, gamma rate) at time t.
-    fn schedule(&self, t: f64) -> (f64, f64, f64) {
-        let mut prev = (0.0, 0.0);
+    fn schedule(&self, t: f64) -> Sched {
+        let mut prev = (0.0, 0.0, self.va0);
         for (i, s) in self.segments.iter().enumerate() {
             let start = self.starts[i];
             let end = start + s.duration;
             if t < end || i + 1 == self.segments.len() {
-                let (b, db) = blend((t - start).max(0.0));
-                let turn = prev.0 + (s.turn_rate - prev.0) * b;
-                let gamma = prev.1 + (s.gamma - prev.1) * b;
-                let gamma_dot = (s.gamma - prev.1) * db;
-                return (turn, gamma, gamma_dot);
+                let tau = (t - start).max(0.0);
+                let (b, db) = blend(tau, BLEND_S);
+                let (bv, dbv) = blend(tau, SPEED_BLEND_S);
+                return Sched {
+                    turn: prev.0 + (s.turn_rate - prev.0) * b,
+                    gamma: prev.1 + (s.gamma - prev.1) * b,
+                    gamma_dot: (s.gamma - prev.1) * db,
+                    va: prev.2 + (s.airspeed - prev.2) * bv,
+                    va_dot: (s.airspeed - prev.2) * dbv,
+                };
             }
-            prev = (s.turn_rate, s.gamma);
+            prev = (s.turn_rate, s.gamma, s.airspeed);
         }
-        (0.0, 0.0, 0.0)
+        Sched {
+            turn: 0.0,
+            gamma: 0.0,
+            gamma_dot: 0.0,
+            va: self.va0,
+            va_dot: 0.0,
+        }
     }
 
     /// (bank mu, alpha) at time t.
     fn bank_alpha(&self, t: f64) -> (f64, f64) {
-        let (turn, gamma, gamma_dot) = self.schedule(t);
-        let lateral = self.va * gamma.cos() * turn;
-        let normal = G * gamma.cos() + self.va * gamma_dot;
+        let s = self.schedule(t);
+        let lateral = s.va * s.gamma.cos() * s.turn;
+        let normal = G * s.gamma.cos() + s.va * s.gamma_dot;
         let load = (lateral * lateral + normal * normal).sqrt() / G;
-        (lateral.atan2(normal), ALPHA0 * load)
+        // Lift ~ Va^2 alpha: the trim alpha scaled by load factor and dynamic pressure.
+        let q_ratio = if s.va > 1.0 {
+            (VA0 / s.va).powi(2)
+        } else {
+            1.0
+        };
+        (lateral.atan2(normal), ALPHA0 * load * q_ratio)
     }
 
     fn attitude(&self, chi: f64, t: f64) -> UnitQuaternion<f64> {
-        let (_, gamma, _) = self.schedule(t);
+        let gamma = self.schedule(t).gamma;
         let (mu, alpha) = self.bank_alpha(t);
         UnitQuaternion::from_axis_angle(&Vector3::z_axis(), chi)
             * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), gamma)
@@ -184,34 +218,34 @@ impl Trajectory {
             * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), alpha)
     }
 
-    fn air_velocity(&self, chi: f64, gamma: f64) -> Vector3<f64> {
-        self.va
-            * Vector3::new(
-                gamma.cos() * chi.cos(),
-                gamma.cos() * chi.sin(),
-                -gamma.sin(),
-            )
+    fn air_velocity(va: f64, chi: f64, gamma: f64) -> Vector3<f64> {
+        va * Vector3::new(
+            gamma.cos() * chi.cos(),
+            gamma.cos() * chi.sin(),
+            -gamma.sin(),
+        )
     }
 
     /// The truth at the present time.
     pub fn truth(&self) -> Truth {
         let t = self.t;
-        let (turn, gamma, gamma_dot) = self.schedule(t);
+        let sc = self.schedule(t);
         let chi = self.chi;
         let q = self.attitude(chi, t);
         let h = 1e-3;
-        let qm = self.attitude(chi - turn * h, t - h);
-        let qp = self.attitude(chi + turn * h, t + h);
+        let qm = self.attitude(chi - sc.turn * h, t - h);
+        let qp = self.attitude(chi + sc.turn * h, t + h);
         let omega = (qm.inverse() * qp).scaled_axis() / (2.0 * h);
-        let va = self.va;
+        let (va, gamma, turn, gamma_dot) = (sc.va, sc.gamma, sc.turn, sc.gamma_dot);
         let (sg, cg) = gamma.sin_cos();
-        let (sc, cc) = chi.sin_cos();
-        let acc = va
-            * Vector3::new(
-                -sg * gamma_dot * cc - cg * sc * turn,
-                -sg * gamma_dot * sc + cg * cc * turn,
-                -cg * gamma_dot,
-            );
+        let (sin_chi, cos_chi) = chi.sin_cos();
+        let dir = Vector3::new(cg * cos_chi, cg * sin_chi, -sg);
+        let ddir = Vector3::new(
+            -sg * gamma_dot * cos_chi - cg * sin_chi * turn,
+            -sg * gamma_dot * sin_chi + cg * cos_chi * turn,
+            -cg * gamma_dot,
+        );
+        let acc = dir * sc.va_dot + ddir * va;
         let f_ned = acc - Vector3::new(0.0, 0.0, G);
         Truth {
             t,
@@ -219,7 +253,7 @@ impl Trajectory {
             omega,
             specific_force: q.inverse_transform_vector(&f_ned),
             pos: self.pos,
-            vel: self.air_velocity(chi, gamma) + self.wind,
+            vel: Self::air_velocity(va, chi, gamma) + self.wind,
             va,
             wind: self.wind,
             turn_rate: turn,
@@ -228,11 +262,11 @@ impl Trajectory {
 
     /// Advances by `dt` (trapezoidal in course and position).
     pub fn step(&mut self, dt: f64) {
-        let (turn0, gamma0, _) = self.schedule(self.t);
-        let v0 = self.air_velocity(self.chi, gamma0) + self.wind;
-        let (turn1, gamma1, _) = self.schedule(self.t + dt);
-        let chi1 = self.chi + 0.5 * dt * (turn0 + turn1);
-        let v1 = self.air_velocity(chi1, gamma1) + self.wind;
+        let s0 = self.schedule(self.t);
+        let v0 = Self::air_velocity(s0.va, self.chi, s0.gamma) + self.wind;
+        let s1 = self.schedule(self.t + dt);
+        let chi1 = self.chi + 0.5 * dt * (s0.turn + s1.turn);
+        let v1 = Self::air_velocity(s1.va, chi1, s1.gamma) + self.wind;
         self.pos += 0.5 * dt * (v0 + v1);
         self.chi = chi1;
         self.t += dt;
@@ -395,6 +429,7 @@ mod tests {
             duration: 30.0,
             turn_rate: turn,
             gamma: 0.0,
+            airspeed: 17.0,
         }];
         let mut tr = Trajectory::new(&segs, 17.0, Vector3::zeros(), 0.0, Vector3::zeros());
         for _ in 0..500 {
