@@ -26,6 +26,19 @@ const INIT_TILT_SIGMA: f32 = 0.1;
 /// Initial 1-sigma heading uncertainty.
 const INIT_YAW_SIGMA: f32 = 0.3;
 
+/// The aircraft's motion as the gravity reference needs it: its acceleration is the
+/// centripetal `rates x v_air_body` of a turn or pull-up plus `along_body`, the acceleration
+/// along the flight path (airspeed changes).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    /// Bias-corrected body rates, rad/s.
+    pub rates: Vector3<f32>,
+    /// Air-relative velocity in body axes, m/s.
+    pub v_air_body: Vector3<f32>,
+    /// Acceleration along the flight path in body axes, m/s^2.
+    pub along_body: Vector3<f32>,
+}
+
 /// How one vector measurement went.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct VectorFusion {
@@ -160,18 +173,14 @@ impl AttitudeEkf {
 
     /// Fuses the accelerometer as a gravity reference.
     ///
-    /// `accel` is the measured specific force, `v_air_body` the air-relative velocity in body
-    /// axes: the aircraft's acceleration is taken as the centripetal `omega x v_air` of a turn
-    /// or pull-up, with `omega` the bias-corrected gyro rate `rates`, plus `along_body`, the
-    /// acceleration along the flight path (airspeed changes). `noise` is the per-axis standard
+    /// `accel` is the measured specific force and `motion` what the aircraft is known to be
+    /// doing, from which its acceleration is formed. `noise` is the per-axis standard
     /// deviation. The update is skipped when the compensated specific force is further than
     /// `gate_mps2` from g: then the aircraft accelerates in a way the model does not know.
     pub fn fuse_accel(
         &mut self,
         accel: &Vector3<f32>,
-        rates: &Vector3<f32>,
-        v_air_body: &Vector3<f32>,
-        along_body: &Vector3<f32>,
+        motion: &Motion,
         noise: f32,
         gate_mps2: f32,
         gate_sigma: f32,
@@ -179,7 +188,8 @@ impl AttitudeEkf {
         if !self.initialized {
             return None;
         }
-        let maneuver_body = rates.cross(v_air_body) + along_body;
+        let v_air_body = &motion.v_air_body;
+        let maneuver_body = motion.rates.cross(v_air_body) + motion.along_body;
         let gravity_part = accel - maneuver_body;
         if libm::fabsf(gravity_part.norm() - GRAVITY) > gate_mps2 {
             return None;
@@ -310,8 +320,7 @@ mod tests {
         f.q = Euler::new(0.087_f32, 0.0, 0.0).to_quaternion();
         for _ in 0..500 {
             f.predict(&Vector3::zeros(), 0.02, 0.0015, 5e-5);
-            let z = Vector3::zeros();
-            f.fuse_accel(&accel, &z, &z, &z, 0.7, 2.5, 100.0);
+            f.fuse_accel(&accel, &Motion::default(), 0.7, 2.5, 100.0);
         }
         let e = Euler::from_quaternion(&f.attitude());
         assert!(e.phi.abs() < 0.005, "roll {}", e.phi);

@@ -33,7 +33,7 @@ use crate::math::frames::{course_and_speed, AirData, Euler};
 use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
 use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
-use attitude::{AttitudeEkf, GRAVITY};
+use attitude::{AttitudeEkf, Motion, GRAVITY};
 use nalgebra::{UnitQuaternion, Vector3};
 use nav::{GpsNoise, NavFilter};
 
@@ -402,9 +402,11 @@ impl Estimator {
         };
         if let Some(f) = self.att.fuse_accel(
             &sample.accel,
-            &self.rates,
-            &v_air,
-            &along,
+            &Motion {
+                rates: self.rates,
+                v_air_body: v_air,
+                along_body: along,
+            },
             c.accel_noise,
             c.accel_gate,
             c.gate_sigma,
