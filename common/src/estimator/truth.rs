@@ -299,6 +299,9 @@ pub struct SensorSim {
     pub gps_period: f64,
     /// Noise on (false: exact samples).
     pub noisy: bool,
+    /// Multiplies the noise of the 50 Hz-specified sensors: `sqrt(0.02 / Ts)` keeps the UMN
+    /// noise power at another sample time `Ts`.
+    pub rate_scale: f64,
     history: VecDeque<Truth>,
     next_gps: f64,
     /// Origin of the truth's NED frame.
@@ -316,6 +319,7 @@ impl SensorSim {
             gps_latency: 0.15,
             gps_period: 0.2,
             noisy: true,
+            rate_scale: 1.0,
             history: VecDeque::new(),
             next_gps: 0.0,
             origin: GeoPoint::from_deg(HOME_LAT, HOME_LON),
@@ -347,30 +351,31 @@ impl SensorSim {
         let gyro = tr.omega
             + self.gyro_bias
             + Vector3::new(
-                self.n(noise::GYRO),
-                self.n(noise::GYRO),
-                self.n(noise::GYRO),
+                self.n(noise::GYRO * self.rate_scale),
+                self.n(noise::GYRO * self.rate_scale),
+                self.n(noise::GYRO * self.rate_scale),
             );
         let accel = tr.specific_force
             + Vector3::new(
-                self.n(noise::ACCEL[0]),
-                self.n(noise::ACCEL[1]),
-                self.n(noise::ACCEL[2]),
+                self.n(noise::ACCEL[0] * self.rate_scale),
+                self.n(noise::ACCEL[1] * self.rate_scale),
+                self.n(noise::ACCEL[2] * self.rate_scale),
             );
         let earth = Vector3::new(EARTH_FIELD[0], EARTH_FIELD[1], EARTH_FIELD[2]);
         let mag = tr.q.inverse_transform_vector(&earth)
             + Vector3::new(
-                self.n(noise::MAG[0]),
-                self.n(noise::MAG[1]),
-                self.n(noise::MAG[2]),
+                self.n(noise::MAG[0] * self.rate_scale),
+                self.n(noise::MAG[1] * self.rate_scale),
+                self.n(noise::MAG[2] * self.rate_scale),
             );
         let air = standard_atmosphere(tr.alt_amsl());
         let baro = BaroSample {
-            pressure_pa: (air.pressure_pa + self.n(noise::STATIC_PA)) as f32,
+            pressure_pa: (air.pressure_pa + self.n(noise::STATIC_PA * self.rate_scale)) as f32,
             temperature_c: (air.temperature_k - 273.15) as f32,
         };
         let pitot = PitotSample {
-            diff_pressure_pa: (0.5 * air.density * tr.va * tr.va + self.n(noise::DIFF_PA)) as f32,
+            diff_pressure_pa: (0.5 * air.density * tr.va * tr.va
+                + self.n(noise::DIFF_PA * self.rate_scale)) as f32,
         };
         let mut gps = None;
         if tr.t + 1e-9 >= self.next_gps {
