@@ -559,10 +559,14 @@ fn latency_run(delay_param: f32) -> (f64, f64) {
 fn delayed_gps_is_fused_at_its_own_time() {
     let (pos_comp, vel_comp) = latency_run(0.2);
     let (pos_raw, vel_raw) = latency_run(0.0);
+    let (pos_mis, vel_mis) = latency_run(0.15);
     println!(
         "GPS 0.2 s late, 20 deg/s turn: compensated pos {pos_comp:.2} m vel {vel_comp:.3} m/s; \
-         ignored pos {pos_raw:.2} m vel {vel_raw:.3} m/s"
+         ignored pos {pos_raw:.2} m vel {vel_raw:.3} m/s; \
+         assumed 0.15 s: pos {pos_mis:.2} m vel {vel_mis:.3} m/s"
     );
+    // A delay parameter 0.05 s short still removes most of the error.
+    assert!(pos_mis < 0.5 * pos_raw && vel_mis < 0.5 * vel_raw);
     // Ignoring 0.2 s at 17 m/s puts the fix 3.4 m behind: the compensated filter must do
     // much better.
     assert!(pos_comp < 1.0 && pos_comp < 0.5 * pos_raw);
