@@ -214,6 +214,22 @@ pub const PARAMS: &[ParamDef] = &[
         "GPS is unhealthy after this long without a good 3D fix",
     ),
     ParamDef::int(
+        "EST_HOME_SATS",
+        6,
+        4,
+        30,
+        "",
+        "satellites a 3D fix needs to set home",
+    ),
+    ParamDef::real(
+        "EST_HOME_HDOP",
+        2.5,
+        0.5,
+        20.0,
+        "",
+        "largest HDOP of a fix that sets home",
+    ),
+    ParamDef::int(
         "EST_MAX_REJECT",
         10,
         1,
@@ -322,6 +338,10 @@ pub struct EstimatorConfig {
     pub sensor_timeout: f32,
     /// `EST_GPS_TOUT`, s.
     pub gps_timeout: f32,
+    /// `EST_HOME_SATS`.
+    pub home_min_sats: u32,
+    /// `EST_HOME_HDOP`.
+    pub home_max_hdop: f32,
     /// `EST_MAX_REJECT`.
     pub max_rejections: u32,
     /// `EST_CONV_TILT`, rad.
@@ -366,6 +386,8 @@ impl Default for EstimatorConfig {
             wind_lateral_noise: 0.0,
             sensor_timeout: 0.0,
             gps_timeout: 0.0,
+            home_min_sats: 0,
+            home_max_hdop: 0.0,
             max_rejections: 0,
             conv_tilt: 0.0,
             conv_heading: 0.0,
@@ -391,25 +413,21 @@ impl EstimatorConfig {
             .find(|d| d.name == name)
             .ok_or(ParamError::Unknown)?;
         let v = def.check(value)?;
-        let slot = match self.slot(name) {
-            Some(s) => s,
-            None => {
-                if name == "EST_MAX_REJECT" {
-                    // Integer parameter: `check` guarantees a whole number within bounds.
-                    self.max_rejections = v as u32;
-                    return Ok(());
-                }
-                return Err(ParamError::Unknown);
-            }
-        };
-        *slot = v;
+        // Integer parameters: `check` guarantees a whole number within bounds.
+        match name {
+            "EST_MAX_REJECT" => self.max_rejections = v as u32,
+            "EST_HOME_SATS" => self.home_min_sats = v as u32,
+            _ => *self.slot(name).ok_or(ParamError::Unknown)? = v,
+        }
         Ok(())
     }
 
     /// The current value of one parameter by name.
     pub fn get(&self, name: &str) -> Option<f32> {
-        if name == "EST_MAX_REJECT" {
-            return Some(self.max_rejections as f32);
+        match name {
+            "EST_MAX_REJECT" => return Some(self.max_rejections as f32),
+            "EST_HOME_SATS" => return Some(self.home_min_sats as f32),
+            _ => {}
         }
         let mut copy = *self;
         copy.slot(name).map(|s| *s)
@@ -443,6 +461,7 @@ impl EstimatorConfig {
             "WIND_VY_NOISE" => &mut self.wind_lateral_noise,
             "EST_SENS_TOUT" => &mut self.sensor_timeout,
             "EST_GPS_TOUT" => &mut self.gps_timeout,
+            "EST_HOME_HDOP" => &mut self.home_max_hdop,
             "EST_CONV_TILT" => &mut self.conv_tilt,
             "EST_CONV_HDG" => &mut self.conv_heading,
             "EST_CONV_GBIAS" => &mut self.conv_gyro_bias,

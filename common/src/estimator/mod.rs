@@ -566,6 +566,10 @@ impl Estimator {
         let c = self.cfg;
         let noise = self.gps_noise();
         let Some(home) = self.home else {
+            // Home is the datum of every altitude and position after it: only a good fix.
+            if u32::from(fix.satellites) < c.home_min_sats || !(fix.hdop <= c.home_max_hdop) {
+                return;
+            }
             let home = Home {
                 point: fix.position,
                 alt_amsl_m: fix.alt_amsl_m,

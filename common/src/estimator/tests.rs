@@ -268,6 +268,21 @@ fn convergence_flag_waits_for_a_good_estimate() {
     }
     let st = f.est.state();
     assert!(st.attitude_valid && !st.position_valid && !st.converged);
+    // A weak fix does not set home.
+    let tr = f.traj.truth();
+    let mut weak = GpsFix {
+        position: offset_point(f.sim.origin, tr.pos.x as f32, tr.pos.y as f32),
+        alt_amsl_m: tr.alt_amsl() as f32,
+        vel_ned: tr.vel.cast::<f32>(),
+        fix_type: 3,
+        satellites: 10,
+        hdop: 4.0,
+    };
+    f.est.update_gps(&weak);
+    weak.hdop = 0.9;
+    weak.satellites = 4;
+    f.est.update_gps(&weak);
+    assert!(f.est.state().home.is_none());
     let mut first = None;
     for _ in 0..1500 {
         let tr = f.step();
