@@ -567,7 +567,8 @@ impl Estimator {
         let noise = self.gps_noise();
         let Some(home) = self.home else {
             // Home is the datum of every altitude and position after it: only a good fix.
-            if u32::from(fix.satellites) < c.home_min_sats || !(fix.hdop <= c.home_max_hdop) {
+            let hdop_ok = fix.hdop.is_finite() && fix.hdop <= c.home_max_hdop;
+            if u32::from(fix.satellites) < c.home_min_sats || !hdop_ok {
                 return;
             }
             let home = Home {
