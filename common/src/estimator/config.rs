@@ -63,11 +63,11 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "MAG_EARTH_E",
-        -0.01,
+        -0.002,
         -1.0,
         1.0,
         "gauss",
-        "earth field at home, east component",
+        "earth field at home, east component (IGRF at the UMN field: 0.5 deg W declination)",
     ),
     ParamDef::real(
         "MAG_EARTH_D",
@@ -485,7 +485,7 @@ mod tests {
         for d in PARAMS {
             assert_eq!(c.get(d.name), Some(d.default), "{}", d.name);
         }
-        assert_eq!(c.mag_earth, [0.18, -0.01, 0.52]);
+        assert_eq!(c.mag_earth, [0.18, -0.002, 0.52]);
     }
 
     #[test]

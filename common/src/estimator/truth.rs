@@ -39,7 +39,7 @@ pub const HOME_LAT: f64 = 44.7258357;
 /// UMN home longitude.
 pub const HOME_LON: f64 = -93.07501316;
 /// Earth field at home used by the simulated magnetometer, gauss NED.
-pub const EARTH_FIELD: [f64; 3] = [0.18, -0.01, 0.52];
+pub const EARTH_FIELD: [f64; 3] = [0.18, -0.002, 0.52];
 
 /// Noise standard deviations (UMN `noise power / 0.02 s`, bolderflight GPS).
 pub mod noise {
