@@ -1,16 +1,80 @@
 //! The autopilot's tick, independent of any board.
+//!
+//! One [`App`] owns every stage of `common` and both MAVLink links:
+//!
+//! ```text
+//! sim link bytes -> FrameParser -> HIL_SENSOR / HIL_GPS -> Estimator
+//!                                  every 20 ms: mode logic -> Autopilot -> Surfaces
+//!                               <- HIL_ACTUATOR_CONTROLS (one per sensor frame, lock-step)
+//! GCS link bytes -> FrameParser -> GroundLink (params, missions, commands) -> requests
+//!                               <- telemetry, acknowledgements, STATUSTEXT
+//! ```
+//!
+//! The clock is the simulator's (`time_usec` of the sensor frames) in SITL and the board's
+//! sensor timestamps on the MCU; nothing here reads a clock of its own.
 
+use common::actuators::Surfaces;
+use common::control::autopilot::{Autopilot, Commands, Measurements};
+use common::control::gains::{GainSet, DESIGNED, NAMED, STAGE_PARAMS};
+use common::control::lateral::{RollMode, YawMode};
+use common::control::longitudinal::LonMode;
+use common::estimator::{EstimatedState, Estimator, EstimatorConfig};
+use common::gcs::modes::{FlightMode, ModeSet};
+use common::gcs::param_store::Registry;
+use common::gcs::snapshot::{Battery, GpsRaw, Home, LandedState, SensorHealth, VehicleSnapshot};
+use common::gcs::{GroundLink, VehicleRequests};
 use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
+use common::params::ParamDef;
 use common::sensors::GpsFix;
 use mavlink::dialects::common::{
-    MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
+    MavAutopilot, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, HEARTBEAT_DATA,
 };
 
 /// MAVLink identity of the autopilot (DESIGN.md: system 1, component 1).
 pub const SYSTEM_ID: u8 = 1;
 /// MAVLink component of the autopilot.
 pub const COMPONENT_ID: u8 = 1;
+
+/// Control period, us: the thesis's 50 Hz.
+pub const CONTROL_PERIOD_US: u64 = 20_000;
+
+/// Settings of the application itself.
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef::int(
+        "SYS_GAIN_SET",
+        0,
+        0,
+        (NAMED.len() - 1) as i32,
+        "",
+        "Gain set loaded into the control parameters: 0 designed, 1 designed_t310, 2 designed_appe, 3 minnesota, 4 minnesota_appe",
+    ),
+    ParamDef::int(
+        "SIM_USE_TRUTH",
+        0,
+        0,
+        1,
+        "",
+        "1: fly on the simulator's truth (HIL_STATE_QUATERNION) instead of the estimator, to measure what estimation costs",
+    ),
+    ParamDef::real(
+        "FW_AIRSPD_TRIM",
+        17.0,
+        10.0,
+        30.0,
+        "m/s",
+        "Airspeed held in the altitude-holding modes until a ground station changes it",
+    ),
+];
+
+/// Every parameter the autopilot has: the control stages, the estimator and the application.
+pub const REGISTRY: Registry = &[
+    STAGE_PARAMS[0],
+    STAGE_PARAMS[1],
+    STAGE_PARAMS[2],
+    common::estimator::config::PARAMS,
+    PARAMS,
+];
 
 /// Counters the autopilot keeps about its simulator link.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -35,16 +99,52 @@ pub struct SimLinkHealth {
     pub rejected_gps: u32,
     /// Sensor frames whose time did not advance.
     pub stale_frames: u32,
+    /// Bytes to the ground station dropped because its buffer was full.
+    pub gcs_bytes_dropped: u32,
 }
+
+/// What the autopilot is asked to hold in the guided modes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Setpoints {
+    /// Course over ground, rad.
+    pub course: f32,
+    /// Altitude above mean sea level, m.
+    pub alt_amsl_m: f32,
+    /// Airspeed, m/s.
+    pub airspeed: f32,
+}
+
+/// Simulator truth, for logging and for the `SIM_USE_TRUTH` comparison only.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Truth {
+    m: Measurements,
+    time_us: u64,
+}
+
+const GCS_OUT: usize = 8192;
 
 /// The autopilot application.
 pub struct App {
     sim_parser: FrameParser,
     sim_tx: Sender,
+    gcs_parser: FrameParser,
+    gcs_tx: Sender,
+    gcs: GroundLink,
+    gcs_out: heapless::Vec<u8, GCS_OUT>,
+    estimator: Estimator,
+    autopilot: Autopilot,
     health: SimLinkHealth,
     last_time_us: Option<u64>,
+    last_control_us: Option<u64>,
     last_gps: Option<GpsFix>,
     armed: bool,
+    mode: FlightMode,
+    setpoints: Setpoints,
+    surfaces: Surfaces,
+    params_seen: Option<u32>,
+    gain_set_seen: f32,
+    truth: Option<Truth>,
+    use_truth: bool,
 }
 
 impl Default for App {
@@ -54,16 +154,40 @@ impl Default for App {
 }
 
 impl App {
-    /// A freshly booted autopilot.
+    /// A freshly booted autopilot with default parameters: disarmed, in Manual.
     pub fn new() -> Self {
-        Self {
+        // Both are constants checked by tests (unique parameter names, a valid gain set): no
+        // input reaches these two lines.
+        let gcs = GroundLink::new(REGISTRY).expect("REGISTRY has unique names (tested)");
+        let autopilot = Autopilot::new(&DESIGNED).expect("DESIGNED validates (tested)");
+        let mut app = Self {
             sim_parser: FrameParser::new(),
             sim_tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
+            gcs_parser: FrameParser::new(),
+            gcs_tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
+            gcs,
+            gcs_out: heapless::Vec::new(),
+            estimator: Estimator::new(EstimatorConfig::default()),
+            autopilot,
             health: SimLinkHealth::default(),
             last_time_us: None,
+            last_control_us: None,
             last_gps: None,
             armed: false,
-        }
+            mode: FlightMode::Manual,
+            setpoints: Setpoints {
+                course: 0.0,
+                alt_amsl_m: 100.0,
+                airspeed: 17.0,
+            },
+            surfaces: trim_surfaces(&DESIGNED),
+            params_seen: None,
+            gain_set_seen: 0.0,
+            truth: None,
+            use_truth: false,
+        };
+        app.apply_params();
+        app
     }
 
     /// Counters of the simulator link.
@@ -76,9 +200,49 @@ impl App {
         self.sim_parser.stats()
     }
 
+    /// Framing counters of the ground link.
+    pub fn gcs_link_stats(&self) -> LinkStats {
+        self.gcs_parser.stats()
+    }
+
     /// The last accepted GPS fix.
     pub fn last_gps(&self) -> Option<GpsFix> {
         self.last_gps
+    }
+
+    /// The estimator's current state.
+    pub fn estimate(&self) -> EstimatedState {
+        self.estimator.state()
+    }
+
+    /// Armed (throttle live).
+    pub fn armed(&self) -> bool {
+        self.armed
+    }
+
+    /// Mode being flown.
+    pub fn mode(&self) -> FlightMode {
+        self.mode
+    }
+
+    /// What the guided modes hold.
+    pub fn setpoints(&self) -> Setpoints {
+        self.setpoints
+    }
+
+    /// The last surface commands.
+    pub fn surfaces(&self) -> Surfaces {
+        self.surfaces
+    }
+
+    /// The ground link (parameters, missions).
+    pub fn ground_link(&self) -> &GroundLink {
+        &self.gcs
+    }
+
+    /// The ground link, mutably (to load persisted parameters at start-up).
+    pub fn ground_link_mut(&mut self) -> &mut GroundLink {
+        &mut self.gcs
     }
 
     /// Feeds bytes from the simulator link; `out` receives the bytes to send back.
@@ -86,6 +250,35 @@ impl App {
         let mut parser = core::mem::take(&mut self.sim_parser);
         parser.push(bytes, |frame| self.on_sim_frame(&frame, out));
         self.sim_parser = parser;
+    }
+
+    /// Feeds bytes from the ground station; the answers wait in [`App::drain_gcs`].
+    pub fn on_gcs_bytes(&mut self, bytes: &[u8]) {
+        let mut parser = core::mem::take(&mut self.gcs_parser);
+        let before = parser.stats();
+        let now = self.last_time_us.unwrap_or(0);
+        let snapshot = self.snapshot();
+        parser.push(bytes, |frame| {
+            self.gcs
+                .handle(&frame.header, &frame.message, now, &snapshot);
+        });
+        let after = parser.stats();
+        let bad = after.crc_errors.wrapping_sub(before.crc_errors)
+            + after.parse_errors.wrapping_sub(before.parse_errors);
+        for _ in 0..bad.min(64) {
+            self.gcs.note_rx_error();
+        }
+        self.gcs_parser = parser;
+        self.apply_requests();
+        self.poll_gcs(now);
+    }
+
+    /// Hands out the bytes waiting for the ground station.
+    pub fn drain_gcs(&mut self, out: &mut impl FnMut(&[u8])) {
+        if !self.gcs_out.is_empty() {
+            out(&self.gcs_out);
+            self.gcs_out.clear();
+        }
     }
 
     fn on_sim_frame(&mut self, frame: &Frame, out: &mut impl FnMut(&[u8])) {
@@ -97,14 +290,33 @@ impl App {
             MavMessage::HIL_SENSOR(d) => {
                 let (sensors, rejected) = simlink::decode_hil_sensor(d);
                 self.count_rejections(rejected);
-                if self.last_time_us.is_some_and(|t| sensors.time_us < t) {
-                    self.health.stale_frames += 1;
-                }
-                self.last_time_us = Some(sensors.time_us);
+                let t = sensors.time_us;
+                let dt_us = match self.last_time_us {
+                    Some(last) if t <= last => {
+                        self.health.stale_frames += 1;
+                        None
+                    }
+                    Some(last) => Some(t - last),
+                    None => None,
+                };
+                self.last_time_us = Some(t.max(self.last_time_us.unwrap_or(0)));
                 self.health.sensor_frames += 1;
+                if let (Some(imu), Some(dt)) = (sensors.imu, dt_us) {
+                    self.estimator.update_imu(&imu, dt as f32 * 1e-6);
+                }
+                if let Some(m) = sensors.mag {
+                    self.estimator.update_mag(&m);
+                }
+                if let Some(b) = sensors.baro {
+                    self.estimator.update_baro(&b);
+                }
+                if let Some(p) = sensors.pitot {
+                    self.estimator.update_pitot(&p);
+                }
+                self.tick(t);
                 let answer = ActuatorFrame {
-                    time_us: sensors.time_us,
-                    surfaces: Default::default(),
+                    time_us: t,
+                    surfaces: self.surfaces,
                     armed: self.armed,
                 };
                 let msg = MavMessage::HIL_ACTUATOR_CONTROLS(simlink::encode_actuators(&answer));
@@ -114,10 +326,19 @@ impl App {
                 Some(fix) => {
                     self.health.gps_frames += 1;
                     self.last_gps = Some(fix);
+                    self.estimator.update_gps(&fix);
                 }
                 None => self.health.rejected_gps += 1,
             },
-            MavMessage::HIL_STATE_QUATERNION(_) | MavMessage::HEARTBEAT(_) => {}
+            MavMessage::HIL_STATE_QUATERNION(d) => {
+                if let Some(m) = truth_measurements(d) {
+                    self.truth = Some(Truth {
+                        m,
+                        time_us: d.time_usec,
+                    });
+                }
+            }
+            MavMessage::HEARTBEAT(_) => {}
             _ => self.health.ignored_frames += 1,
         }
     }
@@ -128,22 +349,364 @@ impl App {
         self.health.rejected_baro += u32::from(r.baro);
         self.health.rejected_pitot += u32::from(r.pitot);
     }
+
+    /// Everything after the sensors: requests, parameters, control at 50 Hz, telemetry.
+    fn tick(&mut self, now_us: u64) {
+        self.apply_requests();
+        self.apply_params();
+        let due = self
+            .last_control_us
+            .is_none_or(|t| now_us >= t + CONTROL_PERIOD_US);
+        if due {
+            let dt = self
+                .last_control_us
+                .map_or(CONTROL_PERIOD_US as f32 * 1e-6, |t| {
+                    (now_us - t) as f32 * 1e-6
+                });
+            self.last_control_us = Some(now_us);
+            self.control(dt);
+        }
+        self.poll_gcs(now_us);
+    }
+
+    fn measurements(&self) -> Measurements {
+        if self.use_truth {
+            if let Some(t) = self.truth {
+                return t.m;
+            }
+        }
+        let e = self.estimator.state();
+        Measurements {
+            roll: e.euler.phi,
+            pitch: e.euler.theta,
+            // Course needs ground speed; on the ground or in a hover-like crawl use heading.
+            course: if e.ground_speed > 3.0 {
+                e.course
+            } else {
+                e.euler.psi
+            },
+            roll_rate: e.body_rates.x,
+            pitch_rate: e.body_rates.y,
+            yaw_rate: e.body_rates.z,
+            altitude: e.alt_amsl_m,
+            airspeed: e.airspeed,
+            sideslip: e.sideslip,
+        }
+    }
+
+    fn control(&mut self, dt: f32) {
+        let m = self.measurements();
+        let sp = self.setpoints;
+        let level = self.autopilot.gains().longitudinal;
+        let commands = match self.mode {
+            FlightMode::Stabilized => Commands {
+                roll: RollMode::Roll(0.0),
+                yaw: YawMode::Sideslip(0.0),
+                lon: LonMode::Pitch {
+                    pitch: 0.0,
+                    throttle: level.trim_throttle,
+                },
+            },
+            FlightMode::Altitude => Commands {
+                roll: RollMode::Roll(0.0),
+                yaw: YawMode::Sideslip(0.0),
+                lon: LonMode::Altitude {
+                    altitude: sp.alt_amsl_m,
+                    airspeed: sp.airspeed,
+                },
+            },
+            FlightMode::Hold => Commands {
+                roll: RollMode::Course(sp.course),
+                yaw: YawMode::Sideslip(0.0),
+                lon: LonMode::Altitude {
+                    altitude: sp.alt_amsl_m,
+                    airspeed: sp.airspeed,
+                },
+            },
+            // Manual without a pilot's stick holds the trim; the navigation modes are refused
+            // before they get here.
+            _ => Commands::OFF,
+        };
+        let out = self.autopilot.step(&m, &commands, dt);
+        self.surfaces = out.surfaces;
+    }
+
+    /// Acts on what the ground station asked for.
+    fn apply_requests(&mut self) {
+        let r: VehicleRequests = self.gcs.take_requests();
+        let e = self.estimator.state();
+        if let Some(a) = r.arm {
+            if a.arm != self.armed {
+                self.armed = a.arm;
+                self.gcs.send_statustext(
+                    MavSeverity::MAV_SEVERITY_INFO,
+                    if a.arm { "Armed" } else { "Disarmed" },
+                );
+            }
+        }
+        if let Some(mode) = r.mode {
+            if mode != self.mode {
+                // Entering a guided mode holds where the aircraft is.
+                if matches!(mode, FlightMode::Hold | FlightMode::Altitude)
+                    && !matches!(self.mode, FlightMode::Hold | FlightMode::Altitude)
+                {
+                    self.setpoints.course = e.course;
+                    self.setpoints.alt_amsl_m = e.alt_amsl_m;
+                }
+                self.mode = mode;
+            }
+        }
+        if let Some(alt) = r.altitude {
+            let base = if alt.relative_to_home {
+                e.home.map(|h| h.alt_amsl_m)
+            } else {
+                Some(0.0)
+            };
+            match base {
+                Some(b) => self.setpoints.alt_amsl_m = b + alt.alt_m,
+                None => self.gcs.send_statustext(
+                    MavSeverity::MAV_SEVERITY_WARNING,
+                    "Altitude above home refused: no home yet",
+                ),
+            }
+        }
+        if let Some(v) = r.airspeed {
+            self.setpoints.airspeed = v;
+        }
+        if let Some(c) = r.course {
+            let base = if c.relative {
+                self.setpoints.course
+            } else {
+                0.0
+            };
+            self.setpoints.course = common::math::wrap_two_pi(base + c.angle);
+        }
+    }
+
+    /// Pushes changed parameters into the stages.
+    fn apply_params(&mut self) {
+        let count = self.gcs.params().change_count();
+        if self.params_seen == Some(count) {
+            return;
+        }
+        self.params_seen = Some(count);
+        let store = self.gcs.params();
+        // A new gain set overwrites the control parameters with its values.
+        let set = store.get("SYS_GAIN_SET").unwrap_or(0.0);
+        if set != self.gain_set_seen {
+            self.gain_set_seen = set;
+            if let Some((_, g, _)) = NAMED.get(set as usize) {
+                let values: heapless::Vec<(&str, f32), 64> = g.params().collect();
+                for (name, v) in values {
+                    let _ = self.gcs.params_mut().set(name, v);
+                }
+            }
+        }
+        let store = self.gcs.params();
+        match GainSet::from_params(|n| store.get(n)) {
+            Ok(g) => {
+                if self.autopilot.set_gains(&g).is_err() {
+                    self.gcs.send_statustext(
+                        MavSeverity::MAV_SEVERITY_WARNING,
+                        "Gains refused: inconsistent set, previous kept",
+                    );
+                }
+            }
+            Err(_) => self.gcs.send_statustext(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                "Gains refused: previous set kept",
+            ),
+        }
+        let store = self.gcs.params();
+        let mut cfg = *self.estimator.config();
+        for d in common::estimator::config::PARAMS {
+            if let Some(v) = store.get(d.name) {
+                let _ = cfg.set(d.name, v);
+            }
+        }
+        self.estimator.set_config(cfg);
+        self.use_truth = store.get("SIM_USE_TRUTH").unwrap_or(0.0) >= 0.5;
+        if let Some(v) = store.get("FW_AIRSPD_TRIM") {
+            if self.params_seen == Some(0) || self.mode == FlightMode::Manual {
+                self.setpoints.airspeed = v;
+            }
+        }
+    }
+
+    fn poll_gcs(&mut self, now_us: u64) {
+        let snapshot = self.snapshot();
+        let (tx, buf, dropped) = (
+            &mut self.gcs_tx,
+            &mut self.gcs_out,
+            &mut self.health.gcs_bytes_dropped,
+        );
+        self.gcs.poll(now_us, &snapshot, |msg| {
+            let raw = tx.encode(&msg);
+            if buf.extend_from_slice(raw.raw_bytes()).is_err() {
+                *dropped = dropped.saturating_add(raw.raw_bytes().len() as u32);
+            }
+        });
+    }
+
+    /// What the ground link reports and checks.
+    pub fn snapshot(&self) -> VehicleSnapshot {
+        let e = self.estimator.state();
+        let h = &e.health;
+        let health = SensorHealth {
+            gyro_ok: h.imu.healthy,
+            accel_ok: h.imu.healthy,
+            mag_ok: h.mag.healthy,
+            baro_ok: h.baro.healthy,
+            airspeed_ok: h.pitot.healthy,
+            gps_ok: h.gps.healthy,
+            attitude_converged: e.converged,
+            position_valid: e.position_valid,
+        };
+        let home = e.home.map_or(Home::default(), |h| Home {
+            valid: true,
+            lat_e7: h.point.lat_e7,
+            lon_e7: h.point.lon_e7,
+            alt_amsl_m: h.alt_amsl_m,
+        });
+        let gps = self.last_gps.map_or(GpsRaw::default(), |g| {
+            let (course, speed) = common::math::course_and_speed(&g.vel_ned);
+            GpsRaw {
+                time_usec: self.last_time_us.unwrap_or(0),
+                fix_type: g.fix_type,
+                lat_e7: g.position.lat_e7,
+                lon_e7: g.position.lon_e7,
+                alt_amsl_m: g.alt_amsl_m,
+                hdop: g.hdop,
+                vdop: g.hdop * 1.5,
+                ground_speed_m_s: speed,
+                course: common::math::wrap_two_pi(course),
+                satellites: g.satellites,
+            }
+        });
+        let mut modes = ModeSet::EMPTY
+            .with(FlightMode::Manual)
+            .with(FlightMode::Stabilized);
+        if e.converged || e.attitude_valid {
+            modes = modes.with(FlightMode::Altitude);
+        }
+        if e.position_valid {
+            modes = modes.with(FlightMode::Hold);
+        }
+        let in_air = e.airspeed > 8.0 && home.valid && e.alt_amsl_m - home.alt_amsl_m > 5.0;
+        VehicleSnapshot {
+            boot_complete: self.last_time_us.is_some(),
+            hil: true,
+            armed: self.armed,
+            failsafe: false,
+            mode: self.mode,
+            modes_available: modes,
+            landed: if in_air {
+                LandedState::InAir
+            } else {
+                LandedState::OnGround
+            },
+            health,
+            roll: e.euler.phi,
+            pitch: e.euler.theta,
+            yaw: e.euler.psi,
+            roll_rate: e.body_rates.x,
+            pitch_rate: e.body_rates.y,
+            yaw_rate: e.body_rates.z,
+            lat_e7: e.position.lat_e7,
+            lon_e7: e.position.lon_e7,
+            alt_amsl_m: e.alt_amsl_m,
+            alt_rel_home_m: e.alt_amsl_m - home.alt_amsl_m,
+            vel_n: e.vel_ned.x,
+            vel_e: e.vel_ned.y,
+            vel_d: e.vel_ned.z,
+            airspeed: e.airspeed,
+            throttle: if self.armed {
+                self.surfaces.throttle
+            } else {
+                0.0
+            },
+            home,
+            gps,
+            battery: Battery {
+                present: false,
+                ..Battery::default()
+            },
+            nav: Default::default(),
+            mission_seq: 0,
+            mission_state: Default::default(),
+            cpu_load: 0.0,
+        }
+    }
+}
+
+fn trim_surfaces(g: &GainSet) -> Surfaces {
+    Surfaces {
+        elevator: g.longitudinal.trim_elevator,
+        aileron: g.lateral.trim_aileron,
+        rudder: g.lateral.trim_rudder,
+        throttle: g.longitudinal.trim_throttle,
+    }
+}
+
+/// Truth as the autopilot's measurements (`HIL_STATE_QUATERNION`: attitude quaternion, body
+/// rates, altitude in mm, velocity in cm/s, true airspeed in cm/s).
+fn truth_measurements(
+    d: &mavlink::dialects::common::HIL_STATE_QUATERNION_DATA,
+) -> Option<Measurements> {
+    let q = d.attitude_quaternion;
+    if q.iter().any(|x| !x.is_finite()) {
+        return None;
+    }
+    let uq =
+        nalgebra::UnitQuaternion::try_new(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]), 1e-6)?;
+    let e = common::math::Euler::from_quaternion(&uq);
+    let v = nalgebra::Vector3::new(f32::from(d.vx), f32::from(d.vy), f32::from(d.vz)) / 100.0;
+    let (chi, vg) = common::math::course_and_speed(&v);
+    let course = if vg > 3.0 { chi } else { e.psi };
+    Some(Measurements {
+        roll: e.phi,
+        pitch: e.theta,
+        course,
+        roll_rate: d.rollspeed,
+        pitch_rate: d.pitchspeed,
+        yaw_rate: d.yawspeed,
+        altitude: d.alt as f32 / 1000.0,
+        airspeed: f32::from(d.true_airspeed) / 100.0,
+        sideslip: 0.0,
+    })
 }
 
 /// A heartbeat frame of the autopilot on its simulator link.
 pub fn heartbeat_frame(app: &mut App) -> heapless::Vec<u8, 280> {
     let msg = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-        custom_mode: 0,
+        custom_mode: app.mode.custom_mode(),
         mavtype: MavType::MAV_TYPE_FIXED_WING,
         autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
         base_mode: if app.armed {
-            MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED
+            MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
         } else {
-            MavModeFlag::empty()
+            MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
         },
         system_status: MavState::MAV_STATE_STANDBY,
         mavlink_version: 3,
     });
     let raw = app.sim_tx.encode(&msg);
     heapless::Vec::from_slice(raw.raw_bytes()).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_registry_builds_and_every_name_is_unique() {
+        assert!(GroundLink::new(REGISTRY).is_ok());
+        assert!(common::params::validate_defs(PARAMS).is_ok());
+    }
+
+    #[test]
+    fn the_application_fits_the_stm32f405_ram_with_room_for_the_stack() {
+        // 128 KiB of SRAM: the whole application state must leave most of it to the stack.
+        assert!(core::mem::size_of::<App>() < 40 * 1024, "{}", core::mem::size_of::<App>());
+    }
 }

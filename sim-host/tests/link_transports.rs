@@ -47,6 +47,8 @@ fn frames(k: u64) -> (u64, Vec<MavMessage>) {
 fn fly<T: Transport>(t: T, log: &std::path::Path) -> Vec<(u64, Vec<u8>)> {
     let tlog = TlogWriter::create(log).expect("tlog");
     let mut link = Lockstep::new(t, Duration::from_secs(5)).with_tlog(tlog);
+    link.wait_for_autopilot(Duration::from_secs(5))
+        .expect("the autopilot announces itself");
     for k in 0..200 {
         let (time, msgs) = frames(k);
         let a = link.exchange(time, &msgs).expect("answer");

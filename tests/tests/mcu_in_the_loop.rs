@@ -51,6 +51,8 @@ fn the_emulated_stm32f405_answers_every_sensor_frame() {
     })
     .expect("QEMU connects to the simulator");
     let mut link = Lockstep::new(server, Duration::from_secs(10));
+    link.wait_for_autopilot(Duration::from_secs(20))
+        .expect("the MCU announces itself once its UART is up");
     for k in 0..100u64 {
         let t = k * 20_000;
         let frame = SensorFrame {

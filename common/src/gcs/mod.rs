@@ -89,7 +89,7 @@ pub struct ArmRequest {
 
 /// What the ground station asked the vehicle to do, after the link's checks. The vehicle takes
 /// these with [`GroundLink::take_requests`] and acts on them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct VehicleRequests {
     /// Arm or disarm.
@@ -100,7 +100,36 @@ pub struct VehicleRequests {
     pub mission_seq: Option<u16>,
     /// Persist the parameters now (`MAV_CMD_PREFLIGHT_STORAGE` write).
     pub save_params: bool,
+    /// New altitude setpoint (`MAV_CMD_DO_CHANGE_ALTITUDE`).
+    pub altitude: Option<AltitudeSetpoint>,
+    /// New airspeed setpoint, m/s (`MAV_CMD_DO_CHANGE_SPEED`, airspeed type).
+    pub airspeed: Option<f32>,
+    /// New course setpoint, rad in [0, 2 pi) (`MAV_CMD_CONDITION_YAW`, absolute or relative).
+    pub course: Option<CourseSetpoint>,
 }
+
+/// An altitude the ground station asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AltitudeSetpoint {
+    /// Altitude, m.
+    pub alt_m: f32,
+    /// `true`: above home (`MAV_FRAME_GLOBAL_RELATIVE_ALT`); `false`: above mean sea level.
+    pub relative_to_home: bool,
+}
+
+/// A course the ground station asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CourseSetpoint {
+    /// Angle, rad.
+    pub angle: f32,
+    /// `true`: added to the current course (direction already applied); `false`: absolute.
+    pub relative: bool,
+}
+
+/// Airspeeds a setpoint may ask for, m/s (the Ultra Stick's envelope with margin).
+pub const AIRSPEED_SETPOINT_RANGE: (f32, f32) = (10.0, 30.0);
 
 /// A STATUSTEXT waiting to be sent.
 #[derive(Clone, Debug, PartialEq)]
@@ -510,6 +539,53 @@ impl GroundLink {
                     MavResult::MAV_RESULT_ACCEPTED
                 } else {
                     MavResult::MAV_RESULT_DENIED
+                }
+            }
+            MavCmd::MAV_CMD_DO_CHANGE_ALTITUDE => {
+                // param1 altitude, param2 frame (MAV_FRAME_GLOBAL = 0 or GLOBAL_RELATIVE_ALT = 3).
+                let frame = c.p[1] as i32;
+                if !c.p[0].is_finite() || !(-500.0..=10_000.0).contains(&c.p[0]) {
+                    MavResult::MAV_RESULT_DENIED
+                } else if frame != 0 && frame != 3 {
+                    MavResult::MAV_RESULT_UNSUPPORTED
+                } else {
+                    self.requests.altitude = Some(AltitudeSetpoint {
+                        alt_m: c.p[0],
+                        relative_to_home: frame == 3,
+                    });
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+            }
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED => {
+                // param1 speed type (0 or 1: airspeed), param2 speed, -1 / -2: no change.
+                let (lo, hi) = AIRSPEED_SETPOINT_RANGE;
+                if c.p[1] == -1.0 || c.p[1] == -2.0 {
+                    MavResult::MAV_RESULT_ACCEPTED
+                } else if c.p[0] as i32 > 1 {
+                    MavResult::MAV_RESULT_UNSUPPORTED
+                } else if !(lo..=hi).contains(&c.p[1]) {
+                    self.textf(
+                        MavSeverity::MAV_SEVERITY_WARNING,
+                        format_args!("Airspeed {} refused: outside [{}, {}] m/s", c.p[1], lo, hi),
+                    );
+                    MavResult::MAV_RESULT_DENIED
+                } else {
+                    self.requests.airspeed = Some(c.p[1]);
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+            }
+            MavCmd::MAV_CMD_CONDITION_YAW => {
+                // param1 angle deg, param3 direction (-1 ccw, 1 cw) when relative, param4 1 = relative.
+                let relative = c.p[3] as i32 == 1;
+                if !c.p[0].is_finite() || !(0.0..=360.0).contains(&c.p[0]) {
+                    MavResult::MAV_RESULT_DENIED
+                } else {
+                    let sign = if relative && c.p[2] < 0.0 { -1.0 } else { 1.0 };
+                    self.requests.course = Some(CourseSetpoint {
+                        angle: sign * c.p[0].to_radians(),
+                        relative,
+                    });
+                    MavResult::MAV_RESULT_ACCEPTED
                 }
             }
             MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {

@@ -88,6 +88,41 @@ impl<T: Transport> Lockstep<T> {
         Ok(self.tlog)
     }
 
+    /// Waits until the autopilot has spoken (its boot heartbeat): a UART drops what arrives
+    /// before the autopilot has enabled it, and a UDP simulator learns its peer that way, so
+    /// no sensor frame is sent before.
+    pub fn wait_for_autopilot(&mut self, timeout: Duration) -> Result<(), LinkError> {
+        let start = Instant::now();
+        loop {
+            let n = self
+                .transport
+                .recv(&mut self.rx, Duration::from_millis(50))?;
+            let mut heard = false;
+            let tlog = &mut self.tlog;
+            let mut log_err = Ok(());
+            self.parser.push(&self.rx[..n], |f| {
+                if let Some(t) = tlog.as_mut() {
+                    let raw = common::link::framing::encode_v2(f.header, &f.message);
+                    if let Err(e) = t.write(0, raw.raw_bytes()) {
+                        log_err = Err(e);
+                    }
+                }
+                heard |= f.header.system_id == u32::from(SIM_SYSTEM_ID);
+            });
+            log_err?;
+            if heard {
+                return Ok(());
+            }
+            if start.elapsed() > timeout {
+                return Err(LinkError::Silent {
+                    time_s: 0.0,
+                    waited: timeout,
+                    frames: 0,
+                });
+            }
+        }
+    }
+
     /// Sends `messages` (stamped `time_us`) in one write and waits for the autopilot's
     /// `HIL_ACTUATOR_CONTROLS` for that time. Other frames from the autopilot are logged and
     /// passed over.
