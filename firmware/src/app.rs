@@ -707,6 +707,10 @@ mod tests {
     #[test]
     fn the_application_fits_the_stm32f405_ram_with_room_for_the_stack() {
         // 128 KiB of SRAM: the whole application state must leave most of it to the stack.
-        assert!(core::mem::size_of::<App>() < 40 * 1024, "{}", core::mem::size_of::<App>());
+        assert!(
+            core::mem::size_of::<App>() < 40 * 1024,
+            "{}",
+            core::mem::size_of::<App>()
+        );
     }
 }

@@ -2,6 +2,10 @@
 //! same [`App`] the MCU runs.
 
 use crate::app::App;
+use common::storage::{
+    load_missions, load_params, save_missions, save_params, AbRegion, RamFlash, MISSION_MAGIC,
+    PARAMS_MAGIC,
+};
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs, UdpSocket};
 use std::os::fd::AsFd;
@@ -182,13 +186,35 @@ fn set_raw(f: &std::fs::File) -> io::Result<()> {
 /// Runs the autopilot against a simulator link until the link closes or stays silent for
 /// `silence`.
 pub fn run(link: &mut dyn ByteLink, app: &mut App, silence: Duration) -> io::Result<()> {
+    run_with(link, app, silence, None, None)
+}
+
+/// [`run`] with a ground-station link and persistent storage.
+pub fn run_with(
+    link: &mut dyn ByteLink,
+    app: &mut App,
+    silence: Duration,
+    mut gcs: Option<&mut GcsUdp>,
+    mut storage: Option<&mut FileStorage>,
+) -> io::Result<()> {
     // Announce ourselves: a UDP simulator learns our address from the first datagram.
     let hb = crate::app::heartbeat_frame(app);
     link.write_all_bytes(&hb)?;
     let mut buf = [0u8; 2048];
     let mut last_rx = Instant::now();
     loop {
-        let n = link.read_timeout(&mut buf, Duration::from_millis(100))?;
+        // Short waits while a ground station is attached, so it is answered even when the
+        // simulator pauses.
+        let wait = if gcs.is_some() { 5 } else { 100 };
+        let n = link.read_timeout(&mut buf, Duration::from_millis(wait))?;
+        if let Some(g) = gcs.as_deref_mut() {
+            g.service(app)?;
+        }
+        if let Some(s) = storage.as_deref_mut() {
+            if let Err(e) = s.save_changes(app) {
+                eprintln!("firmware: {e}");
+            }
+        }
         if n == 0 {
             if last_rx.elapsed() > silence {
                 return Err(io::Error::new(
@@ -204,6 +230,181 @@ pub fn run(link: &mut dyn ByteLink, app: &mut App, silence: Duration) -> io::Res
         if !out.is_empty() {
             link.write_all_bytes(&out)?;
         }
+        if let Some(g) = gcs.as_deref_mut() {
+            g.flush(app);
+        }
+    }
+}
+
+/// The SITL "flash": the parameter and mission records of `common::storage`, in a file.
+///
+/// The records are written A/B with a CRC exactly as on the MCU; the file is the flash image.
+pub struct FileStorage {
+    path: Option<PathBuf>,
+    flash: RamFlash<STORAGE_BYTES>,
+    missions_seen: Option<u32>,
+}
+
+const SECTOR: u32 = 16 * 1024;
+const STORAGE_BYTES: usize = 4 * SECTOR as usize;
+const PARAMS_REGION: AbRegion = AbRegion {
+    magic: PARAMS_MAGIC,
+    slot_a: 0,
+    slot_b: SECTOR,
+    slot_len: SECTOR,
+};
+const MISSIONS_REGION: AbRegion = AbRegion {
+    magic: MISSION_MAGIC,
+    slot_a: 2 * SECTOR,
+    slot_b: 3 * SECTOR,
+    slot_len: SECTOR,
+};
+
+impl FileStorage {
+    /// Storage in `path` (created on the first save); `None` keeps it in memory only.
+    pub fn open(path: Option<PathBuf>) -> Self {
+        let image = path
+            .as_ref()
+            .and_then(|p| std::fs::read(p).ok())
+            .unwrap_or_default();
+        Self {
+            path,
+            flash: RamFlash::from_image(&image, SECTOR),
+            missions_seen: None,
+        }
+    }
+
+    /// Loads saved parameters and missions into the autopilot.
+    pub fn load_into(&mut self, app: &mut App) -> Vec<String> {
+        let mut notes = Vec::new();
+        let mut scratch = vec![0u8; SECTOR as usize];
+        match load_params(
+            &mut self.flash,
+            &PARAMS_REGION,
+            app.ground_link_mut().params_mut(),
+            &mut scratch,
+        ) {
+            Ok(Some(r)) => notes.push(format!("parameters loaded ({r:?})")),
+            Ok(None) => {}
+            Err(e) => notes.push(format!("saved parameters unreadable: {e:?}")),
+        }
+        match load_missions(&mut self.flash, &MISSIONS_REGION, &mut scratch) {
+            Ok(Some(m)) => {
+                app.ground_link_mut().missions_mut().load(m);
+                notes.push("missions loaded".into());
+            }
+            Ok(None) => {}
+            Err(e) => notes.push(format!("saved missions unreadable: {e:?}")),
+        }
+        self.missions_seen = Some(app.ground_link().missions().change_count());
+        app.ground_link_mut().params_mut().mark_saved();
+        notes
+    }
+
+    /// Saves what changed since the last save (PX4 saves parameters as they change).
+    pub fn save_changes(&mut self, app: &mut App) -> io::Result<()> {
+        let mut changed = false;
+        let mut scratch = vec![0u8; SECTOR as usize];
+        if app.ground_link().params().is_dirty() {
+            save_params(
+                &mut self.flash,
+                &PARAMS_REGION,
+                app.ground_link_mut().params_mut(),
+                &mut scratch,
+            )
+            .map_err(|e| io::Error::other(format!("parameter save: {e:?}")))?;
+            changed = true;
+        }
+        let missions = app.ground_link().missions();
+        if Some(missions.change_count()) != self.missions_seen && !missions.busy() {
+            save_missions(
+                &mut self.flash,
+                &MISSIONS_REGION,
+                missions.store(),
+                &mut scratch,
+            )
+            .map_err(|e| io::Error::other(format!("mission save: {e:?}")))?;
+            self.missions_seen = Some(missions.change_count());
+            changed = true;
+        }
+        if changed {
+            if let Some(p) = &self.path {
+                // Write-then-rename: the file is never half written.
+                let tmp = p.with_extension("tmp");
+                std::fs::write(&tmp, self.flash.bytes())?;
+                std::fs::rename(&tmp, p)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The ground-station link over UDP: telemetry to a fixed remote (QGroundControl listens on
+/// 14550) and to every peer that has sent us a frame (MAVSDK, pymavlink, test clients).
+pub struct GcsUdp {
+    socket: UdpSocket,
+    remote: Option<SocketAddr>,
+    peers: Vec<SocketAddr>,
+}
+
+/// Most ground stations a SITL link answers at once.
+pub const MAX_GCS_PEERS: usize = 8;
+
+impl GcsUdp {
+    /// Binds `bind` and sends to `remote` as well as to whoever speaks.
+    pub fn open(bind: &str, remote: Option<&str>) -> io::Result<Self> {
+        let socket = UdpSocket::bind(bind)?;
+        socket.set_nonblocking(true)?;
+        let remote = match remote {
+            Some(r) => r.to_socket_addrs()?.next(),
+            None => None,
+        };
+        Ok(Self {
+            socket,
+            remote,
+            peers: Vec::new(),
+        })
+    }
+
+    /// The bound address.
+    pub fn local_addr(&self) -> io::Result<SocketAddr> {
+        self.socket.local_addr()
+    }
+
+    /// Takes every waiting datagram into the autopilot, then sends its answers.
+    pub fn service(&mut self, app: &mut App) -> io::Result<()> {
+        let mut buf = [0u8; 2048];
+        loop {
+            match self.socket.recv_from(&mut buf) {
+                Ok((n, from)) => {
+                    if Some(from) != self.remote
+                        && !self.peers.contains(&from)
+                        && self.peers.len() < MAX_GCS_PEERS
+                    {
+                        self.peers.push(from);
+                    }
+                    app.on_gcs_bytes(&buf[..n]);
+                }
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
+                // A peer that went away makes the next recv report it (ICMP); keep going.
+                Err(e) if e.kind() == io::ErrorKind::ConnectionRefused => continue,
+                Err(e) => return Err(e),
+            }
+        }
+        self.flush(app);
+        Ok(())
+    }
+
+    /// Sends what the autopilot has for the ground stations.
+    pub fn flush(&mut self, app: &mut App) {
+        let (socket, remote, peers) = (&self.socket, self.remote, &self.peers);
+        app.drain_gcs(&mut |bytes| {
+            // Frames are cut at frame boundaries by the app; one datagram per drain is fine
+            // below 8 KiB, the loopback datagram limit is far above that.
+            for to in remote.iter().chain(peers.iter()) {
+                let _ = socket.send_to(bytes, to);
+            }
+        });
     }
 }
 
@@ -222,6 +423,16 @@ struct Args {
     /// Give up after the simulator has been silent this long, s.
     #[arg(long, default_value_t = 5.0)]
     silence_s: f64,
+    /// Local address of the ground-station link (PX4 SITL uses 18570).
+    #[arg(long, default_value = "127.0.0.1:18570")]
+    gcs_bind: String,
+    /// Where telemetry goes besides every station that speaks (QGroundControl: 14550);
+    /// `none` for no fixed remote.
+    #[arg(long, default_value = "127.0.0.1:14550")]
+    gcs_remote: String,
+    /// File holding the saved parameters and missions (the SITL flash); `none` for none.
+    #[arg(long, default_value = "sitl-storage.bin")]
+    storage: String,
 }
 
 /// Entry point of the SITL build.
@@ -239,11 +450,32 @@ pub fn main() -> std::process::ExitCode {
         }
     };
     let mut app = App::new();
-    eprintln!("firmware: connected to the simulator at {:?}", args.sim);
-    match run(
+    let mut storage =
+        FileStorage::open((args.storage != "none").then(|| PathBuf::from(&args.storage)));
+    for note in storage.load_into(&mut app) {
+        eprintln!("firmware: {note}");
+    }
+    let remote = (args.gcs_remote != "none").then_some(args.gcs_remote.as_str());
+    let mut gcs = match GcsUdp::open(&args.gcs_bind, remote) {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!(
+                "firmware: cannot open the ground link on {}: {e}",
+                args.gcs_bind
+            );
+            return std::process::ExitCode::FAILURE;
+        }
+    };
+    eprintln!(
+        "firmware: connected to the simulator at {:?}; ground link on udp {} -> {}",
+        args.sim, args.gcs_bind, args.gcs_remote
+    );
+    match run_with(
         link.as_mut(),
         &mut app,
         Duration::from_secs_f64(args.silence_s.max(0.1)),
+        Some(&mut gcs),
+        Some(&mut storage),
     ) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

@@ -290,6 +290,15 @@ impl<const N: usize> RamFlash<N> {
         }
     }
 
+    /// A device holding `image` (a saved copy of [`RamFlash::bytes`]); missing bytes read as
+    /// erased, extra ones are ignored. SITL keeps its "flash" in a file this way.
+    pub fn from_image(image: &[u8], sector: u32) -> Self {
+        let mut f = Self::new(sector);
+        let n = image.len().min(N);
+        f.mem[..n].copy_from_slice(&image[..n]);
+        f
+    }
+
     /// Cuts the power during the `ops`-th operation from now: `ops - 1` complete, that one is
     /// torn, none after it happens (`Some(0)`: already off; `None`: power stays on).
     pub fn cut_after(&mut self, ops: Option<usize>) {

@@ -1,0 +1,493 @@
+//! A ground station (this test, speaking MAVLink 2 over UDP) against the SITL autopilot, which
+//! is fed by a simulator over TCP in lock-step: the autopilot's clock is the simulator's, paced
+//! here at real time so message rates can be counted on the wall clock.
+//!
+//! The simulated airplane sits on the ground at home, at rest: the estimator converges there
+//! (as before a real flight), which is what the pre-arm checks wait for.
+
+use common::link::framing::{Frame, FrameParser, Sender};
+use common::link::simlink::{encode_hil_gps, encode_hil_sensor, SensorFrame};
+use common::math::atmosphere::standard_atmosphere;
+use common::math::geodetic::GeoPoint;
+use common::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use firmware::app::App;
+use firmware::sitl::{self, FileStorage, GcsUdp, SimEndpoint};
+use mavlink::dialects::common::*;
+use nalgebra::Vector3;
+use sim_host::link::lockstep::Lockstep;
+use sim_host::link::transport::TcpServer;
+use std::net::{SocketAddr, UdpSocket};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+const HOME_ALT_M: f32 = 250.0;
+
+/// Sensor frames of an airplane at rest on the ground at home, heading north.
+fn at_rest(k: u64, gps: bool) -> (u64, Vec<MavMessage>) {
+    let t = k * 10_000;
+    let air = standard_atmosphere(HOME_ALT_M);
+    let frame = SensorFrame {
+        time_us: t,
+        imu: Some(ImuSample {
+            accel: Vector3::new(0.0, 0.0, -9.8056),
+            gyro: Vector3::zeros(),
+        }),
+        mag: k.is_multiple_of(2).then_some(MagSample {
+            field: Vector3::new(0.18, -0.002, 0.52),
+        }),
+        baro: k.is_multiple_of(2).then_some(BaroSample {
+            pressure_pa: air.pressure_pa,
+            temperature_c: air.temperature_k - 273.15,
+        }),
+        pitot: k.is_multiple_of(2).then_some(PitotSample {
+            diff_pressure_pa: 0.0,
+        }),
+        reset: false,
+    };
+    let mut m = vec![MavMessage::HIL_SENSOR(encode_hil_sensor(
+        &frame, HOME_ALT_M,
+    ))];
+    if gps && k.is_multiple_of(20) {
+        let fix = GpsFix {
+            position: GeoPoint::from_deg(44.7258357, -93.07501316),
+            alt_amsl_m: HOME_ALT_M,
+            vel_ned: Vector3::zeros(),
+            fix_type: 3,
+            satellites: 12,
+            hdop: 0.8,
+        };
+        m.push(MavMessage::HIL_GPS(encode_hil_gps(t, &fix)));
+    }
+    (t, m)
+}
+
+/// One SITL autopilot with its simulator, until dropped.
+struct Sitl {
+    gcs_addr: SocketAddr,
+    stop: Arc<AtomicBool>,
+    threads: Vec<std::thread::JoinHandle<()>>,
+}
+
+impl Sitl {
+    fn start(storage: Option<PathBuf>, gps: Arc<AtomicBool>) -> Self {
+        let stop = Arc::new(AtomicBool::new(false));
+        let gcs = GcsUdp::open("127.0.0.1:0", None).expect("gcs socket");
+        let gcs_addr = gcs.local_addr().expect("gcs addr");
+        let (tx, rx) = std::sync::mpsc::channel();
+        let sim_stop = stop.clone();
+        let sim = std::thread::spawn(move || {
+            let server = TcpServer::listen("127.0.0.1:0", Duration::from_secs(10), |addr| {
+                let _ = tx.send(addr);
+            })
+            .expect("autopilot connects");
+            let mut link = Lockstep::new(server, Duration::from_secs(5));
+            link.wait_for_autopilot(Duration::from_secs(10))
+                .expect("autopilot announces itself");
+            let start = Instant::now();
+            let mut k = 0u64;
+            while !sim_stop.load(Ordering::Relaxed) {
+                let (t, msgs) = at_rest(k, gps.load(Ordering::Relaxed));
+                // Real time: the autopilot's clock is this one.
+                let due = Duration::from_micros(t);
+                if let Some(wait) = due.checked_sub(start.elapsed()) {
+                    std::thread::sleep(wait);
+                }
+                if link.exchange(t, &msgs).is_err() {
+                    break;
+                }
+                k += 1;
+            }
+        });
+        let addr = rx.recv().expect("simulator listening");
+        let fw_stop = stop.clone();
+        let fw = std::thread::spawn(move || {
+            let mut link =
+                sitl::connect(&SimEndpoint::Tcp(addr.to_string()), Duration::from_secs(5))
+                    .expect("connect");
+            let mut app = App::new();
+            let mut storage = FileStorage::open(storage);
+            storage.load_into(&mut app);
+            let mut gcs = gcs;
+            let _ = sitl::run_with(
+                link.as_mut(),
+                &mut app,
+                Duration::from_secs(1),
+                Some(&mut gcs),
+                Some(&mut storage),
+            );
+            drop(fw_stop);
+        });
+        Self {
+            gcs_addr,
+            stop,
+            threads: vec![sim, fw],
+        }
+    }
+}
+
+impl Drop for Sitl {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}
+
+/// A ground station: system 255, component 190, as QGroundControl.
+struct Gcs {
+    socket: UdpSocket,
+    to: SocketAddr,
+    parser: FrameParser,
+    sender: Sender,
+    inbox: Vec<Frame>,
+}
+
+impl Gcs {
+    fn new(to: SocketAddr) -> Self {
+        let socket = UdpSocket::bind("127.0.0.1:0").expect("bind");
+        socket
+            .set_read_timeout(Some(Duration::from_millis(20)))
+            .expect("timeout");
+        let mut g = Self {
+            socket,
+            to,
+            parser: FrameParser::new(),
+            sender: Sender::new(255, 190),
+            inbox: Vec::new(),
+        };
+        g.send(&MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            mavtype: MavType::MAV_TYPE_GCS,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+            ..Default::default()
+        }));
+        g
+    }
+
+    fn send(&mut self, m: &MavMessage) {
+        let raw = self.sender.encode(m);
+        self.socket.send_to(raw.raw_bytes(), self.to).expect("send");
+    }
+
+    fn send_raw(&mut self, bytes: &[u8]) {
+        self.socket.send_to(bytes, self.to).expect("send");
+    }
+
+    fn pump(&mut self) {
+        let mut buf = [0u8; 9000];
+        while let Ok((n, _)) = self.socket.recv_from(&mut buf) {
+            let inbox = &mut self.inbox;
+            self.parser.push(&buf[..n], |f| inbox.push(f));
+        }
+    }
+
+    /// Waits for the first message `pick` accepts.
+    fn wait<T>(&mut self, secs: f64, mut pick: impl FnMut(&MavMessage) -> Option<T>) -> Option<T> {
+        let end = Instant::now() + Duration::from_secs_f64(secs);
+        while Instant::now() < end {
+            self.pump();
+            if let Some(i) = self.inbox.iter().position(|f| pick(&f.message).is_some()) {
+                let f = self.inbox.remove(i);
+                return pick(&f.message);
+            }
+            self.inbox.clear();
+        }
+        None
+    }
+
+    fn command(&mut self, cmd: MavCmd, p: [f32; 7]) -> Option<MavResult> {
+        self.send(&MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
+            target_system: 1,
+            target_component: 1,
+            command: cmd,
+            confirmation: 0,
+            param1: p[0],
+            param2: p[1],
+            param3: p[2],
+            param4: p[3],
+            param5: p[4],
+            param6: p[5],
+            param7: p[6],
+        }));
+        self.wait(2.0, |m| match m {
+            MavMessage::COMMAND_ACK(a) if a.command == cmd => Some(a.result),
+            _ => None,
+        })
+    }
+
+    fn param_set(&mut self, name: &str, value: f32) -> Option<f32> {
+        self.send(&MavMessage::PARAM_SET(PARAM_SET_DATA {
+            param_value: value,
+            target_system: 1,
+            target_component: 1,
+            param_id: name.into(),
+            param_type: MavParamType::MAV_PARAM_TYPE_REAL32,
+        }));
+        let name = name.to_string();
+        self.wait(2.0, move |m| match m {
+            MavMessage::PARAM_VALUE(v) if v.param_id.to_str().ok() == Some(name.as_str()) => {
+                Some(v.param_value)
+            }
+            _ => None,
+        })
+    }
+
+    fn param_read(&mut self, name: &str) -> Option<f32> {
+        self.send(&MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: -1,
+            target_system: 1,
+            target_component: 1,
+            param_id: name.into(),
+        }));
+        let name = name.to_string();
+        self.wait(2.0, move |m| match m {
+            MavMessage::PARAM_VALUE(v) if v.param_id.to_str().ok() == Some(name.as_str()) => {
+                Some(v.param_value)
+            }
+            _ => None,
+        })
+    }
+}
+
+fn heartbeat_of(m: &MavMessage) -> Option<HEARTBEAT_DATA> {
+    match m {
+        MavMessage::HEARTBEAT(h) => Some(h.clone()),
+        _ => None,
+    }
+}
+
+#[test]
+fn parameters_download_set_refuse_and_persist_across_a_reboot() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let storage = dir.path().join("sitl-storage.bin");
+    let gps = Arc::new(AtomicBool::new(true));
+    let sitl = Sitl::start(Some(storage.clone()), gps.clone());
+    let mut gcs = Gcs::new(sitl.gcs_addr);
+    let hb = gcs.wait(5.0, heartbeat_of).expect("heartbeat");
+    assert_eq!(hb.mavtype, MavType::MAV_TYPE_FIXED_WING);
+    assert_eq!(hb.autopilot, MavAutopilot::MAV_AUTOPILOT_GENERIC);
+
+    // Full download: every index once, one stable count.
+    gcs.send(&MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+        target_system: 1,
+        target_component: 1,
+    }));
+    let mut seen = std::collections::BTreeMap::new();
+    let mut count = None;
+    let end = Instant::now() + Duration::from_secs(10);
+    while Instant::now() < end && count.is_none_or(|c| seen.len() < c) {
+        gcs.pump();
+        for f in gcs.inbox.drain(..) {
+            if let MavMessage::PARAM_VALUE(v) = f.message {
+                let c = usize::from(v.param_count);
+                assert_eq!(*count.get_or_insert(c), c, "param_count changed");
+                let name = v.param_id.to_str().unwrap_or("").to_string();
+                let prev = seen.insert(v.param_index, name.clone());
+                assert!(prev.is_none(), "index {} sent twice", v.param_index);
+            }
+        }
+    }
+    let count = count.expect("PARAM_VALUEs");
+    assert_eq!(seen.len(), count, "every index");
+    assert!(seen.values().any(|n| n == "RLL_KP") && seen.values().any(|n| n == "EKF_GYR_NOISE"));
+
+    // Set and read back; refuse NaN and out-of-bounds with the unchanged value echoed.
+    assert_eq!(gcs.param_set("RLL_KP", -0.8), Some(-0.8));
+    assert_eq!(gcs.param_read("RLL_KP"), Some(-0.8));
+    assert_eq!(gcs.param_set("RLL_KP", f32::NAN), Some(-0.8));
+    assert_eq!(
+        gcs.param_set("RLL_KP", 5.0),
+        Some(-0.8),
+        "positive roll gain is out of bounds"
+    );
+
+    // Garbage and truncated frames on the link do not stop the heartbeat.
+    let mut junk = vec![0xFD, 0x40, 0x00, 0x00];
+    junk.extend((0..500).map(|i| (i * 37 % 251) as u8));
+    gcs.send_raw(&junk);
+    let raw = gcs
+        .sender
+        .encode(&MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+            target_system: 1,
+            target_component: 1,
+        }));
+    let truncated = raw.raw_bytes()[..raw.raw_bytes().len() - 3].to_vec();
+    gcs.send_raw(&truncated);
+    gcs.inbox.clear();
+    assert!(
+        gcs.wait(3.0, heartbeat_of).is_some(),
+        "heartbeat after garbage"
+    );
+
+    // Reboot: a new autopilot on the same storage file has the value.
+    drop(gcs);
+    drop(sitl);
+    let sitl = Sitl::start(Some(storage), gps);
+    let mut gcs = Gcs::new(sitl.gcs_addr);
+    assert_eq!(
+        gcs.param_read("RLL_KP"),
+        Some(-0.8),
+        "persisted across the reboot"
+    );
+}
+
+#[test]
+fn a_mission_round_trips_bit_for_bit_with_nan_fields() {
+    let gps = Arc::new(AtomicBool::new(true));
+    let sitl = Sitl::start(None, gps);
+    let mut gcs = Gcs::new(sitl.gcs_addr);
+    assert!(gcs.wait(5.0, heartbeat_of).is_some());
+    let items: Vec<MISSION_ITEM_INT_DATA> = (0..5u16)
+        .map(|seq| MISSION_ITEM_INT_DATA {
+            param1: if seq == 2 { f32::NAN } else { seq as f32 },
+            param2: 5.0,
+            param3: 0.0,
+            param4: f32::NAN,
+            x: 447_258_357 + i32::from(seq) * 1000,
+            y: -930_750_131,
+            z: 100.0 + f32::from(seq),
+            seq,
+            command: MavCmd::MAV_CMD_NAV_WAYPOINT,
+            target_system: 1,
+            target_component: 1,
+            frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+            current: 0,
+            autocontinue: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        })
+        .collect();
+    gcs.send(&MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+        count: items.len() as u16,
+        target_system: 1,
+        target_component: 1,
+        mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        opaque_id: 0,
+    }));
+    let mut acked = None;
+    let end = Instant::now() + Duration::from_secs(10);
+    while acked.is_none() && Instant::now() < end {
+        gcs.pump();
+        let inbox: Vec<Frame> = gcs.inbox.drain(..).collect();
+        for f in inbox {
+            match f.message {
+                MavMessage::MISSION_REQUEST_INT(r) => {
+                    let item = items[usize::from(r.seq)].clone();
+                    gcs.send(&MavMessage::MISSION_ITEM_INT(item));
+                }
+                MavMessage::MISSION_ACK(a) => acked = Some(a.mavtype),
+                _ => {}
+            }
+        }
+    }
+    assert_eq!(acked, Some(MavMissionResult::MAV_MISSION_ACCEPTED));
+
+    gcs.send(&MavMessage::MISSION_REQUEST_LIST(
+        MISSION_REQUEST_LIST_DATA {
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        },
+    ));
+    let n = gcs
+        .wait(3.0, |m| match m {
+            MavMessage::MISSION_COUNT(c) => Some(c.count),
+            _ => None,
+        })
+        .expect("count");
+    assert_eq!(usize::from(n), items.len());
+    for (seq, sent) in items.iter().enumerate() {
+        gcs.send(&MavMessage::MISSION_REQUEST_INT(MISSION_REQUEST_INT_DATA {
+            seq: seq as u16,
+            target_system: 1,
+            target_component: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        }));
+        let got = gcs
+            .wait(3.0, |m| match m {
+                MavMessage::MISSION_ITEM_INT(i) if usize::from(i.seq) == seq => Some(i.clone()),
+                _ => None,
+            })
+            .expect("item");
+        for (a, b) in [
+            (got.param1, sent.param1),
+            (got.param2, sent.param2),
+            (got.param4, sent.param4),
+            (got.z, sent.z),
+        ] {
+            assert_eq!(a.to_bits(), b.to_bits(), "item {seq} bit-exact");
+        }
+        assert_eq!((got.x, got.y, got.command), (sent.x, sent.y, sent.command));
+    }
+    gcs.send(&MavMessage::MISSION_ACK(MISSION_ACK_DATA {
+        target_system: 1,
+        target_component: 1,
+        mavtype: MavMissionResult::MAV_MISSION_ACCEPTED,
+        mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        opaque_id: 0,
+    }));
+}
+
+#[test]
+fn arming_waits_for_the_pre_arm_checks_and_streams_follow_their_interval() {
+    let gps = Arc::new(AtomicBool::new(false));
+    let sitl = Sitl::start(None, gps.clone());
+    let mut gcs = Gcs::new(sitl.gcs_addr);
+    assert!(gcs.wait(5.0, heartbeat_of).is_some());
+    // No GPS: the checks refuse, and say why.
+    std::thread::sleep(Duration::from_secs(2));
+    let r = gcs.command(
+        MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
+        [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    );
+    assert!(
+        matches!(
+            r,
+            Some(MavResult::MAV_RESULT_DENIED | MavResult::MAV_RESULT_TEMPORARILY_REJECTED)
+        ),
+        "{r:?}"
+    );
+    // With GPS the estimator converges and the same command is accepted.
+    gps.store(true, Ordering::Relaxed);
+    let end = Instant::now() + Duration::from_secs(30);
+    let mut armed = false;
+    while !armed && Instant::now() < end {
+        std::thread::sleep(Duration::from_millis(500));
+        armed = gcs.command(
+            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ) == Some(MavResult::MAV_RESULT_ACCEPTED);
+    }
+    assert!(armed, "arming accepted once converged");
+    let hb = gcs
+        .wait(3.0, |m| {
+            heartbeat_of(m).filter(|h| h.base_mode.bits() & 128 != 0)
+        })
+        .expect("armed heartbeat");
+    assert_eq!(hb.system_status, MavState::MAV_STATE_ACTIVE);
+
+    // ATTITUDE at 25 Hz: count over 2 s of (real-time) simulation.
+    let r = gcs.command(
+        MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+        [30.0, 40_000.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    );
+    assert_eq!(r, Some(MavResult::MAV_RESULT_ACCEPTED));
+    std::thread::sleep(Duration::from_millis(300));
+    gcs.pump();
+    gcs.inbox.clear();
+    let start = Instant::now();
+    let mut n = 0;
+    while start.elapsed() < Duration::from_secs(2) {
+        gcs.pump();
+        n += gcs
+            .inbox
+            .drain(..)
+            .filter(|f| matches!(f.message, MavMessage::ATTITUDE(_)))
+            .count();
+    }
+    assert!(
+        (40..=60).contains(&n),
+        "{n} ATTITUDE messages in 2 s at 25 Hz"
+    );
+}
