@@ -3,6 +3,7 @@
 
 pub mod doublet;
 pub mod linearize;
+pub mod scenario;
 pub mod trim;
 pub mod validation;
 
