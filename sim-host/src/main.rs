@@ -103,6 +103,11 @@ enum Command {
         #[command(flatten)]
         fmt: Output,
     },
+    /// Design the "computed" gain set by successive loop closure and predict every loop.
+    Design {
+        #[command(flatten)]
+        out: Output,
+    },
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.
@@ -222,6 +227,19 @@ fn run() -> anyhow::Result<ExitCode> {
                 emit(&render(&r.tables, fmt.format()))?;
                 for f in r.files.iter().chain(results.iter()) {
                     emit(&format!("wrote {}\n", f.display()))?;
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Some(Command::Design { out }) => {
+            if out.markdown {
+                emit(&commands::design::design_markdown(&aircraft)?)?;
+            } else {
+                let r = commands::design::design_report(&aircraft)?;
+                if out.json {
+                    emit(&to_json(&r)?)?;
+                } else {
+                    emit(&render(&r.tables, out.format()))?;
                 }
             }
             Ok(ExitCode::SUCCESS)

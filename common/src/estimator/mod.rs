@@ -1,1 +1,683 @@
-//! State estimation from raw sensors.
+//! State estimation from raw sensors: attitude, gyro bias, position, velocity, air data, wind.
+//!
+//! [`Estimator`] is the facade the autopilot loop talks to. It owns four filters, each a plain
+//! struct with its own `predict`/`update` (see `docs/ESTIMATOR.md` for the design):
+//! - [`attitude::AttitudeEkf`]: multiplicative EKF on the body-to-NED quaternion and the
+//!   gyro bias; gravity reference from the accelerometer with the centripetal acceleration of
+//!   turns removed, heading from the magnetometer against a fixed earth field;
+//! - [`nav::NavFilter`]: linear Kalman filter on NED position, velocity and barometer offset,
+//!   driven by the accelerometer rotated into NED, corrected by delayed GPS and by the
+//!   barometer, and by air data while GPS is lost;
+//! - [`air::AirspeedFilter`]: true airspeed from the pitot and the barometer's density;
+//! - [`air::WindFilter`]: horizontal wind from airspeed and zero sideslip.
+//!
+//! The clock is the sum of the IMU time steps; every other sensor is stamped with it when it
+//! arrives. Each input is checked before use: a non-finite or physically absurd sample is
+//! counted and dropped, and the state stays as it was.
+
+pub mod air;
+pub mod attitude;
+pub mod config;
+pub mod kalman;
+pub mod nav;
+
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+pub(crate) mod truth;
+
+pub use config::{EstimatorConfig, PARAMS};
+
+use crate::math::atmosphere::pressure_altitude;
+use crate::math::frames::{course_and_speed, AirData, Euler};
+use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
+use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
+use attitude::{AttitudeEkf, Motion, GRAVITY};
+use nalgebra::{UnitQuaternion, Vector3};
+use nav::{GpsNoise, NavFilter};
+
+/// Largest accepted IMU time step, s (a longer gap is a stalled loop, not a time step).
+pub const MAX_IMU_DT_S: f32 = 0.2;
+/// Largest accepted specific force per axis, m/s^2 (16 g, the usual accelerometer range).
+pub const MAX_ACCEL_MPS2: f32 = 16.0 * 9.80665;
+/// Largest accepted angular rate per axis, rad/s (2000 deg/s, the usual gyro range).
+pub const MAX_GYRO_RADPS: f32 = 34.9;
+/// Accepted magnetic field strength, gauss (the earth's field is 0.25-0.65 G).
+pub const MAG_RANGE_GAUSS: (f32, f32) = (0.05, 2.0);
+/// Accepted static pressure, Pa (-600 m to 12 km in the standard atmosphere).
+pub const BARO_RANGE_PA: (f32, f32) = (19_000.0, 110_000.0);
+/// Accepted air temperature, deg C.
+pub const TEMP_RANGE_C: (f32, f32) = (-80.0, 85.0);
+/// Accepted differential pressure, Pa (noise at rest reads slightly negative; 20 kPa is
+/// about 180 m/s).
+pub const PITOT_RANGE_PA: (f32, f32) = (-500.0, 20_000.0);
+/// Accepted GPS altitude, m.
+pub const GPS_ALT_RANGE_M: (f32, f32) = (-1_000.0, 20_000.0);
+/// Largest accepted GPS speed, m/s.
+pub const MAX_GPS_SPEED_MPS: f32 = 150.0;
+/// Samples of the other sensors after which a silent IMU is declared unhealthy (the IMU is
+/// the clock, so its silence can only be seen through the others).
+pub const IMU_STALE_SAMPLES: u32 = 50;
+/// Consecutive gated GPS fixes after which position and velocity are moved to GPS.
+pub const GPS_RESET_FIXES: u32 = 5;
+/// Consecutive gated samples of a 50 Hz sensor (about 1 s) after which the filter part it
+/// corrects is taken to be lost and restarted from the measurements: a filter whose
+/// innovations are all beyond the gate would otherwise never listen again.
+pub const LOCKOUT_SAMPLES: u32 = 50;
+/// Density used until the barometer has been read, kg/m^3 (sea-level standard).
+const DEFAULT_DENSITY: f32 = 1.225;
+/// Averaging weight of the magnetometer innovation monitor (about 1 s at 50 Hz).
+const NIS_WEIGHT: f32 = 0.02;
+
+/// Health and bookkeeping of one sensor.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorStatus {
+    /// A good sample arrived within the timeout and fewer than `EST_MAX_REJECT` in a row were
+    /// rejected.
+    pub healthy: bool,
+    /// Samples refused as non-finite or out of range.
+    pub rejected: u32,
+    /// Samples (or components) refused by the filters' innovation gates.
+    pub gated: u32,
+    /// Times the filter part this sensor corrects was restarted after a lock-out.
+    pub resets: u32,
+    consecutive: u32,
+    gated_streak: u32,
+    last_ok_s: Option<f64>,
+}
+
+impl SensorStatus {
+    fn reject(&mut self) {
+        self.rejected = self.rejected.saturating_add(1);
+        self.consecutive = self.consecutive.saturating_add(1);
+    }
+
+    fn accept(&mut self, t: f64) {
+        self.consecutive = 0;
+        self.last_ok_s = Some(t);
+    }
+
+    /// Books `gated` refused components of a sample; `all` when none was fused. Returns true
+    /// when the sensor has been locked out for `limit` samples in a row (and starts over).
+    fn gate(&mut self, gated: u8, all: bool, limit: u32) -> bool {
+        self.gated = self.gated.saturating_add(u32::from(gated));
+        if !all {
+            self.gated_streak = 0;
+            return false;
+        }
+        self.gated_streak = self.gated_streak.saturating_add(1);
+        if self.gated_streak >= limit {
+            self.gated_streak = 0;
+            self.resets = self.resets.saturating_add(1);
+            return true;
+        }
+        false
+    }
+
+    fn evaluate(&mut self, t: f64, timeout: f32, max_rejections: u32) {
+        self.healthy = match self.last_ok_s {
+            Some(last) => t - last <= f64::from(timeout) && self.consecutive < max_rejections,
+            None => false,
+        };
+    }
+}
+
+/// Health of every sensor.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SensorHealth {
+    /// Accelerometer and gyro.
+    pub imu: SensorStatus,
+    /// Magnetometer.
+    pub mag: SensorStatus,
+    /// Static pressure (and temperature).
+    pub baro: SensorStatus,
+    /// Differential pressure.
+    pub pitot: SensorStatus,
+    /// GPS (a 3D fix counts as a good sample).
+    pub gps: SensorStatus,
+}
+
+/// The reference of the local NED frame, set at the first good 3D fix.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Home {
+    /// Horizontal position of the NED origin.
+    pub point: GeoPoint,
+    /// Altitude of the NED origin above mean sea level, m.
+    pub alt_amsl_m: f32,
+}
+
+/// Everything the estimator knows, as the rest of the autopilot reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatedState {
+    /// Estimator clock (sum of accepted IMU time steps), s.
+    pub time_s: f64,
+    /// Body-to-NED attitude.
+    pub attitude: UnitQuaternion<f32>,
+    /// The same attitude as 3-2-1 Euler angles, rad.
+    pub euler: Euler<f32>,
+    /// Body rates with the estimated gyro bias removed, rad/s.
+    pub body_rates: Vector3<f32>,
+    /// Estimated gyro bias, rad/s.
+    pub gyro_bias: Vector3<f32>,
+    /// Position from home in NED, m.
+    pub pos_ned: Vector3<f32>,
+    /// Horizontal position.
+    pub position: GeoPoint,
+    /// Altitude above mean sea level, m (barometric until the first GPS fix).
+    pub alt_amsl_m: f32,
+    /// The NED origin, once set.
+    pub home: Option<Home>,
+    /// Velocity over ground in NED, m/s.
+    pub vel_ned: Vector3<f32>,
+    /// True airspeed (low-passed), m/s.
+    pub airspeed: f32,
+    /// Angle of attack from the wind triangle, rad (0 without wind estimate).
+    pub alpha: f32,
+    /// Sideslip from the wind triangle, rad (near 0 by the wind filter's assumption).
+    pub sideslip: f32,
+    /// Course over ground, rad in (-pi, pi].
+    pub course: f32,
+    /// Horizontal speed over ground, m/s.
+    pub ground_speed: f32,
+    /// Wind in NED (velocity of the air mass), m/s; down is 0.
+    pub wind_ned: Vector3<f32>,
+    /// Per-sensor health and rejection counters.
+    pub health: SensorHealth,
+    /// The attitude filter has been initialised.
+    pub attitude_valid: bool,
+    /// Position and velocity come from a filter that has seen GPS.
+    pub position_valid: bool,
+    /// The wind filter has been initialised.
+    pub wind_valid: bool,
+    /// GPS is lost and position/velocity are carried by inertial + air-data dead reckoning.
+    pub dead_reckoning: bool,
+    /// Fit to arm: see [`Estimator::is_converged`].
+    pub converged: bool,
+}
+
+/// The estimator facade.
+#[derive(Clone, Debug)]
+pub struct Estimator {
+    cfg: EstimatorConfig,
+    att: AttitudeEkf,
+    nav: NavFilter,
+    wind: WindFilter,
+    airspeed: AirspeedFilter,
+    health: SensorHealth,
+    t: f64,
+    rates: Vector3<f32>,
+    last_accel: Option<Vector3<f32>>,
+    last_mag: Option<Vector3<f32>>,
+    baro_alt: Option<f32>,
+    density: f32,
+    home: Option<Home>,
+    mag_nis: f32,
+    last_pitot_t: Option<f64>,
+    imu_silent_samples: u32,
+    alpha_memory: f32,
+    pending_dt: f32,
+}
+
+impl Default for Estimator {
+    fn default() -> Self {
+        Self::new(EstimatorConfig::default())
+    }
+}
+
+fn finite3(v: &Vector3<f32>) -> bool {
+    v.iter().all(|c| c.is_finite())
+}
+
+fn within(v: &Vector3<f32>, limit: f32) -> bool {
+    v.iter().all(|c| c.is_finite() && c.abs() <= limit)
+}
+
+impl Estimator {
+    /// A fresh estimator with the given settings.
+    pub fn new(cfg: EstimatorConfig) -> Self {
+        Self {
+            cfg,
+            att: AttitudeEkf::new(),
+            nav: NavFilter::new(),
+            wind: WindFilter::default(),
+            airspeed: AirspeedFilter::default(),
+            health: SensorHealth::default(),
+            t: 0.0,
+            rates: Vector3::zeros(),
+            last_accel: None,
+            last_mag: None,
+            baro_alt: None,
+            density: DEFAULT_DENSITY,
+            home: None,
+            mag_nis: 0.0,
+            last_pitot_t: None,
+            imu_silent_samples: 0,
+            alpha_memory: 0.0,
+            pending_dt: 0.0,
+        }
+    }
+
+    /// The settings in use.
+    pub fn config(&self) -> &EstimatorConfig {
+        &self.cfg
+    }
+
+    /// Replaces the settings (the filters keep their state).
+    pub fn set_config(&mut self, cfg: EstimatorConfig) {
+        self.cfg = cfg;
+    }
+
+    fn earth_field(&self) -> Vector3<f32> {
+        let m = self.cfg.mag_earth;
+        Vector3::new(m[0], m[1], m[2])
+    }
+
+    fn gps_noise(&self) -> GpsNoise {
+        GpsNoise {
+            horizontal: self.cfg.gps_pos_noise,
+            vertical: self.cfg.gps_alt_noise,
+            velocity: self.cfg.gps_vel_noise,
+        }
+    }
+
+    fn wind_noise(&self) -> WindNoise {
+        WindNoise {
+            process: self.cfg.wind_process_noise,
+            airspeed: self.cfg.wind_airspeed_noise,
+            lateral: self.cfg.wind_lateral_noise,
+        }
+    }
+
+    fn refresh_health(&mut self) {
+        let t = self.t;
+        let c = self.cfg;
+        let h = &mut self.health;
+        // The IMU is the clock: it is judged by rejections and by the other sensors' samples
+        // that arrived while it was silent.
+        h.imu.evaluate(t, f32::INFINITY, c.max_rejections);
+        h.imu.healthy &= self.imu_silent_samples < IMU_STALE_SAMPLES;
+        h.mag.evaluate(t, c.sensor_timeout, c.max_rejections);
+        h.baro.evaluate(t, c.sensor_timeout, c.max_rejections);
+        h.pitot.evaluate(t, c.sensor_timeout, c.max_rejections);
+        h.gps.evaluate(t, c.gps_timeout, c.max_rejections);
+    }
+
+    fn note_other_sensor(&mut self) {
+        self.imu_silent_samples = self.imu_silent_samples.saturating_add(1);
+    }
+
+    /// Restarts the attitude filter from the latest accelerometer and magnetometer samples,
+    /// with the centripetal term of body-frame quantities only (the old attitude is not
+    /// trusted).
+    fn restart_attitude(&mut self) {
+        if let (Some(a), Some(m)) = (self.last_accel, self.last_mag) {
+            let va = if self.health.pitot.healthy {
+                self.airspeed.value()
+            } else {
+                0.0
+            };
+            let gravity = a - self.rates.cross(&Vector3::new(va, 0.0, 0.0));
+            let earth = self.earth_field();
+            self.att
+                .initialize(&gravity, &m, &earth, self.cfg.gyro_bias_init);
+            self.wind = WindFilter::default();
+            self.mag_nis = 0.0;
+        }
+    }
+
+    fn try_initialize_attitude(&mut self) {
+        if self.att.is_initialized() {
+            return;
+        }
+        if let (Some(a), Some(m)) = (self.last_accel, self.last_mag) {
+            let earth = self.earth_field();
+            self.att.initialize(&a, &m, &earth, self.cfg.gyro_bias_init);
+        }
+    }
+
+    /// Air-relative velocity in body axes, for the centripetal term of the gravity reference.
+    fn air_velocity_body(&self) -> Vector3<f32> {
+        let q = self.att.attitude();
+        if self.nav.is_initialized() && self.wind.is_initialized() && self.health.gps.healthy {
+            // The wind triangle carries the angle of attack, which (omega x v) needs: at
+            // 3 deg and 20 deg/s it is worth 0.15 m/s^2, about 1 deg of pitch.
+            q.inverse_transform_vector(&(self.nav.velocity() - self.wind.wind()))
+        } else if self.health.pitot.healthy {
+            let va = self.airspeed.value();
+            let a = self.alpha_memory;
+            Vector3::new(va * libm::cosf(a), 0.0, va * libm::sinf(a))
+        } else {
+            Vector3::zeros()
+        }
+    }
+
+    /// One IMU sample over the time step `dt` (s) that ended with it. This advances the clock,
+    /// propagates every filter and fuses the gravity reference.
+    pub fn update_imu(&mut self, sample: &ImuSample, dt: f32) {
+        if !(dt.is_finite() && dt > 0.0 && dt <= MAX_IMU_DT_S) {
+            self.health.imu.reject();
+            self.refresh_health();
+            return;
+        }
+        if !within(&sample.accel, MAX_ACCEL_MPS2) || !within(&sample.gyro, MAX_GYRO_RADPS) {
+            // The time still passed: the next good sample is held over it, so the state
+            // stays that of the last good sample and no interval is lost.
+            self.pending_dt = (self.pending_dt + dt).min(MAX_IMU_DT_S);
+            self.health.imu.reject();
+            self.refresh_health();
+            return;
+        }
+        let dt = (dt + self.pending_dt).min(MAX_IMU_DT_S);
+        self.pending_dt = 0.0;
+        self.t += f64::from(dt);
+        self.health.imu.accept(self.t);
+        self.imu_silent_samples = 0;
+        self.last_accel = Some(sample.accel);
+        self.refresh_health();
+        self.try_initialize_attitude();
+        if !self.att.is_initialized() {
+            return;
+        }
+        let c = self.cfg;
+        self.att
+            .predict(&sample.gyro, dt, c.gyro_noise, c.gyro_bias_rw);
+        self.rates = sample.gyro - self.att.gyro_bias();
+        let q = self.att.attitude();
+        let acc_ned = q.transform_vector(&sample.accel) + Vector3::new(0.0, 0.0, GRAVITY);
+        self.nav
+            .predict(self.t, &acc_ned, dt, c.nav_accel_noise, c.baro_bias_rw);
+        let wn = self.wind_noise();
+        self.wind.predict(dt, &wn);
+        let v_air = self.air_velocity_body();
+        // Speeding up or slowing down tilts the apparent gravity nose-up or down: the
+        // airspeed's rate of change, along the air velocity, is the acceleration's other part.
+        let along = if self.health.pitot.healthy && v_air.norm() > c.airspeed_min {
+            v_air.normalize() * self.airspeed.rate()
+        } else {
+            Vector3::zeros()
+        };
+        if let Some(f) = self.att.fuse_accel(
+            &sample.accel,
+            &Motion {
+                rates: self.rates,
+                v_air_body: v_air,
+                along_body: along,
+            },
+            c.accel_noise,
+            c.accel_gate,
+            c.gate_sigma,
+        ) {
+            if self.health.imu.gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES) {
+                self.restart_attitude();
+            }
+        }
+    }
+
+    /// One magnetometer sample.
+    pub fn update_mag(&mut self, sample: &MagSample) {
+        self.note_other_sensor();
+        let n = sample.field.norm();
+        if !finite3(&sample.field) || !(MAG_RANGE_GAUSS.0..=MAG_RANGE_GAUSS.1).contains(&n) {
+            self.health.mag.reject();
+            self.refresh_health();
+            return;
+        }
+        self.health.mag.accept(self.t);
+        self.last_mag = Some(sample.field);
+        self.refresh_health();
+        if !self.att.is_initialized() {
+            self.try_initialize_attitude();
+            return;
+        }
+        let earth = self.earth_field();
+        let c = self.cfg;
+        if let Some(f) = self
+            .att
+            .fuse_mag(&sample.field, &earth, c.mag_noise, c.gate_sigma)
+        {
+            if self.health.mag.gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES) {
+                self.restart_attitude();
+            }
+            // A gated component enters the monitor at the gate, so a field that no longer
+            // matches the model shows up instead of vanishing.
+            let nis = if f.fused > 0 {
+                f.nis
+            } else {
+                c.gate_sigma * c.gate_sigma
+            };
+            self.mag_nis += NIS_WEIGHT * (nis - self.mag_nis);
+        }
+    }
+
+    /// One barometer sample.
+    pub fn update_baro(&mut self, sample: &BaroSample) {
+        self.note_other_sensor();
+        let p = sample.pressure_pa;
+        let tc = sample.temperature_c;
+        let ok = p.is_finite()
+            && (BARO_RANGE_PA.0..=BARO_RANGE_PA.1).contains(&p)
+            && tc.is_finite()
+            && (TEMP_RANGE_C.0..=TEMP_RANGE_C.1).contains(&tc);
+        let (Some(alt), Some(rho), true) = (pressure_altitude(p), air_density(p, tc), ok) else {
+            self.health.baro.reject();
+            self.refresh_health();
+            return;
+        };
+        self.health.baro.accept(self.t);
+        self.refresh_health();
+        self.baro_alt = Some(alt);
+        self.density = rho;
+        if let Some(home) = self.home {
+            let c = self.cfg;
+            let f = self
+                .nav
+                .fuse_baro(home.alt_amsl_m - alt, c.baro_noise, c.gate_sigma);
+            if self
+                .health
+                .baro
+                .gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES)
+            {
+                self.nav.reset_baro_offset(home.alt_amsl_m - alt);
+            }
+        }
+    }
+
+    /// One differential-pressure sample.
+    pub fn update_pitot(&mut self, sample: &PitotSample) {
+        self.note_other_sensor();
+        let dp = sample.diff_pressure_pa;
+        if !dp.is_finite() || !(PITOT_RANGE_PA.0..=PITOT_RANGE_PA.1).contains(&dp) {
+            self.health.pitot.reject();
+            self.refresh_health();
+            return;
+        }
+        self.health.pitot.accept(self.t);
+        self.refresh_health();
+        let dt = match self.last_pitot_t {
+            Some(last) => ((self.t - last) as f32).clamp(0.0, 1.0),
+            None => 0.0,
+        };
+        self.last_pitot_t = Some(self.t);
+        let c = self.cfg;
+        let va = self.airspeed.update(
+            true_airspeed(dp, self.density),
+            dt,
+            c.airspeed_tau,
+            c.airspeed_rate_tau,
+        );
+        if !self.att.is_initialized() || !self.nav.is_initialized() || va < c.airspeed_min {
+            return;
+        }
+        let q = self.att.attitude();
+        if self.health.gps.healthy {
+            let x = q.transform_vector(&Vector3::x());
+            let y = q.transform_vector(&Vector3::y());
+            let wn = self.wind_noise();
+            let v = self.nav.velocity();
+            let gated = self.wind.update(va, &v, &x, &y, &wn, c.gate_sigma);
+            if self.health.pitot.gate(gated, gated == 2, LOCKOUT_SAMPLES) {
+                // Starts again from the wind triangle at the next sample.
+                self.wind = WindFilter::default();
+            }
+            if self.wind.is_initialized() {
+                let body = q.inverse_transform_vector(&(v - self.wind.wind()));
+                let ad = AirData::from_body_velocity(&body);
+                if ad.alpha.is_finite() {
+                    self.alpha_memory = ad.alpha.clamp(-0.3, 0.3);
+                }
+            }
+        } else if self.wind.is_initialized() {
+            // GPS lost: the air-data velocity (last angle of attack, frozen wind) keeps the
+            // horizontal velocity, and so the position drift, bounded.
+            let a = self.alpha_memory;
+            let body = Vector3::new(va * libm::cosf(a), 0.0, va * libm::sinf(a));
+            let v = q.transform_vector(&body) + self.wind.wind();
+            self.nav
+                .fuse_horizontal_velocity(v.x, v.y, c.dead_reckon_vel_noise);
+        }
+    }
+
+    /// One GPS fix. Fixes without a 3D solution are ignored (GPS then times out); fixes with
+    /// non-finite or impossible numbers are rejected and counted.
+    pub fn update_gps(&mut self, fix: &GpsFix) {
+        self.note_other_sensor();
+        let ok = fix.position.is_valid()
+            && fix.alt_amsl_m.is_finite()
+            && (GPS_ALT_RANGE_M.0..=GPS_ALT_RANGE_M.1).contains(&fix.alt_amsl_m)
+            && finite3(&fix.vel_ned)
+            && fix.vel_ned.norm() <= MAX_GPS_SPEED_MPS
+            && !fix.hdop.is_nan();
+        if !ok {
+            self.health.gps.reject();
+            self.refresh_health();
+            return;
+        }
+        if fix.fix_type < 3 {
+            self.refresh_health();
+            return;
+        }
+        let was_healthy = self.health.gps.healthy;
+        self.health.gps.accept(self.t);
+        self.refresh_health();
+        let c = self.cfg;
+        let noise = self.gps_noise();
+        let Some(home) = self.home else {
+            // Home is the datum of every altitude and position after it: only a good fix.
+            let hdop_ok = fix.hdop.is_finite() && fix.hdop <= c.home_max_hdop;
+            if u32::from(fix.satellites) < c.home_min_sats || !hdop_ok {
+                return;
+            }
+            let home = Home {
+                point: fix.position,
+                alt_amsl_m: fix.alt_amsl_m,
+            };
+            self.home = Some(home);
+            let baro_offset = self.baro_alt.map_or(0.0, |b| b - fix.alt_amsl_m);
+            self.nav.initialize(
+                self.t,
+                &Vector3::zeros(),
+                &fix.vel_ned,
+                c.gps_delay,
+                baro_offset,
+                &noise,
+            );
+            return;
+        };
+        let (n, e): (f32, f32) = ned_offset(home.point, fix.position);
+        let pos = Vector3::new(n, e, home.alt_amsl_m - fix.alt_amsl_m);
+        let t_fix = self.t - f64::from(c.gps_delay);
+        let f = self
+            .nav
+            .fuse_gps(t_fix, &pos, &fix.vel_ned, &noise, c.gate_sigma);
+        let limit = if was_healthy { GPS_RESET_FIXES } else { 1 };
+        // Back from an outage, dead reckoning may have drifted beyond the gate: the first
+        // refused fix moves the state at once.
+        if self.health.gps.gate(f.gated, f.gated > 0, limit) {
+            self.nav
+                .reset_to_gps(&pos, &fix.vel_ned, c.gps_delay, &noise);
+        }
+    }
+
+    /// True when the estimate is fit to arm on: attitude initialised with roll/pitch and
+    /// heading uncertainty below `EST_CONV_TILT` / `EST_CONV_HDG`, gyro bias uncertainty below
+    /// `EST_CONV_GBIAS` on every axis, the averaged normalised
+    /// magnetometer innovation below `EST_CONV_NIS` (the field matches the model), home set
+    /// with horizontal position and velocity uncertainty below `EST_CONV_POS` /
+    /// `EST_CONV_VEL`, and every sensor healthy.
+    pub fn is_converged(&self) -> bool {
+        let c = &self.cfg;
+        let h = &self.health;
+        let (tilt, hdg) = self.att.tilt_heading_sigma();
+        let (pos, _, vel) = self.nav.sigmas();
+        self.att.is_initialized()
+            && tilt < c.conv_tilt
+            && hdg < c.conv_heading
+            && self.att.bias_sigma().max() < c.conv_gyro_bias
+            && self.mag_nis < c.conv_nis
+            && self.nav.is_initialized()
+            && pos < c.conv_pos
+            && vel < c.conv_vel
+            && h.imu.healthy
+            && h.mag.healthy
+            && h.baro.healthy
+            && h.pitot.healthy
+            && h.gps.healthy
+    }
+
+    /// Averaged normalised magnetometer innovation (about 1 when the field fits the model).
+    pub fn mag_innovation_ratio(&self) -> f32 {
+        self.mag_nis
+    }
+
+    /// 1-sigma uncertainty of the gyro bias, rad/s.
+    pub fn gyro_bias_sigma(&self) -> Vector3<f32> {
+        self.att.bias_sigma()
+    }
+
+    /// The current estimate.
+    pub fn state(&self) -> EstimatedState {
+        let q = self.att.attitude();
+        let vel = self.nav.velocity();
+        let pos = self.nav.position();
+        let (course, ground_speed) = course_and_speed(&vel);
+        let wind = self.wind.wind();
+        let (alpha, sideslip) = if self.wind.is_initialized() && self.nav.is_initialized() {
+            let ad = AirData::from_body_velocity(&q.inverse_transform_vector(&(vel - wind)));
+            (ad.alpha, ad.beta)
+        } else {
+            (0.0, 0.0)
+        };
+        let (position, alt_amsl_m) = match self.home {
+            Some(h) => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
+            None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
+        };
+        EstimatedState {
+            time_s: self.t,
+            attitude: q,
+            euler: Euler::from_quaternion(&q),
+            body_rates: self.rates,
+            gyro_bias: self.att.gyro_bias(),
+            pos_ned: pos,
+            position,
+            alt_amsl_m,
+            home: self.home,
+            vel_ned: vel,
+            airspeed: self.airspeed.value(),
+            alpha,
+            sideslip,
+            course,
+            ground_speed,
+            wind_ned: wind,
+            health: self.health,
+            attitude_valid: self.att.is_initialized(),
+            position_valid: self.nav.is_initialized(),
+            wind_valid: self.wind.is_initialized(),
+            dead_reckoning: self.nav.is_initialized() && !self.health.gps.healthy,
+            converged: self.is_converged(),
+        }
+    }
+}

@@ -217,13 +217,7 @@ impl StateSpace {
 
     /// Eigenvalues of `A`, sorted by real part then imaginary part.
     pub fn eigenvalues(&self) -> Vec<Complex<f64>> {
-        let mut ev: Vec<Complex<f64>> = self.a.complex_eigenvalues().iter().copied().collect();
-        ev.sort_by(|x, y| {
-            x.re.partial_cmp(&y.re)
-                .unwrap_or(std::cmp::Ordering::Equal)
-                .then(x.im.partial_cmp(&y.im).unwrap_or(std::cmp::Ordering::Equal))
-        });
-        ev
+        super::lti::eigenvalues(&self.a)
     }
 }
 

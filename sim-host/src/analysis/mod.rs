@@ -1,6 +1,7 @@
 //! The thesis's analysis: trim, linearisation, transfer functions, the doublet check, and the
 //! linear-systems tools and response figures the loop design and the scenarios use.
 
+pub mod design;
 pub mod doublet;
 pub mod linearize;
 pub mod lti;

@@ -5,7 +5,7 @@
 //! denominator come from characteristic polynomials, computed exactly (no root finding) by the
 //! Faddeev-LeVerrier recursion.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 /// A rational transfer function, coefficients highest power first, denominator monic.
@@ -68,6 +68,143 @@ impl TransferFunction {
     }
 }
 
+/// Polynomial product (coefficients highest power first).
+pub fn poly_mul(a: &[f64], b: &[f64]) -> Vec<f64> {
+    if a.is_empty() || b.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![0.0; a.len() + b.len() - 1];
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            out[i + j] += x * y;
+        }
+    }
+    out
+}
+
+/// Polynomial sum (coefficients highest power first).
+pub fn poly_add(a: &[f64], b: &[f64]) -> Vec<f64> {
+    let n = a.len().max(b.len());
+    (0..n)
+        .map(|k| {
+            let ia = (k + a.len()).checked_sub(n).map_or(0.0, |i| a[i]);
+            let ib = (k + b.len()).checked_sub(n).map_or(0.0, |i| b[i]);
+            ia + ib
+        })
+        .collect()
+}
+
+/// The polynomial at a complex point (Horner).
+pub fn poly_eval(p: &[f64], s: Complex<f64>) -> Complex<f64> {
+    p.iter().fold(Complex::new(0.0, 0.0), |acc, &c| {
+        acc * s + Complex::new(c, 0.0)
+    })
+}
+
+/// Roots of a polynomial, as the eigenvalues of its companion matrix.
+pub fn poly_roots(p: &[f64]) -> Vec<Complex<f64>> {
+    let p = strip(p);
+    let n = p.len().saturating_sub(1);
+    if n == 0 {
+        return Vec::new();
+    }
+    let a = DMatrix::from_fn(n, n, |i, j| {
+        if i == n - 1 {
+            -p[n - j] / p[0]
+        } else if j == i + 1 {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    super::lti::eigenvalues(&a)
+}
+
+fn strip(p: &[f64]) -> Vec<f64> {
+    let first = p.iter().position(|x| *x != 0.0).unwrap_or(p.len());
+    p[first..].to_vec()
+}
+
+impl TransferFunction {
+    /// `num / den`, with leading zeros dropped and the denominator made monic.
+    pub fn new(num: &[f64], den: &[f64]) -> Self {
+        let den = strip(den);
+        let lead = den.first().copied().unwrap_or(1.0);
+        let num = strip(num);
+        Self {
+            num: if num.is_empty() {
+                vec![0.0]
+            } else {
+                num.iter().map(|x| x / lead).collect()
+            },
+            den: den.iter().map(|x| x / lead).collect(),
+        }
+    }
+
+    /// A pure gain.
+    pub fn gain(k: f64) -> Self {
+        Self::new(&[k], &[1.0])
+    }
+
+    /// `self * other`.
+    pub fn series(&self, other: &Self) -> Self {
+        Self::new(
+            &poly_mul(&self.num, &other.num),
+            &poly_mul(&self.den, &other.den),
+        )
+    }
+
+    /// The closed loop `L / (1 + L)` of this loop transfer function under unity negative
+    /// feedback.
+    pub fn closed_loop(&self) -> Self {
+        Self::new(&self.num, &poly_add(&self.den, &self.num))
+    }
+
+    /// Value at `s = j w`.
+    pub fn eval(&self, w: f64) -> Complex<f64> {
+        let s = Complex::new(0.0, w);
+        poly_eval(&self.num, s) / poly_eval(&self.den, s)
+    }
+
+    /// Poles (roots of the denominator).
+    pub fn poles(&self) -> Vec<Complex<f64>> {
+        poly_roots(&self.den)
+    }
+
+    /// Unit-step response up to `t_end` at `dt` (RK4 on the controllable canonical form).
+    /// The transfer function must be proper.
+    pub fn step_response(&self, t_end: f64, dt: f64) -> (Vec<f64>, Vec<f64>) {
+        let n = self.den.len() - 1;
+        let mut b = vec![0.0; n + 1];
+        let off = (n + 1).saturating_sub(self.num.len());
+        for (i, x) in self.num.iter().enumerate() {
+            if let Some(slot) = b.get_mut(off + i) {
+                *slot = *x;
+            }
+        }
+        let a_ = &self.den;
+        let a = DMatrix::from_fn(n, n, |i, j| {
+            if i == n - 1 {
+                -a_[n - j]
+            } else if j == i + 1 {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let bm = DMatrix::from_fn(n, 1, |i, _| if i == n - 1 { 1.0 } else { 0.0 });
+        let c = DMatrix::from_fn(1, n, |_, j| b[n - j] - a_[n - j] * b[0]);
+        let d = DMatrix::from_element(1, 1, b[0]);
+        match super::lti::StateSpace::new(a, bm, c, d) {
+            Ok(ss) => {
+                let (t, y) = ss.step_response(0, t_end, dt);
+                (t, y.iter().map(|v| v[0]).collect())
+            }
+            Err(_) => (Vec::new(), Vec::new()),
+        }
+    }
+}
+
 /// A polynomial as text, highest power first.
 pub fn poly_string(c: &[f64], digits: usize) -> String {
     let n = c.len();
@@ -112,6 +249,25 @@ mod tests {
         assert!(d(tf.den[2], 7.56 * 15.81 + 15.72 * 7.405));
         assert!(d(tf.num[0], -133.7));
         assert!(d(tf.num[1], -7.405 * -2.703 - 7.56 * 133.7));
+    }
+
+    #[test]
+    fn algebra_closed_loop_and_step() {
+        // L = 4 / (s (s + 2)): closed loop 4 / (s^2 + 2 s + 4), wn 2, zeta 0.5.
+        let l = TransferFunction::new(&[4.0], &[1.0, 2.0, 0.0]);
+        let t = l.closed_loop();
+        assert_eq!(t.den, vec![1.0, 2.0, 4.0]);
+        let p = t.poles();
+        assert!((p[0].re + 1.0).abs() < 1e-12 && (p[0].im.abs() - 3f64.sqrt()).abs() < 1e-12);
+        let (_, y) = t.step_response(10.0, 0.001);
+        let peak = y.iter().cloned().fold(0.0, f64::max);
+        // Overshoot exp(-pi zeta / sqrt(1 - zeta^2)) = 16.3 %.
+        assert!((peak - 1.163).abs() < 1e-3, "{peak}");
+        assert!((t.eval(0.0).re - 1.0).abs() < 1e-12);
+        let s =
+            TransferFunction::new(&[1.0, 1.0], &[1.0, 3.0]).series(&TransferFunction::gain(2.0));
+        assert_eq!(s.num, vec![2.0, 2.0]);
+        assert_eq!(poly_add(&[1.0, 2.0], &[1.0, 0.0, 0.0]), vec![1.0, 1.0, 2.0]);
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! several gain sets, with CSV, PNG, JSON and a metrics table per scenario.
 
 use crate::aircraft::Aircraft;
+use crate::analysis::design::computed_gain_set;
 use crate::analysis::trim::{trim, TrimResult, TrimTarget};
 use crate::report::csv_out::write_csv;
 use crate::report::{sig, to_json, Figure, Panel, Series, Table};
@@ -17,10 +18,15 @@ use std::path::{Path, PathBuf};
 /// altitude).
 pub const THESIS_NOISE_SIGMA: f64 = 1e-3;
 
-/// Every gain set the command can fly: the named sets of `common` (and the set computed from
-/// the linear model once it exists).
+/// Name of the gain set designed from the linear model of the aircraft flown
+/// ([`computed_gain_set`]).
+pub const COMPUTED: &str = "computed";
+
+/// Every gain set the command can fly: the named sets of `common`, then [`COMPUTED`].
 pub fn gain_set_names() -> Vec<&'static str> {
-    NAMES.to_vec()
+    let mut v = NAMES.to_vec();
+    v.push(COMPUTED);
+    v
 }
 
 /// An unknown gain-set name, with the valid ones.
@@ -33,8 +39,11 @@ pub struct UnknownGainSet {
     pub valid: Vec<&'static str>,
 }
 
-/// The gain set of this name for `aircraft`.
-pub fn gain_set(_aircraft: &Aircraft, name: &str) -> anyhow::Result<GainSet> {
+/// The gain set of this name for `aircraft` (only [`COMPUTED`] depends on the aircraft).
+pub fn gain_set(aircraft: &Aircraft, name: &str) -> anyhow::Result<GainSet> {
+    if name == COMPUTED {
+        return computed_gain_set(aircraft).context("designing the computed gain set");
+    }
     GainSet::named(name).map_err(|_| {
         UnknownGainSet {
             name: name.to_string(),

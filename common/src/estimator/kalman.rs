@@ -1,0 +1,106 @@
+//! The scalar Kalman measurement update shared by the estimator's filters.
+//!
+//! Every measurement is fused one component at a time: no matrix inverse (nothing to be
+//! singular), and each component can be gated on its own.
+
+use nalgebra::{SMatrix, SVector};
+
+/// Why a measurement component was not fused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refused {
+    /// The innovation was beyond the gate: an outlier, or the filter has lost track.
+    Gated,
+    /// The innovation variance was not a positive finite number.
+    Degenerate,
+}
+
+/// The outcome of one fused component.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fused<const N: usize> {
+    /// State correction.
+    pub dx: SVector<f32, N>,
+    /// Normalised innovation squared, `innov^2 / S`.
+    pub nis: f32,
+}
+
+/// Fuses one scalar measurement `z = h . x + noise(r)` given its innovation `z - h . x_pred`.
+///
+/// Updates `p` in Joseph form (keeps it symmetric and positive in `f32`) and returns the
+/// correction to add to the state, or why the measurement was refused (then `p` is untouched).
+pub fn scalar_update<const N: usize>(
+    p: &mut SMatrix<f32, N, N>,
+    h: &SVector<f32, N>,
+    innov: f32,
+    r: f32,
+    gate_sigma: f32,
+) -> Result<Fused<N>, Refused> {
+    let ph = *p * h;
+    let s = h.dot(&ph) + r;
+    if !(s.is_finite() && s > 0.0 && innov.is_finite()) {
+        return Err(Refused::Degenerate);
+    }
+    let nis = innov * innov / s;
+    if nis > gate_sigma * gate_sigma {
+        return Err(Refused::Gated);
+    }
+    let k = ph / s;
+    let ikh = SMatrix::<f32, N, N>::identity() - k * h.transpose();
+    let new_p = ikh * *p * ikh.transpose() + k * k.transpose() * r;
+    if !new_p.iter().all(|x| x.is_finite()) {
+        return Err(Refused::Degenerate);
+    }
+    *p = new_p;
+    Ok(Fused { dx: k * innov, nis })
+}
+
+/// Makes `p` exactly symmetric and keeps its diagonal between `min_var` and `max_var`.
+///
+/// Returns false when `p` holds a non-finite entry (the caller then resets the filter).
+pub fn condition<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) -> bool {
+    if !p.iter().all(|x| x.is_finite()) {
+        return false;
+    }
+    *p = (*p + p.transpose()) * 0.5;
+    for i in 0..N {
+        let d = p[(i, i)];
+        p[(i, i)] = d.clamp(min_var, max_var);
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix2, Vector2};
+
+    #[test]
+    fn scalar_update_matches_the_textbook_gain() {
+        // One state, prior variance 4, measurement variance 1: K = 4/5, posterior 4/5.
+        let mut p = SMatrix::<f32, 1, 1>::new(4.0);
+        let f = scalar_update(&mut p, &SVector::<f32, 1>::new(1.0), 10.0, 1.0, 100.0).unwrap();
+        assert!((f.dx[0] - 8.0).abs() < 1e-5);
+        assert!((p[(0, 0)] - 0.8).abs() < 1e-6);
+        assert!((f.nis - 20.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn gate_and_degenerate_leave_p_alone() {
+        let mut p = Matrix2::new(1.0, 0.0, 0.0, 1.0);
+        let h = Vector2::new(1.0, 0.0);
+        assert_eq!(
+            scalar_update(&mut p, &h, 100.0, 1.0, 5.0),
+            Err(Refused::Gated)
+        );
+        assert_eq!(
+            scalar_update(&mut p, &h, f32::NAN, 1.0, 5.0),
+            Err(Refused::Degenerate)
+        );
+        assert_eq!(
+            scalar_update(&mut p, &h, 1.0, -2.0, 5.0),
+            Err(Refused::Degenerate)
+        );
+        assert_eq!(p, Matrix2::identity());
+        let mut bad = Matrix2::new(f32::NAN, 0.0, 0.0, 1.0);
+        assert!(!condition(&mut bad, 1e-9, 1e9));
+    }
+}

@@ -1,0 +1,733 @@
+//! Gain design by successive loop closure (thesis chapter 3 and Appendix C, after Beard and
+//! McLain), from the aircraft data and the linear model at the level trim.
+//!
+//! Each loop is designed on a reduced model with the inner loops taken as closed, then judged
+//! on that same reduced model with the inner loops as designed (closed-loop poles, rise time,
+//! overshoot), and its stability margins are computed with what the design formulas leave out:
+//! the 8 Hz servo and the flight software's delay (two 20 ms samples plus half a sample of
+//! zero-order hold, 50 ms in all), and on the altitude and airspeed loops the 2 rad/s feedback
+//! low-pass.
+//!
+//! Loops and design rules (`zeta` = 0.707 throughout):
+//! - roll (PID on aileron): `wn_phi = sqrt(|a_phi2| da_max sqrt(1 - zeta^2) / e_phi_max)`,
+//!   `kp = wn^2 / a_phi2`, `kd = (2 zeta wn - a_phi1) / a_phi2` (Appendix C, with its
+//!   `da_max` = 45 deg and `e_phi_max` = 15 deg). That `kp` keeps only ~6 deg of phase
+//!   margin once the servo and the 50 ms delay are in the loop, so the computed set keeps
+//!   Appendix C's damper and lowers `kp` until the margin is 45 deg (the thesis's own table
+//!   value, -1.1216, sits near that point); `ki` puts the integrator zero at `wn / 50` (the
+//!   thesis picks it on a root locus without a stated rule);
+//! - course (PI on commanded roll): `wn_chi = wn_phi / 10`, `kp = 2 zeta wn Va / g`
+//!   (Appendix C); Appendix C's `ki = wn^2 Va / g` places the integrator zero at
+//!   `wn / (2 zeta)`, inside the loop's bandwidth, which costs ~20 % overshoot against the
+//!   5 % requirement, so the integrators of the loops whose plant already integrates (course,
+//!   altitude) put their zero at 1/20 of the proportional bandwidth `2 zeta wn` instead
+//!   (the thesis's own tables use nearly no integral action there); the loops on type-0
+//!   plants (sideslip, both airspeed loops) keep the pole-placement `ki = wn^2 / a2`, whose
+//!   zero lies well above `wn` because `2 zeta wn - a1` is small;
+//! - sideslip (PI on rudder): `wn_beta = wn_phi / 20`, `kp = (2 zeta wn - a_beta1) / a_beta2`;
+//! - pitch (PID on elevator): `kp = sign(a_theta3) de_max / e_theta_max` (25 deg of elevator
+//!   for the 20 deg pitch-command range), `wn_theta = sqrt(a_theta2 + kp a_theta3)`,
+//!   `kd = (2 zeta wn - a_theta1) / a_theta3`, then `kp` limited by the same 45 deg phase
+//!   margin; the inner integrators put their zero at `wn / 50`;
+//! - altitude (PI on commanded pitch), airspeed by pitch and airspeed by throttle: the thesis
+//!   separates them from the pitch loop by bandwidth, but all three see their feedback through
+//!   the 2 rad/s low-pass, so their natural frequency is also kept a factor of 4 (airspeed)
+//!   or 8 (altitude, behind the pitch loop's own lag) below it;
+//!   `kp`, `ki` from the same pole placement on `h/theta = Va/s`, `Va/theta = -g/(s + a_V1)`
+//!   and the throttle-to-airspeed model with the engine-speed lag.
+
+use super::linearize::{linearize, Linearization};
+use super::lti::{damping_and_frequency, margins, Margins};
+use super::metrics::step_metrics;
+use super::transfer::TransferFunction;
+use super::trim::{trim_with, TrimResult, TrimTarget};
+use crate::aircraft::Aircraft;
+use crate::plant::ModelParams;
+use common::control::gains::{GainSet, DESIGNED};
+use common::math::atmosphere::standard_atmosphere;
+use nalgebra::Complex;
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// The choices a designer makes; defaults are the thesis's.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DesignInputs {
+    /// Damping ratio of every loop.
+    pub zeta: f64,
+    /// Aileron deflection the roll design may use, deg (Appendix C: 45).
+    pub roll_aileron_max_deg: f64,
+    /// Roll error at which the aileron saturates, deg (Appendix C: 15).
+    pub roll_error_max_deg: f64,
+    /// Bandwidth separation of course from roll (Appendix C: 10).
+    pub course_separation: f64,
+    /// Bandwidth separation of sideslip from roll (Appendix C: 20).
+    pub sideslip_separation: f64,
+    /// Elevator deflection the pitch design may use, deg (the servo limit).
+    pub pitch_elevator_max_deg: f64,
+    /// Pitch error at which the elevator saturates, deg (the pitch-command limit).
+    pub pitch_error_max_deg: f64,
+    /// Bandwidth separation of altitude from pitch.
+    pub altitude_separation: f64,
+    /// Separation of the airspeed loops from the feedback low-pass pole.
+    pub filter_separation: f64,
+    /// Separation of the altitude loop from the feedback low-pass pole (the pitch loop adds
+    /// its own lag there).
+    pub altitude_filter_separation: f64,
+    /// Integrator zero of the inner PID loops, as a fraction of their natural frequency.
+    pub integrator_zero_fraction: f64,
+    /// Integrator zero of the outer PI loops, as a fraction of their proportional bandwidth
+    /// `2 zeta wn` (the pole-placement `ki = wn^2 ...` puts the zero at `wn / (2 zeta)`,
+    /// which costs some 20 % overshoot against the thesis's 5 % requirement).
+    pub outer_integrator_fraction: f64,
+    /// Control sample time, s.
+    pub sample_time_s: f64,
+    /// Samples of delay in the flight software.
+    pub delay_samples: f64,
+    /// Phase margin the inner loops must keep with servo and delay, deg.
+    pub inner_phase_margin_deg: f64,
+}
+
+impl Default for DesignInputs {
+    fn default() -> Self {
+        Self {
+            zeta: 0.707,
+            roll_aileron_max_deg: 45.0,
+            roll_error_max_deg: 15.0,
+            course_separation: 10.0,
+            sideslip_separation: 20.0,
+            pitch_elevator_max_deg: 25.0,
+            pitch_error_max_deg: 20.0,
+            altitude_separation: 10.0,
+            filter_separation: 4.0,
+            altitude_filter_separation: 8.0,
+            integrator_zero_fraction: 0.02,
+            outer_integrator_fraction: 0.05,
+            sample_time_s: 0.02,
+            delay_samples: 2.0,
+            inner_phase_margin_deg: 45.0,
+        }
+    }
+}
+
+/// Model coefficients the design rules use.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Coefficients {
+    /// Airspeed, m/s.
+    pub va: f64,
+    /// Density, kg/m^3.
+    pub rho: f64,
+    /// `a_phi1` from the aero data, 1/s.
+    pub a_phi1: f64,
+    /// `a_phi2` from the aero data, rad/s^2 per rad.
+    pub a_phi2: f64,
+    /// `-A[p,p]` of the linear model (the roll-subsidence pole), 1/s.
+    pub a_phi1_linear: f64,
+    /// Combined-aileron `B[p]` of the linear model.
+    pub a_phi2_linear: f64,
+    /// `a_beta1`, 1/s.
+    pub a_beta1: f64,
+    /// `a_beta2`, 1/s.
+    pub a_beta2: f64,
+    /// `a_theta1`, 1/s.
+    pub a_theta1: f64,
+    /// `a_theta2`, 1/s^2.
+    pub a_theta2: f64,
+    /// `a_theta3`, 1/s^2.
+    pub a_theta3: f64,
+    /// Speed damping `-A[u,u]`, 1/s.
+    pub a_v1: f64,
+    /// Steady-state airspeed acceleration per unit throttle, m/s^2.
+    pub a_v2: f64,
+    /// Engine-speed pole `-A[Omega,Omega]`, 1/s.
+    pub engine_pole: f64,
+}
+
+/// Appendix C's roll numbers, and the phase margin they leave once servo and delay are in the
+/// loop.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AppendixC {
+    /// Natural frequency, rad/s.
+    pub wn_phi: f64,
+    /// Roll kp.
+    pub roll_kp: f64,
+    /// Roll-rate kd.
+    pub roll_kd: f64,
+    /// Phase margin with the 8 Hz servo and the 50 ms delay, deg.
+    pub phase_margin_deg: Option<f64>,
+}
+
+/// One designed loop and what the linear model predicts of it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LoopDesign {
+    /// Loop name.
+    pub name: String,
+    /// Gains as (parameter, ours, thesis "designed").
+    pub gains: Vec<(String, f64, f64)>,
+    /// Natural frequency the design aims at, rad/s.
+    pub wn_radps: f64,
+    /// Closed-loop poles of the reduced model with the inner loops as designed.
+    pub poles: Vec<[f64; 2]>,
+    /// Predicted 10-90 % rise time, s.
+    pub rise_time_s: Option<f64>,
+    /// Predicted overshoot, %.
+    pub overshoot_pct: f64,
+    /// Predicted 2 % settling time, s.
+    pub settling_time_s: Option<f64>,
+    /// Margins with servo, delay (and feedback filter where the loop has one).
+    pub margins: Margins,
+}
+
+/// The whole design.
+#[derive(Clone, Debug, Serialize)]
+pub struct Design {
+    /// The designer's choices.
+    pub inputs: DesignInputs,
+    /// Model coefficients.
+    pub coefficients: Coefficients,
+    /// Appendix C's roll design as printed, before the delay is accounted for.
+    pub appendix_c: AppendixC,
+    /// Every loop, inner to outer.
+    pub loops: Vec<LoopDesign>,
+    /// The gain set ("computed").
+    #[serde(skip)]
+    pub gains: GainSet,
+}
+
+type Freq = Box<dyn Fn(f64) -> Complex<f64>>;
+
+fn tf(num: &[f64], den: &[f64]) -> TransferFunction {
+    TransferFunction::new(num, den)
+}
+
+/// `forward / (1 + forward * feedback)`.
+fn closed(forward: &TransferFunction, feedback: &TransferFunction) -> TransferFunction {
+    use super::transfer::{poly_add, poly_mul};
+    TransferFunction::new(
+        &poly_mul(&forward.num, &feedback.den),
+        &poly_add(
+            &poly_mul(&forward.den, &feedback.den),
+            &poly_mul(&forward.num, &feedback.num),
+        ),
+    )
+}
+
+fn predict(
+    name: &str,
+    gains: Vec<(String, f64, f64)>,
+    wn: f64,
+    closed_loop: &TransferFunction,
+    loop_gain: Freq,
+    t_end: f64,
+) -> LoopDesign {
+    let dt = (t_end / 20_000.0).min(1e-3);
+    let (t, y) = closed_loop.step_response(t_end, dt);
+    let m = step_metrics(&t, &y, 0.0, 1.0, 0.0, t_end + dt);
+    LoopDesign {
+        name: name.into(),
+        gains,
+        wn_radps: wn,
+        poles: closed_loop.poles().iter().map(|p| [p.re, p.im]).collect(),
+        rise_time_s: m.rise_time_s,
+        overshoot_pct: m.overshoot_pct,
+        settling_time_s: m.settling_time_s,
+        margins: margins(loop_gain, 1e-3, 1e3),
+    }
+}
+
+/// Designs every loop at the level trim of `aircraft`.
+pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Design> {
+    let params = ModelParams::new(aircraft);
+    let trim: TrimResult = trim_with(&params, &TrimTarget::level());
+    if !trim.converged {
+        anyhow::bail!(
+            "the level trim did not converge (residual {:.3e}); cannot design",
+            trim.residual_norm
+        );
+    }
+    let lin: Linearization = linearize(&params, &trim);
+    let va = trim.target.va_mps;
+    let rho =
+        standard_atmosphere(aircraft.environment.home_alt_msl_m + trim.target.alt_msl_m).density;
+    let g = aircraft.environment.g_mps2;
+    let (m, geo, aero) = (&aircraft.mass, &aircraft.geometry, &aircraft.aero);
+    let z = inputs.zeta;
+
+    // Roll: Appendix C's coefficients from the aero data.
+    let gamma = m.Jx_kgm2 * m.Jz_kgm2 - m.Jxz_kgm2 * m.Jxz_kgm2;
+    let (g3, g4) = (m.Jz_kgm2 / gamma, m.Jxz_kgm2 / gamma);
+    let c_p_p = g3 * aero.roll.Cl_p + g4 * aero.yaw.Cn_p;
+    let c_p_da = g3 * aero.roll.Cl_da + g4 * aero.yaw.Cn_da;
+    let a_phi1 = -0.25 * rho * va * geo.S_m2 * geo.b_m * geo.b_m * c_p_p;
+    let a_phi2 = 0.5 * rho * va * va * geo.S_m2 * geo.b_m * c_p_da;
+    // Lateral model order v, p, r, phi, psi; inputs left, right aileron, rudder.
+    let a_phi1_linear = -lin.lat.a[(1, 1)];
+    let a_phi2_linear = lin.lat.b[(1, 1)] - lin.lat.b[(1, 0)];
+    // Sideslip.
+    let a_beta1 = -rho * va * geo.S_m2 * aero.side.CY_beta / (2.0 * m.mass_kg);
+    let a_beta2 = rho * va * geo.S_m2 * aero.side.CY_dr / (2.0 * m.mass_kg);
+    // Pitch (Beard and McLain's reduced model, from the aero data).
+    let qbar_sc = 0.5 * rho * va * va * geo.S_m2 * geo.c_m;
+    let a_theta1 = -rho * va * geo.c_m * geo.c_m * geo.S_m2 * aero.pitch.Cm_q / (4.0 * m.Jy_kgm2);
+    let a_theta2 = -qbar_sc * aero.pitch.Cm_alpha / m.Jy_kgm2;
+    let a_theta3 = qbar_sc * aero.pitch.Cm_de / m.Jy_kgm2;
+    // Speed: longitudinal order u, w, q, theta, Ze, Omega; inputs elevator, throttle.
+    let lon = &lin.lon;
+    let a_v1 = -lon.a[(0, 0)];
+    let engine_pole = -lon.a[(5, 5)];
+    let a_v2 = lon.a[(0, 5)] * lon.b[(5, 1)] / engine_pole;
+
+    let coefficients = Coefficients {
+        va,
+        rho,
+        a_phi1,
+        a_phi2,
+        a_phi1_linear,
+        a_phi2_linear,
+        a_beta1,
+        a_beta2,
+        a_theta1,
+        a_theta2,
+        a_theta3,
+        a_v1,
+        a_v2,
+        engine_pole,
+    };
+
+    // What the formulas leave out: servo and delay.
+    let servo_w = 2.0 * PI * aircraft.actuators.bandwidth_Hz;
+    let tau = (inputs.delay_samples + 0.5) * inputs.sample_time_s;
+    let servo_delay = move |w: f64| {
+        let s = Complex::new(0.0, w);
+        servo_w / (s + servo_w) * Complex::new(0.0, -w * tau).exp()
+    };
+    let lp = DESIGNED.longitudinal.feedback_lpf_pole as f64;
+    let filter = tf(&[lp], &[1.0, lp]);
+    let d = &DESIGNED;
+    let mut loops = Vec::new();
+
+    // --- Roll.
+    let wn_appendix_c = (a_phi2.abs() * inputs.roll_aileron_max_deg * (1.0 - z * z).sqrt()
+        / inputs.roll_error_max_deg)
+        .sqrt();
+    let roll_plant = tf(&[a_phi2], &[1.0, a_phi1, 0.0]);
+    // The rate damper as Appendix C designs it; the attitude gain then as high as the phase
+    // margin with servo and delay allows (Appendix C's own value leaves almost none).
+    let roll_kd = (2.0 * z * wn_appendix_c - a_phi1) / a_phi2;
+    let roll_gains = |kp: f64| {
+        let wn = (a_phi2 * kp).max(0.0).sqrt();
+        (kp, kp * wn * inputs.integrator_zero_fraction, roll_kd)
+    };
+    let roll_pm = |kp: f64| {
+        let (kp, ki, kd) = roll_gains(kp);
+        let l = tf(&[kd, kp, ki], &[1.0, 0.0]).series(&roll_plant);
+        margins(move |w| l.eval(w) * servo_delay(w), 1e-3, 1e3).phase_margin_deg
+    };
+    let kp_appendix_c = wn_appendix_c * wn_appendix_c / a_phi2;
+    let (roll_kp, roll_ki, roll_kd) = roll_gains(limit_gain(
+        kp_appendix_c,
+        inputs.inner_phase_margin_deg,
+        roll_pm,
+    ));
+    let wn_phi = (a_phi2 * roll_kp).sqrt();
+    let appendix_c = AppendixC {
+        wn_phi: wn_appendix_c,
+        roll_kp: kp_appendix_c,
+        roll_kd,
+        phase_margin_deg: roll_pm(kp_appendix_c),
+    };
+    let roll_pid = tf(&[roll_kd, roll_kp, roll_ki], &[1.0, 0.0]);
+    let roll_cl = tf(
+        &[a_phi2 * roll_kp, a_phi2 * roll_ki],
+        &[
+            1.0,
+            a_phi1 + a_phi2 * roll_kd,
+            a_phi2 * roll_kp,
+            a_phi2 * roll_ki,
+        ],
+    );
+    let roll_loop = roll_pid.series(&roll_plant);
+    let roll_real = {
+        let l = roll_loop.clone();
+        let pi_part = tf(&[roll_kp, roll_ki], &[1.0, 0.0]).series(&roll_plant);
+        // phi/phi_c with servo and delay in the loop, for the outer loops' margins.
+        move |w: f64| {
+            let sd = servo_delay(w);
+            let lw = l.eval(w) * sd;
+            pi_part.eval(w) * sd / (1.0 + lw)
+        }
+    };
+    loops.push(predict(
+        "roll attitude (aileron)",
+        vec![
+            ("RLL_KP".into(), roll_kp, d.lateral.roll_kp as f64),
+            ("RLL_KI".into(), roll_ki, d.lateral.roll_ki as f64),
+            ("RLL_RATE_KD".into(), roll_kd, d.lateral.roll_rate_kd as f64),
+        ],
+        wn_phi,
+        &roll_cl,
+        Box::new({
+            let l = roll_loop.clone();
+            move |w| l.eval(w) * servo_delay(w)
+        }),
+        3.0,
+    ));
+
+    // --- Course.
+    let wn_chi = wn_phi / inputs.course_separation;
+    let course_kp = 2.0 * z * wn_chi * va / g;
+    let course_ki = course_kp * 2.0 * z * wn_chi * inputs.outer_integrator_fraction;
+    let course_pi = tf(&[course_kp, course_ki], &[1.0, 0.0]);
+    let kin = tf(&[g / va], &[1.0, 0.0]);
+    let course_fwd = course_pi.series(&roll_cl).series(&kin);
+    let course_cl = course_fwd.closed_loop();
+    loops.push(predict(
+        "course (commanded roll)",
+        vec![
+            ("CRS_KP".into(), course_kp, d.lateral.course_kp as f64),
+            ("CRS_KI".into(), course_ki, d.lateral.course_ki as f64),
+        ],
+        wn_chi,
+        &course_cl,
+        Box::new({
+            let (c, k) = (course_pi.clone(), kin.clone());
+            let r = roll_real.clone();
+            move |w| c.eval(w) * r(w) * k.eval(w)
+        }),
+        20.0,
+    ));
+
+    // --- Sideslip.
+    let wn_beta = wn_phi / inputs.sideslip_separation;
+    let slip_kp = (2.0 * z * wn_beta - a_beta1) / a_beta2;
+    let slip_ki = wn_beta * wn_beta / a_beta2;
+    let slip_plant = tf(&[a_beta2], &[1.0, a_beta1]);
+    let slip_loop = tf(&[slip_kp, slip_ki], &[1.0, 0.0]).series(&slip_plant);
+    loops.push(predict(
+        "sideslip (rudder)",
+        vec![
+            ("SLIP_KP".into(), slip_kp, d.lateral.slip_kp as f64),
+            ("SLIP_KI".into(), slip_ki, d.lateral.slip_ki as f64),
+        ],
+        wn_beta,
+        &slip_loop.closed_loop(),
+        Box::new({
+            let l = slip_loop.clone();
+            move |w| l.eval(w) * servo_delay(w)
+        }),
+        20.0,
+    ));
+
+    // --- Pitch: designed on the reduced model, predicted on the linear short period.
+    let q_de = &super::transfer::thesis_transfer_functions(&lin).q_over_de;
+    let theta_de = q_de.series(&tf(&[1.0], &[1.0, 0.0]));
+    let kp_nominal = a_theta3.signum() * inputs.pitch_elevator_max_deg / inputs.pitch_error_max_deg;
+    let wn_nominal = (a_theta2 + kp_nominal * a_theta3).max(0.0).sqrt();
+    // The damper from the nominal design, the attitude gain limited by the phase margin.
+    let pitch_kd = (2.0 * z * wn_nominal - a_theta1) / a_theta3;
+    let pitch_gains = |kp: f64| {
+        let wn = (a_theta2 + kp * a_theta3).max(0.0).sqrt();
+        (kp, kp * wn * inputs.integrator_zero_fraction, pitch_kd)
+    };
+    let pitch_pm = |kp: f64| {
+        let (kp, ki, kd) = pitch_gains(kp);
+        let l = tf(&[kd, kp, ki], &[1.0, 0.0]).series(&theta_de);
+        margins(move |w| l.eval(w) * servo_delay(w), 1e-3, 1e3).phase_margin_deg
+    };
+    let (pitch_kp, pitch_ki, pitch_kd) = pitch_gains(limit_gain(
+        kp_nominal,
+        inputs.inner_phase_margin_deg,
+        pitch_pm,
+    ));
+    let wn_theta = (a_theta2 + pitch_kp * a_theta3).max(0.0).sqrt();
+    let pitch_pid = tf(&[pitch_kd, pitch_kp, pitch_ki], &[1.0, 0.0]);
+    let pitch_loop = pitch_pid.series(&theta_de);
+    let pitch_pi_fwd = tf(&[pitch_kp, pitch_ki], &[1.0, 0.0]).series(&theta_de);
+    // theta/theta_c = PI P / (1 + PID P).
+    let pitch_cl = {
+        use super::transfer::{poly_add, poly_mul};
+        TransferFunction::new(
+            &poly_mul(&pitch_pi_fwd.num, &pitch_loop.den),
+            &poly_mul(
+                &pitch_pi_fwd.den,
+                &poly_add(&pitch_loop.den, &pitch_loop.num),
+            ),
+        )
+    };
+    let pitch_cl = reduce(&pitch_cl);
+    let pitch_real = {
+        let (l, f) = (pitch_loop.clone(), pitch_pi_fwd.clone());
+        move |w: f64| {
+            let sd = servo_delay(w);
+            f.eval(w) * sd / (1.0 + l.eval(w) * sd)
+        }
+    };
+    loops.push(predict(
+        "pitch attitude (elevator)",
+        vec![
+            ("PTCH_KP".into(), pitch_kp, d.longitudinal.pitch_kp as f64),
+            ("PTCH_KI".into(), pitch_ki, d.longitudinal.pitch_ki as f64),
+            (
+                "PTCH_RATE_KD".into(),
+                pitch_kd,
+                d.longitudinal.pitch_rate_kd as f64,
+            ),
+        ],
+        wn_theta,
+        &pitch_cl,
+        Box::new({
+            let l = pitch_loop.clone();
+            move |w| l.eval(w) * servo_delay(w)
+        }),
+        4.0,
+    ));
+
+    let slow_wn =
+        |wn_inner: f64, separation: f64| (wn_inner / separation).min(lp / inputs.filter_separation);
+
+    // --- Altitude by pitch.
+    let wn_h = (wn_theta / inputs.altitude_separation).min(lp / inputs.altitude_filter_separation);
+    let alt_kp = 2.0 * z * wn_h / va;
+    let alt_ki = alt_kp * 2.0 * z * wn_h * inputs.outer_integrator_fraction;
+    let alt_pi = tf(&[alt_kp, alt_ki], &[1.0, 0.0]);
+    let climb = tf(&[va], &[1.0, 0.0]);
+    let alt_fwd = alt_pi.series(&pitch_cl).series(&climb);
+    loops.push(predict(
+        "altitude (commanded pitch)",
+        vec![
+            ("ALT_KP".into(), alt_kp, d.longitudinal.alt_kp as f64),
+            ("ALT_KI".into(), alt_ki, d.longitudinal.alt_ki as f64),
+        ],
+        wn_h,
+        &reduce(&closed(&alt_fwd, &filter)),
+        Box::new({
+            let (c, k, f) = (alt_pi.clone(), climb.clone(), filter.clone());
+            let p = pitch_real.clone();
+            move |w| c.eval(w) * p(w) * k.eval(w) * f.eval(w)
+        }),
+        40.0,
+    ));
+
+    // --- Airspeed by pitch (climb and descent regimes).
+    let wn_v2 = slow_wn(wn_theta, inputs.altitude_separation);
+    let aspd_pitch_kp = (a_v1 - 2.0 * z * wn_v2) / g;
+    let aspd_pitch_ki = -wn_v2 * wn_v2 / g;
+    let v_theta = tf(&[-g], &[1.0, a_v1]);
+    let ap_pi = tf(&[aspd_pitch_kp, aspd_pitch_ki], &[1.0, 0.0]);
+    let ap_fwd = ap_pi.series(&pitch_cl).series(&v_theta);
+    loops.push(predict(
+        "airspeed (commanded pitch)",
+        vec![
+            (
+                "ASPD_PTCH_KP".into(),
+                aspd_pitch_kp,
+                d.longitudinal.aspd_pitch_kp as f64,
+            ),
+            (
+                "ASPD_PTCH_KI".into(),
+                aspd_pitch_ki,
+                d.longitudinal.aspd_pitch_ki as f64,
+            ),
+        ],
+        wn_v2,
+        &reduce(&closed(&ap_fwd, &filter)),
+        Box::new({
+            let (c, k, f) = (ap_pi.clone(), v_theta.clone(), filter.clone());
+            let p = pitch_real.clone();
+            move |w| c.eval(w) * p(w) * k.eval(w) * f.eval(w)
+        }),
+        40.0,
+    ));
+
+    // --- Airspeed by throttle (altitude-hold regime).
+    let wn_v = lp / inputs.filter_separation;
+    let aspd_thr_kp = (2.0 * z * wn_v - a_v1) / a_v2;
+    let aspd_thr_ki = wn_v * wn_v / a_v2;
+    let v_dt = tf(
+        &[a_v2 * engine_pole],
+        &[1.0, a_v1 + engine_pole, a_v1 * engine_pole],
+    );
+    let at_pi = tf(&[aspd_thr_kp, aspd_thr_ki], &[1.0, 0.0]);
+    let at_fwd = at_pi.series(&v_dt);
+    loops.push(predict(
+        "airspeed (throttle)",
+        vec![
+            (
+                "ASPD_THR_KP".into(),
+                aspd_thr_kp,
+                d.longitudinal.aspd_thr_kp as f64,
+            ),
+            (
+                "ASPD_THR_KI".into(),
+                aspd_thr_ki,
+                d.longitudinal.aspd_thr_ki as f64,
+            ),
+        ],
+        wn_v,
+        &closed(&at_fwd, &filter),
+        Box::new({
+            let (l, f) = (at_fwd.clone(), filter.clone());
+            move |w| l.eval(w) * f.eval(w) * Complex::new(0.0, -w * tau).exp()
+        }),
+        40.0,
+    ));
+
+    let mut gains = *d;
+    let lat = &mut gains.lateral;
+    lat.roll_kp = roll_kp as f32;
+    lat.roll_ki = roll_ki as f32;
+    lat.roll_rate_kd = roll_kd as f32;
+    lat.course_kp = course_kp as f32;
+    lat.course_ki = course_ki as f32;
+    lat.slip_kp = slip_kp as f32;
+    lat.slip_ki = slip_ki as f32;
+    lat.trim_aileron = trim.aileron as f32;
+    lat.trim_rudder = trim.rudder as f32;
+    let lon_g = &mut gains.longitudinal;
+    lon_g.pitch_kp = pitch_kp as f32;
+    lon_g.pitch_ki = pitch_ki as f32;
+    lon_g.pitch_rate_kd = pitch_kd as f32;
+    lon_g.alt_kp = alt_kp as f32;
+    lon_g.alt_ki = alt_ki as f32;
+    lon_g.aspd_pitch_kp = aspd_pitch_kp as f32;
+    lon_g.aspd_pitch_ki = aspd_pitch_ki as f32;
+    lon_g.aspd_thr_kp = aspd_thr_kp as f32;
+    lon_g.aspd_thr_ki = aspd_thr_ki as f32;
+    lon_g.trim_elevator = trim.elevator as f32;
+    lon_g.trim_throttle = trim.throttle as f32;
+    if let Err(e) = gains.validate() {
+        anyhow::bail!("the computed gains are outside their parameter bounds: {e}");
+    }
+    Ok(Design {
+        inputs: inputs.clone(),
+        coefficients,
+        appendix_c,
+        loops,
+        gains,
+    })
+}
+
+/// The largest gain, at most `k` in size, whose loop keeps `pm_deg` of phase margin (1 % steps
+/// down; the delay costs phase in proportion to the crossover frequency).
+fn limit_gain(k: f64, pm_deg: f64, pm: impl Fn(f64) -> Option<f64>) -> f64 {
+    let mut g = k;
+    for _ in 0..400 {
+        if pm(g).is_some_and(|m| m >= pm_deg) {
+            return g;
+        }
+        g *= 0.99;
+    }
+    g
+}
+
+/// Cancels pole-zero pairs that coincide (the pitch loop's closed form repeats factors).
+fn reduce(t: &TransferFunction) -> TransferFunction {
+    use super::transfer::{poly_mul, poly_roots};
+    let mut zeros = poly_roots(&t.num);
+    let mut poles = poly_roots(&t.den);
+    let gain = t.num.first().copied().unwrap_or(0.0);
+    let mut i = 0;
+    while i < zeros.len() {
+        let scale = zeros[i].norm().max(1.0);
+        if let Some(j) = poles
+            .iter()
+            .position(|p| (p - zeros[i]).norm() < 1e-6 * scale)
+        {
+            poles.remove(j);
+            zeros.remove(i);
+        } else {
+            i += 1;
+        }
+    }
+    let expand = |roots: &[Complex<f64>]| {
+        roots
+            .iter()
+            .fold(vec![Complex::new(1.0, 0.0)], |acc, r| {
+                let mut out = vec![Complex::new(0.0, 0.0); acc.len() + 1];
+                for (k, a) in acc.iter().enumerate() {
+                    out[k] += a;
+                    out[k + 1] -= a * r;
+                }
+                out
+            })
+            .iter()
+            .map(|c| c.re)
+            .collect::<Vec<f64>>()
+    };
+    let num = poly_mul(&[gain], &expand(&zeros));
+    TransferFunction::new(&num, &expand(&poles))
+}
+
+/// The "computed" gain set: [`design`] with the thesis's design inputs.
+pub fn computed_gain_set(aircraft: &Aircraft) -> anyhow::Result<GainSet> {
+    Ok(design(aircraft, &DesignInputs::default())?.gains)
+}
+
+/// Damping and natural frequency of each pole, for reports.
+pub fn describe_poles(poles: &[[f64; 2]]) -> Vec<(f64, f64)> {
+    poles
+        .iter()
+        .map(|p| damping_and_frequency(Complex::new(p[0], p[1])))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn appendix_c_numbers_are_reproduced() {
+        let a = Aircraft::ultrastick25e().expect("built-in aircraft");
+        let d = design(&a, &DesignInputs::default()).expect("design");
+        let c = &d.coefficients;
+        // The aero-data roll coefficients equal the linear model's p/da (thesis eq. 20).
+        assert!((c.a_phi1 - 16.09).abs() < 0.02, "{}", c.a_phi1);
+        assert!((c.a_phi2 + 156.5).abs() < 0.2, "{}", c.a_phi2);
+        assert!((c.a_phi1 - c.a_phi1_linear).abs() / c.a_phi1 < 0.01);
+        // Thesis section 3.4.1: kd_phi = -0.0618 moves the roll pole from -16.09 to -25.76.
+        let kd = d.appendix_c.roll_kd;
+        assert!((kd + 0.0618).abs() < 5e-4, "kd {kd}");
+        assert!((c.a_phi1 + c.a_phi2 * kd - 25.76).abs() < 0.05);
+        // Appendix C's kp = wn^2 / a_phi2 = -(45 / 15) sqrt(1 - 0.707^2) = -2.1216.
+        assert!((d.appendix_c.roll_kp + 2.1216).abs() < 1e-3);
+        // With the servo and the 50 ms software delay that design keeps almost no phase
+        // margin, so the computed set is slower.
+        assert!(d.appendix_c.phase_margin_deg.unwrap_or(0.0) < 10.0);
+        assert!(d.gains.lateral.roll_kp.abs() < 2.0);
+        // B&M sideslip coefficients: a_beta1 = 0.796, a_beta2 = 0.312 at 17 m/s.
+        assert!((c.a_beta1 - 0.7963).abs() < 1e-3 && (c.a_beta2 - 0.3116).abs() < 1e-3);
+        // Short-period elevator effectiveness: a_theta3 matches q/de's -133.7 within 1 %.
+        assert!((c.a_theta3 + 133.7).abs() < 1.4, "{}", c.a_theta3);
+    }
+
+    #[test]
+    fn every_loop_is_stable_with_margins() {
+        let a = Aircraft::ultrastick25e().expect("built-in aircraft");
+        let d = design(&a, &DesignInputs::default()).expect("design");
+        for l in &d.loops {
+            assert!(
+                l.poles.iter().all(|p| p[0] < 0.0),
+                "{} unstable: {:?}",
+                l.name,
+                l.poles
+            );
+            let pm = l.margins.phase_margin_deg.unwrap_or(90.0);
+            assert!(pm > 30.0, "{}: phase margin {pm}", l.name);
+            if let Some(gm) = l.margins.gain_margin_db {
+                assert!(gm > 6.0, "{}: gain margin {gm}", l.name);
+            }
+        }
+        // Inner loops meet the thesis's rise-time requirement on the linear model.
+        for name in ["roll", "pitch"] {
+            let l = d
+                .loops
+                .iter()
+                .find(|l| l.name.starts_with(name))
+                .expect("loop");
+            assert!(
+                l.rise_time_s.unwrap_or(9.0) < 1.0,
+                "{name}: {:?}",
+                l.rise_time_s
+            );
+        }
+    }
+}
