@@ -246,3 +246,36 @@ fn cli_refuses_bad_names_and_noise() {
         assert!(err.contains("--noise") && err.contains("finite"), "{err}");
     }
 }
+
+/// The designed sideslip loop's divergence is not an artefact of the input delay: without it
+/// the rudder still runs between its stops.
+#[test]
+fn designed_sideslip_loop_diverges_without_the_delay_too() {
+    let cfg = SimConfig {
+        delay_samples: 0,
+        ..SimConfig::default()
+    };
+    let r = fly_sets("sideslip_doublet", &["designed", "computed"], &cfg);
+    let d = of(&r, "designed");
+    assert!(d.peak_rudder_deg > 24.9 && d.ripple_rms > 5.0, "{d:?}");
+    // The computed set's sideslip loop tracks the same doublet.
+    let c = of(&r, "computed");
+    assert!(
+        c.peak_rudder_deg < 20.0 && c.steady_state_error.abs() < 0.5,
+        "{c:?}"
+    );
+}
+
+/// With no altitude integrator, the altitude loop settles trim pitch / kp below the command:
+/// the altitude PI commands absolute pitch and its bumpless offset fades to zero.
+#[test]
+fn p_only_altitude_loop_holds_trim_pitch_over_kp_below() {
+    let r = fly_sets("altitude_step", &["designed_appe"], &SimConfig::default());
+    let g = gain_set(aircraft(), "designed_appe").unwrap();
+    let predicted = trim().theta / f64::from(g.longitudinal.alt_kp);
+    let flown = of(&r, "designed_appe").steady_state_error;
+    assert!(
+        (flown - predicted).abs() < 0.15 * predicted,
+        "predicted {predicted} m, flown {flown} m"
+    );
+}

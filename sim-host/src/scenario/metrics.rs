@@ -59,9 +59,12 @@ pub struct RunMetrics {
     /// Altitude scenarios: time from the first step until the altitude first comes within 2 %
     /// of the first step of the command, s.
     pub time_to_2pct_s: Option<f64>,
-    /// Ripple: RMS of the tracking error over the second half of every held segment (deg or
-    /// m), where a settled loop shows only what noise and limit cycles leave.
+    /// Ripple: RMS of the tracking error about its mean over the second half of every held
+    /// segment (deg or m), where a settled loop shows only what noise and limit cycles leave
+    /// (a steady offset is not ripple).
     pub ripple_rms: f64,
+    /// Lowest and highest throttle over the second half of the run.
+    pub throttle_range_tail: [f64; 2],
     /// Surface activity: mean |change| per second of the surface of the loop under test
     /// (aileron, rudder or elevator), deg/s.
     pub surface_activity_dps: f64,
@@ -133,10 +136,17 @@ pub fn run_metrics(scenario: &Scenario, run: &Run) -> RunMetrics {
     let (mut sq, mut n) = (0.0, 0usize);
     for (a, b) in bounds {
         let mid = 0.5 * (a + b);
-        for x in s.iter().filter(|x| x.t >= mid && x.t < b) {
-            sq += (x.response - x.command).powi(2);
-            n += 1;
+        let err: Vec<f64> = s
+            .iter()
+            .filter(|x| x.t >= mid && x.t < b)
+            .map(|x| x.response - x.command)
+            .collect();
+        if err.is_empty() {
+            continue;
         }
+        let mean = err.iter().sum::<f64>() / err.len() as f64;
+        sq += err.iter().map(|e| (e - mean).powi(2)).sum::<f64>();
+        n += err.len();
     }
     let ripple_rms = if n > 0 { (sq / n as f64).sqrt() } else { 0.0 };
     let surface = |x: &super::sim::Sample| match scenario.axis {
@@ -169,6 +179,7 @@ pub fn run_metrics(scenario: &Scenario, run: &Run) -> RunMetrics {
         airspeed_range_mps: range(s.iter().map(|x| x.airspeed_mps)),
         time_to_2pct_s,
         ripple_rms,
+        throttle_range_tail: range(s.iter().filter(|x| x.t >= 0.5 * t_end).map(|x| x.throttle)),
         surface_activity_dps: travel / duration,
         rejected_ticks: run.rejected_ticks,
     }
