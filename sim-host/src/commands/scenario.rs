@@ -247,19 +247,26 @@ fn figure(r: &ScenarioResult) -> Figure {
         return Figure::new(r.scenario.name, "time (s)", Vec::new());
     };
     let t: Vec<f64> = first.samples.iter().map(|s| s.t).collect();
-    let mut resp = vec![Series::new(
-        "command",
-        t.clone(),
-        first.samples.iter().map(|s| s.command).collect(),
-    )
-    .dashed()];
-    for run in &r.runs {
-        resp.push(Series::new(
-            run.gains.clone(),
+    // The command goes last so each gain set keeps the same colour in every panel.
+    let mut resp: Vec<Series> = r
+        .runs
+        .iter()
+        .map(|run| {
+            Series::new(
+                run.gains.clone(),
+                t.clone(),
+                run.samples.iter().map(|s| s.response).collect(),
+            )
+        })
+        .collect();
+    resp.push(
+        Series::new(
+            "command",
             t.clone(),
-            run.samples.iter().map(|s| s.response).collect(),
-        ));
-    }
+            first.samples.iter().map(|s| s.command).collect(),
+        )
+        .dashed(),
+    );
     let (sname, sfn): (&str, fn(&crate::scenario::sim::Sample) -> f64) = match axis {
         Axis::Roll | Axis::Heading => ("aileron", |s| s.aileron_deg),
         Axis::Sideslip => ("rudder", |s| s.rudder_deg),
@@ -882,6 +889,28 @@ fn findings(report: &ScenarioReport) -> String {
             sig(a.throttle_range_tail[1], 2),
             sig(a.ripple_rms, 2),
             sig(a.steady_state_error, 2),
+        ));
+    }
+    let swings: Vec<String> = report
+        .get("climb", false)
+        .map(|r| {
+            r.metrics
+                .iter()
+                .filter_map(|m| {
+                    m.climb_regime_pitch_deg
+                        .map(|[lo, hi]| format!("{} {:.1}..{:.1} deg", m.gains, lo, hi))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if !swings.is_empty() {
+        s.push_str(&format!(
+            "- **Airspeed by pitch in the climb regime (Table 3.8, kp -0.866, shared by every \
+             thesis set).** With full throttle the pitch command reaches the 20 deg limit; \
+             the thesis's gain cycles against it, several degrees peak to peak with a period of \
+             about 2 s (see `climb.png`). Pitch range over the second half of the climb \
+             regime: {}. The climb still completes in the times above.\n",
+            swings.join(", ")
         ));
     }
     let worst = |sc: &str| {

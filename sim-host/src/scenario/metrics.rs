@@ -63,6 +63,10 @@ pub struct RunMetrics {
     /// segment (deg or m), where a settled loop shows only what noise and limit cycles leave
     /// (a steady offset is not ripple).
     pub ripple_rms: f64,
+    /// Lowest and highest pitch in the climb regime, deg, over the second half of the time
+    /// spent in it, less its last second (`None` if the run spends under 4 s in it): a settled
+    /// climb shows a narrow range, a cycling airspeed-by-pitch loop a wide one.
+    pub climb_regime_pitch_deg: Option<[f64; 2]>,
     /// Lowest and highest throttle over the second half of the run.
     pub throttle_range_tail: [f64; 2],
     /// Surface activity: mean |change| per second of the surface of the loop under test
@@ -159,7 +163,18 @@ pub fn run_metrics(scenario: &Scenario, run: &Run) -> RunMetrics {
         .map(|w| (surface(&w[1]) - surface(&w[0])).abs())
         .sum();
     let duration = (t_end - run.config.dt_s).max(run.config.dt_s);
+    let climb: Vec<&super::sim::Sample> = s.iter().filter(|x| x.regime == 1).collect();
+    let climb_regime_pitch_deg = match (climb.first(), climb.last()) {
+        (Some(a), Some(b)) if b.t - a.t > 4.0 => Some(range(
+            climb
+                .iter()
+                .filter(|x| x.t >= 0.5 * (a.t + b.t) && x.t <= b.t - 1.0)
+                .map(|x| x.pitch_deg),
+        )),
+        _ => None,
+    };
     RunMetrics {
+        climb_regime_pitch_deg,
         scenario: run.scenario,
         gains: run.gains.clone(),
         noise_sigma: run.config.noise_sigma,
