@@ -309,8 +309,8 @@ fn figure(r: &ScenarioResult) -> Figure {
     };
     Figure::new(
         format!(
-            "{}{noise} (nonlinear plant, servos, 2-sample delay)",
-            r.scenario.description
+            "{}{noise}: nonlinear plant, servos, 2-sample delay",
+            r.scenario.name
         ),
         "time (s)",
         panels,
