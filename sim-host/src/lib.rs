@@ -7,7 +7,8 @@
 //! - [`link`]: the simulator end of PX4's simulator MAVLink interface, in lock-step;
 //! - [`analysis`]: trim, linearisation, transfer functions, the linear-versus-nonlinear
 //!   doublet check of the thesis, and linear-systems tools;
-//! - [`report`]: tables, JSON, CSV and plots shared by every command.
+//! - [`report`]: tables, JSON, CSV and plots shared by every command;
+//! - [`scenario`]: the closed-loop tests of thesis chapter 4 on the nonlinear plant.
 #![warn(missing_docs)]
 
 pub mod aircraft;
@@ -17,4 +18,5 @@ pub mod environment;
 pub mod link;
 pub mod plant;
 pub mod report;
+pub mod scenario;
 pub mod sensors;

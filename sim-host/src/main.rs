@@ -78,6 +78,31 @@ enum Command {
         #[command(flatten)]
         fmt: Output,
     },
+    /// Closed-loop tests of thesis chapter 4 on the nonlinear plant (servos, 50 Hz autopilot,
+    /// 2-sample input delay, optional sensor noise), for several gain sets.
+    Scenario {
+        /// Scenario name, or `all` (every scenario, without noise and with noise 1e-3).
+        name: String,
+        /// Gain sets, comma separated (default: every named set).
+        #[arg(long, value_delimiter = ',', value_name = "SET[,SET...]")]
+        gains: Option<Vec<String>>,
+        /// White noise sigma on every measurement, SI units (rad, rad/s, m, m/s); with `all`
+        /// the sigma of the noisy half (default 1e-3).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        noise: f64,
+        /// Noise seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Directory for the CSV, PNG and JSON files.
+        #[arg(long, default_value = "out/scenarios")]
+        out: PathBuf,
+        /// Also write the results document (Markdown, with the verdicts on the thesis's
+        /// claims) to this file.
+        #[arg(long, value_name = "FILE")]
+        results: Option<PathBuf>,
+        #[command(flatten)]
+        fmt: Output,
+    },
     /// Design the "computed" gain set by successive loop closure and predict every loop.
     Design {
         #[command(flatten)]
@@ -160,6 +185,47 @@ fn run() -> anyhow::Result<ExitCode> {
             } else {
                 emit(&render(&r.tables, fmt.format()))?;
                 for f in &r.files {
+                    emit(&format!("wrote {}\n", f.display()))?;
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Some(Command::Scenario {
+            name,
+            gains,
+            noise,
+            seed,
+            out,
+            results,
+            fmt,
+        }) => {
+            let opts = commands::scenario::ScenarioOptions {
+                gains: gains.unwrap_or_else(|| {
+                    commands::scenario::gain_set_names()
+                        .iter()
+                        .map(|s| s.to_string())
+                        .collect()
+                }),
+                noise_sigma: noise,
+                seed,
+                progress: true,
+            };
+            let r = commands::scenario::scenario_report(&aircraft, &name, &opts, Some(&out))?;
+            if let Some(path) = &results {
+                let cmdline = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
+                let md = commands::scenario::results_markdown(&r, &format!("sim-host {cmdline}"));
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(dir)
+                        .with_context(|| format!("cannot create `{}`", dir.display()))?;
+                }
+                std::fs::write(path, md)
+                    .with_context(|| format!("cannot write `{}`", path.display()))?;
+            }
+            if fmt.json {
+                emit(&to_json(&r)?)?;
+            } else {
+                emit(&render(&r.tables, fmt.format()))?;
+                for f in r.files.iter().chain(results.iter()) {
                     emit(&format!("wrote {}\n", f.display()))?;
                 }
             }

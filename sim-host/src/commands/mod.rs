@@ -4,6 +4,7 @@
 pub mod design;
 pub mod doublet;
 pub mod linearize;
+pub mod scenario;
 pub mod trim;
 pub mod validation;
 
