@@ -22,7 +22,7 @@ use common::estimator::{EstimatedState, Estimator, EstimatorConfig};
 use common::gcs::modes::{FlightMode, ModeSet};
 use common::gcs::param_store::Registry;
 use common::gcs::snapshot::{Battery, GpsRaw, Home, LandedState, SensorHealth, VehicleSnapshot};
-use common::gcs::{GroundLink, VehicleRequests};
+use common::gcs::{GroundLink, ManualInput, VehicleRequests};
 use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
 use common::params::ParamDef;
@@ -145,7 +145,11 @@ pub struct App {
     gain_set_seen: f32,
     truth: Option<Truth>,
     use_truth: bool,
+    sticks: Option<ManualInput>,
 }
+
+/// Sticks older than this are ignored (the ground station stopped sending), us.
+const STICK_TIMEOUT_US: u64 = 500_000;
 
 impl Default for App {
     fn default() -> Self {
@@ -185,6 +189,7 @@ impl App {
             gain_set_seen: 0.0,
             truth: None,
             use_truth: false,
+            sticks: None,
         };
         app.apply_params();
         app
@@ -397,14 +402,31 @@ impl App {
     fn control(&mut self, dt: f32) {
         let m = self.measurements();
         let sp = self.setpoints;
-        let level = self.autopilot.gains().longitudinal;
+        let gains = *self.autopilot.gains();
+        let level = gains.longitudinal;
+        let now = self.last_time_us.unwrap_or(0);
+        let sticks = self
+            .sticks
+            .filter(|s| now.saturating_sub(s.time_us) <= STICK_TIMEOUT_US);
+        if self.mode == FlightMode::Manual {
+            // Pass-through: sticks straight to the surfaces (PX4's normalised sense), trim
+            // when no stick is live.
+            self.surfaces = match sticks {
+                Some(s) => Surfaces::from_px4_controls([s.roll, s.pitch, s.yaw, s.throttle]),
+                None => trim_surfaces(&gains),
+            };
+            // The loops start from these positions when a stabilised mode engages.
+            self.autopilot.handover(self.surfaces);
+            return;
+        }
         let commands = match self.mode {
             FlightMode::Stabilized => Commands {
-                roll: RollMode::Roll(0.0),
+                // Sticks command attitude within the loops' limits; centred: wings level.
+                roll: RollMode::Roll(sticks.map_or(0.0, |s| s.roll * gains.lateral.roll_max)),
                 yaw: YawMode::Sideslip(0.0),
                 lon: LonMode::Pitch {
-                    pitch: 0.0,
-                    throttle: level.trim_throttle,
+                    pitch: sticks.map_or(0.0, |s| s.pitch * level.pitch_max),
+                    throttle: sticks.map_or(level.trim_throttle, |s| s.throttle),
                 },
             },
             FlightMode::Altitude => Commands {
@@ -472,6 +494,9 @@ impl App {
         }
         if let Some(v) = r.airspeed {
             self.setpoints.airspeed = v;
+        }
+        if r.manual.is_some() {
+            self.sticks = r.manual;
         }
         if let Some(c) = r.course {
             let base = if c.relative {
@@ -704,6 +729,76 @@ mod tests {
         assert!(common::params::validate_defs(PARAMS).is_ok());
     }
 
+    extern crate std;
+    use common::link::simlink::{encode_hil_sensor, SensorFrame};
+    use common::sensors::ImuSample;
+    use mavlink::dialects::common::MANUAL_CONTROL_DATA;
+    use std::vec::Vec;
+
+    fn sensor_frame(k: u64) -> Vec<u8> {
+        let f = SensorFrame {
+            time_us: k * 10_000,
+            imu: Some(ImuSample {
+                accel: nalgebra::Vector3::new(0.0, 0.0, -9.8),
+                gyro: nalgebra::Vector3::zeros(),
+            }),
+            ..Default::default()
+        };
+        let mut sim = Sender::new(1, 51);
+        sim.encode(&MavMessage::HIL_SENSOR(encode_hil_sensor(&f, 0.0)))
+            .raw_bytes()
+            .to_vec()
+    }
+
+    pub(super) fn actuators_pub(app: &mut App, k: u64) -> [f32; 16] {
+        actuators(app, k)
+    }
+
+    fn actuators(app: &mut App, k: u64) -> [f32; 16] {
+        let mut out = Vec::new();
+        app.on_sim_bytes(&sensor_frame(k), &mut |b| out.extend_from_slice(b));
+        let mut p = FrameParser::new();
+        let mut controls = [f32::NAN; 16];
+        p.push(&out, |f| {
+            if let MavMessage::HIL_ACTUATOR_CONTROLS(d) = f.message {
+                controls = d.controls;
+            }
+        });
+        controls
+    }
+
+    #[test]
+    fn manual_mode_passes_the_sticks_through() {
+        let mut app = App::new();
+        assert_eq!(app.mode(), FlightMode::Manual);
+        // No stick yet: the trim (UMN elevator -0.0963 rad is nose-up: positive PX4 pitch).
+        let c = actuators(&mut app, 0);
+        assert!(c[1] > 0.0 && c[1] < 0.3, "{c:?}");
+        // Full right roll, half nose-up (stick back is negative x), some right yaw.
+        let mut gcs = Sender::new(255, 190);
+        let stick = MavMessage::MANUAL_CONTROL(MANUAL_CONTROL_DATA {
+            x: -500,
+            y: 1000,
+            z: 600,
+            r: 250,
+            target: 1,
+            ..Default::default()
+        });
+        app.on_gcs_bytes(gcs.encode(&stick).raw_bytes());
+        // The next control tick (50 Hz: the frame at 20 ms) applies them.
+        let c = actuators(&mut app, 2);
+        assert!(
+            (c[0] - 1.0).abs() < 1e-5 && (c[1] - 0.5).abs() < 1e-5,
+            "{c:?}"
+        );
+        assert!((c[2] - 0.25).abs() < 1e-5, "{c:?}");
+        // Disarmed: no throttle reaches the motor whatever the stick says.
+        assert_eq!(c[3], 0.0);
+        // Sticks that stop arriving fall back to the trim.
+        let c = actuators(&mut app, 80);
+        assert!(c[0].abs() < 0.1, "{c:?}");
+    }
+
     #[test]
     fn the_application_fits_the_stm32f405_ram_with_room_for_the_stack() {
         // 128 KiB of SRAM: the whole application state must leave most of it to the stack.
@@ -712,5 +807,27 @@ mod tests {
             "{}",
             core::mem::size_of::<App>()
         );
+    }
+}
+#[cfg(test)]
+mod rate_probe {
+    extern crate std;
+    use super::*;
+    #[test]
+    fn probe() {
+        let mut app = App::new();
+        let mut total = std::collections::BTreeMap::new();
+        for k in 0..200u64 {
+            let _ = super::tests::actuators_pub(&mut app, k);
+            let mut out = std::vec::Vec::new();
+            app.drain_gcs(&mut |b| out.extend_from_slice(b));
+            let mut p = FrameParser::new();
+            p.push(&out, |f| {
+                *total
+                    .entry(mavlink::Message::message_id(&f.message))
+                    .or_insert(0) += 1
+            });
+        }
+        std::println!("{total:?}");
     }
 }

@@ -1,6 +1,6 @@
 //! A ground station (this test, speaking MAVLink 2 over UDP) against the SITL autopilot, which
 //! is fed by a simulator over TCP in lock-step: the autopilot's clock is the simulator's, paced
-//! here at real time so message rates can be counted on the wall clock.
+//! here at a few times real time; message rates are counted in that clock.
 //!
 //! The simulated airplane sits on the ground at home, at rest: the estimator converges there
 //! (as before a real flight), which is what the pre-arm checks wait for.
@@ -13,6 +13,7 @@ use common::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use firmware::app::App;
 use firmware::sitl::{self, FileStorage, GcsUdp, SimEndpoint};
 use mavlink::dialects::common::*;
+use mavlink::Message;
 use nalgebra::Vector3;
 use sim_host::link::lockstep::Lockstep;
 use sim_host::link::transport::TcpServer;
@@ -23,6 +24,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 const HOME_ALT_M: f32 = 250.0;
+/// Simulated seconds per wall second.
+const SPEEDUP: u64 = 1;
 
 /// Sensor frames of an airplane at rest on the ground at home, heading north.
 fn at_rest(k: u64, gps: bool) -> (u64, Vec<MavMessage>) {
@@ -89,13 +92,17 @@ impl Sitl {
             let mut k = 0u64;
             while !sim_stop.load(Ordering::Relaxed) {
                 let (t, msgs) = at_rest(k, gps.load(Ordering::Relaxed));
-                // Real time: the autopilot's clock is this one.
-                let due = Duration::from_micros(t);
+                // Paced at a few times real time: the autopilot's clock is this one, and the
+                // rates below are counted in it.
+                let due = Duration::from_micros(t / SPEEDUP);
                 if let Some(wait) = due.checked_sub(start.elapsed()) {
                     std::thread::sleep(wait);
                 }
                 if link.exchange(t, &msgs).is_err() {
                     break;
+                }
+                if k % 500 == 0 {
+                    eprintln!("SIM k={k} t={} wall={:?}", t, start.elapsed());
                 }
                 k += 1;
             }
@@ -148,9 +155,7 @@ struct Gcs {
 impl Gcs {
     fn new(to: SocketAddr) -> Self {
         let socket = UdpSocket::bind("127.0.0.1:0").expect("bind");
-        socket
-            .set_read_timeout(Some(Duration::from_millis(20)))
-            .expect("timeout");
+        socket.set_nonblocking(true).expect("non-blocking");
         let mut g = Self {
             socket,
             to,
@@ -175,12 +180,15 @@ impl Gcs {
         self.socket.send_to(bytes, self.to).expect("send");
     }
 
+    /// Takes what has arrived so far (the autopilot streams without pause, so this must not
+    /// wait for a quiet moment).
     fn pump(&mut self) {
         let mut buf = [0u8; 9000];
         while let Ok((n, _)) = self.socket.recv_from(&mut buf) {
             let inbox = &mut self.inbox;
             self.parser.push(&buf[..n], |f| inbox.push(f));
         }
+        std::thread::sleep(Duration::from_millis(2));
     }
 
     /// Waits for the first message `pick` accepts.
@@ -467,27 +475,64 @@ fn arming_waits_for_the_pre_arm_checks_and_streams_follow_their_interval() {
         .expect("armed heartbeat");
     assert_eq!(hb.system_status, MavState::MAV_STATE_ACTIVE);
 
-    // ATTITUDE at 25 Hz: count over 2 s of (real-time) simulation.
-    let r = gcs.command(
-        MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
-        [30.0, 40_000.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    );
-    assert_eq!(r, Some(MavResult::MAV_RESULT_ACCEPTED));
+    // Every telemetry stream at 10 Hz: count each over 2 s of (real-time) simulation.
+    let streams: [(u32, &str); 10] = [
+        (1, "SYS_STATUS"),
+        (24, "GPS_RAW_INT"),
+        (30, "ATTITUDE"),
+        (33, "GLOBAL_POSITION_INT"),
+        (42, "MISSION_CURRENT"),
+        (62, "NAV_CONTROLLER_OUTPUT"),
+        (74, "VFR_HUD"),
+        (147, "BATTERY_STATUS"),
+        (242, "HOME_POSITION"),
+        (245, "EXTENDED_SYS_STATE"),
+    ];
+    for (id, name) in streams {
+        let r = gcs.command(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [id as f32, 100_000.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        );
+        assert_eq!(r, Some(MavResult::MAV_RESULT_ACCEPTED), "{name}");
+    }
+    // Count in the autopilot's own time: the ATTITUDE timestamps bound a window of simulated
+    // time, whatever the delivery latency of this test's socket.
     std::thread::sleep(Duration::from_millis(300));
     gcs.pump();
     gcs.inbox.clear();
     let start = Instant::now();
-    let mut n = 0;
-    while start.elapsed() < Duration::from_secs(2) {
+    let mut arrived: Vec<(u32, Option<u32>)> = Vec::new();
+    while start.elapsed() < Duration::from_secs(3) {
         gcs.pump();
-        n += gcs
-            .inbox
-            .drain(..)
-            .filter(|f| matches!(f.message, MavMessage::ATTITUDE(_)))
-            .count();
+        for f in gcs.inbox.drain(..) {
+            let t = match &f.message {
+                MavMessage::ATTITUDE(a) => Some(a.time_boot_ms),
+                _ => None,
+            };
+            arrived.push((f.message.message_id(), t));
+        }
     }
-    assert!(
-        (40..=60).contains(&n),
-        "{n} ATTITUDE messages in 2 s at 25 Hz"
+    let stamps: Vec<(usize, u32)> = arrived
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (_, t))| t.map(|t| (i, t)))
+        .collect();
+    let (&(i0, t0), &(i1, t1)) = (
+        stamps.first().expect("ATTITUDE"),
+        stamps.last().expect("ATTITUDE"),
     );
+    let window_s = f64::from(t1 - t0) / 1000.0;
+    assert!(window_s > 1.5, "window {window_s} s");
+    let mut counts = std::collections::BTreeMap::new();
+    for (id, _) in &arrived[i0..i1] {
+        *counts.entry(*id).or_insert(0u32) += 1;
+    }
+    for (id, name) in streams {
+        let n = counts.get(&id).copied().unwrap_or(0);
+        let rate = f64::from(n) / window_s;
+        assert!(
+            (rate - 10.0).abs() <= 1.5,
+            "{name}: {rate:.2} Hz, asked for 10 Hz ({counts:?} over {window_s} s)"
+        );
+    }
 }

@@ -106,6 +106,24 @@ pub struct VehicleRequests {
     pub airspeed: Option<f32>,
     /// New course setpoint, rad in [0, 2 pi) (`MAV_CMD_CONDITION_YAW`, absolute or relative).
     pub course: Option<CourseSetpoint>,
+    /// The latest stick positions (`MANUAL_CONTROL`: QGC's virtual joystick or a gamepad).
+    pub manual: Option<ManualInput>,
+}
+
+/// Stick positions from a ground station, normalised.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ManualInput {
+    /// Roll stick, -1..1, positive right.
+    pub roll: f32,
+    /// Pitch stick, -1..1, positive nose up (stick back; MANUAL_CONTROL's x is forward).
+    pub pitch: f32,
+    /// Yaw stick, -1..1, positive nose right.
+    pub yaw: f32,
+    /// Throttle, 0..1.
+    pub throttle: f32,
+    /// When it arrived, us.
+    pub time_us: u64,
 }
 
 /// An altitude the ground station asked for.
@@ -338,6 +356,23 @@ impl GroundLink {
                 }
             }
             MavMessage::PARAM_SET(d) => self.on_param_set(d),
+            MavMessage::MANUAL_CONTROL(d) => {
+                // Axes are -1000..1000 (throttle 0..1000); INT16_MAX marks an axis as unused.
+                let axis = |v: i16| {
+                    if v == i16::MAX {
+                        0.0
+                    } else {
+                        (f32::from(v) / 1000.0).clamp(-1.0, 1.0)
+                    }
+                };
+                self.requests.manual = Some(ManualInput {
+                    roll: axis(d.y),
+                    pitch: -axis(d.x),
+                    yaw: axis(d.r),
+                    throttle: axis(d.z).clamp(0.0, 1.0),
+                    time_us: now_us,
+                });
+            }
             MavMessage::COMMAND_LONG(d) => {
                 let c = Command {
                     cmd: d.command,
