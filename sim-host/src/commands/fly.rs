@@ -229,12 +229,13 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
         ),
     ]);
     let mut tables = vec![run];
-    if let Some(e) = &s.estimator {
+    for (e, when) in [
+        (&s.estimator, "convergence"),
+        (&s.estimator_settled, "30 s after convergence"),
+    ] {
+        let Some(e) = e else { continue };
         let mut t = Table::new(
-            format!(
-                "Estimator error from convergence ({:.1} s) to the end",
-                e.from_s
-            ),
+            format!("Estimator error from {when} ({:.1} s) to the end", e.from_s),
             &["quantity", "RMS", "max"],
         );
         t.row([

@@ -19,6 +19,11 @@ use std::path::{Path, PathBuf};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
+/// Time after the estimator first reports `converged` from which the "settled" errors count,
+/// s: the autopilot has taken over (arming follows convergence within a second) and pulled
+/// the aircraft onto its course and altitude.
+pub const SETTLE_S: f64 = 30.0;
+
 /// One frame of the flight, SI units and radians.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Sample {
@@ -116,8 +121,8 @@ impl Sample {
             airspeed: truth.airspeed_mps,
             wind: [wind.x, wind.y, wind.z],
             wind_steady: [wind_steady.x, wind_steady.y, wind_steady.z],
-            est_north: est_ne.0,
-            est_east: est_ne.1,
+            est_north: if e.position_valid { est_ne.0 } else { f64::NAN },
+            est_east: if e.position_valid { est_ne.1 } else { f64::NAN },
             est_alt: f64::from(e.alt_amsl_m),
             est_roll: f64::from(e.euler.phi),
             est_pitch: f64::from(e.euler.theta),
@@ -214,8 +219,11 @@ pub struct FlightSummary {
     pub wind_ned: [f64; 3],
     /// Arming accepted at, s.
     pub armed_at_s: Option<f64>,
-    /// Estimator errors once converged.
+    /// Estimator errors from the first `converged` to the end.
     pub estimator: Option<EstimatorErrors>,
+    /// Estimator errors from 30 s after the first `converged` ([`SETTLE_S`]) to the end: the
+    /// launch transient flown out.
+    pub estimator_settled: Option<EstimatorErrors>,
     /// One entry per altitude or course command.
     pub segments: Vec<Segment>,
     /// Every ground-station command and its answer.
@@ -288,9 +296,10 @@ fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-/// Estimator errors over the samples from the first `converged` on.
-pub fn estimator_errors(samples: &[Sample]) -> Option<EstimatorErrors> {
-    let first = samples.iter().position(|s| s.converged)?;
+/// Estimator errors over the samples from `delay_s` after the first `converged` on.
+pub fn estimator_errors(samples: &[Sample], delay_s: f64) -> Option<EstimatorErrors> {
+    let t0 = samples.iter().find(|s| s.converged)?.t + delay_s;
+    let first = samples.iter().position(|s| s.t >= t0)?;
     let s = &samples[first..];
     let col = |f: &dyn Fn(&Sample) -> f64| s.iter().map(f).collect::<Vec<f64>>();
     let roll = col(&|x| wrap_pi(x.est_roll - x.roll) * DEG);
@@ -416,7 +425,8 @@ pub(crate) fn summarise(
         turbulence: super::turbulence_name(cfg.turbulence),
         wind_ned: cfg.wind_ned,
         armed_at_s: gcs.armed_at_s(),
-        estimator: estimator_errors(samples),
+        estimator: estimator_errors(samples, 0.0),
+        estimator_settled: estimator_errors(samples, SETTLE_S),
         segments: segments(samples, gcs, home_alt),
         commands: gcs.commands.clone(),
         texts: gcs.texts.clone(),
@@ -638,10 +648,16 @@ pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec
             "east (m)",
             vec![Panel::new(
                 "north (m)",
-                vec![
-                    Series::new("truth", col(&|s| s.east), col(&|s| s.north)),
-                    Series::new("estimate", col(&|s| s.est_east), col(&|s| s.est_north)).dashed(),
-                ],
+                vec![Series::new("truth", col(&|s| s.east), col(&|s| s.north)), {
+                    let valid: Vec<&&Sample> =
+                        p.iter().filter(|s| s.est_north.is_finite()).collect();
+                    Series::new(
+                        "estimate",
+                        valid.iter().map(|s| s.est_east).collect(),
+                        valid.iter().map(|s| s.est_north).collect(),
+                    )
+                    .dashed()
+                }],
             )],
         ),
     )?);

@@ -13,7 +13,7 @@ use crate::sensors::{SensorSuite, Truth};
 use common::link::simlink::{encode_hil_gps, encode_hil_sensor};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
-use common::math::{course_and_speed, Euler};
+use common::math::{course_and_speed, ned_to_body, Euler};
 use mavlink::dialects::common::{MavMessage, HIL_STATE_QUATERNION_DATA};
 use nalgebra::Vector3;
 use std::time::{Duration, Instant};
@@ -132,7 +132,11 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             trim.residual_norm
         )));
     }
-    let mut plant = Plant::from_params(params.clone(), trim.state);
+    // Trimmed in the air mass: the steady wind carries the aircraft, so the airspeed is the
+    // trim's 17 m/s whatever the wind.
+    let mut start = trim.state;
+    start.vel_body += ned_to_body(&start.attitude, &Vector3::from(cfg.wind_ned));
+    let mut plant = Plant::from_params(params.clone(), start);
     let trim_controls = trim.controls;
     let mut servos = ServoBank::new(&aircraft.actuators, &trim_controls);
     let mut wind = Wind::new(Vector3::from(cfg.wind_ned), cfg.turbulence, cfg.seed);
@@ -143,7 +147,19 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     plant.set_inputs(&trim_controls, &env0);
     let mut env = env0;
 
-    let mut gcs = GroundStation::new(cfg.script.clone(), home_alt);
+    // The ground station tells the autopilot its GPS receiver's latency, as an operator
+    // configures the airframe's receiver (the parameter's default is another receiver's).
+    let mut script = cfg.script.clone();
+    if !script.params.iter().any(|(n, _)| n == "EKF_GPS_DELAY") {
+        script.params.insert(
+            0,
+            (
+                "EKF_GPS_DELAY".into(),
+                aircraft.sensors.gps.latency_s as f32,
+            ),
+        );
+    }
+    let mut gcs = GroundStation::new(script, home_alt);
     link.wait_for_autopilot(cfg.link_timeout)?;
 
     let frames = (cfg.duration_s / frame_s).round() as u64;
