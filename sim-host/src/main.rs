@@ -315,7 +315,10 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
             &cfg,
             &r.outcome,
             &t.outcome,
-            &std::env::args().collect::<Vec<_>>().join(" "),
+            &format!(
+                "cargo run --release -p sim-host -- {}",
+                std::env::args().skip(1).collect::<Vec<_>>().join(" ")
+            ),
         );
         std::fs::write(&path, md).with_context(|| format!("cannot write `{}`", path.display()))?;
         emit(&format!("wrote {}", path.display()))?;
