@@ -284,6 +284,18 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
     if let Some(d) = a.duration {
         cfg.duration_s = d;
     }
+    if let Some(g) = a.gains {
+        let names: Vec<&str> = common::control::gains::NAMED
+            .iter()
+            .map(|(n, _, _)| *n)
+            .collect();
+        anyhow::ensure!(
+            (g as usize) < names.len(),
+            "--gains {g}: no such gain set (0..={}: {})",
+            names.len() - 1,
+            names.join(", ")
+        );
+    }
     let opts = commands::fly::FlyOptions {
         link: a.link,
         bind: a.bind,
@@ -302,6 +314,12 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         ))?;
         for f in &r.files {
             emit(&format!("wrote {}", f.display()))?;
+        }
+    }
+    for (t, text) in &r.outcome.summary.texts {
+        // Arming refusals while the estimator converges are expected (the script retries).
+        if text.contains("refused") {
+            eprintln!("autopilot at {t:.1} s: {text}");
         }
     }
     if let Some(path) = a.report {

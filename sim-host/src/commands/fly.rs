@@ -284,7 +284,7 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
             "overshoot (%)",
             "settling (s)",
             "final error",
-            "alt. held within (m)",
+            "alt. held in turn (m)",
         ],
     );
     for g in &s.segments {
@@ -300,7 +300,11 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
                 .settling_time_s
                 .map_or("-".into(), |x| format!("{x:.1}")),
             format!("{:.2} {unit}", g.final_error_max),
-            format!("{:.2}", g.alt_hold_error_max_m),
+            if g.signal == "course" {
+                format!("{:.2}", g.alt_hold_error_max_m)
+            } else {
+                "-".into()
+            },
         ]);
     }
     tables.push(seg);
