@@ -61,7 +61,7 @@ fn accepted(o: &FlightOutcome) {
 }
 
 #[test]
-fn the_same_flight_is_bit_identical_over_inproc_tcp_and_udp() {
+fn the_same_flight_is_bit_identical_over_inproc_tcp_udp_and_pty() {
     let dir = tempfile::tempdir().expect("tempdir");
     let cfg = FlightConfig {
         duration_s: 35.0,
@@ -92,7 +92,21 @@ fn the_same_flight_is_bit_identical_over_inproc_tcp_and_udp() {
     // Per frame: HIL_STATE_QUATERNION, HIL_SENSOR and the answer, plus 5 Hz GPS and the
     // autopilot's boot heartbeat.
     assert!(frames.len() > 3 * 3500, "{} tlog frames", frames.len());
-    for link in [LinkKind::Tcp, LinkKind::Udp] {
+    // Every record is a whole MAVLink 2 frame with a good checksum, time-stamped in order.
+    let mut parser = FrameParser::new();
+    let mut sensors = 0;
+    for (_, f) in &frames {
+        parser.push(f, |fr| {
+            if matches!(fr.message, MavMessage::HIL_SENSOR(_)) {
+                sensors += 1;
+            }
+        });
+    }
+    assert_eq!(parser.stats().frames_ok as usize, frames.len());
+    assert_eq!(parser.stats().crc_errors, 0);
+    assert_eq!(sensors, a.summary.frames);
+    assert!(frames.windows(2).all(|w| w[0].0 <= w[1].0), "time order");
+    for link in [LinkKind::Tcp, LinkKind::Udp, LinkKind::Pty] {
         let (b, tlog_b, csv_b) = run(link);
         assert_eq!(tlog_a.len(), tlog_b.len(), "{}: tlog length", link.name());
         assert!(tlog_a == tlog_b, "{}: tlog bytes differ", link.name());

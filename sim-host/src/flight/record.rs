@@ -408,13 +408,14 @@ pub(crate) fn summarise(
     samples: &[Sample],
     gcs: &GroundStation,
     frames: u64,
+    frame_s: f64,
     armed_frames: u64,
     wall_s: f64,
     sim_rx: LinkStats,
     (health, ap_stats): (SimLinkHealth, LinkStats),
     home_alt: f64,
 ) -> FlightSummary {
-    let sim_s = samples.last().map_or(0.0, |s| s.t) + samples.get(1).map_or(0.0, |s| s.t);
+    let sim_s = frames as f64 * frame_s;
     FlightSummary {
         frames,
         armed_frames,

@@ -254,6 +254,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         &samples,
         &gcs,
         frames,
+        frame_s,
         armed_frames,
         wall_s,
         link.stats(),
