@@ -209,17 +209,17 @@ fn the_estimator_is_accurate_in_light_turbulence() {
     // Counted from 30 s after convergence: the launch transient (the autopilot taking over a
     // hand-launched aircraft) is flown out; docs/RESULTS-SITL.md gives both windows.
     // These are regression bounds about 1.5 times what the estimator achieves on this flight
-    // (roll 0.58, pitch 0.91, heading 2.2 deg, altitude 0.62 m, airspeed 0.23 m/s, wind
-    // 1.56 m/s); the targets (0.5, 0.5, 2 deg, 1 m, 0.5 m/s, 1 m/s) are asserted by the
+    // (roll 0.73, pitch 0.94, heading 2.86 deg, altitude 0.62 m, airspeed 0.23 m/s, wind
+    // 1.53 m/s); the targets (0.5, 0.5, 2 deg, 1 m, 0.5 m/s, 1 m/s) are asserted by the
     // ignored test below, and the misses are explained in docs/RESULTS-SITL.md.
-    assert!(e.roll_rms_deg < 0.9, "roll RMS {:.3} deg", e.roll_rms_deg);
+    assert!(e.roll_rms_deg < 1.1, "roll RMS {:.3} deg", e.roll_rms_deg);
     assert!(
         e.pitch_rms_deg < 1.4,
         "pitch RMS {:.3} deg",
         e.pitch_rms_deg
     );
     assert!(
-        e.heading_rms_deg < 3.3,
+        e.heading_rms_deg < 4.3,
         "heading RMS {:.3} deg",
         e.heading_rms_deg
     );
@@ -229,7 +229,7 @@ fn the_estimator_is_accurate_in_light_turbulence() {
         "airspeed RMS {:.3} m/s",
         e.airspeed_rms_mps
     );
-    assert!(e.wind_rms_mps < 2.4, "wind RMS {:.3} m/s", e.wind_rms_mps);
+    assert!(e.wind_rms_mps < 2.3, "wind RMS {:.3} m/s", e.wind_rms_mps);
 }
 
 #[test]
