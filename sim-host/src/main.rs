@@ -338,7 +338,16 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
                 std::env::args().skip(1).collect::<Vec<_>>().join(" ")
             ),
         );
-        std::fs::write(&path, md).with_context(|| format!("cannot write `{}`", path.display()))?;
+        // Notes written by hand below the generated part survive a new run.
+        let notes = std::fs::read_to_string(&path)
+            .ok()
+            .and_then(|old| {
+                old.find(commands::fly::NOTES_MARKER)
+                    .map(|i| old[i..].to_string())
+            })
+            .unwrap_or_default();
+        std::fs::write(&path, md + &notes)
+            .with_context(|| format!("cannot write `{}`", path.display()))?;
         emit(&format!("wrote {}", path.display()))?;
     }
     Ok(ExitCode::SUCCESS)

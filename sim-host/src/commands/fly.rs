@@ -311,6 +311,10 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
     tables
 }
 
+/// Where the hand-written notes of a results file begin; `sim-host fly --report` keeps
+/// everything from here on when it rewrites the file.
+pub const NOTES_MARKER: &str = "\n---\n";
+
 /// `docs/RESULTS-SITL.md`: estimator accuracy of the flight and the step figures of the same
 /// scripted flight flown on the estimate and on the truth (`SIM_USE_TRUTH`).
 pub fn results_markdown(
