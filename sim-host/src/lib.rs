@@ -4,6 +4,8 @@
 //! - [`plant`]: the nonlinear 6-DOF model (aero, propulsion, rigid body, servos, RK4);
 //! - [`environment`]: steady wind and Dryden turbulence;
 //! - [`sensors`]: IMU, magnetometer, barometer, pitot and GPS models;
+//! - [`flight`]: firmware in the loop: the plant flown by the autopilot over the link, a
+//!   scripted ground station, the flight log and its figures;
 //! - [`link`]: the simulator end of PX4's simulator MAVLink interface, in lock-step;
 //! - [`analysis`]: trim, linearisation, transfer functions, the linear-versus-nonlinear
 //!   doublet check of the thesis, and linear-systems tools;
@@ -15,6 +17,7 @@ pub mod aircraft;
 pub mod analysis;
 pub mod commands;
 pub mod environment;
+pub mod flight;
 pub mod link;
 pub mod plant;
 pub mod report;

@@ -108,6 +108,9 @@ enum Command {
         #[command(flatten)]
         out: Output,
     },
+    /// Fly the firmware against the plant over the simulator link, commanded by a scripted
+    /// ground station: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet.
+    Fly(FlyArgs),
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.
@@ -117,6 +120,65 @@ enum Command {
         #[arg(long, default_value = "out")]
         out_dir: PathBuf,
     },
+}
+
+#[derive(clap::Args)]
+struct FlyArgs {
+    /// Simulator link: inproc, tcp, udp or pty.
+    #[arg(long, default_value = "inproc")]
+    link: commands::fly::LinkKind,
+    /// Address the simulator listens on for tcp and udp.
+    #[arg(long, default_value = "127.0.0.1:4560")]
+    bind: String,
+    /// Pace the simulation to the wall clock.
+    #[arg(long)]
+    realtime: bool,
+    /// Steady wind N,E,D in m/s (the direction it blows towards).
+    #[arg(long, value_parser = parse_wind, default_value = "0,0,0", allow_hyphen_values = true)]
+    wind: [f64; 3],
+    /// Turbulence: none, light, moderate or severe (MIL-F-8785C Dryden).
+    #[arg(long, default_value = "none", value_parser = sim_host::flight::parse_turbulence)]
+    turbulence: sim_host::environment::wind::Turbulence,
+    /// Seed of the sensor noise and turbulence.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Simulated time, s (default: long enough for the whole script).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Plant integration step, s.
+    #[arg(long, default_value_t = 0.001)]
+    dt: f64,
+    /// Directory for flight.csv, flight.tlog, the PNG plots and summary.json.
+    #[arg(long, default_value = "out/fly")]
+    out: PathBuf,
+    /// Gain set loaded before arming (SYS_GAIN_SET): 0 designed, 1 designed_t310,
+    /// 2 designed_appe, 3 minnesota, 4 minnesota_appe.
+    #[arg(long)]
+    gains: Option<u32>,
+    /// Fly on the simulator's truth instead of the estimator (SIM_USE_TRUTH = 1).
+    #[arg(long)]
+    truth: bool,
+    /// Also fly the same flight on truth and write this Markdown report (estimator accuracy,
+    /// step figures on estimates vs on truth).
+    #[arg(long, value_name = "FILE")]
+    report: Option<PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_wind(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("wind `{s}`: {e} (expected N,E,D in m/s)"))?;
+    match v.as_slice() {
+        [n, e, d] if v.iter().all(|x| x.is_finite()) => Ok([*n, *e, *d]),
+        _ => Err(format!(
+            "wind `{s}`: expected three finite numbers N,E,D in m/s"
+        )),
+    }
 }
 
 fn main() -> ExitCode {
@@ -244,6 +306,7 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Some(Command::Fly(args)) => fly_command(&aircraft, args),
         Some(Command::Validation { out, out_dir }) => {
             let md = commands::validation::validation_markdown(&aircraft, Some(&out_dir))?;
             if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -273,14 +336,106 @@ fn emit(text: &str) -> anyhow::Result<()> {
     }
 }
 
-/// With no subcommand: trim level flight and fly the nonlinear doublet check.
-fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
-    let trims = commands::trim::trim_report(aircraft);
-    if let Some(level) = trims.tables.first() {
-        emit(&level.render_text())?;
+fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
+    use sim_host::flight::FlightConfig;
+    let mut cfg = FlightConfig {
+        wind_ned: a.wind,
+        turbulence: a.turbulence,
+        seed: a.seed,
+        realtime: a.realtime,
+        progress: true,
+        dt_s: a.dt,
+        ..FlightConfig::default()
+    };
+    if let Some(d) = a.duration {
+        cfg.duration_s = d;
     }
-    let r = commands::doublet::doublet_report(aircraft, &DoubletConfig::default(), None)?;
-    emit(&format!("\n{}", render(&r.tables, Format::Text)))?;
-    emit("\n(see `sim-host --help` for trim, linearize, doublet and validation)\n")?;
+    if let Some(g) = a.gains {
+        let names: Vec<&str> = common::control::gains::NAMED
+            .iter()
+            .map(|(n, _, _)| *n)
+            .collect();
+        anyhow::ensure!(
+            (g as usize) < names.len(),
+            "--gains {g}: no such gain set (0..={}: {})",
+            names.len() - 1,
+            names.join(", ")
+        );
+    }
+    let opts = commands::fly::FlyOptions {
+        link: a.link,
+        bind: a.bind,
+        out: Some(a.out.clone()),
+        plots: true,
+        gain_set: a.gains,
+        use_truth: a.truth,
+    };
+    let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
+    if a.json {
+        emit(&to_json(&r.outcome.summary)?)?;
+    } else {
+        emit(&render(
+            &commands::fly::summary_tables(&r.outcome),
+            Format::Text,
+        ))?;
+        for f in &r.files {
+            emit(&format!("wrote {}", f.display()))?;
+        }
+    }
+    for (t, text) in &r.outcome.summary.texts {
+        // Arming refusals while the estimator converges are expected (the script retries).
+        if text.contains("refused") {
+            eprintln!("autopilot at {t:.1} s: {text}");
+        }
+    }
+    if let Some(path) = a.report {
+        let truth_opts = commands::fly::FlyOptions {
+            use_truth: true,
+            out: Some(a.out.join("truth")),
+            ..opts
+        };
+        let t = commands::fly::fly_report(aircraft, &cfg, &truth_opts)?;
+        let md = commands::fly::results_markdown(
+            &cfg,
+            &r.outcome,
+            &t.outcome,
+            &format!(
+                "cargo run --release -p sim-host -- {}",
+                std::env::args().skip(1).collect::<Vec<_>>().join(" ")
+            ),
+        );
+        // Notes written by hand below the generated part survive a new run.
+        let notes = std::fs::read_to_string(&path)
+            .ok()
+            .and_then(|old| {
+                old.find(commands::fly::NOTES_MARKER)
+                    .map(|i| old[i..].to_string())
+            })
+            .unwrap_or_default();
+        std::fs::write(&path, md + &notes)
+            .with_context(|| format!("cannot write `{}`", path.display()))?;
+        emit(&format!("wrote {}", path.display()))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// With no subcommand: fly the scripted flight in-process and print a short summary.
+fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
+    let cfg = sim_host::flight::FlightConfig {
+        progress: true,
+        ..Default::default()
+    };
+    let opts = commands::fly::FlyOptions {
+        out: Some(PathBuf::from("out/fly")),
+        ..Default::default()
+    };
+    emit("Flying the firmware in-process: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet")?;
+    let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
+    emit(&render(
+        &commands::fly::summary_tables(&r.outcome),
+        Format::Text,
+    ))?;
+    emit("\nfiles in out/fly (flight.csv, flight.tlog, PNG plots, summary.json)")?;
+    emit("(see `sim-host --help` for fly, trim, linearize, doublet, design and validation)")?;
     Ok(ExitCode::SUCCESS)
 }

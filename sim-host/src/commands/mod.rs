@@ -3,6 +3,7 @@
 
 pub mod design;
 pub mod doublet;
+pub mod fly;
 pub mod linearize;
 pub mod scenario;
 pub mod trim;

@@ -70,6 +70,11 @@ impl<T: Transport> Lockstep<T> {
         &self.transport
     }
 
+    /// The transport, mutably (e.g. to reach an in-process autopilot between exchanges).
+    pub fn transport_mut(&mut self) -> &mut T {
+        &mut self.transport
+    }
+
     /// Framing counters of what the autopilot sent.
     pub fn stats(&self) -> LinkStats {
         self.parser.stats()

@@ -247,6 +247,11 @@ impl Inproc {
     pub fn app(&self) -> &firmware::app::App {
         &self.app
     }
+
+    /// The autopilot, to reach its ground link between exchanges.
+    pub fn app_mut(&mut self) -> &mut firmware::app::App {
+        &mut self.app
+    }
 }
 
 impl Transport for Inproc {

@@ -1,0 +1,472 @@
+//! `sim-host fly`: the firmware flies the plant over the simulator link, commanded by a
+//! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
+
+use crate::aircraft::Aircraft;
+use crate::flight::record::write_log_and_plots;
+use crate::flight::{fly, spawn_firmware, FlightConfig, FlightOutcome, InprocOnboard, Onboard};
+use crate::link::lockstep::Lockstep;
+use crate::link::tlog::TlogWriter;
+use crate::link::transport::{Inproc, PtyServer, TcpServer, Transport, UdpServer};
+use crate::report::{sig, to_json, Table};
+use anyhow::Context;
+use firmware::app::App;
+use firmware::sitl::SimEndpoint;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Which transport carries the simulator link.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinkKind {
+    /// The firmware's application inside this process, through a byte pipe.
+    Inproc,
+    /// TCP: the simulator listens, the firmware (a thread here) connects.
+    Tcp,
+    /// UDP.
+    Udp,
+    /// A pseudo-terminal pair (a virtual serial line).
+    Pty,
+}
+
+impl std::str::FromStr for LinkKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "inproc" => Ok(Self::Inproc),
+            "tcp" => Ok(Self::Tcp),
+            "udp" => Ok(Self::Udp),
+            "pty" => Ok(Self::Pty),
+            _ => Err(format!("link `{s}`: expected inproc, tcp, udp or pty")),
+        }
+    }
+}
+
+impl LinkKind {
+    /// The name the command line uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Inproc => "inproc",
+            Self::Tcp => "tcp",
+            Self::Udp => "udp",
+            Self::Pty => "pty",
+        }
+    }
+}
+
+/// Options of `sim-host fly` beyond the flight itself.
+#[derive(Clone, Debug)]
+pub struct FlyOptions {
+    /// Transport.
+    pub link: LinkKind,
+    /// Address the simulator binds for TCP and UDP (port 0: any free port).
+    pub bind: String,
+    /// Directory for the CSV, `.tlog`, PNG and JSON files; nothing written when `None`.
+    pub out: Option<PathBuf>,
+    /// Write PNG plots (they take a second or two).
+    pub plots: bool,
+    /// Gain set (`SYS_GAIN_SET`) to load before arming.
+    pub gain_set: Option<u32>,
+    /// Fly on the simulator's truth (`SIM_USE_TRUTH` = 1).
+    pub use_truth: bool,
+}
+
+impl Default for FlyOptions {
+    fn default() -> Self {
+        Self {
+            link: LinkKind::Inproc,
+            bind: "127.0.0.1:4560".into(),
+            out: None,
+            plots: true,
+            gain_set: None,
+            use_truth: false,
+        }
+    }
+}
+
+/// A flown flight and the files it left.
+#[derive(Clone, Debug)]
+pub struct FlyReport {
+    /// Log and summary.
+    pub outcome: FlightOutcome,
+    /// Files written.
+    pub files: Vec<PathBuf>,
+}
+
+fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
+    let mut cfg = cfg.clone();
+    if let Some(g) = opts.gain_set {
+        cfg.script.params.push(("SYS_GAIN_SET".into(), g as f32));
+    }
+    if opts.use_truth {
+        cfg.script.params.push(("SIM_USE_TRUTH".into(), 1.0));
+    }
+    cfg
+}
+
+fn run_on<T: Transport, O: Onboard<T>>(
+    aircraft: &Aircraft,
+    cfg: &FlightConfig,
+    transport: T,
+    onboard: &mut O,
+    tlog: Option<&Path>,
+) -> anyhow::Result<FlightOutcome> {
+    let mut link = Lockstep::new(transport, cfg.link_timeout);
+    if let Some(p) = tlog {
+        let w =
+            TlogWriter::create(p).with_context(|| format!("cannot create `{}`", p.display()))?;
+        link = link.with_tlog(w);
+    }
+    let outcome = fly(aircraft, cfg, &mut link, onboard)?;
+    link.finish().context("cannot write the tlog")?;
+    Ok(outcome)
+}
+
+/// Flies `cfg` over the transport of `opts`, and writes the files into `opts.out`.
+pub fn fly_report(
+    aircraft: &Aircraft,
+    cfg: &FlightConfig,
+    opts: &FlyOptions,
+) -> anyhow::Result<FlyReport> {
+    let cfg = with_params(cfg, opts);
+    if let Some(dir) = &opts.out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create `{}`", dir.display()))?;
+    }
+    let tlog = opts.out.as_ref().map(|d| d.join("flight.tlog"));
+    let tlog = tlog.as_deref();
+    let wait = Duration::from_secs(10);
+    let silence = cfg.link_timeout.max(Duration::from_secs(2));
+    let outcome = match opts.link {
+        LinkKind::Inproc => run_on(
+            aircraft,
+            &cfg,
+            Inproc::new(App::new()),
+            &mut InprocOnboard,
+            tlog,
+        )?,
+        LinkKind::Tcp => {
+            let mut fw = None;
+            let server = TcpServer::listen(&opts.bind, wait, |addr| {
+                fw = Some(spawn_firmware(
+                    SimEndpoint::Tcp(addr.to_string()),
+                    App::new(),
+                    wait,
+                    silence,
+                ));
+            })
+            .with_context(|| format!("tcp simulator link on {}", opts.bind))?;
+            let mut fw = fw.context("the firmware thread did not start")?;
+            let r = run_on(aircraft, &cfg, server, &mut fw, tlog);
+            drop(fw);
+            r?
+        }
+        LinkKind::Udp => {
+            let mut server = UdpServer::bind(&opts.bind)
+                .with_context(|| format!("udp simulator link on {}", opts.bind))?;
+            let addr = server.local_addr()?;
+            let mut fw = spawn_firmware(
+                SimEndpoint::Udp(addr.to_string()),
+                App::new(),
+                wait,
+                silence,
+            );
+            server
+                .wait_for_peer(wait)
+                .context("the firmware did not reach the udp simulator link")?;
+            run_on(aircraft, &cfg, server, &mut fw, tlog)?
+        }
+        LinkKind::Pty => {
+            let pty = PtyServer::open().context("cannot open a pty")?;
+            let path = pty.slave_path().to_path_buf();
+            let mut fw = spawn_firmware(SimEndpoint::Serial(path), App::new(), wait, silence);
+            run_on(aircraft, &cfg, pty, &mut fw, tlog)?
+        }
+    };
+    let mut files = Vec::new();
+    if let Some(dir) = &opts.out {
+        if let Some(t) = tlog {
+            files.push(t.to_path_buf());
+        }
+        if opts.plots {
+            files.extend(write_log_and_plots(dir, &outcome.samples)?);
+        } else {
+            let csv = dir.join("flight.csv");
+            let rows: Vec<Vec<f64>> = outcome
+                .samples
+                .iter()
+                .map(crate::flight::record::csv_row)
+                .collect();
+            crate::report::csv_out::write_csv(&csv, &crate::flight::record::csv_headers(), &rows)?;
+            files.push(csv);
+        }
+        let json = dir.join("summary.json");
+        std::fs::write(&json, to_json(&outcome.summary)?)
+            .with_context(|| format!("cannot write `{}`", json.display()))?;
+        files.push(json);
+    }
+    Ok(FlyReport { outcome, files })
+}
+
+/// The short summary printed after a flight.
+pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
+    let s = &r.summary;
+    let mut run = Table::new("Flight", &["quantity", "value"]);
+    run.row(["simulated".to_string(), format!("{:.1} s", s.sim_s)]);
+    run.row(["wall clock".to_string(), format!("{:.2} s", s.wall_s)]);
+    run.row([
+        "real-time factor".to_string(),
+        format!("{:.0}x", s.real_time_factor),
+    ]);
+    run.row(["frames".to_string(), s.frames.to_string()]);
+    run.row([
+        "armed at".to_string(),
+        s.armed_at_s.map_or("never".into(), |t| format!("{t:.1} s")),
+    ]);
+    run.row([
+        "wind, turbulence".to_string(),
+        format!(
+            "({}, {}, {}) m/s NED, {}",
+            s.wind_ned[0], s.wind_ned[1], s.wind_ned[2], s.turbulence
+        ),
+    ]);
+    let mut tables = vec![run];
+    for (e, when) in [
+        (&s.estimator, "convergence"),
+        (&s.estimator_settled, "30 s after convergence"),
+    ] {
+        let Some(e) = e else { continue };
+        let mut t = Table::new(
+            format!("Estimator error from {when} ({:.1} s) to the end", e.from_s),
+            &["quantity", "RMS", "max"],
+        );
+        t.row([
+            "roll (deg)".into(),
+            sig(e.roll_rms_deg, 3),
+            sig(e.roll_max_deg, 3),
+        ]);
+        t.row([
+            "pitch (deg)".into(),
+            sig(e.pitch_rms_deg, 3),
+            sig(e.pitch_max_deg, 3),
+        ]);
+        t.row([
+            "heading (deg)".into(),
+            sig(e.heading_rms_deg, 3),
+            sig(e.heading_max_deg, 3),
+        ]);
+        t.row([
+            "altitude (m)".into(),
+            sig(e.alt_rms_m, 3),
+            sig(e.alt_max_m, 3),
+        ]);
+        t.row([
+            "airspeed (m/s)".into(),
+            sig(e.airspeed_rms_mps, 3),
+            "".into(),
+        ]);
+        t.row([
+            "wind, steady (m/s)".into(),
+            sig(e.wind_rms_mps, 3),
+            "".into(),
+        ]);
+        t.row([
+            "wind, with turbulence (m/s)".into(),
+            sig(e.wind_total_rms_mps, 3),
+            "".into(),
+        ]);
+        tables.push(t);
+    }
+    let mut seg = Table::new(
+        "Scripted commands: true response",
+        &[
+            "t (s)",
+            "command",
+            "rise (s)",
+            "overshoot (%)",
+            "settling (s)",
+            "final error",
+            "alt. held in turn (m)",
+        ],
+    );
+    for g in &s.segments {
+        let unit = if g.signal == "altitude" { "m" } else { "deg" };
+        seg.row([
+            format!("{:.1}", g.t_s),
+            g.what.clone(),
+            g.metrics
+                .rise_time_s
+                .map_or("-".into(), |x| format!("{x:.1}")),
+            format!("{:.1}", g.metrics.overshoot_pct),
+            g.metrics
+                .settling_time_s
+                .map_or("-".into(), |x| format!("{x:.1}")),
+            format!("{:.2} {unit}", g.final_error_max),
+            if g.signal == "course" {
+                format!("{:.2}", g.alt_hold_error_max_m)
+            } else {
+                "-".into()
+            },
+        ]);
+    }
+    tables.push(seg);
+    tables
+}
+
+/// Where the hand-written notes of a results file begin; `sim-host fly --report` keeps
+/// everything from here on when it rewrites the file.
+pub const NOTES_MARKER: &str = "\n---\n";
+
+/// `docs/RESULTS-SITL.md`: estimator accuracy of the flight and the step figures of the same
+/// scripted flight flown on the estimate and on the truth (`SIM_USE_TRUTH`).
+pub fn results_markdown(
+    cfg: &FlightConfig,
+    est: &FlightOutcome,
+    truth: &FlightOutcome,
+    command_line: &str,
+) -> String {
+    use std::fmt::Write;
+    let s = &est.summary;
+    let mut md = String::new();
+    let _ = writeln!(md, "# Firmware in the loop: results\n");
+    let _ = writeln!(
+        md,
+        "Produced by `{command_line}` (the firmware's `App` in-process, lock-step, seed {}, \
+         {:.0} s simulated, wind ({}, {}, {}) m/s NED, {} turbulence). The flight starts \
+         trimmed and level 100 m above home at 17 m/s; the simulator holds the trim until the \
+         ground station has armed the autopilot (a hand launch with a safety pilot), then the \
+         autopilot flies: Hold, the +100 m climb, four 90 deg right turns 30 s apart and a \
+         +-10 m altitude doublet (`sim_host::flight::Script::thesis`). The script repeats no \
+         command after its end; the rest of the flight is held level.\n",
+        cfg.seed, s.sim_s, cfg.wind_ned[0], cfg.wind_ned[1], cfg.wind_ned[2], s.turbulence
+    );
+    let _ = writeln!(
+        md,
+        "## Estimator accuracy\n\nErrors of the firmware's estimate against the simulator's truth, \
+         every frame (100 Hz). Two windows: from the first `converged` (the launch transient \
+         included: arming follows within a second and the autopilot pulls the hand-launched \
+         aircraft onto its course and into the +100 m climb), and from 30 s after it. Wind error \
+         is horizontal, against the steady wind (what the wind filter estimates) and against the \
+         total wind with the Dryden turbulence. Targets: roll and pitch < 0.5 deg, heading < 2 deg, \
+         altitude < 1 m, airspeed < 0.5 m/s, wind < 1 m/s.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| quantity | RMS from convergence | max | RMS from 30 s after | max | target |\n|---|---|---|---|---|---|"
+    );
+    if let (Some(e), Some(l)) = (&s.estimator, &s.estimator_settled) {
+        let _ = writeln!(
+            md,
+            "| window starts at (s) | {:.1} | | {:.1} | | |",
+            e.from_s, l.from_s
+        );
+        let rows: [(&str, f64, f64, f64, f64, &str); 7] = [
+            (
+                "roll (deg)",
+                e.roll_rms_deg,
+                e.roll_max_deg,
+                l.roll_rms_deg,
+                l.roll_max_deg,
+                "0.5",
+            ),
+            (
+                "pitch (deg)",
+                e.pitch_rms_deg,
+                e.pitch_max_deg,
+                l.pitch_rms_deg,
+                l.pitch_max_deg,
+                "0.5",
+            ),
+            (
+                "heading (deg)",
+                e.heading_rms_deg,
+                e.heading_max_deg,
+                l.heading_rms_deg,
+                l.heading_max_deg,
+                "2",
+            ),
+            (
+                "altitude (m)",
+                e.alt_rms_m,
+                e.alt_max_m,
+                l.alt_rms_m,
+                l.alt_max_m,
+                "1",
+            ),
+            (
+                "airspeed (m/s)",
+                e.airspeed_rms_mps,
+                f64::NAN,
+                l.airspeed_rms_mps,
+                f64::NAN,
+                "0.5",
+            ),
+            (
+                "wind vs steady (m/s)",
+                e.wind_rms_mps,
+                f64::NAN,
+                l.wind_rms_mps,
+                f64::NAN,
+                "1",
+            ),
+            (
+                "wind vs total (m/s)",
+                e.wind_total_rms_mps,
+                f64::NAN,
+                l.wind_total_rms_mps,
+                f64::NAN,
+                "",
+            ),
+        ];
+        let m = |x: f64| if x.is_nan() { String::new() } else { sig(x, 3) };
+        for (name, a, b, c, d, t) in rows {
+            let _ = writeln!(
+                md,
+                "| {name} | {} | {} | {} | {} | {t} |",
+                sig(a, 3),
+                m(b),
+                sig(c, 3),
+                m(d)
+            );
+        }
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(
+        md,
+        "## Step figures: flown on the estimate vs on the truth\n\nThe same flight (same seed, \
+         same turbulence) flown twice: on the autopilot's estimator, and with `SIM_USE_TRUTH` = 1 \
+         on the simulator's HIL_STATE_QUATERNION. Figures of the true response, as chapter 4 reads \
+         them (rise 10-90 %, overshoot, 2 % settling); the difference is (estimate - truth) / truth.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| command | rise est. (s) | rise truth (s) | diff | overshoot est. (%) | overshoot truth (%) | settling est. (s) | settling truth (s) | diff | final error est. | final error truth |\n|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    let f = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.1}"));
+    let d = |a: Option<f64>, b: Option<f64>| match (a, b) {
+        (Some(a), Some(b)) if b != 0.0 => format!("{:+.0} %", (a - b) / b * 100.0),
+        _ => "-".into(),
+    };
+    for (a, b) in s.segments.iter().zip(&truth.summary.segments) {
+        let unit = if a.signal == "altitude" { "m" } else { "deg" };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {} | {} | {} | {:.2} {unit} | {:.2} {unit} |",
+            a.what,
+            f(a.metrics.rise_time_s),
+            f(b.metrics.rise_time_s),
+            d(a.metrics.rise_time_s, b.metrics.rise_time_s),
+            a.metrics.overshoot_pct,
+            b.metrics.overshoot_pct,
+            f(a.metrics.settling_time_s),
+            f(b.metrics.settling_time_s),
+            d(a.metrics.settling_time_s, b.metrics.settling_time_s),
+            a.final_error_max,
+            b.final_error_max,
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nSpeed of this run: {:.1} s simulated in {:.2} s wall clock ({:.0}x real time, release build).",
+        s.sim_s, s.wall_s, s.real_time_factor
+    );
+    md
+}

@@ -1,0 +1,666 @@
+//! The flight log (one sample per frame) and its figures: estimator errors against the truth,
+//! the chapter-4 step figures of each scripted command, and the speed of the loop.
+
+use super::runner::{truth_angles, FlightConfig};
+use super::script::{Action, CommandRecord, GroundStation};
+use crate::analysis::metrics::{step_metrics, StepMetrics};
+use crate::report::csv_out::write_csv;
+use crate::report::{Figure, Panel, Series};
+use crate::sensors::Truth;
+use common::actuators::Surfaces;
+use common::estimator::EstimatedState;
+use common::gcs::modes::FlightMode;
+use common::link::framing::LinkStats;
+use common::math::wrap_pi;
+use firmware::app::{Setpoints, SimLinkHealth};
+use nalgebra::Vector3;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+
+/// Time after the estimator first reports `converged` from which the "settled" errors count,
+/// s: the autopilot has taken over (arming follows convergence within a second) and pulled
+/// the aircraft onto its course and altitude.
+pub const SETTLE_S: f64 = 30.0;
+
+/// One frame of the flight, SI units and radians.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Sample {
+    /// Simulated time, s.
+    pub t: f64,
+    /// The autopilot flies (its answer has the armed bit).
+    pub armed: bool,
+    /// Mode (PX4 main mode of the heartbeat's custom mode).
+    pub mode: u8,
+    /// The estimator's `converged` flag.
+    pub converged: bool,
+    /// Truth: north, east from home, m.
+    pub north: f64,
+    /// Truth east, m.
+    pub east: f64,
+    /// Truth altitude AMSL, m.
+    pub alt: f64,
+    /// Truth roll, pitch, yaw, rad.
+    pub roll: f64,
+    /// Truth pitch, rad.
+    pub pitch: f64,
+    /// Truth yaw (heading), rad.
+    pub yaw: f64,
+    /// Truth course over ground, rad.
+    pub course: f64,
+    /// Truth airspeed, m/s.
+    pub airspeed: f64,
+    /// Truth wind (steady + turbulence), NED, m/s.
+    pub wind: [f64; 3],
+    /// Steady wind, NED, m/s.
+    pub wind_steady: [f64; 3],
+    /// Estimate: north, east from the simulator's home, m.
+    pub est_north: f64,
+    /// Estimated east, m.
+    pub est_east: f64,
+    /// Estimated altitude AMSL, m.
+    pub est_alt: f64,
+    /// Estimated roll, rad.
+    pub est_roll: f64,
+    /// Estimated pitch, rad.
+    pub est_pitch: f64,
+    /// Estimated yaw, rad.
+    pub est_yaw: f64,
+    /// Estimated course, rad.
+    pub est_course: f64,
+    /// Estimated airspeed, m/s.
+    pub est_airspeed: f64,
+    /// Estimated wind, NED, m/s.
+    pub est_wind: [f64; 3],
+    /// Setpoint course, rad.
+    pub sp_course: f64,
+    /// Setpoint altitude AMSL, m.
+    pub sp_alt: f64,
+    /// Setpoint airspeed, m/s.
+    pub sp_airspeed: f64,
+    /// Commanded surfaces (UMN signs), rad, and throttle 0..1.
+    pub elevator: f64,
+    /// Commanded aileron, rad.
+    pub aileron: f64,
+    /// Commanded rudder, rad.
+    pub rudder: f64,
+    /// Commanded throttle.
+    pub throttle: f64,
+}
+
+impl Sample {
+    /// Builds a sample from the truth and what the autopilot holds.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        t: f64,
+        truth: &Truth,
+        alt_amsl: f64,
+        wind: &Vector3<f64>,
+        wind_steady: &Vector3<f64>,
+        e: &EstimatedState,
+        est_ne: (f64, f64),
+        sp: &Setpoints,
+        mode: FlightMode,
+        armed: bool,
+        s: &Surfaces,
+    ) -> Self {
+        let (eu, course, _) = truth_angles(truth);
+        Self {
+            t,
+            armed,
+            mode: mode.px4().0,
+            converged: e.converged,
+            north: truth.pos_ned.x,
+            east: truth.pos_ned.y,
+            alt: alt_amsl,
+            roll: eu.phi,
+            pitch: eu.theta,
+            yaw: eu.psi,
+            course,
+            airspeed: truth.airspeed_mps,
+            wind: [wind.x, wind.y, wind.z],
+            wind_steady: [wind_steady.x, wind_steady.y, wind_steady.z],
+            est_north: if e.position_valid { est_ne.0 } else { f64::NAN },
+            est_east: if e.position_valid { est_ne.1 } else { f64::NAN },
+            est_alt: f64::from(e.alt_amsl_m),
+            est_roll: f64::from(e.euler.phi),
+            est_pitch: f64::from(e.euler.theta),
+            est_yaw: f64::from(e.euler.psi),
+            est_course: f64::from(e.course),
+            est_airspeed: f64::from(e.airspeed),
+            est_wind: [
+                f64::from(e.wind_ned.x),
+                f64::from(e.wind_ned.y),
+                f64::from(e.wind_ned.z),
+            ],
+            sp_course: f64::from(sp.course),
+            sp_alt: f64::from(sp.alt_amsl_m),
+            sp_airspeed: f64::from(sp.airspeed),
+            elevator: f64::from(s.elevator),
+            aileron: f64::from(s.aileron),
+            rudder: f64::from(s.rudder),
+            throttle: f64::from(s.throttle),
+        }
+    }
+}
+
+/// Root-mean-square and largest estimation errors, from convergence to the end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct EstimatorErrors {
+    /// Time the estimator first reported itself converged, s.
+    pub from_s: f64,
+    /// Samples counted.
+    pub samples: usize,
+    /// Roll RMS error, deg.
+    pub roll_rms_deg: f64,
+    /// Pitch RMS error, deg.
+    pub pitch_rms_deg: f64,
+    /// Heading RMS error, deg.
+    pub heading_rms_deg: f64,
+    /// Altitude RMS error, m.
+    pub alt_rms_m: f64,
+    /// Airspeed RMS error, m/s.
+    pub airspeed_rms_mps: f64,
+    /// Horizontal wind RMS error against the steady wind, m/s.
+    pub wind_rms_mps: f64,
+    /// Horizontal wind RMS error against the total wind (turbulence included), m/s.
+    pub wind_total_rms_mps: f64,
+    /// Largest roll error, deg.
+    pub roll_max_deg: f64,
+    /// Largest pitch error, deg.
+    pub pitch_max_deg: f64,
+    /// Largest heading error, deg.
+    pub heading_max_deg: f64,
+    /// Largest altitude error, m.
+    pub alt_max_m: f64,
+}
+
+/// Figures of one scripted command.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Segment {
+    /// What was commanded.
+    pub what: String,
+    /// `altitude` (m) or `course` (deg).
+    pub signal: &'static str,
+    /// Time of the command, s.
+    pub t_s: f64,
+    /// End of the segment (next command or end of flight), s.
+    pub t_end_s: f64,
+    /// Commanded value (m AMSL or deg, course unwrapped from the start value).
+    pub command: f64,
+    /// Chapter-4 step figures of the true response (unit as `signal`).
+    pub metrics: StepMetrics,
+    /// Largest |command - truth| over the last 5 s of the segment.
+    pub final_error_max: f64,
+    /// Largest |altitude setpoint - true altitude| over the segment after 15 s (m): how well
+    /// altitude is held through the turns.
+    pub alt_hold_error_max_m: f64,
+}
+
+/// Figures of a flight.
+#[derive(Clone, Debug, Serialize)]
+pub struct FlightSummary {
+    /// Sensor frames exchanged.
+    pub frames: u64,
+    /// Frames the autopilot flew (armed).
+    pub armed_frames: u64,
+    /// Simulated time, s.
+    pub sim_s: f64,
+    /// Wall-clock time of the loop, s.
+    pub wall_s: f64,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Turbulence.
+    pub turbulence: &'static str,
+    /// Steady wind, NED, m/s.
+    pub wind_ned: [f64; 3],
+    /// Arming accepted at, s.
+    pub armed_at_s: Option<f64>,
+    /// Estimator errors from the first `converged` to the end.
+    pub estimator: Option<EstimatorErrors>,
+    /// Estimator errors from 30 s after the first `converged` ([`SETTLE_S`]) to the end: the
+    /// launch transient flown out.
+    pub estimator_settled: Option<EstimatorErrors>,
+    /// One entry per altitude or course command.
+    pub segments: Vec<Segment>,
+    /// Every ground-station command and its answer.
+    pub commands: Vec<CommandRecord>,
+    /// The autopilot's STATUSTEXT messages.
+    pub texts: Vec<(f64, String)>,
+    /// Framing counters of the autopilot's answers (simulator side).
+    pub sim_rx: LinkStatsJson,
+    /// The autopilot's counters of what it received.
+    pub autopilot_rx: AutopilotRx,
+}
+
+/// [`LinkStats`] for JSON.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LinkStatsJson {
+    /// Frames decoded.
+    pub frames_ok: u32,
+    /// CRC errors.
+    pub crc_errors: u32,
+    /// Unknown message ids.
+    pub unknown_ids: u32,
+    /// Undecodable payloads.
+    pub parse_errors: u32,
+    /// Bytes skipped.
+    pub bytes_skipped: u32,
+    /// Sequence gaps.
+    pub seq_gaps: u32,
+}
+
+impl From<LinkStats> for LinkStatsJson {
+    fn from(s: LinkStats) -> Self {
+        Self {
+            frames_ok: s.frames_ok,
+            crc_errors: s.crc_errors,
+            unknown_ids: s.unknown_ids,
+            parse_errors: s.parse_errors,
+            bytes_skipped: s.bytes_skipped,
+            seq_gaps: s.seq_gaps,
+        }
+    }
+}
+
+/// What the autopilot counted on its simulator link.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct AutopilotRx {
+    /// Framing counters.
+    pub framing: LinkStatsJson,
+    /// Sensor frames accepted.
+    pub sensor_frames: u32,
+    /// GPS frames accepted.
+    pub gps_frames: u32,
+    /// Frames from other systems.
+    pub foreign_frames: u32,
+    /// Frames of messages the sim link does not carry.
+    pub ignored_frames: u32,
+    /// Sensor groups rejected (IMU, mag, baro, pitot) and GPS frames rejected.
+    pub rejected: [u32; 5],
+    /// Stale sensor frames.
+    pub stale_frames: u32,
+}
+
+fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Estimator errors over the samples from `delay_s` after the first `converged` on.
+pub fn estimator_errors(samples: &[Sample], delay_s: f64) -> Option<EstimatorErrors> {
+    let t0 = samples.iter().find(|s| s.converged)?.t + delay_s;
+    let first = samples.iter().position(|s| s.t >= t0)?;
+    let s = &samples[first..];
+    let col = |f: &dyn Fn(&Sample) -> f64| s.iter().map(f).collect::<Vec<f64>>();
+    let roll = col(&|x| wrap_pi(x.est_roll - x.roll) * DEG);
+    let pitch = col(&|x| wrap_pi(x.est_pitch - x.pitch) * DEG);
+    let yaw = col(&|x| wrap_pi(x.est_yaw - x.yaw) * DEG);
+    let alt = col(&|x| x.est_alt - x.alt);
+    let va = col(&|x| x.est_airspeed - x.airspeed);
+    let wind = col(&|x| (x.est_wind[0] - x.wind_steady[0]).hypot(x.est_wind[1] - x.wind_steady[1]));
+    let wind_t = col(&|x| (x.est_wind[0] - x.wind[0]).hypot(x.est_wind[1] - x.wind[1]));
+    Some(EstimatorErrors {
+        from_s: s[0].t,
+        samples: s.len(),
+        roll_rms_deg: rms(&roll),
+        pitch_rms_deg: rms(&pitch),
+        heading_rms_deg: rms(&yaw),
+        alt_rms_m: rms(&alt),
+        airspeed_rms_mps: rms(&va),
+        wind_rms_mps: rms(&wind),
+        wind_total_rms_mps: rms(&wind_t),
+        roll_max_deg: max_abs(&roll),
+        pitch_max_deg: max_abs(&pitch),
+        heading_max_deg: max_abs(&yaw),
+        alt_max_m: max_abs(&alt),
+    })
+}
+
+/// Step figures of each scripted altitude and course command.
+fn segments(samples: &[Sample], gcs: &GroundStation, home_alt: f64) -> Vec<Segment> {
+    let Some(t0) = gcs.armed_at_s() else {
+        return Vec::new();
+    };
+    let end = samples.last().map_or(0.0, |s| s.t);
+    let steps = &gcs.script().steps;
+    let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    let mut out = Vec::new();
+    for (i, step) in steps.iter().enumerate() {
+        // The command goes out at the first frame at or after its time.
+        let Some(k0) = samples.iter().position(|s| s.t >= t0 + step.after_arm_s) else {
+            break;
+        };
+        let ts = samples[k0].t;
+        let te = steps
+            .get(i + 1)
+            .map_or(end + 1e-9, |n| t0 + n.after_arm_s)
+            .min(end + 1e-9);
+        let idx: Vec<usize> = (k0..samples.len()).filter(|&k| samples[k].t < te).collect();
+        let last5: Vec<usize> = idx
+            .iter()
+            .copied()
+            .filter(|&k| samples[k].t >= te - 5.0)
+            .collect();
+        let alt_hold_error_max_m = idx
+            .iter()
+            .filter(|&&k| samples[k].t >= ts + 15.0)
+            .map(|&k| (samples[k].sp_alt - samples[k].alt).abs())
+            .fold(0.0, f64::max);
+        let (signal, command, y, y0) = match step.action {
+            Action::AltitudeAboveHome(h) => {
+                let y: Vec<f64> = samples.iter().map(|s| s.alt).collect();
+                ("altitude", home_alt + f64::from(h), y, samples[k0].alt)
+            }
+            Action::Turn(_) => {
+                // Unwrap the course about its value at the command, and read the new
+                // setpoint the autopilot adopted one frame later.
+                let c0 = samples[k0].course;
+                let y: Vec<f64> = samples
+                    .iter()
+                    .map(|s| (c0 + wrap_pi(s.course - c0)) * DEG)
+                    .collect();
+                let sp = samples
+                    .get(k0 + 1)
+                    .map_or(samples[k0].sp_course, |s| s.sp_course);
+                let target = (c0 + wrap_pi(sp - c0)) * DEG;
+                // A 90 deg turn passes +-180 from the start value only past the target.
+                ("course", target, y, c0 * DEG)
+            }
+            _ => continue,
+        };
+        let metrics = step_metrics(&t, &y, y0, command, ts, te);
+        let final_error_max = last5
+            .iter()
+            .map(|&k| (command - y[k]).abs())
+            .fold(0.0, f64::max);
+        out.push(Segment {
+            what: gcs
+                .commands
+                .iter()
+                .find(|c| (c.t_s - ts).abs() < 1e-9)
+                .map_or_else(|| format!("{:?}", step.action), |c| c.what.clone()),
+            signal,
+            t_s: ts,
+            t_end_s: te,
+            command,
+            metrics,
+            final_error_max,
+            alt_hold_error_max_m,
+        });
+    }
+    out
+}
+
+/// Builds the summary of a flight.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn summarise(
+    cfg: &FlightConfig,
+    samples: &[Sample],
+    gcs: &GroundStation,
+    frames: u64,
+    frame_s: f64,
+    armed_frames: u64,
+    wall_s: f64,
+    sim_rx: LinkStats,
+    (health, ap_stats): (SimLinkHealth, LinkStats),
+    home_alt: f64,
+) -> FlightSummary {
+    let sim_s = frames as f64 * frame_s;
+    FlightSummary {
+        frames,
+        armed_frames,
+        sim_s,
+        wall_s,
+        real_time_factor: if wall_s > 0.0 { sim_s / wall_s } else { 0.0 },
+        seed: cfg.seed,
+        turbulence: super::turbulence_name(cfg.turbulence),
+        wind_ned: cfg.wind_ned,
+        armed_at_s: gcs.armed_at_s(),
+        estimator: estimator_errors(samples, 0.0),
+        estimator_settled: estimator_errors(samples, SETTLE_S),
+        segments: segments(samples, gcs, home_alt),
+        commands: gcs.commands.clone(),
+        texts: gcs.texts.clone(),
+        sim_rx: sim_rx.into(),
+        autopilot_rx: AutopilotRx {
+            framing: ap_stats.into(),
+            sensor_frames: health.sensor_frames,
+            gps_frames: health.gps_frames,
+            foreign_frames: health.foreign_frames,
+            ignored_frames: health.ignored_frames,
+            rejected: [
+                health.rejected_imu,
+                health.rejected_mag,
+                health.rejected_baro,
+                health.rejected_pitot,
+                health.rejected_gps,
+            ],
+            stale_frames: health.stale_frames,
+        },
+    }
+}
+
+/// Column names of the CSV log (degrees for angles, as a user reads them).
+pub fn csv_headers() -> Vec<String> {
+    [
+        "t_s",
+        "armed",
+        "mode",
+        "converged",
+        "north_m",
+        "east_m",
+        "alt_amsl_m",
+        "roll_deg",
+        "pitch_deg",
+        "yaw_deg",
+        "course_deg",
+        "airspeed_mps",
+        "wind_n_mps",
+        "wind_e_mps",
+        "wind_d_mps",
+        "est_north_m",
+        "est_east_m",
+        "est_alt_amsl_m",
+        "est_roll_deg",
+        "est_pitch_deg",
+        "est_yaw_deg",
+        "est_course_deg",
+        "est_airspeed_mps",
+        "est_wind_n_mps",
+        "est_wind_e_mps",
+        "sp_course_deg",
+        "sp_alt_amsl_m",
+        "sp_airspeed_mps",
+        "elevator_deg",
+        "aileron_deg",
+        "rudder_deg",
+        "throttle",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+/// One CSV row per sample.
+pub fn csv_row(s: &Sample) -> Vec<f64> {
+    let b = |x: bool| if x { 1.0 } else { 0.0 };
+    vec![
+        s.t,
+        b(s.armed),
+        f64::from(s.mode),
+        b(s.converged),
+        s.north,
+        s.east,
+        s.alt,
+        s.roll * DEG,
+        s.pitch * DEG,
+        s.yaw * DEG,
+        s.course * DEG,
+        s.airspeed,
+        s.wind[0],
+        s.wind[1],
+        s.wind[2],
+        s.est_north,
+        s.est_east,
+        s.est_alt,
+        s.est_roll * DEG,
+        s.est_pitch * DEG,
+        s.est_yaw * DEG,
+        s.est_course * DEG,
+        s.est_airspeed,
+        s.est_wind[0],
+        s.est_wind[1],
+        s.sp_course * DEG,
+        s.sp_alt,
+        s.sp_airspeed,
+        s.elevator * DEG,
+        s.aileron * DEG,
+        s.rudder * DEG,
+        s.throttle,
+    ]
+}
+
+/// Writes `flight.csv` and the PNG plots into `dir`; returns the files written.
+pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let csv = dir.join("flight.csv");
+    let rows: Vec<Vec<f64>> = samples.iter().map(csv_row).collect();
+    write_csv(&csv, &csv_headers(), &rows)?;
+    files.push(csv);
+
+    // Plots at 10 Hz: enough for the eye, light for the encoder.
+    let p: Vec<&Sample> = samples.iter().step_by(10).collect();
+    let t: Vec<f64> = p.iter().map(|s| s.t).collect();
+    let col = |f: &dyn Fn(&Sample) -> f64| p.iter().map(|s| f(s)).collect::<Vec<f64>>();
+    let fig = |name: &str, f: Figure| -> anyhow::Result<PathBuf> {
+        let path = dir.join(name);
+        f.save_png(&path)?;
+        Ok(path)
+    };
+    files.push(fig(
+        "altitude.png",
+        Figure::new(
+            "Altitude",
+            "t (s)",
+            vec![
+                Panel::new(
+                    "altitude AMSL (m)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| s.alt)),
+                        Series::new("estimate", t.clone(), col(&|s| s.est_alt)),
+                        Series::new("setpoint", t.clone(), col(&|s| s.sp_alt)).dashed(),
+                    ],
+                ),
+                Panel::new(
+                    "airspeed (m/s)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| s.airspeed)),
+                        Series::new("estimate", t.clone(), col(&|s| s.est_airspeed)),
+                        Series::new("setpoint", t.clone(), col(&|s| s.sp_airspeed)).dashed(),
+                    ],
+                ),
+                Panel::new(
+                    "elevator (deg), throttle (%)",
+                    vec![
+                        Series::new("elevator", t.clone(), col(&|s| s.elevator * DEG)),
+                        Series::new("throttle", t.clone(), col(&|s| s.throttle * 100.0)),
+                    ],
+                ),
+            ],
+        ),
+    )?);
+    let wrap360 = |x: f64| (x * DEG).rem_euclid(360.0);
+    files.push(fig(
+        "course.png",
+        Figure::new(
+            "Course and heading",
+            "t (s)",
+            vec![
+                Panel::new(
+                    "course (deg)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| wrap360(s.course))),
+                        Series::new("estimate", t.clone(), col(&|s| wrap360(s.est_course))),
+                        Series::new("setpoint", t.clone(), col(&|s| wrap360(s.sp_course))).dashed(),
+                    ],
+                ),
+                Panel::new(
+                    "heading (deg)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| wrap360(s.yaw))),
+                        Series::new("estimate", t.clone(), col(&|s| wrap360(s.est_yaw))),
+                    ],
+                ),
+                Panel::new(
+                    "aileron, rudder (deg)",
+                    vec![
+                        Series::new("aileron", t.clone(), col(&|s| s.aileron * DEG)),
+                        Series::new("rudder", t.clone(), col(&|s| s.rudder * DEG)),
+                    ],
+                ),
+            ],
+        ),
+    )?);
+    files.push(fig(
+        "attitude.png",
+        Figure::new(
+            "Attitude: truth and estimate",
+            "t (s)",
+            vec![
+                Panel::new(
+                    "roll (deg)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| s.roll * DEG)),
+                        Series::new("estimate", t.clone(), col(&|s| s.est_roll * DEG)).dashed(),
+                    ],
+                ),
+                Panel::new(
+                    "pitch (deg)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| s.pitch * DEG)),
+                        Series::new("estimate", t.clone(), col(&|s| s.est_pitch * DEG)).dashed(),
+                    ],
+                ),
+                Panel::new(
+                    "heading error (deg)",
+                    vec![Series::new(
+                        "estimate - truth",
+                        t.clone(),
+                        col(&|s| wrap_pi(s.est_yaw - s.yaw) * DEG),
+                    )],
+                ),
+            ],
+        ),
+    )?);
+    files.push(fig(
+        "ground_track.png",
+        Figure::new(
+            "Ground track",
+            "east (m)",
+            vec![Panel::new(
+                "north (m)",
+                vec![Series::new("truth", col(&|s| s.east), col(&|s| s.north)), {
+                    let valid: Vec<&&Sample> =
+                        p.iter().filter(|s| s.est_north.is_finite()).collect();
+                    Series::new(
+                        "estimate",
+                        valid.iter().map(|s| s.est_east).collect(),
+                        valid.iter().map(|s| s.est_north).collect(),
+                    )
+                    .dashed()
+                }],
+            )],
+        ),
+    )?);
+    Ok(files)
+}

@@ -1,0 +1,301 @@
+//! The flight loop.
+
+use super::onboard::Onboard;
+use super::record::{summarise, FlightSummary, Sample};
+use super::script::{GroundStation, Script};
+use crate::aircraft::Aircraft;
+use crate::analysis::trim::{trim_with, TrimTarget};
+use crate::environment::wind::{Turbulence, Wind};
+use crate::link::lockstep::{LinkError, Lockstep};
+use crate::link::transport::Transport;
+use crate::plant::{Controls, Environment, ModelParams, Plant, ServoBank};
+use crate::sensors::{SensorSuite, Truth};
+use common::link::simlink::{encode_hil_gps, encode_hil_sensor};
+use common::math::atmosphere::standard_atmosphere;
+use common::math::geodetic::ned_offset;
+use common::math::{course_and_speed, ned_to_body, Euler};
+use mavlink::dialects::common::{MavMessage, HIL_STATE_QUATERNION_DATA};
+use nalgebra::Vector3;
+use std::time::{Duration, Instant};
+
+/// Everything that defines a flight.
+#[derive(Clone, Debug)]
+pub struct FlightConfig {
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Plant integration step, s (several per sensor frame).
+    pub dt_s: f64,
+    /// Steady wind, NED, m/s (the direction it blows towards).
+    pub wind_ned: [f64; 3],
+    /// Turbulence severity.
+    pub turbulence: Turbulence,
+    /// Seed of the sensor noise and the turbulence.
+    pub seed: u64,
+    /// Pace the flight to the wall clock.
+    pub realtime: bool,
+    /// Show a progress bar.
+    pub progress: bool,
+    /// The ground station's script.
+    pub script: Script,
+    /// How long to wait for an answer of the autopilot before calling it silent.
+    pub link_timeout: Duration,
+}
+
+impl Default for FlightConfig {
+    fn default() -> Self {
+        let script = Script::thesis();
+        Self {
+            // About 10 s to converge and arm, then the script.
+            duration_s: (10.0 + script.length_s()).ceil(),
+            dt_s: 0.001,
+            wind_ned: [0.0; 3],
+            turbulence: Turbulence::None,
+            seed: 1,
+            realtime: false,
+            progress: false,
+            script,
+            link_timeout: Duration::from_secs(5),
+        }
+    }
+}
+
+/// Why a flight stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum FlightError {
+    /// The autopilot stopped answering (or never started).
+    #[error(transparent)]
+    Link(#[from] LinkError),
+    /// The configuration cannot be flown.
+    #[error("flight configuration: {0}")]
+    Config(String),
+}
+
+/// A flown flight: the log and its summary.
+#[derive(Clone, Debug)]
+pub struct FlightOutcome {
+    /// One sample per sensor frame.
+    pub samples: Vec<Sample>,
+    /// Figures of the flight.
+    pub summary: FlightSummary,
+}
+
+fn validate(cfg: &FlightConfig, frame_s: f64) -> Result<(), FlightError> {
+    let bad = |m: String| Err(FlightError::Config(m));
+    if !(cfg.duration_s.is_finite() && cfg.duration_s > 0.0) {
+        return bad(format!("duration {} s: must be positive", cfg.duration_s));
+    }
+    if !(cfg.dt_s.is_finite() && cfg.dt_s > 0.0 && cfg.dt_s <= frame_s) {
+        return bad(format!(
+            "step {} s: must be positive and at most the sensor frame period {frame_s} s",
+            cfg.dt_s
+        ));
+    }
+    if cfg
+        .wind_ned
+        .iter()
+        .any(|w| !w.is_finite() || w.abs() > 15.0)
+    {
+        return bad(format!(
+            "wind {:?} m/s: each component must be finite and within +-15 m/s (the aircraft flies at 17 m/s)",
+            cfg.wind_ned
+        ));
+    }
+    Ok(())
+}
+
+/// Flies `cfg` with the autopilot at the other end of `link`, reached through `onboard`.
+///
+/// Waits for the autopilot's boot heartbeat first; fails with [`LinkError::Silent`] if it
+/// does not answer a frame within `cfg.link_timeout`.
+pub fn fly<T: Transport, O: Onboard<T>>(
+    aircraft: &Aircraft,
+    cfg: &FlightConfig,
+    link: &mut Lockstep<T>,
+    onboard: &mut O,
+) -> Result<FlightOutcome, FlightError> {
+    let params = ModelParams::new(aircraft);
+    let home = params.home;
+    let home_alt = params.home_alt_msl_m;
+    let mut sensors = SensorSuite::new(aircraft.sensors.clone(), home, home_alt, cfg.seed);
+    let frame_us = sensors.period_us();
+    let frame_s = frame_us as f64 * 1e-6;
+    validate(cfg, frame_s)?;
+    let substeps = ((frame_s / cfg.dt_s).round() as usize).max(1);
+    let dt = frame_s / substeps as f64;
+
+    // Trimmed, level, 100 m above home, 17 m/s (TrimTarget::level is at 100 m AGL).
+    let level = TrimTarget::level();
+    let trim = trim_with(&params, &level);
+    if !trim.converged {
+        return Err(FlightError::Config(format!(
+            "level trim did not converge (residual {:.3e})",
+            trim.residual_norm
+        )));
+    }
+    // Trimmed in the air mass: the steady wind carries the aircraft, so the airspeed is the
+    // trim's 17 m/s whatever the wind.
+    let mut start = trim.state;
+    start.vel_body += ned_to_body(&start.attitude, &Vector3::from(cfg.wind_ned));
+    let mut plant = Plant::from_params(params.clone(), start);
+    let trim_controls = trim.controls;
+    let mut servos = ServoBank::new(&aircraft.actuators, &trim_controls);
+    let mut wind = Wind::new(Vector3::from(cfg.wind_ned), cfg.turbulence, cfg.seed);
+    let q0 = plant.attitude();
+    let env0 = Environment {
+        wind_ned: wind.step(0.0, plant.air_data().va, -plant.position_ned().z, &q0),
+    };
+    plant.set_inputs(&trim_controls, &env0);
+    let mut env = env0;
+
+    // The ground station tells the autopilot its GPS receiver's latency, as an operator
+    // configures the airframe's receiver (the parameter's default is another receiver's).
+    let mut script = cfg.script.clone();
+    if !script.params.iter().any(|(n, _)| n == "EKF_GPS_DELAY") {
+        script.params.insert(
+            0,
+            (
+                "EKF_GPS_DELAY".into(),
+                aircraft.sensors.gps.latency_s as f32,
+            ),
+        );
+    }
+    let mut gcs = GroundStation::new(script, home_alt);
+    link.wait_for_autopilot(cfg.link_timeout)?;
+
+    let frames = (cfg.duration_s / frame_s).round() as u64;
+    let bar = if cfg.progress {
+        let b = indicatif::ProgressBar::new(frames);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} simulated {msg} [{bar:30}] {percent}% {elapsed_precise}",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let start = Instant::now();
+    let mut samples = Vec::with_capacity(frames as usize + 1);
+    let mut armed_frames = 0u64;
+    for k in 0..frames {
+        let time_us = sensors.next_time_us();
+        let t_s = time_us as f64 * 1e-6;
+        let truth = Truth {
+            pos_ned: plant.position_ned(),
+            vel_ned: plant.velocity_ned(),
+            attitude: plant.attitude(),
+            omega_body: plant.body_rates(),
+            specific_force_body: plant.specific_force_body(),
+            airspeed_mps: plant.air_data().va,
+        };
+        let (frame, fix) = sensors.sample(&truth);
+        let alt_amsl = home_alt - truth.pos_ned.z;
+        let mut msgs = Vec::with_capacity(3);
+        if let Some(f) = fix {
+            msgs.push(MavMessage::HIL_GPS(encode_hil_gps(time_us, &f)));
+        }
+        msgs.push(MavMessage::HIL_STATE_QUATERNION(truth_frame(
+            time_us, &truth, &plant, alt_amsl,
+        )));
+        msgs.push(MavMessage::HIL_SENSOR(encode_hil_sensor(
+            &frame,
+            alt_amsl as f32,
+        )));
+
+        gcs.poll(t_s, link, onboard);
+        let answer = link.exchange(time_us, &msgs)?;
+        let command = if answer.armed {
+            armed_frames += 1;
+            Controls::from(answer.surfaces)
+        } else {
+            // The safety pilot holds the trim until the autopilot is armed.
+            trim_controls
+        };
+        let view = onboard.with_app(link, |app| {
+            (app.estimate(), app.setpoints(), app.mode(), app.armed())
+        });
+        samples.push(Sample::new(
+            t_s,
+            &truth,
+            alt_amsl,
+            &env.wind_ned,
+            &Vector3::from(cfg.wind_ned),
+            &view.0,
+            ned_offset::<f64>(home, view.0.position),
+            &view.1,
+            view.2,
+            answer.armed,
+            &answer.surfaces,
+        ));
+
+        for _ in 0..substeps {
+            let seen = servos.step(&command, dt);
+            plant.step(&seen, &env, dt);
+        }
+        let q = plant.attitude();
+        env.wind_ned = wind.step(frame_s, plant.air_data().va, -plant.position_ned().z, &q);
+
+        if cfg.realtime {
+            let due = Duration::from_secs_f64((k + 1) as f64 * frame_s);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+        }
+        if k % 100 == 0 {
+            bar.set_position(k);
+            bar.set_message(format!("{t_s:6.1} s"));
+        }
+    }
+    bar.finish_and_clear();
+    let wall_s = start.elapsed().as_secs_f64();
+    let health = onboard.with_app(link, |app| (app.sim_health(), app.sim_link_stats()));
+    let summary = summarise(
+        cfg,
+        &samples,
+        &gcs,
+        frames,
+        frame_s,
+        armed_frames,
+        wall_s,
+        link.stats(),
+        health,
+        home_alt,
+    );
+    Ok(FlightOutcome { samples, summary })
+}
+
+/// HIL_STATE_QUATERNION from the truth: logged and, with `SIM_USE_TRUTH`, flown on.
+fn truth_frame(time_us: u64, t: &Truth, plant: &Plant, alt_amsl: f64) -> HIL_STATE_QUATERNION_DATA {
+    let q = t.attitude.quaternion();
+    let p = plant.geodetic();
+    let cm = |v: f64| (v * 100.0).round().clamp(-32768.0, 32767.0) as i16;
+    let mg = |v: f64| (v / 9.80665 * 1000.0).round().clamp(-32768.0, 32767.0) as i16;
+    let rho0 = standard_atmosphere(0.0).density;
+    let rho = standard_atmosphere(alt_amsl).density;
+    let eas = t.airspeed_mps * (rho / rho0).sqrt();
+    let speed_cm = |v: f64| (v * 100.0).round().clamp(0.0, 65535.0) as u16;
+    HIL_STATE_QUATERNION_DATA {
+        time_usec: time_us,
+        attitude_quaternion: [q.w as f32, q.i as f32, q.j as f32, q.k as f32],
+        rollspeed: t.omega_body.x as f32,
+        pitchspeed: t.omega_body.y as f32,
+        yawspeed: t.omega_body.z as f32,
+        lat: p.lat_e7,
+        lon: p.lon_e7,
+        alt: (alt_amsl * 1000.0).round() as i32,
+        vx: cm(t.vel_ned.x),
+        vy: cm(t.vel_ned.y),
+        vz: cm(t.vel_ned.z),
+        ind_airspeed: speed_cm(eas),
+        true_airspeed: speed_cm(t.airspeed_mps),
+        xacc: mg(t.specific_force_body.x),
+        yacc: mg(t.specific_force_body.y),
+        zacc: mg(t.specific_force_body.z),
+    }
+}
+
+/// Course over ground and Euler angles of the truth (helpers for the log).
+pub(crate) fn truth_angles(t: &Truth) -> (Euler<f64>, f64, f64) {
+    let (course, gs) = course_and_speed(&t.vel_ned);
+    (Euler::from_quaternion(&t.attitude), course, gs)
+}
