@@ -135,6 +135,7 @@ pub struct App {
     autopilot: Autopilot,
     health: SimLinkHealth,
     last_time_us: Option<u64>,
+    last_imu_us: Option<u64>,
     last_control_us: Option<u64>,
     last_gps: Option<GpsFix>,
     armed: bool,
@@ -175,6 +176,7 @@ impl App {
             autopilot,
             health: SimLinkHealth::default(),
             last_time_us: None,
+            last_imu_us: None,
             last_control_us: None,
             last_gps: None,
             armed: false,
@@ -296,18 +298,18 @@ impl App {
                 let (sensors, rejected) = simlink::decode_hil_sensor(d);
                 self.count_rejections(rejected);
                 let t = sensors.time_us;
-                let dt_us = match self.last_time_us {
-                    Some(last) if t <= last => {
-                        self.health.stale_frames += 1;
-                        None
-                    }
-                    Some(last) => Some(t - last),
-                    None => None,
-                };
+                if self.last_time_us.is_some_and(|last| t <= last) {
+                    self.health.stale_frames += 1;
+                }
                 self.last_time_us = Some(t.max(self.last_time_us.unwrap_or(0)));
                 self.health.sensor_frames += 1;
-                if let (Some(imu), Some(dt)) = (sensors.imu, dt_us) {
-                    self.estimator.update_imu(&imu, dt as f32 * 1e-6);
+                // The gyro integrates over the time since the last *accepted* IMU sample, so a
+                // rejected sample does not lose its share of the rotation.
+                if let Some(imu) = sensors.imu {
+                    if let Some(last) = self.last_imu_us.filter(|&l| t > l) {
+                        self.estimator.update_imu(&imu, (t - last) as f32 * 1e-6);
+                    }
+                    self.last_imu_us = Some(t);
                 }
                 if let Some(m) = sensors.mag {
                     self.estimator.update_mag(&m);
@@ -750,10 +752,6 @@ mod tests {
             .to_vec()
     }
 
-    pub(super) fn actuators_pub(app: &mut App, k: u64) -> [f32; 16] {
-        actuators(app, k)
-    }
-
     fn actuators(app: &mut App, k: u64) -> [f32; 16] {
         let mut out = Vec::new();
         app.on_sim_bytes(&sensor_frame(k), &mut |b| out.extend_from_slice(b));
@@ -807,27 +805,5 @@ mod tests {
             "{}",
             core::mem::size_of::<App>()
         );
-    }
-}
-#[cfg(test)]
-mod rate_probe {
-    extern crate std;
-    use super::*;
-    #[test]
-    fn probe() {
-        let mut app = App::new();
-        let mut total = std::collections::BTreeMap::new();
-        for k in 0..200u64 {
-            let _ = super::tests::actuators_pub(&mut app, k);
-            let mut out = std::vec::Vec::new();
-            app.drain_gcs(&mut |b| out.extend_from_slice(b));
-            let mut p = FrameParser::new();
-            p.push(&out, |f| {
-                *total
-                    .entry(mavlink::Message::message_id(&f.message))
-                    .or_insert(0) += 1
-            });
-        }
-        std::println!("{total:?}");
     }
 }

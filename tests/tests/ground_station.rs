@@ -101,9 +101,6 @@ impl Sitl {
                 if link.exchange(t, &msgs).is_err() {
                     break;
                 }
-                if k % 500 == 0 {
-                    eprintln!("SIM k={k} t={} wall={:?}", t, start.elapsed());
-                }
                 k += 1;
             }
         });

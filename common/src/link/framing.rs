@@ -69,7 +69,7 @@ impl Default for FrameParser {
 enum Check {
     NeedMore,
     Bad,
-    /// Skip a whole frame of this length (its id is unknown, so its checksum cannot be checked).
+    /// Skip a whole frame of this length (its CRC matched but its payload did not decode).
     Skip(usize),
     Done(Frame, usize),
 }
@@ -228,8 +228,11 @@ impl FrameParser {
 
     fn classify_failure(&mut self, id: u32, total: usize) -> Check {
         if MavMessage::default_message_from_id(id).is_none() {
+            // Its checksum cannot be checked, so its length cannot be trusted either: a
+            // corrupt start marker with a garbage id must not swallow the real frame behind
+            // it. Resynchronise as after any bad candidate.
             self.stats.unknown_ids = self.stats.unknown_ids.wrapping_add(1);
-            Check::Skip(total)
+            Check::Bad
         } else {
             self.stats.crc_errors = self.stats.crc_errors.wrapping_add(1);
             Check::Bad
@@ -367,7 +370,7 @@ mod tests {
     }
 
     #[test]
-    fn unknown_id_with_good_length_is_skipped_whole() {
+    fn an_unknown_id_is_counted_and_the_next_frame_still_arrives() {
         let mut s = Vec::new();
         s.extend([STX_V2, 2, 0, 0, 9, 1, 1, 0xDE, 0xBC, 0x0A, 1, 2, 0x55, 0x66]);
         s.extend(heartbeat(7));
