@@ -152,7 +152,8 @@ struct FlyArgs {
     #[arg(long, default_value = "out/fly")]
     out: PathBuf,
     /// Gain set loaded before arming (SYS_GAIN_SET): 0 designed, 1 designed_t310,
-    /// 2 designed_appe, 3 minnesota, 4 minnesota_appe.
+    /// 2 designed_appe, 3 minnesota, 4 minnesota_appe. Without it the "computed" set
+    /// (`sim-host design`) is uploaded parameter by parameter, as a ground station would.
     #[arg(long)]
     gains: Option<u32>,
     /// Fly on the simulator's truth instead of the estimator (SIM_USE_TRUTH = 1).
@@ -275,7 +276,11 @@ fn run() -> anyhow::Result<ExitCode> {
             let r = commands::scenario::scenario_report(&aircraft, &name, &opts, Some(&out))?;
             if let Some(path) = &results {
                 let cmdline = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
-                let md = commands::scenario::results_markdown(&r, &format!("sim-host {cmdline}"));
+                let md = commands::scenario::results_markdown(
+                    &r,
+                    &format!("sim-host {cmdline}"),
+                    &aircraft,
+                );
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir)
                         .with_context(|| format!("cannot create `{}`", dir.display()))?;
@@ -368,6 +373,10 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         out: Some(a.out.clone()),
         plots: true,
         gain_set: a.gains,
+        upload_gains: match a.gains {
+            Some(_) => None,
+            None => Some(sim_host::analysis::design::computed_gain_set(aircraft)?),
+        },
         use_truth: a.truth,
     };
     let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
@@ -427,6 +436,7 @@ fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
     };
     let opts = commands::fly::FlyOptions {
         out: Some(PathBuf::from("out/fly")),
+        upload_gains: Some(sim_host::analysis::design::computed_gain_set(aircraft)?),
         ..Default::default()
     };
     emit("Flying the firmware in-process: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet")?;

@@ -84,6 +84,7 @@ fn no_trim(mut g: GainSet) -> GainSet {
     g.lateral.trim_rudder = 0.0;
     g.longitudinal.trim_elevator = 0.0;
     g.longitudinal.trim_throttle = 0.0;
+    g.longitudinal.trim_pitch = 0.0;
     g
 }
 

@@ -106,6 +106,9 @@ pub struct LongitudinalGains {
     pub trim_elevator: f32,
     /// Throttle trim, the feed-forward of the airspeed-by-throttle loop, 0..1.
     pub trim_throttle: f32,
+    /// Pitch at trim, rad: the feed-forward of the altitude and airspeed-by-pitch loops, whose
+    /// design (thesis chapter 3) is about the trim, so their output is a pitch *offset*.
+    pub trim_pitch: f32,
     /// Pole of the low-pass on the altitude and airspeed feedback, rad/s.
     pub feedback_lpf_pole: f32,
     /// Pitch held in the take-off regime, rad.
@@ -165,6 +168,7 @@ pub const DESIGNED: GainSet = GainSet {
         throttle_max: 1.0,
         trim_elevator: -0.0963,
         trim_throttle: 0.569,
+        trim_pitch: 0.054,
         feedback_lpf_pole: 2.0,
         takeoff_pitch: 10.0 * DEG,
         alt_band: 10.0,
@@ -375,6 +379,7 @@ pub const BINDINGS: &[Binding] = &[
     bind!("THR_MAX", longitudinal.throttle_max, 1.0),
     bind!("TRIM_ELEV_DEG", longitudinal.trim_elevator, RAD2DEG),
     bind!("TRIM_THR", longitudinal.trim_throttle, 1.0),
+    bind!("TRIM_PTCH_DEG", longitudinal.trim_pitch, RAD2DEG),
     bind!("FB_LPF_POLE", longitudinal.feedback_lpf_pole, 1.0),
     bind!("TKO_PTCH_DEG", longitudinal.takeoff_pitch, RAD2DEG),
     bind!("ALT_BAND_M", longitudinal.alt_band, 1.0),

@@ -154,6 +154,14 @@ pub const PARAMS: &[ParamDef] = &[
         "Throttle trim, feed-forward of the airspeed-by-throttle loop",
     ),
     ParamDef::real(
+        "TRIM_PTCH_DEG",
+        G.trim_pitch * RAD2DEG,
+        -20.0,
+        20.0,
+        "deg",
+        "Pitch at trim, feed-forward of the altitude and airspeed-by-pitch loops (trim I)",
+    ),
+    ParamDef::real(
         "FB_LPF_POLE",
         G.feedback_lpf_pole,
         0.1,
@@ -659,11 +667,15 @@ impl Longitudinal {
         }
         let theta_c = match src {
             PitchSource::Fixed(v) => v.clamp(-g.pitch_max, g.pitch_max),
+            // Both outer loops were designed about the trim: their output is added to it.
             PitchSource::Airspeed(v) => {
                 self.aspd_pitch
-                    .step(v - feedback, Derivative::None, 0.0, dt)
+                    .step(v - feedback, Derivative::None, g.trim_pitch, dt)
             }
-            PitchSource::Altitude(v) => self.alt.step(v - feedback, Derivative::None, 0.0, dt),
+            PitchSource::Altitude(v) => {
+                self.alt
+                    .step(v - feedback, Derivative::None, g.trim_pitch, dt)
+            }
         };
         let e = wrap_pi(theta_c - m.pitch);
         self.elevator = self

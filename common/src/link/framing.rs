@@ -198,7 +198,7 @@ impl FrameParser {
             raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
             let id = raw.message_id();
             if !raw.has_valid_crc::<MavMessage>() {
-                return self.classify_failure(id, total);
+                return self.classify_failure(id);
             }
             let header = MavHeader {
                 system_id: raw.system_id(),
@@ -215,7 +215,7 @@ impl FrameParser {
             raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
             let id = u32::from(raw.message_id());
             if !raw.has_valid_crc::<MavMessage>() {
-                return self.classify_failure(id, total);
+                return self.classify_failure(id);
             }
             let header = MavHeader {
                 system_id: u32::from(raw.system_id()),
@@ -226,7 +226,7 @@ impl FrameParser {
         }
     }
 
-    fn classify_failure(&mut self, id: u32, total: usize) -> Check {
+    fn classify_failure(&mut self, id: u32) -> Check {
         if MavMessage::default_message_from_id(id).is_none() {
             // Its checksum cannot be checked, so its length cannot be trusted either: a
             // corrupt start marker with a garbage id must not swallow the real frame behind

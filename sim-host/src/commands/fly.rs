@@ -65,6 +65,9 @@ pub struct FlyOptions {
     pub plots: bool,
     /// Gain set (`SYS_GAIN_SET`) to load before arming.
     pub gain_set: Option<u32>,
+    /// Gains uploaded parameter by parameter before arming, as a ground station would (the
+    /// "computed" set lives on the host, not in the firmware's table of named sets).
+    pub upload_gains: Option<common::control::gains::GainSet>,
     /// Fly on the simulator's truth (`SIM_USE_TRUTH` = 1).
     pub use_truth: bool,
 }
@@ -77,6 +80,7 @@ impl Default for FlyOptions {
             out: None,
             plots: true,
             gain_set: None,
+            upload_gains: None,
             use_truth: false,
         }
     }
@@ -95,6 +99,11 @@ fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
     let mut cfg = cfg.clone();
     if let Some(g) = opts.gain_set {
         cfg.script.params.push(("SYS_GAIN_SET".into(), g as f32));
+    }
+    if let Some(g) = &opts.upload_gains {
+        for (name, value) in g.params() {
+            cfg.script.params.push((name.into(), value));
+        }
     }
     if opts.use_truth {
         cfg.script.params.push(("SIM_USE_TRUTH".into(), 1.0));
