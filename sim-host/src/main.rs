@@ -350,6 +350,10 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         realtime: a.realtime,
         progress: true,
         dt_s: a.dt,
+        // With --realtime, QGroundControl can watch: telemetry to 14550, as from PX4 SITL.
+        ground_link: a
+            .realtime
+            .then(|| ("127.0.0.1:18570".into(), "127.0.0.1:14550".into())),
         ..FlightConfig::default()
     };
     if let Some(d) = a.duration {

@@ -39,6 +39,10 @@ pub struct FlightConfig {
     pub script: Script,
     /// How long to wait for an answer of the autopilot before calling it silent.
     pub link_timeout: Duration,
+    /// A ground-station port beside the script, `(bind, remote)`: the autopilot's telemetry
+    /// goes to `remote` (QGroundControl listens on 127.0.0.1:14550) and to any station that
+    /// sends to `bind`, whose frames reach the autopilot's ground link.
+    pub ground_link: Option<(String, String)>,
 }
 
 impl Default for FlightConfig {
@@ -55,6 +59,7 @@ impl Default for FlightConfig {
             progress: false,
             script,
             link_timeout: Duration::from_secs(5),
+            ground_link: None,
         }
     }
 }
@@ -122,6 +127,12 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     validate(cfg, frame_s)?;
     let substeps = ((frame_s / cfg.dt_s).round() as usize).max(1);
     let dt = frame_s / substeps as f64;
+    let mut bridge = match &cfg.ground_link {
+        Some((bind, remote)) => Some(firmware::sitl::GcsUdp::open(bind, Some(remote)).map_err(
+            |e| FlightError::Config(format!("ground-station port {bind} -> {remote}: {e}")),
+        )?),
+        None => None,
+    };
 
     // Trimmed, level, 100 m above home, 17 m/s (TrimTarget::level is at 100 m AGL).
     let level = TrimTarget::level();
@@ -202,6 +213,14 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             alt_amsl as f32,
         )));
 
+        // The station's port first: it takes the telemetry of the last frame (the script
+        // reads only the answers to its own commands).
+        if let Some(b) = bridge.as_mut() {
+            onboard.with_app(link, |app| {
+                // A station that misbehaves must not stop the flight.
+                let _ = b.service(app);
+            });
+        }
         gcs.poll(t_s, link, onboard);
         let answer = link.exchange(time_us, &msgs)?;
         let command = if answer.armed {
