@@ -107,6 +107,10 @@ enum Command {
     Design {
         #[command(flatten)]
         out: Output,
+        /// Also write the computed gain set to this TOML file (a gain file for
+        /// `scenario --gains FILE.toml`).
+        #[arg(long, value_name = "FILE")]
+        write_gains: Option<PathBuf>,
     },
     /// Fly the firmware against the plant over the simulator link, commanded by a scripted
     /// ground station: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet.
@@ -298,7 +302,13 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Some(Command::Design { out }) => {
+        Some(Command::Design { out, write_gains }) => {
+            if let Some(path) = &write_gains {
+                let g = sim_host::analysis::design::computed_gain_set(&aircraft)?;
+                let text = toml::to_string(&g).context("encoding the gain set")?;
+                std::fs::write(path, text)
+                    .with_context(|| format!("cannot write `{}`", path.display()))?;
+            }
             if out.markdown {
                 emit(&commands::design::design_markdown(&aircraft)?)?;
             } else {

@@ -283,3 +283,50 @@ fn p_only_altitude_loop_settles_on_the_command() {
     assert!(without_feed_forward > 2.0);
     assert!(flown.abs() < 0.1, "flown {flown} m");
 }
+
+/// A gain file is checked gain by gain: a missing or non-finite gain is refused with its name.
+#[test]
+fn gain_files_name_the_missing_or_bad_gain() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = sim_host::analysis::design::computed_gain_set(aircraft()).unwrap();
+    let text = toml::to_string(&g).unwrap();
+    let good = dir.path().join("computed.toml");
+    std::fs::write(&good, &text).unwrap();
+    let back = sim_host::commands::scenario::gain_file(&good).unwrap();
+    assert_eq!(back, g);
+    // The same file flies as a gain set.
+    let by_name = gain_set(aircraft(), good.to_str().unwrap()).unwrap();
+    assert_eq!(by_name, g);
+
+    let missing = dir.path().join("missing.toml");
+    let without: String = text
+        .lines()
+        .filter(|l| !l.starts_with("roll_kp"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&missing, without).unwrap();
+    let e = format!(
+        "{:#}",
+        sim_host::commands::scenario::gain_file(&missing).unwrap_err()
+    );
+    assert!(e.contains("missing.toml") && e.contains("roll_kp"), "{e}");
+
+    let nan = dir.path().join("nan.toml");
+    let with_nan: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("pitch_kp") {
+                "pitch_kp = nan".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&nan, with_nan).unwrap();
+    let e = format!(
+        "{:#}",
+        sim_host::commands::scenario::gain_file(&nan).unwrap_err()
+    );
+    assert!(e.contains("nan.toml") && e.contains("PTCH_KP"), "{e}");
+}

@@ -39,8 +39,38 @@ pub struct UnknownGainSet {
     pub valid: Vec<&'static str>,
 }
 
-/// The gain set of this name for `aircraft` (only [`COMPUTED`] depends on the aircraft).
+/// Reads a gain set from a TOML file (the `GainSet` fields: `[lateral]`, `[longitudinal]`,
+/// `transfer_tc`; as `sim-host design --write-gains` writes it). Every gain must be there and
+/// finite: the error names the file and the gain.
+pub fn gain_file(path: &std::path::Path) -> anyhow::Result<GainSet> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("gain file `{}`: cannot read", path.display()))?;
+    let de = toml::Deserializer::parse(&text)
+        .map_err(|e| anyhow::anyhow!("gain file `{}`: {e}", path.display()))?;
+    let g: GainSet = serde_path_to_error::deserialize(de).map_err(|e| {
+        anyhow::anyhow!(
+            "gain file `{}`: key `{}`: {}",
+            path.display(),
+            e.path(),
+            e.inner()
+        )
+    })?;
+    g.validate().map_err(|e| {
+        anyhow::anyhow!(
+            "gain file `{}`: gain `{}` refused ({e:?})",
+            path.display(),
+            e.name()
+        )
+    })?;
+    Ok(g)
+}
+
+/// The gain set of this name for `aircraft` (only [`COMPUTED`] depends on the aircraft); a
+/// name ending in `.toml` is a gain file.
 pub fn gain_set(aircraft: &Aircraft, name: &str) -> anyhow::Result<GainSet> {
+    if name.ends_with(".toml") {
+        return gain_file(std::path::Path::new(name));
+    }
     if name == COMPUTED {
         return computed_gain_set(aircraft).context("designing the computed gain set");
     }
