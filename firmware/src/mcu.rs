@@ -46,6 +46,21 @@ impl Usart {
         }
     }
 
+    /// Reads what has arrived, up to `buf.len()` bytes.
+    fn read_into(&self, buf: &mut [u8]) -> usize {
+        let mut n = 0;
+        while n < buf.len() {
+            match self.try_read() {
+                Some(b) => {
+                    buf[n] = b;
+                    n += 1;
+                }
+                None => break,
+            }
+        }
+        n
+    }
+
     fn write(&self, bytes: &[u8]) {
         for &b in bytes {
             // SAFETY: as above.
@@ -68,19 +83,16 @@ fn main() -> ! {
     sim.write(&firmware::app::heartbeat_frame(&mut app));
     let mut chunk = [0u8; 64];
     loop {
-        // Gather what has arrived, then hand it over in one piece.
-        let mut n = 0;
-        while n < chunk.len() {
-            match sim.try_read() {
-                Some(b) => {
-                    chunk[n] = b;
-                    n += 1;
-                }
-                None => break,
-            }
-        }
+        // Gather what has arrived on each UART, then hand it over in one piece.
+        let n = sim.read_into(&mut chunk);
         if n > 0 {
             app.on_sim_bytes(&chunk[..n], &mut |out| sim.write(out));
         }
+        let n = gcs.read_into(&mut chunk);
+        if n > 0 {
+            app.on_gcs_bytes(&chunk[..n]);
+        }
+        // Telemetry and answers for the ground, produced by both calls above.
+        app.drain_gcs(&mut |out| gcs.write(out));
     }
 }

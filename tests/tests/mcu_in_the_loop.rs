@@ -25,6 +25,38 @@ fn the_emulated_stm32f405_answers_every_sensor_frame() {
         return;
     }
     let elf = build_mcu_firmware();
+    // The second UART is the ground link: QEMU sends its bytes to `gcs` over UDP.
+    // QEMU sends each UART byte as its own datagram, so the socket is read while the
+    // simulation runs (a 1-byte datagram costs a full buffer slot).
+    let gcs = std::net::UdpSocket::bind("127.0.0.1:0").expect("gcs socket");
+    gcs.set_read_timeout(Some(Duration::from_millis(100)))
+        .expect("timeout");
+    let gcs_addr = gcs.local_addr().expect("gcs addr");
+    let heartbeats = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let reader = {
+        let (heartbeats, done) = (heartbeats.clone(), done.clone());
+        std::thread::spawn(move || {
+            let mut parser = common::link::framing::FrameParser::new();
+            let mut buf = [0u8; 4096];
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                if let Ok((n, _)) = gcs.recv_from(&mut buf) {
+                    parser.push(&buf[..n], |f| {
+                        if let MavMessage::HEARTBEAT(h) = f.message {
+                            if h.mavtype == mavlink::dialects::common::MavType::MAV_TYPE_FIXED_WING
+                            {
+                                heartbeats.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            }
+                        }
+                    });
+                }
+            }
+        })
+    };
+    let qemu_port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .and_then(|s| s.local_addr())
+        .expect("free port")
+        .port();
     let mut qemu = None;
     let server = TcpServer::listen("127.0.0.1:0", Duration::from_secs(20), |addr| {
         let child = Command::new("qemu-system-arm")
@@ -39,7 +71,8 @@ fn the_emulated_stm32f405_answers_every_sensor_frame() {
             .args(["-monitor", "none"])
             .arg("-serial")
             .arg(format!("tcp:{addr},nodelay=on"))
-            .args(["-serial", "null"])
+            .arg("-serial")
+            .arg(format!("udp:{gcs_addr}@:{qemu_port}"))
             .arg("-kernel")
             .arg(&elf)
             .stdin(Stdio::null())
@@ -53,8 +86,8 @@ fn the_emulated_stm32f405_answers_every_sensor_frame() {
     let mut link = Lockstep::new(server, Duration::from_secs(10));
     link.wait_for_autopilot(Duration::from_secs(20))
         .expect("the MCU announces itself once its UART is up");
-    for k in 0..100u64 {
-        let t = k * 20_000;
+    for k in 0..250u64 {
+        let t = k * 20_000; // 50 Hz: 250 frames are 5 s of autopilot time
         let frame = SensorFrame {
             time_us: t,
             imu: Some(ImuSample {
@@ -69,5 +102,12 @@ fn the_emulated_stm32f405_answers_every_sensor_frame() {
         assert!(!answer.armed, "a fresh autopilot is disarmed");
     }
     assert_eq!(link.stats().crc_errors, 0);
+
+    // 5 s of autopilot time: heartbeats (1 Hz) of a fixed wing came down the ground UART.
+    std::thread::sleep(Duration::from_millis(500));
+    done.store(true, std::sync::atomic::Ordering::Relaxed);
+    let _ = reader.join();
+    let n = heartbeats.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(n >= 4, "{n} heartbeats on the ground UART");
     drop(qemu);
 }
