@@ -2,7 +2,7 @@
 
 use super::tlog::TlogWriter;
 use super::transport::Transport;
-use common::link::framing::{FrameParser, LinkStats, Sender};
+use common::link::framing::{encode_v2, Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame};
 use mavlink::dialects::common::MavMessage;
 use std::io;
@@ -97,35 +97,9 @@ impl<T: Transport> Lockstep<T> {
     /// before the autopilot has enabled it, and a UDP simulator learns its peer that way, so
     /// no sensor frame is sent before.
     pub fn wait_for_autopilot(&mut self, timeout: Duration) -> Result<(), LinkError> {
-        let start = Instant::now();
-        loop {
-            let n = self
-                .transport
-                .recv(&mut self.rx, Duration::from_millis(50))?;
-            let mut heard = false;
-            let tlog = &mut self.tlog;
-            let mut log_err = Ok(());
-            self.parser.push(&self.rx[..n], |f| {
-                if let Some(t) = tlog.as_mut() {
-                    let raw = common::link::framing::encode_v2(f.header, &f.message);
-                    if let Err(e) = t.write(0, raw.raw_bytes()) {
-                        log_err = Err(e);
-                    }
-                }
-                heard |= f.header.system_id == u32::from(SIM_SYSTEM_ID);
-            });
-            log_err?;
-            if heard {
-                return Ok(());
-            }
-            if start.elapsed() > timeout {
-                return Err(LinkError::Silent {
-                    time_s: 0.0,
-                    waited: timeout,
-                    frames: 0,
-                });
-            }
-        }
+        self.await_frame(0, timeout, |f| {
+            (f.header.system_id == u32::from(SIM_SYSTEM_ID)).then_some(())
+        })
     }
 
     /// Sends `messages` (stamped `time_us`) in one write and waits for the autopilot's
@@ -145,37 +119,53 @@ impl<T: Transport> Lockstep<T> {
             self.buf.extend_from_slice(raw.raw_bytes());
         }
         self.transport.send(&self.buf)?;
+        let answer = self.await_frame(time_us, self.timeout, |f| match &f.message {
+            MavMessage::HIL_ACTUATOR_CONTROLS(d) if d.time_usec == time_us => {
+                Some(simlink::decode_actuators(d))
+            }
+            _ => None,
+        })?;
+        self.answered += 1;
+        Ok(answer)
+    }
 
+    /// Reads the autopilot's frames, logging each at `time_us`, until `pick` accepts one; a
+    /// link quiet for longer than `timeout` is a silent autopilot.
+    fn await_frame<R>(
+        &mut self,
+        time_us: u64,
+        timeout: Duration,
+        mut pick: impl FnMut(&Frame) -> Option<R>,
+    ) -> Result<R, LinkError> {
         let start = Instant::now();
         loop {
             let n = self
                 .transport
                 .recv(&mut self.rx, Duration::from_millis(50))?;
-            let mut answer = None;
+            let mut found = None;
             let tlog = &mut self.tlog;
             let mut log_err = Ok(());
             self.parser.push(&self.rx[..n], |f| {
                 if let Some(t) = tlog.as_mut() {
-                    let raw = common::link::framing::encode_v2(f.header, &f.message);
+                    // Re-encoding a parsed MAVLink 2 frame gives back its bytes (same header,
+                    // same trimmed payload); the autopilot sends nothing else.
+                    let raw = encode_v2(f.header, &f.message);
                     if let Err(e) = t.write(time_us, raw.raw_bytes()) {
                         log_err = Err(e);
                     }
                 }
-                if let MavMessage::HIL_ACTUATOR_CONTROLS(d) = &f.message {
-                    if d.time_usec == time_us {
-                        answer = Some(simlink::decode_actuators(d));
-                    }
+                if found.is_none() {
+                    found = pick(&f);
                 }
             });
             log_err?;
-            if let Some(a) = answer {
-                self.answered += 1;
-                return Ok(a);
+            if let Some(r) = found {
+                return Ok(r);
             }
-            if n == 0 && start.elapsed() > self.timeout {
+            if n == 0 && start.elapsed() > timeout {
                 return Err(LinkError::Silent {
                     time_s: time_us as f64 * 1e-6,
-                    waited: self.timeout,
+                    waited: timeout,
                     frames: self.answered,
                 });
             }
