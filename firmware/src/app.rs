@@ -27,9 +27,7 @@ use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
 use common::params::ParamDef;
 use common::sensors::GpsFix;
-use mavlink::dialects::common::{
-    MavAutopilot, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, HEARTBEAT_DATA,
-};
+use mavlink::dialects::common::{MavMessage, MavSeverity};
 
 /// MAVLink identity of the autopilot (DESIGN.md: system 1, component 1).
 pub const SYSTEM_ID: u8 = 1;
@@ -703,20 +701,10 @@ fn truth_measurements(
     })
 }
 
-/// A heartbeat frame of the autopilot on its simulator link.
+/// A heartbeat frame of the autopilot on its simulator link (the ground link's heartbeat, so
+/// both links describe the vehicle the same way).
 pub fn heartbeat_frame(app: &mut App) -> heapless::Vec<u8, 280> {
-    let msg = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-        custom_mode: app.mode.custom_mode(),
-        mavtype: MavType::MAV_TYPE_FIXED_WING,
-        autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
-        base_mode: if app.armed {
-            MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
-        } else {
-            MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
-        },
-        system_status: MavState::MAV_STATE_STANDBY,
-        mavlink_version: 3,
-    });
+    let msg = common::gcs::telemetry::heartbeat(&app.snapshot());
     let raw = app.sim_tx.encode(&msg);
     heapless::Vec::from_slice(raw.raw_bytes()).unwrap_or_default()
 }
