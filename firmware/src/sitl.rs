@@ -51,26 +51,65 @@ impl std::str::FromStr for SimEndpoint {
 
 struct Tcp(TcpStream);
 
+/// Whether a read error only means that nothing arrived in time.
+pub fn timed_out(e: &io::Error) -> bool {
+    matches!(
+        e.kind(),
+        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
+    )
+}
+
+/// Reads from a TCP stream, waiting at most `timeout`: `Ok(0)` means nothing arrived, a
+/// closed connection is an `UnexpectedEof` error saying `who` closed it. Both ends of the
+/// simulator link read this way.
+pub fn read_tcp(
+    stream: &mut TcpStream,
+    buf: &mut [u8],
+    timeout: Duration,
+    who: &str,
+) -> io::Result<usize> {
+    stream.set_read_timeout(Some(timeout.max(Duration::from_micros(1))))?;
+    match stream.read(buf) {
+        Ok(0) => Err(io::Error::new(
+            io::ErrorKind::UnexpectedEof,
+            format!("{who} closed the connection"),
+        )),
+        Ok(n) => Ok(n),
+        Err(e) if timed_out(&e) => Ok(0),
+        Err(e) => Err(e),
+    }
+}
+
+/// Reads from a serial line or pty, waiting at most `timeout` (poll(2)): `Ok(0)` means
+/// nothing arrived, a line that hung up is an `UnexpectedEof` error.
+pub fn read_serial(
+    file: &mut std::fs::File,
+    buf: &mut [u8],
+    timeout: Duration,
+) -> io::Result<usize> {
+    use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
+    let ms = timeout.as_millis().min(i32::MAX as u128) as i32;
+    let mut fds = [PollFd::new(file.as_fd(), PollFlags::POLLIN)];
+    let ready = poll(
+        &mut fds,
+        PollTimeout::try_from(ms).unwrap_or(PollTimeout::MAX),
+    )
+    .map_err(io::Error::from)?;
+    if ready == 0 {
+        return Ok(0);
+    }
+    match file.read(buf) {
+        Ok(0) => Err(io::Error::new(
+            io::ErrorKind::UnexpectedEof,
+            "serial line closed",
+        )),
+        r => r,
+    }
+}
+
 impl ByteLink for Tcp {
     fn read_timeout(&mut self, buf: &mut [u8], timeout: Duration) -> io::Result<usize> {
-        self.0
-            .set_read_timeout(Some(timeout.max(Duration::from_micros(1))))?;
-        match self.0.read(buf) {
-            Ok(0) => Err(io::Error::new(
-                io::ErrorKind::UnexpectedEof,
-                "simulator closed the connection",
-            )),
-            Ok(n) => Ok(n),
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                ) =>
-            {
-                Ok(0)
-            }
-            Err(e) => Err(e),
-        }
+        read_tcp(&mut self.0, buf, timeout, "simulator")
     }
 
     fn write_all_bytes(&mut self, bytes: &[u8]) -> io::Result<()> {
@@ -90,14 +129,7 @@ impl ByteLink for Udp {
         match self.socket.recv_from(buf) {
             Ok((n, from)) if from == self.peer => Ok(n),
             Ok(_) => Ok(0),
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                ) =>
-            {
-                Ok(0)
-            }
+            Err(e) if timed_out(&e) => Ok(0),
             Err(e) => Err(e),
         }
     }
@@ -111,24 +143,7 @@ struct Serial(std::fs::File);
 
 impl ByteLink for Serial {
     fn read_timeout(&mut self, buf: &mut [u8], timeout: Duration) -> io::Result<usize> {
-        use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
-        let ms = timeout.as_millis().clamp(0, i32::MAX as u128) as i32;
-        let mut fds = [PollFd::new(self.0.as_fd(), PollFlags::POLLIN)];
-        let ready = poll(
-            &mut fds,
-            PollTimeout::try_from(ms).unwrap_or(PollTimeout::MAX),
-        )
-        .map_err(io::Error::from)?;
-        if ready == 0 {
-            return Ok(0);
-        }
-        match self.0.read(buf) {
-            Ok(0) => Err(io::Error::new(
-                io::ErrorKind::UnexpectedEof,
-                "serial line closed",
-            )),
-            r => r,
-        }
+        read_serial(&mut self.0, buf, timeout)
     }
 
     fn write_all_bytes(&mut self, bytes: &[u8]) -> io::Result<()> {

@@ -7,8 +7,9 @@
 //! - in-process: the firmware's own [`App`](firmware::app::App) runs inside this process; each
 //!   send hands it the encoded bytes and collects its encoded answer, with no thread hop.
 
+use firmware::sitl::{read_serial, read_tcp, timed_out};
 use std::collections::VecDeque;
-use std::io::{self, Read, Write};
+use std::io::{self, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, UdpSocket};
 use std::os::fd::{AsFd, OwnedFd};
 use std::path::PathBuf;
@@ -22,13 +23,6 @@ pub trait Transport {
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> io::Result<usize>;
     /// A description for messages ("tcp 127.0.0.1:4560", ...).
     fn describe(&self) -> String;
-}
-
-fn timed_out(e: &io::Error) -> bool {
-    matches!(
-        e.kind(),
-        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-    )
 }
 
 /// TCP: the simulator listens and accepts one autopilot.
@@ -77,17 +71,7 @@ impl Transport for TcpServer {
     }
 
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> io::Result<usize> {
-        self.stream
-            .set_read_timeout(Some(timeout.max(Duration::from_micros(1))))?;
-        match self.stream.read(buf) {
-            Ok(0) => Err(io::Error::new(
-                io::ErrorKind::UnexpectedEof,
-                "autopilot closed the connection",
-            )),
-            Ok(n) => Ok(n),
-            Err(e) if timed_out(&e) => Ok(0),
-            Err(e) => Err(e),
-        }
+        read_tcp(&mut self.stream, buf, timeout, "autopilot")
     }
 
     fn describe(&self) -> String {
@@ -207,18 +191,7 @@ impl Transport for PtyServer {
     }
 
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> io::Result<usize> {
-        use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
-        let ms = timeout.as_millis().min(i32::MAX as u128) as i32;
-        let mut fds = [PollFd::new(self.master.as_fd(), PollFlags::POLLIN)];
-        let ready = poll(
-            &mut fds,
-            PollTimeout::try_from(ms).unwrap_or(PollTimeout::MAX),
-        )
-        .map_err(io::Error::from)?;
-        if ready == 0 {
-            return Ok(0);
-        }
-        self.master.read(buf)
+        read_serial(&mut self.master, buf, timeout)
     }
 
     fn describe(&self) -> String {
