@@ -203,6 +203,29 @@ fn tf(num: &[f64], den: &[f64]) -> TransferFunction {
     TransferFunction::new(num, den)
 }
 
+/// A gain row of a loop: parameter, computed value, the thesis's designed value.
+fn gain(name: &str, computed: f64, thesis: f32) -> (String, f64, f64) {
+    (name.into(), computed, f64::from(thesis))
+}
+
+/// The loop transfer `L(jw)` of an inner loop with the servo and delay that act on it.
+fn with_actuation(l: &TransferFunction, actuation: impl Fn(f64) -> Complex<f64> + 'static) -> Freq {
+    let l = l.clone();
+    Box::new(move |w| l.eval(w) * actuation(w))
+}
+
+/// The loop transfer of an outer loop: its controller, the inner closed loop (as flown, with
+/// servo and delay), the kinematics from the inner loop's output, and the feedback path.
+fn through_inner(
+    controller: &TransferFunction,
+    inner: impl Fn(f64) -> Complex<f64> + 'static,
+    kinematics: &TransferFunction,
+    feedback: &TransferFunction,
+) -> Freq {
+    let (c, k, f) = (controller.clone(), kinematics.clone(), feedback.clone());
+    Box::new(move |w| c.eval(w) * inner(w) * k.eval(w) * f.eval(w))
+}
+
 /// `forward / (1 + forward * feedback)`.
 fn closed(forward: &TransferFunction, feedback: &TransferFunction) -> TransferFunction {
     use super::transfer::{poly_add, poly_mul};
@@ -363,16 +386,13 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "roll attitude (aileron)",
         vec![
-            ("RLL_KP".into(), roll_kp, d.lateral.roll_kp as f64),
-            ("RLL_KI".into(), roll_ki, d.lateral.roll_ki as f64),
-            ("RLL_RATE_KD".into(), roll_kd, d.lateral.roll_rate_kd as f64),
+            gain("RLL_KP", roll_kp, d.lateral.roll_kp),
+            gain("RLL_KI", roll_ki, d.lateral.roll_ki),
+            gain("RLL_RATE_KD", roll_kd, d.lateral.roll_rate_kd),
         ],
         wn_phi,
         &roll_cl,
-        Box::new({
-            let l = roll_loop.clone();
-            move |w| l.eval(w) * servo_delay(w)
-        }),
+        with_actuation(&roll_loop, servo_delay),
         3.0,
     ));
 
@@ -387,16 +407,17 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "course (commanded roll)",
         vec![
-            ("CRS_KP".into(), course_kp, d.lateral.course_kp as f64),
-            ("CRS_KI".into(), course_ki, d.lateral.course_ki as f64),
+            gain("CRS_KP", course_kp, d.lateral.course_kp),
+            gain("CRS_KI", course_ki, d.lateral.course_ki),
         ],
         wn_chi,
         &course_cl,
-        Box::new({
-            let (c, k) = (course_pi.clone(), kin.clone());
-            let r = roll_real.clone();
-            move |w| c.eval(w) * r(w) * k.eval(w)
-        }),
+        through_inner(
+            &course_pi,
+            roll_real.clone(),
+            &kin,
+            &TransferFunction::gain(1.0),
+        ),
         20.0,
     ));
 
@@ -409,15 +430,12 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "sideslip (rudder)",
         vec![
-            ("SLIP_KP".into(), slip_kp, d.lateral.slip_kp as f64),
-            ("SLIP_KI".into(), slip_ki, d.lateral.slip_ki as f64),
+            gain("SLIP_KP", slip_kp, d.lateral.slip_kp),
+            gain("SLIP_KI", slip_ki, d.lateral.slip_ki),
         ],
         wn_beta,
         &slip_loop.closed_loop(),
-        Box::new({
-            let l = slip_loop.clone();
-            move |w| l.eval(w) * servo_delay(w)
-        }),
+        with_actuation(&slip_loop, servo_delay),
         20.0,
     ));
 
@@ -468,20 +486,13 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "pitch attitude (elevator)",
         vec![
-            ("PTCH_KP".into(), pitch_kp, d.longitudinal.pitch_kp as f64),
-            ("PTCH_KI".into(), pitch_ki, d.longitudinal.pitch_ki as f64),
-            (
-                "PTCH_RATE_KD".into(),
-                pitch_kd,
-                d.longitudinal.pitch_rate_kd as f64,
-            ),
+            gain("PTCH_KP", pitch_kp, d.longitudinal.pitch_kp),
+            gain("PTCH_KI", pitch_ki, d.longitudinal.pitch_ki),
+            gain("PTCH_RATE_KD", pitch_kd, d.longitudinal.pitch_rate_kd),
         ],
         wn_theta,
         &pitch_cl,
-        Box::new({
-            let l = pitch_loop.clone();
-            move |w| l.eval(w) * servo_delay(w)
-        }),
+        with_actuation(&pitch_loop, servo_delay),
         4.0,
     ));
 
@@ -498,16 +509,12 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "altitude (commanded pitch)",
         vec![
-            ("ALT_KP".into(), alt_kp, d.longitudinal.alt_kp as f64),
-            ("ALT_KI".into(), alt_ki, d.longitudinal.alt_ki as f64),
+            gain("ALT_KP", alt_kp, d.longitudinal.alt_kp),
+            gain("ALT_KI", alt_ki, d.longitudinal.alt_ki),
         ],
         wn_h,
         &reduce(&closed(&alt_fwd, &filter)),
-        Box::new({
-            let (c, k, f) = (alt_pi.clone(), climb.clone(), filter.clone());
-            let p = pitch_real.clone();
-            move |w| c.eval(w) * p(w) * k.eval(w) * f.eval(w)
-        }),
+        through_inner(&alt_pi, pitch_real.clone(), &climb, &filter),
         40.0,
     ));
 
@@ -521,24 +528,12 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "airspeed (commanded pitch)",
         vec![
-            (
-                "ASPD_PTCH_KP".into(),
-                aspd_pitch_kp,
-                d.longitudinal.aspd_pitch_kp as f64,
-            ),
-            (
-                "ASPD_PTCH_KI".into(),
-                aspd_pitch_ki,
-                d.longitudinal.aspd_pitch_ki as f64,
-            ),
+            gain("ASPD_PTCH_KP", aspd_pitch_kp, d.longitudinal.aspd_pitch_kp),
+            gain("ASPD_PTCH_KI", aspd_pitch_ki, d.longitudinal.aspd_pitch_ki),
         ],
         wn_v2,
         &reduce(&closed(&ap_fwd, &filter)),
-        Box::new({
-            let (c, k, f) = (ap_pi.clone(), v_theta.clone(), filter.clone());
-            let p = pitch_real.clone();
-            move |w| c.eval(w) * p(w) * k.eval(w) * f.eval(w)
-        }),
+        through_inner(&ap_pi, pitch_real.clone(), &v_theta, &filter),
         40.0,
     ));
 
@@ -555,16 +550,8 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
     loops.push(predict(
         "airspeed (throttle)",
         vec![
-            (
-                "ASPD_THR_KP".into(),
-                aspd_thr_kp,
-                d.longitudinal.aspd_thr_kp as f64,
-            ),
-            (
-                "ASPD_THR_KI".into(),
-                aspd_thr_ki,
-                d.longitudinal.aspd_thr_ki as f64,
-            ),
+            gain("ASPD_THR_KP", aspd_thr_kp, d.longitudinal.aspd_thr_kp),
+            gain("ASPD_THR_KI", aspd_thr_ki, d.longitudinal.aspd_thr_ki),
         ],
         wn_v,
         &closed(&at_fwd, &filter),
