@@ -112,6 +112,13 @@ pub struct Setpoints {
     pub airspeed: f32,
 }
 
+/// What the rudder does in every stabilised mode: the yaw damper. The airframe has no
+/// sideslip sensor, and the sideslip the estimator derives from the wind triangle is circular
+/// (its wind filter assumes zero sideslip to find the wind), so a sideslip-hold loop on it
+/// would steer by the wind estimate's error: in light turbulence that held 2-3 deg of
+/// sideslip and doubled the course error. The truth feed carries no sideslip either.
+const RUDDER: YawMode = YawMode::Damper;
+
 /// Simulator truth, for logging and for the `SIM_USE_TRUTH` comparison only.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Truth {
@@ -423,7 +430,7 @@ impl App {
             FlightMode::Stabilized => Commands {
                 // Sticks command attitude within the loops' limits; centred: wings level.
                 roll: RollMode::Roll(sticks.map_or(0.0, |s| s.roll * gains.lateral.roll_max)),
-                yaw: YawMode::Sideslip(0.0),
+                yaw: RUDDER,
                 lon: LonMode::Pitch {
                     pitch: sticks.map_or(0.0, |s| s.pitch * level.pitch_max),
                     throttle: sticks.map_or(level.trim_throttle, |s| s.throttle),
@@ -431,7 +438,7 @@ impl App {
             },
             FlightMode::Altitude => Commands {
                 roll: RollMode::Roll(0.0),
-                yaw: YawMode::Sideslip(0.0),
+                yaw: RUDDER,
                 lon: LonMode::Altitude {
                     altitude: sp.alt_amsl_m,
                     airspeed: sp.airspeed,
@@ -439,7 +446,7 @@ impl App {
             },
             FlightMode::Hold => Commands {
                 roll: RollMode::Course(sp.course),
-                yaw: YawMode::Sideslip(0.0),
+                yaw: RUDDER,
                 lon: LonMode::Altitude {
                     altitude: sp.alt_amsl_m,
                     airspeed: sp.airspeed,

@@ -79,11 +79,11 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "EKF_NAV_ACC_N",
-        0.35,
+        0.1,
         0.001,
         10.0,
         "m/s^2/sqrt(Hz)",
-        "NED acceleration process-noise density of the position/velocity filter",
+        "accelerometer noise density of the inertial filter (velocity process noise)",
     ),
     ParamDef::real(
         "EKF_GPS_P_NOISE",
@@ -103,7 +103,7 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "EKF_GPS_V_NOISE",
-        0.15,
+        0.08,
         0.01,
         10.0,
         "m/s",
@@ -283,7 +283,7 @@ pub const PARAMS: &[ParamDef] = &[
         0.5,
         100.0,
         "",
-        "converged: averaged normalised mag innovation below this",
+        "converged: averaged normalised GPS-velocity and mag-heading innovations below this",
     ),
 ];
 

@@ -1,13 +1,11 @@
 //! State estimation from raw sensors: attitude, gyro bias, position, velocity, air data, wind.
 //!
-//! [`Estimator`] is the facade the autopilot loop talks to. It owns four filters, each a plain
+//! [`Estimator`] is the facade the autopilot loop talks to. It owns three filters, each a plain
 //! struct with its own `predict`/`update` (see `docs/ESTIMATOR.md` for the design):
-//! - [`attitude::AttitudeEkf`]: multiplicative EKF on the body-to-NED quaternion and the
-//!   gyro bias; gravity reference from the accelerometer with the centripetal acceleration of
-//!   turns removed, heading from the magnetometer against a fixed earth field;
-//! - [`nav::NavFilter`]: linear Kalman filter on NED position, velocity and barometer offset,
-//!   driven by the accelerometer rotated into NED, corrected by delayed GPS and by the
-//!   barometer, and by air data while GPS is lost;
+//! - [`ins::Ins`]: error-state EKF on attitude, velocity, position, gyro bias and barometer
+//!   offset, driven by the IMU and corrected by delayed GPS position and velocity (which level
+//!   it whatever the aircraft's accelerations), the barometer, the magnetic heading, and,
+//!   while GPS is missing, by the accelerometer as a gravity reference and by air data;
 //! - [`air::AirspeedFilter`]: true airspeed from the pitot and the barometer's density;
 //! - [`air::WindFilter`]: horizontal wind from airspeed and zero sideslip.
 //!
@@ -16,10 +14,9 @@
 //! counted and dropped, and the state stays as it was.
 
 pub mod air;
-pub mod attitude;
 pub mod config;
+pub mod ins;
 pub mod kalman;
-pub mod nav;
 
 #[cfg(test)]
 mod tests;
@@ -33,9 +30,8 @@ use crate::math::frames::{course_and_speed, AirData, Euler};
 use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
 use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
-use attitude::{AttitudeEkf, Motion, GRAVITY};
+use ins::{Fusion, GpsNoise, Ins, Motion, ProcessNoise};
 use nalgebra::{UnitQuaternion, Vector3};
-use nav::{GpsNoise, NavFilter};
 
 /// Largest accepted IMU time step, s (a longer gap is a stalled loop, not a time step).
 pub const MAX_IMU_DT_S: f32 = 0.2;
@@ -69,6 +65,12 @@ pub const LOCKOUT_SAMPLES: u32 = 50;
 const DEFAULT_DENSITY: f32 = 1.225;
 /// Averaging weight of the magnetometer innovation monitor (about 1 s at 50 Hz).
 const NIS_WEIGHT: f32 = 0.02;
+/// Averaging weight of the GPS velocity innovation monitor (about 2 s at 5 Hz).
+const GPS_NIS_WEIGHT: f32 = 0.1;
+/// GPS fixes fused into velocity before the estimate may be called converged (5 s at 5 Hz):
+/// long enough for a tilt error to show in the velocity innovations, which it does at
+/// `g * tilt` per second.
+pub const CONV_MIN_FIXES: u32 = 25;
 
 /// Health and bookkeeping of one sensor.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -203,8 +205,7 @@ pub struct EstimatedState {
 #[derive(Clone, Debug)]
 pub struct Estimator {
     cfg: EstimatorConfig,
-    att: AttitudeEkf,
-    nav: NavFilter,
+    ins: Ins,
     wind: WindFilter,
     airspeed: AirspeedFilter,
     health: SensorHealth,
@@ -216,6 +217,8 @@ pub struct Estimator {
     density: f32,
     home: Option<Home>,
     mag_nis: f32,
+    vel_nis: f32,
+    aided_fixes: u32,
     last_pitot_t: Option<f64>,
     imu_silent_samples: u32,
     alpha_memory: f32,
@@ -241,8 +244,7 @@ impl Estimator {
     pub fn new(cfg: EstimatorConfig) -> Self {
         Self {
             cfg,
-            att: AttitudeEkf::new(),
-            nav: NavFilter::new(),
+            ins: Ins::new(),
             wind: WindFilter::default(),
             airspeed: AirspeedFilter::default(),
             health: SensorHealth::default(),
@@ -254,6 +256,8 @@ impl Estimator {
             density: DEFAULT_DENSITY,
             home: None,
             mag_nis: 0.0,
+            vel_nis: 0.0,
+            aided_fixes: 0,
             last_pitot_t: None,
             imu_silent_samples: 0,
             alpha_memory: 0.0,
@@ -310,9 +314,8 @@ impl Estimator {
         self.imu_silent_samples = self.imu_silent_samples.saturating_add(1);
     }
 
-    /// Restarts the attitude filter from the latest accelerometer and magnetometer samples,
-    /// with the centripetal term of body-frame quantities only (the old attitude is not
-    /// trusted).
+    /// Restarts the attitude from the latest accelerometer and magnetometer samples, with the
+    /// centripetal term of body-frame quantities only (the old attitude is not trusted).
     fn restart_attitude(&mut self) {
         if let (Some(a), Some(m)) = (self.last_accel, self.last_mag) {
             let va = if self.health.pitot.healthy {
@@ -322,30 +325,37 @@ impl Estimator {
             };
             let gravity = a - self.rates.cross(&Vector3::new(va, 0.0, 0.0));
             let earth = self.earth_field();
-            self.att
-                .initialize(&gravity, &m, &earth, self.cfg.gyro_bias_init);
+            self.ins
+                .align(&gravity, &m, &earth, self.cfg.gyro_bias_init);
             self.wind = WindFilter::default();
             self.mag_nis = 0.0;
+            self.aided_fixes = 0;
         }
     }
 
     fn try_initialize_attitude(&mut self) {
-        if self.att.is_initialized() {
+        if self.ins.attitude_initialized() {
             return;
         }
         if let (Some(a), Some(m)) = (self.last_accel, self.last_mag) {
             let earth = self.earth_field();
-            self.att.initialize(&a, &m, &earth, self.cfg.gyro_bias_init);
+            self.ins.align(&a, &m, &earth, self.cfg.gyro_bias_init);
         }
+    }
+
+    /// GPS is levelling the filter: velocity is observed, so the accelerometer is not needed
+    /// (and must not be used) as a gravity reference.
+    fn gps_aided(&self) -> bool {
+        self.ins.nav_initialized() && self.health.gps.healthy
     }
 
     /// Air-relative velocity in body axes, for the centripetal term of the gravity reference.
     fn air_velocity_body(&self) -> Vector3<f32> {
-        let q = self.att.attitude();
-        if self.nav.is_initialized() && self.wind.is_initialized() && self.health.gps.healthy {
+        let q = self.ins.attitude();
+        if self.ins.nav_initialized() && self.wind.is_initialized() {
             // The wind triangle carries the angle of attack, which (omega x v) needs: at
             // 3 deg and 20 deg/s it is worth 0.15 m/s^2, about 1 deg of pitch.
-            q.inverse_transform_vector(&(self.nav.velocity() - self.wind.wind()))
+            q.inverse_transform_vector(&(self.ins.velocity() - self.wind.wind()))
         } else if self.health.pitot.healthy {
             let va = self.airspeed.value();
             let a = self.alpha_memory;
@@ -355,8 +365,19 @@ impl Estimator {
         }
     }
 
+    fn process_noise(&self) -> ProcessNoise {
+        let c = &self.cfg;
+        ProcessNoise {
+            gyro: c.gyro_noise,
+            gyro_bias: c.gyro_bias_rw,
+            accel: c.nav_accel_noise,
+            baro_offset: c.baro_bias_rw,
+        }
+    }
+
     /// One IMU sample over the time step `dt` (s) that ended with it. This advances the clock,
-    /// propagates every filter and fuses the gravity reference.
+    /// propagates every filter and, while GPS does not level the filter, fuses the gravity
+    /// reference.
     pub fn update_imu(&mut self, sample: &ImuSample, dt: f32) {
         if !(dt.is_finite() && dt > 0.0 && dt <= MAX_IMU_DT_S) {
             self.health.imu.reject();
@@ -379,19 +400,19 @@ impl Estimator {
         self.last_accel = Some(sample.accel);
         self.refresh_health();
         self.try_initialize_attitude();
-        if !self.att.is_initialized() {
+        if !self.ins.attitude_initialized() {
             return;
         }
         let c = self.cfg;
-        self.att
-            .predict(&sample.gyro, dt, c.gyro_noise, c.gyro_bias_rw);
-        self.rates = sample.gyro - self.att.gyro_bias();
-        let q = self.att.attitude();
-        let acc_ned = q.transform_vector(&sample.accel) + Vector3::new(0.0, 0.0, GRAVITY);
-        self.nav
-            .predict(self.t, &acc_ned, dt, c.nav_accel_noise, c.baro_bias_rw);
+        let noise = self.process_noise();
+        self.ins
+            .predict(self.t, &sample.accel, &sample.gyro, dt, &noise);
+        self.rates = sample.gyro - self.ins.gyro_bias();
         let wn = self.wind_noise();
         self.wind.predict(dt, &wn);
+        if self.gps_aided() {
+            return;
+        }
         let v_air = self.air_velocity_body();
         // Speeding up or slowing down tilts the apparent gravity nose-up or down: the
         // airspeed's rate of change, along the air velocity, is the acceleration's other part.
@@ -400,13 +421,15 @@ impl Estimator {
         } else {
             Vector3::zeros()
         };
-        if let Some(f) = self.att.fuse_accel(
+        let motion = Motion {
+            rates: self.rates,
+            v_air_body: v_air,
+            along_body: along,
+        };
+        if let Some(f) = self.ins.fuse_gravity(
+            self.t,
             &sample.accel,
-            &Motion {
-                rates: self.rates,
-                v_air_body: v_air,
-                along_body: along,
-            },
+            &motion,
             c.accel_noise,
             c.accel_gate,
             c.gate_sigma,
@@ -429,28 +452,22 @@ impl Estimator {
         self.health.mag.accept(self.t);
         self.last_mag = Some(sample.field);
         self.refresh_health();
-        if !self.att.is_initialized() {
+        if !self.ins.attitude_initialized() {
             self.try_initialize_attitude();
             return;
         }
         let earth = self.earth_field();
         let c = self.cfg;
-        if let Some(f) = self
-            .att
-            .fuse_mag(&sample.field, &earth, c.mag_noise, c.gate_sigma)
-        {
-            if self.health.mag.gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES) {
-                self.restart_attitude();
-            }
-            // A gated component enters the monitor at the gate, so a field that no longer
-            // matches the model shows up instead of vanishing.
-            let nis = if f.fused > 0 {
-                f.nis
-            } else {
-                c.gate_sigma * c.gate_sigma
-            };
-            self.mag_nis += NIS_WEIGHT * (nis - self.mag_nis);
+        let f = self
+            .ins
+            .fuse_mag_heading(self.t, &sample.field, &earth, c.mag_noise, c.gate_sigma);
+        if f.fused == 0 && f.gated == 0 {
+            return;
         }
+        if self.health.mag.gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES) {
+            self.restart_attitude();
+        }
+        self.mag_nis += NIS_WEIGHT * (monitored_nis(&f, c.gate_sigma) - self.mag_nis);
     }
 
     /// One barometer sample.
@@ -474,14 +491,14 @@ impl Estimator {
         if let Some(home) = self.home {
             let c = self.cfg;
             let f = self
-                .nav
-                .fuse_baro(home.alt_amsl_m - alt, c.baro_noise, c.gate_sigma);
+                .ins
+                .fuse_baro(self.t, home.alt_amsl_m - alt, c.baro_noise, c.gate_sigma);
             if self
                 .health
                 .baro
                 .gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES)
             {
-                self.nav.reset_baro_offset(home.alt_amsl_m - alt);
+                self.ins.reset_baro_offset(home.alt_amsl_m - alt);
             }
         }
     }
@@ -509,15 +526,15 @@ impl Estimator {
             c.airspeed_tau,
             c.airspeed_rate_tau,
         );
-        if !self.att.is_initialized() || !self.nav.is_initialized() || va < c.airspeed_min {
+        if !self.ins.attitude_initialized() || !self.ins.nav_initialized() || va < c.airspeed_min {
             return;
         }
-        let q = self.att.attitude();
+        let q = self.ins.attitude();
         if self.health.gps.healthy {
             let x = q.transform_vector(&Vector3::x());
             let y = q.transform_vector(&Vector3::y());
             let wn = self.wind_noise();
-            let v = self.nav.velocity();
+            let v = self.ins.velocity();
             let gated = self.wind.update(va, &v, &x, &y, &wn, c.gate_sigma);
             if self.health.pitot.gate(gated, gated == 2, LOCKOUT_SAMPLES) {
                 // Starts again from the wind triangle at the next sample.
@@ -536,8 +553,8 @@ impl Estimator {
             let a = self.alpha_memory;
             let body = Vector3::new(va * libm::cosf(a), 0.0, va * libm::sinf(a));
             let v = q.transform_vector(&body) + self.wind.wind();
-            self.nav
-                .fuse_horizontal_velocity(v.x, v.y, c.dead_reckon_vel_noise);
+            self.ins
+                .fuse_horizontal_velocity(self.t, v.x, v.y, c.dead_reckon_vel_noise);
         }
     }
 
@@ -563,6 +580,9 @@ impl Estimator {
         let was_healthy = self.health.gps.healthy;
         self.health.gps.accept(self.t);
         self.refresh_health();
+        if !self.ins.attitude_initialized() {
+            return;
+        }
         let c = self.cfg;
         let noise = self.gps_noise();
         let Some(home) = self.home else {
@@ -577,7 +597,7 @@ impl Estimator {
             };
             self.home = Some(home);
             let baro_offset = self.baro_alt.map_or(0.0, |b| b - fix.alt_amsl_m);
-            self.nav.initialize(
+            self.ins.start_nav(
                 self.t,
                 &Vector3::zeros(),
                 &fix.vel_ned,
@@ -585,40 +605,61 @@ impl Estimator {
                 baro_offset,
                 &noise,
             );
+            self.ins.reopen_attitude(c.gyro_bias_init);
+            self.restart_gps_monitor();
             return;
         };
+
         let (n, e): (f32, f32) = ned_offset(home.point, fix.position);
         let pos = Vector3::new(n, e, home.alt_amsl_m - fix.alt_amsl_m);
         let t_fix = self.t - f64::from(c.gps_delay);
-        let f = self
-            .nav
+        let (fp, fv) = self
+            .ins
             .fuse_gps(t_fix, &pos, &fix.vel_ned, &noise, c.gate_sigma);
+        if fv.fused > 0 || fv.gated > 0 {
+            self.vel_nis += GPS_NIS_WEIGHT * (monitored_nis(&fv, c.gate_sigma) - self.vel_nis);
+        }
+        if fv.fused > 0 {
+            self.aided_fixes = self.aided_fixes.saturating_add(1);
+        }
+        let gated = fp.gated + fv.gated;
         let limit = if was_healthy { GPS_RESET_FIXES } else { 1 };
         // Back from an outage, dead reckoning may have drifted beyond the gate: the first
         // refused fix moves the state at once.
-        if self.health.gps.gate(f.gated, f.gated > 0, limit) {
-            self.nav
-                .reset_to_gps(&pos, &fix.vel_ned, c.gps_delay, &noise);
+        if self.health.gps.gate(gated, gated > 0, limit) {
+            self.ins
+                .reset_to_gps(&pos, &fix.vel_ned, c.gps_delay, &noise, c.gyro_bias_init);
+            self.restart_gps_monitor();
         }
     }
 
-    /// True when the estimate is fit to arm on: attitude initialised with roll/pitch and
-    /// heading uncertainty below `EST_CONV_TILT` / `EST_CONV_HDG`, gyro bias uncertainty below
-    /// `EST_CONV_GBIAS` on every axis, the averaged normalised
-    /// magnetometer innovation below `EST_CONV_NIS` (the field matches the model), home set
-    /// with horizontal position and velocity uncertainty below `EST_CONV_POS` /
-    /// `EST_CONV_VEL`, and every sensor healthy.
+    fn restart_gps_monitor(&mut self) {
+        self.vel_nis = 0.0;
+        self.aided_fixes = 0;
+    }
+
+    /// True when the estimate is fit to arm on: attitude aligned with roll/pitch and heading
+    /// uncertainty below `EST_CONV_TILT` / `EST_CONV_HDG`, gyro bias uncertainty below
+    /// `EST_CONV_GBIAS` on every axis, home set with horizontal position and velocity
+    /// uncertainty below `EST_CONV_POS` / `EST_CONV_VEL`, every sensor healthy, and the
+    /// estimate agreeing with the sensors: at least [`CONV_MIN_FIXES`] GPS velocities fused
+    /// since the last start, and both the averaged normalised GPS velocity innovation and the
+    /// magnetic heading innovation below `EST_CONV_NIS`. A wrong attitude cannot pass the last
+    /// test for long: a tilt error makes the velocity drift by `g * tilt` per second, which
+    /// the GPS velocity (a few cm/s) sees.
     pub fn is_converged(&self) -> bool {
         let c = &self.cfg;
         let h = &self.health;
-        let (tilt, hdg) = self.att.tilt_heading_sigma();
-        let (pos, _, vel) = self.nav.sigmas();
-        self.att.is_initialized()
+        let (tilt, hdg) = self.ins.tilt_heading_sigma();
+        let (pos, _, vel) = self.ins.nav_sigmas();
+        self.ins.attitude_initialized()
             && tilt < c.conv_tilt
             && hdg < c.conv_heading
-            && self.att.bias_sigma().max() < c.conv_gyro_bias
+            && self.ins.bias_sigma().max() < c.conv_gyro_bias
             && self.mag_nis < c.conv_nis
-            && self.nav.is_initialized()
+            && self.ins.nav_initialized()
+            && self.aided_fixes >= CONV_MIN_FIXES
+            && self.vel_nis < c.conv_nis
             && pos < c.conv_pos
             && vel < c.conv_vel
             && h.imu.healthy
@@ -628,6 +669,10 @@ impl Estimator {
             && h.gps.healthy
     }
 
+    /// Averaged normalised GPS velocity innovation (about 1 when the estimate agrees with GPS).
+    pub fn gps_innovation_ratio(&self) -> f32 {
+        self.vel_nis
+    }
     /// Averaged normalised magnetometer innovation (about 1 when the field fits the model).
     pub fn mag_innovation_ratio(&self) -> f32 {
         self.mag_nis
@@ -635,17 +680,17 @@ impl Estimator {
 
     /// 1-sigma uncertainty of the gyro bias, rad/s.
     pub fn gyro_bias_sigma(&self) -> Vector3<f32> {
-        self.att.bias_sigma()
+        self.ins.bias_sigma()
     }
 
     /// The current estimate.
     pub fn state(&self) -> EstimatedState {
-        let q = self.att.attitude();
-        let vel = self.nav.velocity();
-        let pos = self.nav.position();
+        let q = self.ins.attitude();
+        let vel = self.ins.velocity();
+        let pos = self.ins.position();
         let (course, ground_speed) = course_and_speed(&vel);
         let wind = self.wind.wind();
-        let (alpha, sideslip) = if self.wind.is_initialized() && self.nav.is_initialized() {
+        let (alpha, sideslip) = if self.wind.is_initialized() && self.ins.nav_initialized() {
             let ad = AirData::from_body_velocity(&q.inverse_transform_vector(&(vel - wind)));
             (ad.alpha, ad.beta)
         } else {
@@ -660,7 +705,7 @@ impl Estimator {
             attitude: q,
             euler: Euler::from_quaternion(&q),
             body_rates: self.rates,
-            gyro_bias: self.att.gyro_bias(),
+            gyro_bias: self.ins.gyro_bias(),
             pos_ned: pos,
             position,
             alt_amsl_m,
@@ -673,11 +718,21 @@ impl Estimator {
             ground_speed,
             wind_ned: wind,
             health: self.health,
-            attitude_valid: self.att.is_initialized(),
-            position_valid: self.nav.is_initialized(),
+            attitude_valid: self.ins.attitude_initialized(),
+            position_valid: self.ins.nav_initialized(),
             wind_valid: self.wind.is_initialized(),
-            dead_reckoning: self.nav.is_initialized() && !self.health.gps.healthy,
+            dead_reckoning: self.ins.nav_initialized() && !self.health.gps.healthy,
             converged: self.is_converged(),
         }
+    }
+}
+
+/// The normalised innovation a monitor averages: a gated component enters at the gate, so a
+/// sensor that no longer matches the estimate shows up instead of vanishing.
+fn monitored_nis(f: &Fusion, gate_sigma: f32) -> f32 {
+    if f.fused > 0 && f.gated == 0 {
+        f.nis()
+    } else {
+        gate_sigma * gate_sigma
     }
 }

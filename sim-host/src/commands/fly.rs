@@ -353,8 +353,9 @@ pub fn results_markdown(
          every frame (100 Hz). Two windows: from the first `converged` (the launch transient \
          included: arming follows within a second and the autopilot pulls the hand-launched \
          aircraft onto its course and into the +100 m climb), and from 30 s after it. Wind error \
-         is horizontal, against the steady wind (what the wind filter estimates) and against the \
-         total wind with the Dryden turbulence. Targets: roll and pitch < 0.5 deg, heading < 2 deg, \
+         is horizontal, against the total wind at the aircraft (steady plus Dryden: the air mass \
+         the wind triangle measures, and the target's reference) and, for comparison, against \
+         the steady part alone. Targets: roll and pitch < 0.5 deg, heading < 2 deg, \
          altitude < 1 m, airspeed < 0.5 m/s, wind < 1 m/s.\n"
     );
     let _ = writeln!(
@@ -409,18 +410,18 @@ pub fn results_markdown(
                 "0.5",
             ),
             (
-                "wind vs steady (m/s)",
-                e.wind_rms_mps,
-                f64::NAN,
-                l.wind_rms_mps,
-                f64::NAN,
-                "1",
-            ),
-            (
                 "wind vs total (m/s)",
                 e.wind_total_rms_mps,
                 f64::NAN,
                 l.wind_total_rms_mps,
+                f64::NAN,
+                "1",
+            ),
+            (
+                "wind vs steady (m/s)",
+                e.wind_rms_mps,
+                f64::NAN,
+                l.wind_rms_mps,
                 f64::NAN,
                 "",
             ),

@@ -1,0 +1,854 @@
+//! Attitude, velocity, position, gyro bias and barometer offset: one error-state (multiplicative)
+//! extended Kalman filter with the IMU as its process input, aided by GPS.
+//!
+//! Why one filter: an attitude filter that takes the accelerometer for gravity is wrong
+//! whenever the aircraft accelerates in a way it cannot model, and a gust at 17 m/s on a
+//! 2 kg aircraft is exactly that (light Dryden turbulence moves the specific force by
+//! several m/s^2). Here the accelerometer is never a gravity measurement while GPS is
+//! healthy: it is integrated into velocity, and a tilt error shows as a growing velocity
+//! error (`g * tilt` per second) that the GPS velocity, good to 0.05 m/s, sees within a
+//! fix or two. Gusts then cost nothing: the IMU measures the acceleration they cause.
+//!
+//! Nominal state: body-to-NED quaternion `q`, NED velocity `v`, NED position from home `p`,
+//! gyro bias `b` and barometer offset `o` (baro altitude minus true altitude). Error state
+//! (13): a small rotation `dtheta` in NED (`R_true = (I + [dtheta]x) R`, so the heading
+//! error is the single component `dtheta.z`), `dv`, `dp`, `db`, `do`.
+//!
+//! - Propagation: `q <- q exp((w - b) dt)`, `v <- v + (R f + g) dt`, `p <- p + v dt`;
+//!   `d(dtheta)' = -R db`, `dv' = -[R f]x dtheta`, `dp' = dv`.
+//! - GPS position and velocity, delayed: innovations are formed against the state of the
+//!   fix's time (a short history is kept) and the correction is applied to the present
+//!   state and to the stored states after the fix (the error is nearly constant over the
+//!   0.1-0.2 s of latency).
+//! - Barometer: `home_alt - baro_alt = p_d - o`.
+//! - Magnetometer: heading only (tilt-compensated with the estimated roll and pitch), so a
+//!   field that does not match the model can never tilt the attitude.
+//! - Gravity reference from the accelerometer: only while nothing else levels the filter
+//!   (before the first fix, or GPS lost), with the centripetal acceleration of turns removed.
+//! - Air-data velocity while GPS is lost keeps the horizontal velocity bounded.
+
+use super::kalman::{condition, scalar_update, Fused, Refused};
+use crate::math::frames::Euler;
+use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
+
+/// Standard gravity, m/s^2.
+pub const GRAVITY: f32 = 9.80665;
+/// States kept for the delayed GPS update (0.64 s at 100 Hz).
+pub const HISTORY: usize = 64;
+/// Size of the error state.
+pub const N: usize = 13;
+
+type Mat = SMatrix<f32, N, N>;
+type Vecn = SVector<f32, N>;
+
+const ITH: usize = 0;
+const IV: usize = 3;
+const IP: usize = 6;
+const IBG: usize = 9;
+const IBO: usize = 12;
+
+/// Initial 1-sigma roll/pitch uncertainty (accelerometer levelling is good to a few deg).
+const INIT_TILT_SIGMA: f32 = 0.1;
+/// Initial 1-sigma heading uncertainty.
+const INIT_YAW_SIGMA: f32 = 0.3;
+/// Velocity uncertainty before the first fix, m/s (only attitude is meaningful then).
+const UNAIDED_VEL_SIGMA: f32 = 30.0;
+/// Position uncertainty before the first fix, m.
+const UNAIDED_POS_SIGMA: f32 = 100.0;
+
+/// The aircraft's motion as the gravity reference needs it: its acceleration is the
+/// centripetal `rates x v_air_body` of a turn or pull-up plus `along_body`, the acceleration
+/// along the flight path (airspeed changes).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    /// Bias-corrected body rates, rad/s.
+    pub rates: Vector3<f32>,
+    /// Air-relative velocity in body axes, m/s.
+    pub v_air_body: Vector3<f32>,
+    /// Acceleration along the flight path in body axes, m/s^2.
+    pub along_body: Vector3<f32>,
+}
+
+/// How one measurement (all its components) went.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Fusion {
+    /// Components fused.
+    pub fused: u8,
+    /// Components refused by the innovation gate.
+    pub gated: u8,
+    /// Sum of the normalised innovations squared of the fused components.
+    pub nis_sum: f32,
+}
+
+impl Fusion {
+    /// Mean normalised innovation squared of the fused components (0 when none).
+    pub fn nis(&self) -> f32 {
+        if self.fused == 0 {
+            0.0
+        } else {
+            self.nis_sum / f32::from(self.fused)
+        }
+    }
+}
+
+/// Noise settings of one GPS fix.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpsNoise {
+    /// Horizontal position, m.
+    pub horizontal: f32,
+    /// Vertical position, m.
+    pub vertical: f32,
+    /// Velocity per axis, m/s.
+    pub velocity: f32,
+}
+
+/// Process noise densities.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProcessNoise {
+    /// Gyro white noise, rad/s/sqrt(Hz).
+    pub gyro: f32,
+    /// Gyro bias random walk, rad/s^2/sqrt(Hz).
+    pub gyro_bias: f32,
+    /// Accelerometer white noise (and unmodelled accelerometer error), m/s^2/sqrt(Hz).
+    pub accel: f32,
+    /// Barometer offset random walk, m/sqrt(s).
+    pub baro_offset: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Snapshot {
+    t: f64,
+    q: UnitQuaternion<f32>,
+    v: Vector3<f32>,
+    p: Vector3<f32>,
+}
+
+impl Default for Snapshot {
+    fn default() -> Self {
+        Self {
+            t: f64::NEG_INFINITY,
+            q: UnitQuaternion::identity(),
+            v: Vector3::zeros(),
+            p: Vector3::zeros(),
+        }
+    }
+}
+
+/// The inertial navigation filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ins {
+    q: UnitQuaternion<f32>,
+    v: Vector3<f32>,
+    p: Vector3<f32>,
+    bias: Vector3<f32>,
+    baro_offset: f32,
+    cov: Mat,
+    history: [Snapshot; HISTORY],
+    head: usize,
+    len: usize,
+    attitude_ok: bool,
+    nav_ok: bool,
+}
+
+impl Default for Ins {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Ins {
+    /// An uninitialised filter (level, north, zero bias, no position).
+    pub fn new() -> Self {
+        Self {
+            q: UnitQuaternion::identity(),
+            v: Vector3::zeros(),
+            p: Vector3::zeros(),
+            bias: Vector3::zeros(),
+            baro_offset: 0.0,
+            cov: Mat::identity(),
+            history: [Snapshot::default(); HISTORY],
+            head: 0,
+            len: 0,
+            attitude_ok: false,
+            nav_ok: false,
+        }
+    }
+
+    /// True once the attitude has been levelled and aligned ([`Ins::align`]).
+    pub fn attitude_initialized(&self) -> bool {
+        self.attitude_ok
+    }
+
+    /// True once a GPS fix has set position and velocity.
+    pub fn nav_initialized(&self) -> bool {
+        self.nav_ok
+    }
+
+    /// Body-to-NED attitude.
+    pub fn attitude(&self) -> UnitQuaternion<f32> {
+        self.q
+    }
+
+    /// Estimated gyro bias, rad/s.
+    pub fn gyro_bias(&self) -> Vector3<f32> {
+        self.bias
+    }
+
+    /// Velocity NED, m/s.
+    pub fn velocity(&self) -> Vector3<f32> {
+        self.v
+    }
+
+    /// Position NED from home, m.
+    pub fn position(&self) -> Vector3<f32> {
+        self.p
+    }
+
+    /// Barometer offset (baro altitude minus true altitude), m.
+    pub fn baro_offset(&self) -> f32 {
+        self.baro_offset
+    }
+
+    fn sigma(&self, i: usize) -> f32 {
+        libm::sqrtf(self.cov[(i, i)])
+    }
+
+    /// 1-sigma roll/pitch (combined) and heading uncertainty, rad.
+    pub fn tilt_heading_sigma(&self) -> (f32, f32) {
+        (
+            libm::sqrtf(self.cov[(ITH, ITH)] + self.cov[(ITH + 1, ITH + 1)]),
+            self.sigma(ITH + 2),
+        )
+    }
+
+    /// 1-sigma uncertainty of each gyro bias component, rad/s.
+    pub fn bias_sigma(&self) -> Vector3<f32> {
+        Vector3::new(self.sigma(IBG), self.sigma(IBG + 1), self.sigma(IBG + 2))
+    }
+
+    /// 1-sigma horizontal position, vertical position and velocity (largest axis) uncertainty.
+    pub fn nav_sigmas(&self) -> (f32, f32, f32) {
+        let d = self.cov.diagonal();
+        (
+            libm::sqrtf(d[IP].max(d[IP + 1])),
+            libm::sqrtf(d[IP + 2]),
+            libm::sqrtf(d[IV].max(d[IV + 1]).max(d[IV + 2])),
+        )
+    }
+
+    /// Levels from the specific force `gravity` (the accelerometer with any known acceleration
+    /// removed) and takes the heading from the magnetometer against the earth field
+    /// `earth_ned`. Returns false, and changes nothing, when the vectors are too short to
+    /// define an attitude. Velocity and position keep their values; their correlation with
+    /// the old attitude is dropped.
+    pub fn align(
+        &mut self,
+        gravity: &Vector3<f32>,
+        mag: &Vector3<f32>,
+        earth_ned: &Vector3<f32>,
+        bias_sigma: f32,
+    ) -> bool {
+        let horizontal_earth = libm::hypotf(earth_ned.x, earth_ned.y);
+        if gravity.norm() < 0.5 * GRAVITY || mag.norm() < 1e-3 || horizontal_earth < 1e-3 {
+            return false;
+        }
+        // In steady flight or at rest the accelerometer reads -g rotated into the body.
+        let phi = libm::atan2f(-gravity.y, -gravity.z);
+        let theta = libm::atan2f(gravity.x, libm::hypotf(gravity.y, gravity.z));
+        let Some(psi) = mag_heading(phi, theta, mag, earth_ned) else {
+            return false;
+        };
+        let q = Euler::new(phi, theta, psi).to_quaternion();
+        if !q.coords.iter().all(|c| c.is_finite()) {
+            return false;
+        }
+        self.q = q;
+        self.bias = Vector3::zeros();
+        self.reset_attitude_covariance(bias_sigma, false);
+        if !self.nav_ok {
+            self.reset_nav_covariance(
+                UNAIDED_POS_SIGMA,
+                UNAIDED_POS_SIGMA,
+                UNAIDED_VEL_SIGMA,
+                UNAIDED_POS_SIGMA,
+            );
+        }
+        self.attitude_ok = true;
+        true
+    }
+
+    /// Raises the attitude and gyro-bias uncertainty back to their initial values (never
+    /// lowering one) and forgets their correlations: what the gravity reference taught the
+    /// filter before GPS (or during an outage) is a coarse alignment, made under assumptions
+    /// about the aircraft's motion, and GPS velocity should be free to overrule it.
+    pub fn reopen_attitude(&mut self, bias_sigma: f32) {
+        self.reset_attitude_covariance(bias_sigma, true);
+    }
+
+    fn reset_attitude_covariance(&mut self, bias_sigma: f32, keep_larger: bool) {
+        let t = INIT_TILT_SIGMA * INIT_TILT_SIGMA;
+        let b = bias_sigma * bias_sigma;
+        let initial = [t, t, INIT_YAW_SIGMA * INIT_YAW_SIGMA, b, b, b];
+        let states = [ITH, ITH + 1, ITH + 2, IBG, IBG + 1, IBG + 2];
+        for (k, init) in states.into_iter().zip(initial) {
+            let d = if keep_larger {
+                self.cov[(k, k)].max(init)
+            } else {
+                init
+            };
+            for i in 0..N {
+                self.cov[(i, k)] = 0.0;
+                self.cov[(k, i)] = 0.0;
+            }
+            self.cov[(k, k)] = d;
+        }
+    }
+
+    /// Starts navigation from a GPS fix taken `delay` s ago: position `pos` (NED from home),
+    /// velocity `vel`, barometer offset `baro_offset` (0 without a barometer reading).
+    pub fn start_nav(
+        &mut self,
+        t: f64,
+        pos: &Vector3<f32>,
+        vel: &Vector3<f32>,
+        delay: f32,
+        baro_offset: f32,
+        noise: &GpsNoise,
+    ) {
+        self.p = pos + vel * delay;
+        self.v = *vel;
+        self.baro_offset = baro_offset;
+        let vel_sigma = noise.velocity.max(0.5);
+        self.reset_nav_covariance(
+            noise.horizontal,
+            noise.vertical,
+            vel_sigma,
+            libm::sqrtf(noise.vertical * noise.vertical + 1.0),
+        );
+        self.len = 0;
+        self.head = 0;
+        self.nav_ok = true;
+        self.remember(t);
+    }
+
+    /// Sets the velocity, position and baro-offset variances and drops their correlations.
+    fn reset_nav_covariance(&mut self, horizontal: f32, vertical: f32, vel: f32, offset: f32) {
+        for k in IV..IBG {
+            for i in 0..N {
+                self.cov[(i, k)] = 0.0;
+                self.cov[(k, i)] = 0.0;
+            }
+        }
+        for i in 0..N {
+            self.cov[(i, IBO)] = 0.0;
+            self.cov[(IBO, i)] = 0.0;
+        }
+        let v2 = vel * vel;
+        let h2 = horizontal * horizontal;
+        for k in 0..3 {
+            self.cov[(IV + k, IV + k)] = v2;
+        }
+        self.cov[(IP, IP)] = h2;
+        self.cov[(IP + 1, IP + 1)] = h2;
+        self.cov[(IP + 2, IP + 2)] = vertical * vertical;
+        self.cov[(IBO, IBO)] = offset * offset;
+    }
+
+    /// Propagates the state and covariance over `dt` ending at time `t` with one IMU sample
+    /// (specific force `accel`, m/s^2, and rates `gyro`, rad/s, both body axes).
+    pub fn predict(
+        &mut self,
+        t: f64,
+        accel: &Vector3<f32>,
+        gyro: &Vector3<f32>,
+        dt: f32,
+        noise: &ProcessNoise,
+    ) {
+        if !self.attitude_ok {
+            return;
+        }
+        let r = self.q.to_rotation_matrix().into_inner();
+        let f_ned = r * accel;
+        let a = f_ned + Vector3::new(0.0, 0.0, GRAVITY);
+        let omega = gyro - self.bias;
+        let q = self.q * UnitQuaternion::from_scaled_axis(omega * dt);
+        let (v, p) = if self.nav_ok {
+            (self.v + a * dt, self.p + self.v * dt + a * (0.5 * dt * dt))
+        } else {
+            (self.v, self.p)
+        };
+        let mut phi = Mat::identity();
+        phi.fixed_view_mut::<3, 3>(ITH, IBG).copy_from(&(-r * dt));
+        if self.nav_ok {
+            let fx = f_ned.cross_matrix();
+            phi.fixed_view_mut::<3, 3>(IV, ITH).copy_from(&(-fx * dt));
+            phi.fixed_view_mut::<3, 3>(IP, ITH)
+                .copy_from(&(-fx * (0.5 * dt * dt)));
+            phi.fixed_view_mut::<3, 3>(IP, IV)
+                .copy_from(&(Matrix3::identity() * dt));
+        }
+        let mut qd = Mat::zeros();
+        let g = noise.gyro * noise.gyro * dt;
+        let qa = noise.accel * noise.accel * dt;
+        let b = noise.gyro_bias * noise.gyro_bias * dt;
+        for k in 0..3 {
+            qd[(ITH + k, ITH + k)] = g;
+            qd[(IBG + k, IBG + k)] = b;
+            if self.nav_ok {
+                // Integrated white acceleration: the exact discrete covariance of (p, v).
+                qd[(IV + k, IV + k)] = qa;
+                qd[(IP + k, IP + k)] = qa * dt * dt / 3.0;
+                qd[(IP + k, IV + k)] = qa * dt / 2.0;
+                qd[(IV + k, IP + k)] = qa * dt / 2.0;
+            }
+        }
+        qd[(IBO, IBO)] = noise.baro_offset * noise.baro_offset * dt;
+        let cov = phi * self.cov * phi.transpose() + qd;
+        self.commit(q, v, p, self.bias, self.baro_offset, cov);
+        if self.nav_ok {
+            self.remember(t);
+        }
+    }
+
+    fn remember(&mut self, t: f64) {
+        self.head = (self.head + 1) % HISTORY;
+        if let Some(s) = self.history.get_mut(self.head) {
+            *s = Snapshot {
+                t,
+                q: self.q,
+                v: self.v,
+                p: self.p,
+            };
+        }
+        self.len = (self.len + 1).min(HISTORY);
+    }
+
+    /// The stored state closest to time `t` (the present state when nothing is stored).
+    fn state_at(&self, t: f64) -> Snapshot {
+        let mut best = Snapshot {
+            t,
+            q: self.q,
+            v: self.v,
+            p: self.p,
+        };
+        let mut best_err = f64::INFINITY;
+        for k in 0..self.len {
+            let i = (self.head + HISTORY - k) % HISTORY;
+            if let Some(s) = self.history.get(i) {
+                let e = (s.t - t).abs();
+                if e < best_err {
+                    best_err = e;
+                    best = *s;
+                }
+            }
+        }
+        best
+    }
+
+    /// Applies an error-state correction to the present state and to the stored states after
+    /// `t_meas` (so the next delayed fix compares like with like). Returns whether the
+    /// present state accepted it.
+    fn apply(&mut self, dx: &Vecn, cov: Mat, t_meas: f64) -> bool {
+        let dtheta = Vector3::new(dx[ITH], dx[ITH + 1], dx[ITH + 2]);
+        let dv = Vector3::new(dx[IV], dx[IV + 1], dx[IV + 2]);
+        let dp = Vector3::new(dx[IP], dx[IP + 1], dx[IP + 2]);
+        let db = Vector3::new(dx[IBG], dx[IBG + 1], dx[IBG + 2]);
+        let rot = UnitQuaternion::from_scaled_axis(dtheta);
+        let ok = self.commit(
+            rot * self.q,
+            self.v + dv,
+            self.p + dp,
+            self.bias + db,
+            self.baro_offset + dx[IBO],
+            cov,
+        );
+        if ok {
+            for k in 0..self.len {
+                let i = (self.head + HISTORY - k) % HISTORY;
+                if let Some(s) = self.history.get_mut(i) {
+                    if s.t >= t_meas - 1e-4 {
+                        s.q = rot * s.q;
+                        s.v += dv;
+                        s.p += dp;
+                    }
+                }
+            }
+        }
+        ok
+    }
+
+    /// Fuses one scalar component: `innov` against the error-state row `h`.
+    fn fuse_scalar(
+        &mut self,
+        h: &Vecn,
+        innov: f32,
+        r: f32,
+        gate_sigma: f32,
+        t_meas: f64,
+        out: &mut Fusion,
+    ) {
+        let mut cov = self.cov;
+        match scalar_update(&mut cov, h, innov, r, gate_sigma) {
+            Ok(Fused { dx, nis }) => {
+                if self.apply(&dx, cov, t_meas) {
+                    out.fused += 1;
+                    out.nis_sum += nis;
+                }
+            }
+            Err(Refused::Gated) => out.gated += 1,
+            Err(Refused::Degenerate) => {}
+        }
+    }
+
+    /// Fuses a GPS fix taken at time `t_meas`: position NED from home and velocity NED.
+    pub fn fuse_gps(
+        &mut self,
+        t_meas: f64,
+        pos: &Vector3<f32>,
+        vel: &Vector3<f32>,
+        noise: &GpsNoise,
+        gate_sigma: f32,
+    ) -> (Fusion, Fusion) {
+        let mut pos_out = Fusion::default();
+        let mut vel_out = Fusion::default();
+        if !self.nav_ok {
+            return (pos_out, vel_out);
+        }
+        let past = self.state_at(t_meas);
+        let (v0, p0) = (self.v, self.p);
+        let h2 = noise.horizontal * noise.horizontal;
+        let z2 = noise.vertical * noise.vertical;
+        let v2 = noise.velocity * noise.velocity;
+        // Velocity first: it carries the attitude information, and is the sharper measurement.
+        for i in 0..3 {
+            let mut h = Vecn::zeros();
+            h[IV + i] = 1.0;
+            let innov = vel[i] - (past.v[i] + (self.v[i] - v0[i]));
+            self.fuse_scalar(&h, innov, v2, gate_sigma, t_meas, &mut vel_out);
+        }
+        for (i, r) in [h2, h2, z2].into_iter().enumerate() {
+            let mut h = Vecn::zeros();
+            h[IP + i] = 1.0;
+            let innov = pos[i] - (past.p[i] + (self.p[i] - p0[i]));
+            self.fuse_scalar(&h, innov, r, gate_sigma, t_meas, &mut pos_out);
+        }
+        (pos_out, vel_out)
+    }
+
+    /// Fuses a barometric altitude: `home_minus_baro = home_alt - baro_alt` (m).
+    pub fn fuse_baro(&mut self, t: f64, home_minus_baro: f32, noise: f32, gate: f32) -> Fusion {
+        let mut out = Fusion::default();
+        if !self.nav_ok {
+            return out;
+        }
+        let mut h = Vecn::zeros();
+        h[IP + 2] = 1.0;
+        h[IBO] = -1.0;
+        let innov = home_minus_baro - (self.p.z - self.baro_offset);
+        self.fuse_scalar(&h, innov, noise * noise, gate, t, &mut out);
+        out
+    }
+
+    /// Fuses a horizontal velocity (north, east) known to `noise` m/s, e.g. from air data.
+    /// Not gated: it stands in for GPS while GPS is missing and must not lock itself out.
+    pub fn fuse_horizontal_velocity(&mut self, t: f64, vn: f32, ve: f32, noise: f32) -> Fusion {
+        let mut out = Fusion::default();
+        if !self.nav_ok {
+            return out;
+        }
+        for (i, z) in [(0, vn), (1, ve)] {
+            let mut h = Vecn::zeros();
+            h[IV + i] = 1.0;
+            let innov = z - self.v[i];
+            self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t, &mut out);
+        }
+        out
+    }
+
+    /// Fuses the magnetic heading: the direction of the magnetometer's field `mag`, rotated
+    /// into NED with the estimated attitude, in the horizontal plane, against that of the
+    /// earth field `earth_ned`. `noise` is the per-axis field noise, gauss.
+    ///
+    /// A tilt error moves that direction too (by `B_d / B_h`, about 3 at mid-latitudes, per
+    /// radian of roll or pitch about the field's horizontal axis), and the Jacobian says so:
+    /// a heading fusion that ignored it would turn every roll error into a heading and gyro
+    /// bias error, which the centripetal term of the gravity reference turns back into roll.
+    pub fn fuse_mag_heading(
+        &mut self,
+        t: f64,
+        mag: &Vector3<f32>,
+        earth_ned: &Vector3<f32>,
+        noise: f32,
+        gate_sigma: f32,
+    ) -> Fusion {
+        let mut out = Fusion::default();
+        let bh2 = earth_ned.x * earth_ned.x + earth_ned.y * earth_ned.y;
+        if !self.attitude_ok || bh2 < 1e-6 {
+            return out;
+        }
+        let m_ned = self.q.transform_vector(mag);
+        if libm::hypotf(m_ned.x, m_ned.y) < 1e-4 {
+            return out;
+        }
+        let innov = crate::math::wrap_pi(
+            libm::atan2f(earth_ned.y, earth_ned.x) - libm::atan2f(m_ned.y, m_ned.x),
+        );
+        let mut h = Vecn::zeros();
+        h[ITH] = -earth_ned.z * earth_ned.x / bh2;
+        h[ITH + 1] = -earth_ned.z * earth_ned.y / bh2;
+        h[ITH + 2] = 1.0;
+        let sigma = noise / libm::sqrtf(bh2);
+        self.fuse_scalar(&h, innov, sigma * sigma, gate_sigma, t, &mut out);
+        out
+    }
+
+    /// Fuses the accelerometer as a gravity reference: `accel` is the measured specific force
+    /// and `motion` what the aircraft is known to be doing. Skipped (None) when the
+    /// compensated specific force is further than `gate_mps2` from g: then the aircraft
+    /// accelerates in a way the model does not know.
+    pub fn fuse_gravity(
+        &mut self,
+        t: f64,
+        accel: &Vector3<f32>,
+        motion: &Motion,
+        noise: f32,
+        gate_mps2: f32,
+        gate_sigma: f32,
+    ) -> Option<Fusion> {
+        if !self.attitude_ok {
+            return None;
+        }
+        let v_air = &motion.v_air_body;
+        let maneuver = motion.rates.cross(v_air) + motion.along_body;
+        if libm::fabsf((accel - maneuver).norm() - GRAVITY) > gate_mps2 {
+            return None;
+        }
+        let minus_g = Vector3::new(0.0, 0.0, -GRAVITY);
+        // The centripetal term carries the bias error too: (w - db) x v = m + [v]x db. Left
+        // out, a bias error would read as a tilt and feed itself.
+        let bias_jac = v_air.cross_matrix();
+        let mut out = Fusion::default();
+        for axis in 0..3 {
+            let rt = self.q.to_rotation_matrix().into_inner().transpose();
+            let predicted = maneuver + rt * minus_g;
+            let jac = rt * minus_g.cross_matrix();
+            let mut h = Vecn::zeros();
+            h.fixed_rows_mut::<3>(ITH)
+                .copy_from(&jac.row(axis).transpose());
+            h.fixed_rows_mut::<3>(IBG)
+                .copy_from(&bias_jac.row(axis).transpose());
+            let innov = accel[axis] - predicted[axis];
+            self.fuse_scalar(&h, innov, noise * noise, gate_sigma, t, &mut out);
+        }
+        Some(out)
+    }
+
+    /// Moves position and velocity to a GPS fix taken `delay` s ago (after a long outage or a
+    /// lock-out the filter may have drifted beyond its gate). The attitude and gyro-bias
+    /// uncertainty is raised back to its initial value (`bias_sigma` for the bias), so an
+    /// attitude error that caused the drift is learned again rather than believed.
+    pub fn reset_to_gps(
+        &mut self,
+        pos: &Vector3<f32>,
+        vel: &Vector3<f32>,
+        delay: f32,
+        noise: &GpsNoise,
+        bias_sigma: f32,
+    ) {
+        let now = pos + vel * delay;
+        let (dp, dv) = (now - self.p, vel - self.v);
+        if !(dp.iter().all(|c| c.is_finite()) && dv.iter().all(|c| c.is_finite())) {
+            return;
+        }
+        self.p = now;
+        self.v = *vel;
+        for k in 0..self.len {
+            let i = (self.head + HISTORY - k) % HISTORY;
+            if let Some(s) = self.history.get_mut(i) {
+                s.p += dp;
+                s.v += dv;
+            }
+        }
+        let offset = libm::sqrtf(self.cov[(IBO, IBO)] + noise.vertical * noise.vertical);
+        self.reset_nav_covariance(
+            noise.horizontal,
+            noise.vertical,
+            noise.velocity.max(0.5),
+            offset,
+        );
+        self.reopen_attitude(bias_sigma);
+    }
+
+    /// Makes the baro offset agree with one barometric altitude (`home_alt - baro_alt`) after
+    /// a lock-out, with its uncertainty back to the vertical position's.
+    pub fn reset_baro_offset(&mut self, home_minus_baro: f32) {
+        let b = self.p.z - home_minus_baro;
+        if !b.is_finite() {
+            return;
+        }
+        self.baro_offset = b;
+        for i in 0..N {
+            self.cov[(i, IBO)] = 0.0;
+            self.cov[(IBO, i)] = 0.0;
+        }
+        self.cov[(IBO, IBO)] = self.cov[(IP + 2, IP + 2)] + 1.0;
+    }
+
+    /// Accepts a new state only when everything in it is finite; the covariance is kept
+    /// symmetric and bounded. Returns whether the state was accepted.
+    fn commit(
+        &mut self,
+        q: UnitQuaternion<f32>,
+        v: Vector3<f32>,
+        p: Vector3<f32>,
+        bias: Vector3<f32>,
+        baro_offset: f32,
+        mut cov: Mat,
+    ) -> bool {
+        let q = UnitQuaternion::new_normalize(q.into_inner());
+        let finite = q.coords.iter().all(|c| c.is_finite())
+            && v.iter().all(|c| c.is_finite())
+            && p.iter().all(|c| c.is_finite())
+            && bias.iter().all(|c| c.is_finite())
+            && baro_offset.is_finite();
+        if !finite || !condition(&mut cov, 1e-12, 1e8) {
+            return false;
+        }
+        self.q = q;
+        self.v = v;
+        self.p = p;
+        self.bias = bias;
+        self.baro_offset = baro_offset;
+        self.cov = cov;
+        true
+    }
+}
+
+/// Heading from a magnetometer sample levelled with roll `phi` and pitch `theta`, against the
+/// earth field `earth_ned` (so the declination is included). None for a degenerate field.
+pub fn mag_heading(
+    phi: f32,
+    theta: f32,
+    mag: &Vector3<f32>,
+    earth_ned: &Vector3<f32>,
+) -> Option<f32> {
+    let tilt = Euler::new(phi, theta, 0.0).to_quaternion();
+    let m_level = tilt.transform_vector(mag);
+    if libm::hypotf(m_level.x, m_level.y) < 1e-4 {
+        return None;
+    }
+    let psi = libm::atan2f(earth_ned.y, earth_ned.x) - libm::atan2f(m_level.y, m_level.x);
+    let psi = crate::math::wrap_pi(psi);
+    psi.is_finite().then_some(psi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const EARTH: Vector3<f32> = Vector3::new(0.18, -0.01, 0.52);
+
+    fn noise() -> ProcessNoise {
+        ProcessNoise {
+            gyro: 0.0015,
+            gyro_bias: 5e-5,
+            accel: 0.2,
+            baro_offset: 0.01,
+        }
+    }
+
+    fn gps() -> GpsNoise {
+        GpsNoise {
+            horizontal: 1.5,
+            vertical: 5.5,
+            velocity: 0.05,
+        }
+    }
+
+    #[test]
+    fn aligns_from_gravity_and_field() {
+        let truth = Euler::new(0.2_f32, -0.1, 2.0);
+        let q = truth.to_quaternion();
+        let accel = q.inverse_transform_vector(&Vector3::new(0.0, 0.0, -GRAVITY));
+        let mag = q.inverse_transform_vector(&EARTH);
+        let mut f = Ins::new();
+        assert!(!f.align(&Vector3::zeros(), &mag, &EARTH, 0.05));
+        assert!(f.align(&accel, &mag, &EARTH, 0.05));
+        let e = Euler::from_quaternion(&f.attitude());
+        assert!((e.phi - 0.2).abs() < 1e-4);
+        assert!((e.theta + 0.1).abs() < 1e-4);
+        assert!((e.psi - 2.0).abs() < 1e-4);
+    }
+
+    /// Straight flight north at 17 m/s with a vertical specific force that jumps by +-4 m/s^2
+    /// every half second (a gusty ride): the filter starts 8 deg off in roll and 6 deg in
+    /// pitch and must level itself from GPS velocity alone, the accelerometer never being
+    /// taken for gravity.
+    #[test]
+    fn gps_velocity_levels_a_tilted_start_in_gusts() {
+        let mut f = Ins::new();
+        let level_accel = Vector3::new(0.0, 0.0, -GRAVITY);
+        let mag = EARTH;
+        assert!(f.align(&level_accel, &mag, &EARTH, 0.01));
+        f.q = Euler::new(0.14_f32, 0.10, 0.0).to_quaternion();
+        let vel = Vector3::new(17.0, 0.0, 0.0);
+        f.start_nav(0.0, &Vector3::zeros(), &vel, 0.0, 0.0, &gps());
+        let dt = 0.01;
+        let mut v_true = vel;
+        let mut p_true = Vector3::zeros();
+        for k in 1..=3000 {
+            let t = f64::from(k) * f64::from(dt);
+            // Gust load: the true specific force and the true vertical acceleration agree.
+            let gust = if (k / 50) % 2 == 0 { 4.0 } else { -4.0 };
+            let accel = Vector3::new(0.0, 0.0, -GRAVITY - gust);
+            v_true.z += -gust * dt;
+            p_true += v_true * dt;
+            f.predict(t, &accel, &Vector3::zeros(), dt, &noise());
+            if k % 20 == 0 {
+                f.fuse_gps(t, &p_true, &v_true, &gps(), 5.0);
+                f.fuse_mag_heading(t, &mag, &EARTH, 0.02, 5.0);
+            }
+        }
+        let e = Euler::from_quaternion(&f.attitude());
+        assert!(e.phi.abs() < 0.005, "roll {}", e.phi);
+        assert!(e.theta.abs() < 0.005, "pitch {}", e.theta);
+        assert!(e.psi.abs() < 0.01, "heading {}", e.psi);
+        // Confident enough to pass the default convergence threshold (EST_CONV_TILT).
+        let (tilt, _) = f.tilt_heading_sigma();
+        assert!(tilt < 0.0175, "tilt sigma {tilt}");
+    }
+
+    #[test]
+    fn heading_fusion_corrects_heading_and_keeps_a_good_tilt() {
+        let mut f = Ins::new();
+        let accel = Vector3::new(0.0, 0.0, -GRAVITY);
+        let truth = Euler::new(0.0_f32, 0.0, 0.5).to_quaternion();
+        let mag = truth.inverse_transform_vector(&EARTH);
+        assert!(f.align(&accel, &EARTH, &EARTH, 0.01));
+        for k in 0..500 {
+            let t = f64::from(k) * 0.02;
+            f.predict(t, &accel, &Vector3::zeros(), 0.02, &noise());
+            // At rest, the accelerometer holds the tilt while the heading is corrected.
+            f.fuse_gravity(t, &accel, &Motion::default(), 0.7, 2.5, 100.0);
+            f.fuse_mag_heading(t, &mag, &EARTH, 0.02, 1e3);
+        }
+        let e = Euler::from_quaternion(&f.attitude());
+        assert!(e.phi.abs() < 1e-3 && e.theta.abs() < 1e-3, "{e:?}");
+        assert!((e.psi - 0.5).abs() < 0.01, "{e:?}");
+    }
+
+    #[test]
+    fn gravity_reference_corrects_a_roll_error_without_gps() {
+        let accel = Vector3::new(0.0, 0.0, -GRAVITY);
+        let mut f = Ins::new();
+        assert!(f.align(&accel, &EARTH, &EARTH, 0.05));
+        f.q = Euler::new(0.087_f32, 0.0, 0.0).to_quaternion();
+        for k in 0..500 {
+            let t = f64::from(k) * 0.02;
+            f.predict(t, &accel, &Vector3::zeros(), 0.02, &noise());
+            f.fuse_gravity(t, &accel, &Motion::default(), 0.7, 2.5, 100.0);
+        }
+        let e = Euler::from_quaternion(&f.attitude());
+        assert!(e.phi.abs() < 0.005, "roll {}", e.phi);
+    }
+}
