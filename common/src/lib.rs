@@ -13,6 +13,8 @@
 //! - [`params`]: how each stage declares its parameters (name, default, bounds, unit).
 //! - [`sensors`]: the raw sensor samples the estimator consumes.
 //! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
+//! - [`failsafe`]: what the aircraft does on its own when the ground link, GPS, the airspeed
+//!   sensor or the geofence fails it.
 //! - [`control`]: the successive-loop-closure autopilot of the thesis.
 //! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
@@ -28,6 +30,7 @@
 pub mod actuators;
 pub mod control;
 pub mod estimator;
+pub mod failsafe;
 pub mod gcs;
 pub mod link;
 pub mod math;

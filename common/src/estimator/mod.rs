@@ -175,8 +175,12 @@ pub struct EstimatedState {
     pub home: Option<Home>,
     /// Velocity over ground in NED, m/s.
     pub vel_ned: Vector3<f32>,
-    /// True airspeed (low-passed), m/s.
+    /// True airspeed, m/s: the pitot's (low-passed) while it is healthy, otherwise synthetic
+    /// (see `airspeed_synthetic`).
     pub airspeed: f32,
+    /// The pitot has failed and `airspeed` is the ground velocity minus the last wind
+    /// estimate (frozen since the failure): good while the wind does not change.
+    pub airspeed_synthetic: bool,
     /// Angle of attack from the wind triangle, rad (0 without wind estimate).
     pub alpha: f32,
     /// Sideslip from the wind triangle, rad (near 0 by the wind filter's assumption).
@@ -696,6 +700,13 @@ impl Estimator {
         } else {
             (0.0, 0.0)
         };
+        let synthetic =
+            !self.health.pitot.healthy && self.wind.is_initialized() && self.ins.nav_initialized();
+        let (airspeed, airspeed_synthetic) = if synthetic {
+            ((vel - wind).norm(), true)
+        } else {
+            (self.airspeed.value(), false)
+        };
         let (position, alt_amsl_m) = match self.home {
             Some(h) => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
             None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
@@ -711,7 +722,8 @@ impl Estimator {
             alt_amsl_m,
             home: self.home,
             vel_ned: vel,
-            airspeed: self.airspeed.value(),
+            airspeed,
+            airspeed_synthetic,
             alpha,
             sideslip,
             course,

@@ -783,3 +783,31 @@ fn converged_never_vouches_for_a_wrong_attitude() {
         );
     }
 }
+
+/// The pitot fails in flight (a 5 m/s wind, turns): the airspeed goes on as ground velocity
+/// minus the last wind estimate, flagged synthetic, within 1 m/s of the truth while the wind
+/// holds; the pitot's return ends it.
+#[test]
+fn a_failed_pitot_leaves_a_synthetic_airspeed() {
+    let mut f = Flight::new(&mission(), 4, EstimatorConfig::default());
+    f.run_until(60.0);
+    assert!(!f.est.state().airspeed_synthetic);
+    let mut worst = 0.0_f64;
+    for _ in 0..(60.0 / DT) as usize {
+        let tr = f.step_with(On {
+            pitot: false,
+            ..On::ALL
+        });
+        let st = f.est.state();
+        if tr.t > 61.0 {
+            assert!(st.airspeed_synthetic && !st.health.pitot.healthy);
+            worst = worst.max((f64::from(st.airspeed) - tr.va).abs());
+        }
+    }
+    println!("synthetic airspeed over 60 s without pitot: max error {worst:.2} m/s");
+    assert!(worst < 1.0, "synthetic airspeed error {worst}");
+    for _ in 0..50 {
+        f.step();
+    }
+    assert!(!f.est.state().airspeed_synthetic);
+}
