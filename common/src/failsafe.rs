@@ -222,11 +222,11 @@ impl Failsafes {
                 self.gps_lost_since = Some(i.t_s);
                 push(Event::GpsLost);
             }
-            (false, Some(t0)) => {
-                if !self.gps_loiter && i.t_s - t0 >= f64::from(cfg.gps_wings_level_s) {
-                    self.gps_loiter = true;
-                    push(Event::GpsLoiter);
-                }
+            (false, Some(t0))
+                if !self.gps_loiter && i.t_s - t0 >= f64::from(cfg.gps_wings_level_s) =>
+            {
+                self.gps_loiter = true;
+                push(Event::GpsLoiter);
             }
             (true, Some(_)) => {
                 self.gps_lost_since = None;
