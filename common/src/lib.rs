@@ -13,6 +13,10 @@
 //! - [`params`]: how each stage declares its parameters (name, default, bounds, unit).
 //! - [`sensors`]: the raw sensor samples the estimator consumes.
 //! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
+//! - [`navigation`]: the mission executor, path manager (waypoint switching with fillets),
+//!   take-off, landing, return and loiter behaviours, mission validation and the geofence.
+//! - [`guidance`]: vector-field path following: a line or orbit to course, altitude and
+//!   airspeed commands.
 //! - [`control`]: the successive-loop-closure autopilot of the thesis.
 //! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
@@ -29,8 +33,10 @@ pub mod actuators;
 pub mod control;
 pub mod estimator;
 pub mod gcs;
+pub mod guidance;
 pub mod link;
 pub mod math;
+pub mod navigation;
 pub mod params;
 pub mod sensors;
 pub mod storage;

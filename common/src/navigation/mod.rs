@@ -1,0 +1,1 @@
+//! Navigation: what path to fly now. Filled in stage by stage (path manager, mission executor).
