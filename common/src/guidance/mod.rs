@@ -17,7 +17,14 @@
 //!   h_c   = -c_d
 //! ```
 //!
-//! One deviation from the book: the along-track distance `s` of the line's altitude is signed
+//! The book's fields assume the course follows its command at once. The course loop is a lag
+//! (time constant `tau`, the thesis's outer loop ~1 s): on a circle, where the course turns at
+//! `Vg / rho`, a lag alone would ride outside the circle by about `rho/k_orbit tan(tau Vg/rho)`
+//! (12 m on a 50 m circle at 22 m/s). The orbit's command therefore leads the field by
+//! `lambda tau Vg / rho` (at most 45 degrees), the rate term of Nelson et al.'s
+//! `chi_c = chi_d + chi_dot_d / alpha` for a first-order course loop.
+//!
+//! A second deviation: the along-track distance `s` of the line's altitude is signed
 //! and clamped at 0, so behind the line's origin the command is the origin's altitude rather
 //! than the mirror image of the slope ahead.
 //!
@@ -55,6 +62,14 @@ pub const PARAMS: &[ParamDef] = &[
         10.0,
         "",
         "Orbit field gain: how sharply the approach bends onto the circle",
+    ),
+    ParamDef::real(
+        "NAV_CRS_TAU_S",
+        1.0,
+        0.0,
+        5.0,
+        "s",
+        "Course-loop time constant the orbit lead makes up for (0: no lead)",
     ),
 ];
 
@@ -103,6 +118,9 @@ pub struct GuidanceParams {
     pub k_path: f32,
     /// Orbit field gain.
     pub k_orbit: f32,
+    /// Time constant of the closed course loop, s: an orbit's course command leads the field
+    /// by the turn rate times this.
+    pub course_tau: f32,
 }
 
 impl Default for GuidanceParams {
@@ -111,6 +129,7 @@ impl Default for GuidanceParams {
             chi_inf: default_of(PARAMS, "NAV_CHI_INF_DEG") * DEG,
             k_path: default_of(PARAMS, "NAV_K_PATH"),
             k_orbit: default_of(PARAMS, "NAV_K_ORBIT"),
+            course_tau: default_of(PARAMS, "NAV_CRS_TAU_S"),
         }
     }
 }
@@ -123,6 +142,7 @@ impl GuidanceParams {
             "NAV_CHI_INF_DEG" => self.chi_inf = v * DEG,
             "NAV_K_PATH" => self.k_path = v,
             "NAV_K_ORBIT" => self.k_orbit = v,
+            "NAV_CRS_TAU_S" => self.course_tau = v,
             _ => return Err(ParamError::Unknown),
         }
         Ok(())
@@ -134,6 +154,7 @@ impl GuidanceParams {
             "NAV_CHI_INF_DEG" => self.chi_inf / DEG,
             "NAV_K_PATH" => self.k_path,
             "NAV_K_ORBIT" => self.k_orbit,
+            "NAV_CRS_TAU_S" => self.course_tau,
             _ => return None,
         })
     }
@@ -247,11 +268,12 @@ impl Guidance {
         Self { params }
     }
 
-    /// Commands to follow `path` from `pos` (NED from home, m). Stateless: the same inputs give
+    /// Commands to follow `path` from `pos` (NED from home, m) at the ground speed
+    /// `ground_speed` (m/s, used for the orbit's lead only). Stateless: the same inputs give
     /// the same outputs. A degenerate line (no horizontal direction) is flown as its course
     /// north at the origin's altitude; an orbit radius below 1 m is flown as 1 m. Non-finite
     /// inputs give non-finite commands, which the autopilot refuses (holding its outputs).
-    pub fn step(&self, path: &Path, pos: &Vector3<f32>) -> GuidanceOutput {
+    pub fn step(&self, path: &Path, pos: &Vector3<f32>, ground_speed: f32) -> GuidanceOutput {
         match *path {
             Path::Line {
                 origin,
@@ -290,8 +312,14 @@ impl Guidance {
                 let d = libm::hypotf(dn, de);
                 let phi = libm::atan2f(de, dn);
                 let lambda = direction.lambda();
-                let chi_c =
-                    phi + lambda * (FRAC_PI_2 + libm::atanf(self.params.k_orbit * (d - rho) / rho));
+                let lead = if ground_speed.is_finite() {
+                    (self.params.course_tau * ground_speed.max(0.0) / rho).min(FRAC_PI_2 / 2.0)
+                } else {
+                    0.0
+                };
+                let chi_c = phi
+                    + lambda
+                        * (FRAC_PI_2 + libm::atanf(self.params.k_orbit * (d - rho) / rho) + lead);
                 GuidanceOutput {
                     course: wrap_pi(chi_c),
                     altitude: -center.z,
@@ -342,16 +370,16 @@ mod tests {
             let p = line(chi_q);
             let (s, c) = libm::sincosf(chi_q);
             let on = Vector3::new(100.0 + 70.0 * c, -50.0 + 70.0 * s, -80.0);
-            let o = g.step(&p, &on);
+            let o = g.step(&p, &on, 20.0);
             assert_abs_diff_eq!(wrap_pi(o.course - chi_q), 0.0, epsilon = 1e-4);
             assert_abs_diff_eq!(o.cross_track, 0.0, epsilon = 1e-3);
             // 10 km to the right: turn left by chi_inf (within 0.2 deg).
             let right = on + Vector3::new(-s, c, 0.0) * 10_000.0;
-            let o = g.step(&p, &right);
+            let o = g.step(&p, &right, 20.0);
             assert_abs_diff_eq!(o.cross_track, 10_000.0, epsilon = 0.05);
             assert_abs_diff_eq!(wrap_pi(o.course - (chi_q - chi_inf)), 0.0, epsilon = 0.004);
             let left = on - Vector3::new(-s, c, 0.0) * 10_000.0;
-            let o = g.step(&p, &left);
+            let o = g.step(&p, &left, 20.0);
             assert_abs_diff_eq!(wrap_pi(o.course - (chi_q + chi_inf)), 0.0, epsilon = 0.004);
         }
     }
@@ -362,7 +390,7 @@ mod tests {
     fn line_field_slope_near_the_line() {
         let g = Guidance::default();
         let p = line(0.0);
-        let o = g.step(&p, &Vector3::new(200.0, -49.0, -80.0));
+        let o = g.step(&p, &Vector3::new(200.0, -49.0, -80.0), 20.0);
         let expect = -g.params.chi_inf * 2.0 / PI * g.params.k_path; // atan(x) ~ x
         assert_abs_diff_eq!(o.course, expect, epsilon = 1e-4);
     }
@@ -376,19 +404,20 @@ mod tests {
         let p = Path::line_between(&from, &to, 17.0).unwrap();
         for s in [0.0_f32, 100.0, 400.0] {
             // 30 m off the line: the altitude depends only on the along-track distance.
-            let o = g.step(&p, &Vector3::new(30.0, s, -10.0));
+            let o = g.step(&p, &Vector3::new(30.0, s, -10.0), 20.0);
             assert_abs_diff_eq!(o.altitude, 50.0 + s / 20.0, epsilon = 1e-3);
         }
-        let behind = g.step(&p, &Vector3::new(0.0, -100.0, -10.0));
+        let behind = g.step(&p, &Vector3::new(0.0, -100.0, -10.0), 20.0);
         assert_abs_diff_eq!(behind.altitude, 50.0, epsilon = 1e-4);
         assert!(Path::line_between(&from, &Vector3::new(0.0, 0.001, -90.0), 17.0).is_none());
     }
 
     /// On the circle the command is the tangent in the orbit's direction; far away it points
-    /// at the centre; the altitude is the centre's.
+    /// at the centre; the altitude is the centre's. (Lead off: the book's field.)
     #[test]
     fn orbit_field_tangent_and_capture() {
-        let g = Guidance::default();
+        let mut g = Guidance::default();
+        g.params.course_tau = 0.0;
         let center = Vector3::new(10.0, 20.0, -60.0);
         for dir in [OrbitDirection::Clockwise, OrbitDirection::CounterClockwise] {
             let p = Path::Orbit {
@@ -398,13 +427,13 @@ mod tests {
                 airspeed: 15.0,
             };
             // North of the centre: clockwise flies east (+pi/2), counter-clockwise west.
-            let o = g.step(&p, &(center + Vector3::new(50.0, 0.0, 0.0)));
+            let o = g.step(&p, &(center + Vector3::new(50.0, 0.0, 0.0)), 20.0);
             assert_abs_diff_eq!(o.course, dir.lambda() * FRAC_PI_2, epsilon = 1e-5);
             assert_abs_diff_eq!(o.cross_track, 0.0, epsilon = 1e-4);
             assert_abs_diff_eq!(o.altitude, 60.0, epsilon = 1e-5);
             assert_eq!(o.airspeed, 15.0);
             // East of the centre: clockwise flies south.
-            let o = g.step(&p, &(center + Vector3::new(0.0, 50.0, 0.0)));
+            let o = g.step(&p, &(center + Vector3::new(0.0, 50.0, 0.0)), 20.0);
             let expect = if dir == OrbitDirection::Clockwise {
                 PI
             } else {
@@ -412,9 +441,31 @@ mod tests {
             };
             assert_abs_diff_eq!(wrap_pi(o.course - expect), 0.0, epsilon = 1e-5);
             // 50 km east: head west, at the centre.
-            let o = g.step(&p, &(center + Vector3::new(0.0, 50_000.0, 0.0)));
+            let o = g.step(&p, &(center + Vector3::new(0.0, 50_000.0, 0.0)), 20.0);
             assert_abs_diff_eq!(wrap_pi(o.course + FRAC_PI_2), 0.0, epsilon = 0.01);
         }
+    }
+
+    /// With the lead, a first-order course loop of time constant tau fed the command turns at
+    /// exactly the circle's rate Vg/rho when on the circle and on its tangent.
+    #[test]
+    fn orbit_lead_makes_up_for_the_course_lag() {
+        let g = Guidance::default();
+        let tau = g.params.course_tau;
+        assert!(tau > 0.0);
+        let p = Path::Orbit {
+            center: Vector3::zeros(),
+            radius: 50.0,
+            direction: OrbitDirection::CounterClockwise,
+            airspeed: 17.0,
+        };
+        let o = g.step(&p, &Vector3::new(50.0, 0.0, 0.0), 20.0);
+        // Tangent west (-pi/2); the lag turns at (chi_c - chi)/tau.
+        let rate = wrap_pi(o.course + FRAC_PI_2) / tau;
+        assert_abs_diff_eq!(rate, -20.0 / 50.0, epsilon = 1e-5);
+        // A non-finite ground speed drops the lead rather than the command.
+        let o = g.step(&p, &Vector3::new(50.0, 0.0, 0.0), f32::NAN);
+        assert_abs_diff_eq!(o.course, -FRAC_PI_2, epsilon = 1e-6);
     }
 
     #[test]

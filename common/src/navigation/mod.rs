@@ -1,1 +1,8 @@
-//! Navigation: what path to fly now. Filled in stage by stage (path manager, mission executor).
+//! Navigation: what path to fly now.
+//!
+//! - [`path_manager`]: waypoint switching with fillets (Beard & McLain 11.2).
+
+pub mod path_manager;
+
+#[cfg(test)]
+pub(crate) mod sim;
