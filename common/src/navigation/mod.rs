@@ -1,8 +1,27 @@
 //! Navigation: what path to fly now.
 //!
+//! - [`executor`]: the [`Navigator`]: mission items to commands for the autopilot, plus the
+//!   return and loiter-here behaviours.
 //! - [`path_manager`]: waypoint switching with fillets (Beard & McLain 11.2).
+//! - [`items`]: mission items as the navigator reads them (commands, frames, altitudes).
 
+pub mod executor;
+pub mod items;
 pub mod path_manager;
 
 #[cfg(test)]
 pub(crate) mod sim;
+#[cfg(test)]
+mod tests;
+
+use crate::params::ParamDef;
+
+/// Every parameter list of guidance and navigation, for the parameter registry.
+pub const PARAM_LISTS: &[&[ParamDef]] = &[
+    crate::guidance::PARAMS,
+    path_manager::PARAMS,
+    executor::PARAMS,
+];
+
+pub use executor::{HomeRequest, NavOutput, NavParams, NavState, NavWarning, Navigator, Phase};
+pub use path_manager::{PathManager, Waypoint};

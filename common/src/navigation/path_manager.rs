@@ -20,8 +20,9 @@
 //! Where a leg is too short for the fillet's tangent length (more than half of either leg), the
 //! fillet radius shrinks to fit, so a tight zig-zag is flown with the turn it allows rather than
 //! with arcs that overlap; such a corner is turned tighter than the aircraft can and is
-//! overshot. Without a following waypoint (or with a turn under 1 degree) the waypoint is
-//! reached when inside its acceptance radius or when the half-plane through it is crossed.
+//! overshot. Without a following waypoint (or with a turn under 1 degree, or a reversal within
+//! 1 degree of 180) the waypoint is reached when inside its acceptance radius or when the
+//! half-plane through it is crossed.
 //!
 //! The caller shifts the window by one after each `reached` event.
 
@@ -170,7 +171,9 @@ impl PathManager {
         let fillet = next.and_then(|n| {
             let (q_next, len_next) = unit(horizontal(&n.ned) - w)?;
             let rho = libm::acosf((-q_prev.dot(&q_next)).clamp(-1.0, 1.0));
-            if rho > core::f32::consts::PI - STRAIGHT_ON {
+            // Straight on needs no fillet; a reversal has none (its tangent points are at
+            // infinity): both switch at the waypoint.
+            if !(STRAIGHT_ON..=core::f32::consts::PI - STRAIGHT_ON).contains(&rho) {
                 return None;
             }
             let half = 0.5 * rho;
@@ -352,6 +355,24 @@ mod tests {
                 // Half of the 30 m leg at 90 degrees.
                 assert_abs_diff_eq!(radius, 15.0, epsilon = 1e-3);
             }
+            p => panic!("{p:?}"),
+        }
+    }
+
+    #[test]
+    fn a_reversal_switches_at_the_waypoint() {
+        let mut m = PathManager::new(40.0);
+        let win = [
+            wp(0, 0.0, 0.0, 50.0),
+            wp(1, 300.0, 0.0, 50.0),
+            wp(2, 0.0, 0.0, 50.0),
+        ];
+        let s = m.step(&Vector3::new(250.0, 0.0, -50.0), &win).unwrap();
+        assert_eq!((s.reached, s.segment), (None, Segment::Straight));
+        let s = m.step(&Vector3::new(300.5, 0.0, -50.0), &win).unwrap();
+        assert_eq!(s.reached, Some(1));
+        match s.path {
+            Path::Line { direction, .. } => assert!(direction.x < -0.99),
             p => panic!("{p:?}"),
         }
     }
