@@ -627,3 +627,91 @@ fn a_new_home_moves_the_targets() {
     assert!((a.x - 300.0).abs() < 0.05);
     assert!((b.x - n).abs() < 0.05 && (b.x - 200.0).abs() < 0.1);
 }
+
+/// A waypoint without autocontinue: reached, then held (circled) rather than left.
+#[test]
+fn no_autocontinue_holds_at_the_waypoint() {
+    let mut first = wp(300.0, 0.0, 80.0);
+    first.autocontinue = false;
+    let items = [first, wp(300.0, 300.0, 80.0)];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 150.0, |_| false);
+    assert_eq!(log.reached, [0]);
+    let (_, last, p) = log.outs.last().unwrap();
+    assert_eq!((last.phase, last.current_seq), (Phase::Hold, Some(0)));
+    let r = libm::hypotf(p.x - 300.0, p.y);
+    assert!((r - 60.0).abs() < 5.0, "radius {r}");
+    // The firmware moves on with set_current.
+    nav.set_current(1);
+    let log = fly(&mut nav, &mut plane, &items, 100.0, |o| o.reached.is_some());
+    assert_eq!(log.reached, [1]);
+}
+
+/// Items with garbage in every field (NaN and huge parameters, wild frames, jumps anywhere)
+/// and a garbage state: the navigator never panics and never stalls in a step.
+#[test]
+fn garbage_items_and_state_do_not_panic() {
+    let mut seed = 0x2545_f491_u32;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    let specials = [f32::NAN, f32::INFINITY, -1.0, 0.0, 1e30, -2.0, 3.0, 0.5];
+    for _ in 0..200 {
+        let mut items = [MissionItem::default(); 12];
+        for it in items.iter_mut() {
+            let cmds = [
+                NAV_WAYPOINT,
+                NAV_LOITER_UNLIM,
+                NAV_LOITER_TURNS,
+                NAV_LOITER_TIME,
+                NAV_RETURN_TO_LAUNCH,
+                NAV_LAND,
+                NAV_TAKEOFF,
+                NAV_LOITER_TO_ALT,
+                DO_JUMP,
+                DO_CHANGE_SPEED,
+                DO_SET_HOME,
+                0xffff,
+            ];
+            it.command = cmds[(next() % cmds.len() as u32) as usize];
+            it.frame = (next() % 12) as u8;
+            it.x = next() as i32;
+            it.y = next() as i32;
+            it.z = specials[(next() % 8) as usize].to_bits();
+            it.params = core::array::from_fn(|_| {
+                if next() % 2 == 0 {
+                    specials[(next() % 8) as usize].to_bits()
+                } else {
+                    ((next() % 14) as f32).to_bits()
+                }
+            });
+            it.autocontinue = next() % 4 != 0;
+        }
+        let mut nav = Navigator::default();
+        nav.start_mission((next() % 14) as u16);
+        let mut plane = Plane::flying(0.0, 0.0, 50.0, 0.0);
+        let _ = fly(&mut nav, &mut plane, &items, 10.0, |_| false);
+        let bad = NavState {
+            pos_ned: Vector3::new(f32::NAN, 1e30, f32::INFINITY),
+            vel_ned: Vector3::new(f32::NAN, 0.0, 0.0),
+            heading: f32::NAN,
+            airspeed: f32::NAN,
+        };
+        nav.set_current((next() % 14) as u16);
+        let _ = nav.step(&items, &home(), &bad, f32::NAN);
+        let _ = nav.step(&items, &home(), &bad, -1.0);
+        let _ = super::validate::validate_mission(
+            &items,
+            Some(&home()),
+            &MissionLimits::default(),
+            &NavParams::default(),
+        );
+        let _ = super::fence::validate_fence(&items);
+        let _ = breached(&items, &home(), &bad.pos_ned, &FenceParams::default());
+    }
+}
