@@ -798,8 +798,10 @@ impl Navigator {
                     let v = item.param(1);
                     if kind == 0.0 || kind == 1.0 {
                         if v > 0.0 {
-                            self.airspeed =
-                                Some(v.clamp(self.params.airspeed_min, self.params.airspeed_max));
+                            self.airspeed = Some(
+                                v.max(self.params.airspeed_min)
+                                    .min(self.params.airspeed_max),
+                            );
                         } else if v == -2.0 {
                             self.airspeed = None;
                         }
@@ -839,7 +841,7 @@ impl Navigator {
     }
 
     /// The next navigation item after `seq` as the walk would find it (jumps followed, counts
-    /// not spent), and its index.
+    /// not spent).
     fn peek_nav<'a>(&self, items: &'a [MissionItem], seq: usize) -> Option<&'a MissionItem> {
         let mut jumps = self.jumps;
         let mut s = seq + 1;

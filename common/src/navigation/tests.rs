@@ -360,6 +360,13 @@ fn change_speed_and_set_home() {
     let o = nav.step(&items, &home(), &plane.state(), DT);
     assert_eq!(last.current_seq, Some(4));
     assert_eq!(o.guidance.unwrap().airspeed, 25.0);
+    // Crossed limits (a minimum above the maximum) are no reason to panic: the maximum wins.
+    let mut nav = Navigator::default();
+    nav.set_param("NAV_ASPD_MIN", 30.0).unwrap();
+    nav.set_param("NAV_ASPD_MAX", 20.0).unwrap();
+    nav.start_mission(0);
+    let o = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(o.guidance.unwrap().airspeed, 20.0);
 }
 
 /// LOITER_TURNS, 2 turns counter-clockwise (radius -80): the angle swept round the centre
