@@ -13,6 +13,10 @@
 //! - [`params`]: how each stage declares its parameters (name, default, bounds, unit).
 //! - [`sensors`]: the raw sensor samples the estimator consumes.
 //! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
+//! - [`navigation`]: the mission executor, path manager (waypoint switching with fillets),
+//!   take-off, landing, return and loiter behaviours, mission validation and the geofence.
+//! - [`guidance`]: vector-field path following: a line or orbit to course, altitude and
+//!   airspeed commands.
 //! - [`failsafe`]: what the aircraft does on its own when the ground link, GPS, the airspeed
 //!   sensor or the geofence fails it.
 //! - [`control`]: the successive-loop-closure autopilot of the thesis.
@@ -32,8 +36,10 @@ pub mod control;
 pub mod estimator;
 pub mod failsafe;
 pub mod gcs;
+pub mod guidance;
 pub mod link;
 pub mod math;
+pub mod navigation;
 pub mod params;
 pub mod sensors;
 pub mod storage;

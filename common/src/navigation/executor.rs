@@ -1,0 +1,1381 @@
+//! The mission executor and the automatic behaviours (return, loiter here).
+//!
+//! [`Navigator::step`] walks the mission items, keeps the one being flown as the *current* item
+//! (for `MISSION_CURRENT`), reports each navigation item when it is done (for
+//! `MISSION_ITEM_REACHED`), and turns the item into [`Commands`] for the autopilot through the
+//! path manager and the guidance.
+//!
+//! - `DO_*` items run when they become current, in the same step, and the walk goes on to the
+//!   next navigation item. An item this navigator does not fly is skipped with a
+//!   [`NavWarning`]: the mission never stalls on it.
+//! - `DO_JUMP` jumps `param2` times (`-1`: for ever, the only way to loop without end); its
+//!   count is kept per item and reset by [`Navigator::start_mission`]. A walk that meets more
+//!   than `4 n + 8` items without reaching a navigation item (a jump loop with nothing to fly)
+//!   ends the mission with [`NavWarning::JumpLoop`].
+//! - Waypoints are joined by the fillet path manager; a waypoint followed by a landing turns
+//!   onto the final approach through a fillet too.
+//! - Loiters orbit their point (radius `param3`, `param2` for `LOITER_TO_ALT`, or `NAV_LOIT_RAD`
+//!   when 0; a negative radius turns counter-clockwise). `LOITER_TURNS` counts the angle swept
+//!   round the centre once on the circle; `LOITER_TIME` the time on the circle;
+//!   `LOITER_TO_ALT` waits for the altitude. `LOITER_UNLIM` is reported reached on arrival and
+//!   never ends.
+//! - Take-off is a runway take-off: full throttle, wings level, pitch 0 until the rotation
+//!   airspeed, then the thesis's take-off regime (`LonMode::TakeOff`: fixed pitch, full
+//!   throttle to the clear height, then climb) to the item's altitude; the course is held along
+//!   the runway once above the clear height.
+//! - Landing flies the line from the previous waypoint (or from where the item began) to the
+//!   land point, level until it meets the glide slope, then down it; below the flare height
+//!   the throttle is closed and the pitch follows a sink rate that shrinks with height; a
+//!   second on the ground (height under `NAV_LND_TD_M`, sinking slower than 0.5 m/s) is the
+//!   touchdown: [`NavOutput::landed`] for the firmware to disarm.
+//! - Items with an item-relative altitude frame are heights above home; absolute (AMSL) frames
+//!   are converted with the home altitude; a non-global frame or a NaN altitude keeps the
+//!   present altitude, a latitude/longitude of 0/0 the present position.
+//! - After the last item (or when a walk falls off the end) the aircraft circles where it is
+//!   ([`Phase::Complete`]).
+//!
+//! Not done here: go-around, abort altitude, hold times at waypoints, ground speed (a
+//! `DO_CHANGE_SPEED` of ground speed sets the airspeed), terrain, rally points.
+
+use super::items::{self, *};
+use super::path_manager::{PathManager, Waypoint};
+use crate::control::autopilot::Commands;
+use crate::control::lateral::{RollMode, YawMode};
+use crate::control::longitudinal::LonMode;
+use crate::estimator::{EstimatedState, Home};
+use crate::gcs::mission::{MissionItem, MISSION_CAPACITY};
+use crate::guidance::{check_param, Guidance, GuidanceOutput, OrbitDirection, Path};
+use crate::math::wrap_pi;
+use crate::params::{ParamDef, ParamError};
+use core::f32::consts::{PI, TAU};
+use nalgebra::Vector3;
+
+const DEG: f32 = PI / 180.0;
+
+/// Parameters of the mission executor and its behaviours.
+pub const PARAMS: &[ParamDef] = &[
+    ParamDef::real(
+        "NAV_ACC_RAD",
+        15.0,
+        1.0,
+        200.0,
+        "m",
+        "Waypoint acceptance radius when an item gives none",
+    ),
+    ParamDef::real(
+        "NAV_LOIT_RAD",
+        60.0,
+        10.0,
+        1000.0,
+        "m",
+        "Loiter radius when an item gives none",
+    ),
+    ParamDef::real(
+        "NAV_ALT_ACC",
+        5.0,
+        0.5,
+        50.0,
+        "m",
+        "Altitude counted as reached (take-off, loiter to altitude, return)",
+    ),
+    ParamDef::real(
+        "NAV_ASPD",
+        17.0,
+        8.0,
+        40.0,
+        "m/s",
+        "Cruise airspeed (the thesis's trim I)",
+    ),
+    ParamDef::real(
+        "NAV_ASPD_MIN",
+        13.0,
+        8.0,
+        40.0,
+        "m/s",
+        "Lowest airspeed DO_CHANGE_SPEED may set",
+    ),
+    ParamDef::real(
+        "NAV_ASPD_MAX",
+        25.0,
+        8.0,
+        40.0,
+        "m/s",
+        "Highest airspeed DO_CHANGE_SPEED may set",
+    ),
+    ParamDef::real(
+        "NAV_RTL_ALT",
+        60.0,
+        10.0,
+        1000.0,
+        "m",
+        "Return altitude above home",
+    ),
+    ParamDef::int(
+        "NAV_RTL_LAND",
+        0,
+        0,
+        1,
+        "",
+        "Return mode lands at home after the return (1) or circles (0)",
+    ),
+    ParamDef::real(
+        "NAV_TKO_VR",
+        13.0,
+        5.0,
+        30.0,
+        "m/s",
+        "Take-off rotation airspeed",
+    ),
+    ParamDef::real(
+        "NAV_TKO_CLR_M",
+        10.0,
+        1.0,
+        100.0,
+        "m",
+        "Take-off regime (fixed pitch, full throttle) ends at this height",
+    ),
+    ParamDef::real(
+        "NAV_LND_SLP_DEG",
+        6.0,
+        1.0,
+        20.0,
+        "deg",
+        "Landing glide slope",
+    ),
+    ParamDef::real(
+        "NAV_LND_ASPD",
+        14.0,
+        8.0,
+        30.0,
+        "m/s",
+        "Landing approach airspeed",
+    ),
+    ParamDef::real(
+        "NAV_FLR_ALT",
+        4.0,
+        0.5,
+        20.0,
+        "m",
+        "Flare below this height above the land point",
+    ),
+    ParamDef::real(
+        "NAV_FLR_PTCH_DEG",
+        3.0,
+        -5.0,
+        15.0,
+        "deg",
+        "Flare pitch at the touchdown sink rate",
+    ),
+    ParamDef::real(
+        "NAV_FLR_SINK",
+        0.4,
+        0.05,
+        3.0,
+        "m/s",
+        "Sink rate aimed for at touchdown",
+    ),
+    ParamDef::real(
+        "NAV_FLR_K",
+        0.05,
+        0.0,
+        1.0,
+        "rad s/m",
+        "Flare pitch per m/s of sink rate above the aim",
+    ),
+    ParamDef::real(
+        "NAV_LND_TD_M",
+        0.5,
+        0.05,
+        5.0,
+        "m",
+        "Touchdown: height above the land point under this for 1 s",
+    ),
+];
+
+/// Time on the ground that makes a touchdown, s.
+const TOUCHDOWN_S: f32 = 1.0;
+/// Sink rate under which the aircraft counts as on the ground, m/s.
+const TOUCHDOWN_SINK: f32 = 0.5;
+
+/// The executor's parameters in SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct NavParams {
+    /// Default acceptance radius, m.
+    pub accept_radius: f32,
+    /// Default loiter radius, m.
+    pub loiter_radius: f32,
+    /// Altitude acceptance, m.
+    pub alt_accept: f32,
+    /// Cruise airspeed, m/s.
+    pub airspeed: f32,
+    /// Lowest settable airspeed, m/s.
+    pub airspeed_min: f32,
+    /// Highest settable airspeed, m/s.
+    pub airspeed_max: f32,
+    /// Return altitude above home, m.
+    pub rtl_alt: f32,
+    /// Return mode lands.
+    pub rtl_land: bool,
+    /// Rotation airspeed, m/s.
+    pub takeoff_vr: f32,
+    /// Take-off regime clear height, m.
+    pub takeoff_clear: f32,
+    /// Glide slope, rad.
+    pub glide_slope: f32,
+    /// Approach airspeed, m/s.
+    pub land_airspeed: f32,
+    /// Flare height, m.
+    pub flare_alt: f32,
+    /// Flare pitch, rad.
+    pub flare_pitch: f32,
+    /// Touchdown sink rate, m/s.
+    pub flare_sink: f32,
+    /// Flare pitch gain, rad per m/s.
+    pub flare_k: f32,
+    /// Touchdown height, m.
+    pub touchdown_alt: f32,
+}
+
+impl Default for NavParams {
+    fn default() -> Self {
+        let mut p = Self {
+            accept_radius: 0.0,
+            loiter_radius: 0.0,
+            alt_accept: 0.0,
+            airspeed: 0.0,
+            airspeed_min: 0.0,
+            airspeed_max: 0.0,
+            rtl_alt: 0.0,
+            rtl_land: false,
+            takeoff_vr: 0.0,
+            takeoff_clear: 0.0,
+            glide_slope: 0.0,
+            land_airspeed: 0.0,
+            flare_alt: 0.0,
+            flare_pitch: 0.0,
+            flare_sink: 0.0,
+            flare_k: 0.0,
+            touchdown_alt: 0.0,
+        };
+        for d in PARAMS {
+            // Defaults lie inside their bounds (checked by the tests).
+            let _ = p.set(d.name, d.default);
+        }
+        p
+    }
+}
+
+impl NavParams {
+    /// Sets one parameter by name after checking it; a refused value changes nothing.
+    pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+        let v = check_param(PARAMS, name, value)?;
+        match name {
+            "NAV_RTL_LAND" => self.rtl_land = v != 0.0,
+            "NAV_LND_SLP_DEG" => self.glide_slope = v * DEG,
+            "NAV_FLR_PTCH_DEG" => self.flare_pitch = v * DEG,
+            _ => *self.slot(name).ok_or(ParamError::Unknown)? = v,
+        }
+        Ok(())
+    }
+
+    /// The value of one parameter by name, in its parameter unit.
+    pub fn get(&self, name: &str) -> Option<f32> {
+        match name {
+            "NAV_RTL_LAND" => Some(f32::from(u8::from(self.rtl_land))),
+            "NAV_LND_SLP_DEG" => Some(self.glide_slope / DEG),
+            "NAV_FLR_PTCH_DEG" => Some(self.flare_pitch / DEG),
+            _ => {
+                let mut c = *self;
+                c.slot(name).map(|s| *s)
+            }
+        }
+    }
+
+    fn slot(&mut self, name: &str) -> Option<&mut f32> {
+        Some(match name {
+            "NAV_ACC_RAD" => &mut self.accept_radius,
+            "NAV_LOIT_RAD" => &mut self.loiter_radius,
+            "NAV_ALT_ACC" => &mut self.alt_accept,
+            "NAV_ASPD" => &mut self.airspeed,
+            "NAV_ASPD_MIN" => &mut self.airspeed_min,
+            "NAV_ASPD_MAX" => &mut self.airspeed_max,
+            "NAV_RTL_ALT" => &mut self.rtl_alt,
+            "NAV_TKO_VR" => &mut self.takeoff_vr,
+            "NAV_TKO_CLR_M" => &mut self.takeoff_clear,
+            "NAV_LND_ASPD" => &mut self.land_airspeed,
+            "NAV_FLR_ALT" => &mut self.flare_alt,
+            "NAV_FLR_SINK" => &mut self.flare_sink,
+            "NAV_FLR_K" => &mut self.flare_k,
+            "NAV_LND_TD_M" => &mut self.touchdown_alt,
+            _ => return None,
+        })
+    }
+}
+
+/// What the navigator needs of the estimate.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NavState {
+    /// Position NED from home, m.
+    pub pos_ned: Vector3<f32>,
+    /// Velocity over ground NED, m/s.
+    pub vel_ned: Vector3<f32>,
+    /// Heading (yaw), rad.
+    pub heading: f32,
+    /// Airspeed, m/s.
+    pub airspeed: f32,
+}
+
+impl NavState {
+    /// The navigator's view of the estimator's state.
+    pub fn from_estimate(s: &EstimatedState) -> Self {
+        Self {
+            pos_ned: s.pos_ned,
+            vel_ned: s.vel_ned,
+            heading: s.euler.psi,
+            airspeed: s.airspeed,
+        }
+    }
+
+    /// Height above home, m.
+    pub fn height(&self) -> f32 {
+        -self.pos_ned.z
+    }
+
+    /// Horizontal speed over ground, m/s.
+    pub fn ground_speed(&self) -> f32 {
+        libm::hypotf(self.vel_ned.x, self.vel_ned.y)
+    }
+}
+
+/// Something the mission asked for that was not flown as written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum NavWarning {
+    /// An item with a command this navigator does not execute was skipped.
+    UnknownCommand {
+        /// Its sequence number.
+        seq: u16,
+        /// Its `MAV_CMD`.
+        command: u16,
+    },
+    /// A `DO_JUMP` with a target outside the mission was skipped.
+    BadJump {
+        /// Its sequence number.
+        seq: u16,
+    },
+    /// A jump loop with no navigation item in it: the mission was ended.
+    JumpLoop {
+        /// Sequence number where the walk stopped.
+        seq: u16,
+    },
+    /// A `DO_CHANGE_SPEED` this navigator cannot apply (climb or descent speed) was skipped.
+    UnsupportedSpeed {
+        /// Its sequence number.
+        seq: u16,
+    },
+    /// The mission is empty.
+    NoMission,
+}
+
+/// Where the home should move (`DO_SET_HOME`); the firmware applies it to the estimator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HomeRequest {
+    /// Home becomes the present position.
+    Here,
+    /// Home becomes this point.
+    At(Home),
+}
+
+/// What the navigator is doing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Phase {
+    /// Nothing started.
+    #[default]
+    Idle,
+    /// Take-off run on the runway.
+    TakeoffRoll,
+    /// Take-off climb.
+    TakeoffClimb,
+    /// Flying to a waypoint.
+    Waypoint,
+    /// Circling a loiter item.
+    Loiter,
+    /// Flying home (return).
+    Return,
+    /// Circling home after a return.
+    ReturnLoiter,
+    /// Landing approach.
+    Approach,
+    /// Landing flare.
+    Flare,
+    /// On the ground after a landing.
+    Landed,
+    /// Circling a point (loiter here, or an item that does not continue by itself).
+    Hold,
+    /// The mission is over; circling where it ended.
+    Complete,
+}
+
+/// Result of one step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NavOutput {
+    /// Commands for the autopilot (`None` while idle: the caller keeps its own).
+    pub commands: Option<Commands>,
+    /// The guidance output behind the commands (cross-track error and so on).
+    pub guidance: Option<GuidanceOutput>,
+    /// The point flown to (or circled), NED from home.
+    pub target: Option<Vector3<f32>>,
+    /// Horizontal distance to `target`, m (NaN without one).
+    pub wp_dist_m: f32,
+    /// Bearing to `target`, rad (NaN without one).
+    pub target_bearing: f32,
+    /// The mission item being flown.
+    pub current_seq: Option<u16>,
+    /// A mission item finished on this step.
+    pub reached: Option<u16>,
+    /// What was skipped or refused on this step.
+    pub warnings: heapless::Vec<NavWarning, 4>,
+    /// A `DO_SET_HOME` ran on this step.
+    pub set_home: Option<HomeRequest>,
+    /// What the navigator is doing.
+    pub phase: Phase,
+    /// On the ground after a landing: the firmware may disarm.
+    pub landed: bool,
+}
+
+impl NavOutput {
+    fn warn(&mut self, w: NavWarning) {
+        // A fifth warning in one step is dropped; the first four say enough.
+        let _ = self.warnings.push(w);
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum LoiterGoal {
+    Unlimited,
+    Turns {
+        goal: f32,
+        swept: f32,
+        last: Option<f32>,
+    },
+    Time {
+        goal: f32,
+        elapsed: f32,
+    },
+    Altitude,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Orbit {
+    center: Vector3<f32>,
+    radius: f32,
+    direction: OrbitDirection,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LandPhase {
+    Approach,
+    Flare,
+    Landed,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Landing {
+    origin: Vector3<f32>,
+    point: Vector3<f32>,
+    phase: LandPhase,
+    ground_time: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ReturnPhase {
+    Home {
+        origin: Vector3<f32>,
+    },
+    Circle,
+    ToFinal {
+        origin: Vector3<f32>,
+        gate: Vector3<f32>,
+    },
+    Land(Landing),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Active {
+    Idle,
+    Waypoint {
+        origin: Vector3<f32>,
+        target: Vector3<f32>,
+        accept: f32,
+        airspeed: f32,
+        next: Option<Vector3<f32>>,
+    },
+    Loiter {
+        orbit: Orbit,
+        goal: LoiterGoal,
+        arrived: bool,
+    },
+    Takeoff {
+        start: Vector3<f32>,
+        course: f32,
+        height: f32,
+        rolling: bool,
+    },
+    Land(Landing),
+    Return {
+        phase: ReturnPhase,
+        land: bool,
+    },
+    Hold(Orbit),
+    Complete(Orbit),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Request {
+    Mission(u16),
+    Return { land: bool },
+    LoiterAt(Option<Vector3<f32>>),
+}
+
+/// The navigator: mission executor plus return and loiter behaviours.
+#[derive(Clone, Debug)]
+pub struct Navigator {
+    params: NavParams,
+    guidance: Guidance,
+    paths: PathManager,
+    active: Active,
+    /// Mission item being flown, when the mission is.
+    seq: Option<u16>,
+    /// Jumps done per `DO_JUMP` item.
+    jumps: [u16; MISSION_CAPACITY],
+    /// `DO_CHANGE_SPEED` airspeed, m/s.
+    airspeed: Option<f32>,
+    /// The last waypoint reached (where a landing's approach comes from).
+    prev_waypoint: Option<Vector3<f32>>,
+    /// Runway course of the last take-off, rad (a return's landing lands on it).
+    runway: Option<f32>,
+    home: Option<Home>,
+    request: Option<Request>,
+}
+
+impl Default for Navigator {
+    fn default() -> Self {
+        Self::new(
+            NavParams::default(),
+            Guidance::default(),
+            PathManager::default(),
+        )
+    }
+}
+
+fn orbit_path(o: &Orbit, airspeed: f32) -> Path {
+    Path::Orbit {
+        center: o.center,
+        radius: o.radius,
+        direction: o.direction,
+        airspeed,
+    }
+}
+
+fn follow(g: &GuidanceOutput) -> Commands {
+    Commands {
+        roll: RollMode::Course(g.course),
+        yaw: YawMode::Sideslip(0.0),
+        lon: LonMode::Altitude {
+            altitude: g.altitude,
+            airspeed: g.airspeed,
+        },
+    }
+}
+
+fn horizontal_dist(a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
+    libm::hypotf(a.x - b.x, a.y - b.y)
+}
+
+impl Navigator {
+    /// An idle navigator.
+    pub fn new(params: NavParams, guidance: Guidance, paths: PathManager) -> Self {
+        Self {
+            params,
+            guidance,
+            paths,
+            active: Active::Idle,
+            seq: None,
+            jumps: [0; MISSION_CAPACITY],
+            airspeed: None,
+            prev_waypoint: None,
+            runway: None,
+            home: None,
+            request: None,
+        }
+    }
+
+    /// The executor's parameters.
+    pub fn params(&self) -> &NavParams {
+        &self.params
+    }
+
+    /// Sets a parameter of the executor, the path manager or the guidance by name.
+    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
+        match self.params.set(name, value) {
+            Err(ParamError::Unknown) => {}
+            r => return r,
+        }
+        match self.paths.set(name, value) {
+            Err(ParamError::Unknown) => {}
+            r => return r,
+        }
+        self.guidance.params.set(name, value)
+    }
+
+    /// Flies the mission from item `seq` on the next step, with fresh jump counts and the
+    /// cruise airspeed.
+    pub fn start_mission(&mut self, seq: u16) {
+        self.jumps = [0; MISSION_CAPACITY];
+        self.airspeed = None;
+        self.prev_waypoint = None;
+        self.request = Some(Request::Mission(seq));
+    }
+
+    /// Continues the mission at item `seq` (`MISSION_SET_CURRENT`, or resuming after another
+    /// mode), keeping jump counts and airspeed.
+    pub fn set_current(&mut self, seq: u16) {
+        self.request = Some(Request::Mission(seq));
+    }
+
+    /// The return behaviour: fly home at `NAV_RTL_ALT`, circle there, then land if `land`.
+    pub fn start_return(&mut self, land: bool) {
+        self.request = Some(Request::Return { land });
+    }
+
+    /// Circle `center` (NED from home; its altitude is `-z`) at the default loiter radius, or
+    /// the present position and height when `None`.
+    pub fn start_loiter(&mut self, center: Option<Vector3<f32>>) {
+        self.request = Some(Request::LoiterAt(center));
+    }
+
+    /// Stops: the next steps give no commands.
+    pub fn stop(&mut self) {
+        self.request = None;
+        self.active = Active::Idle;
+        self.seq = None;
+        self.paths.reset();
+    }
+
+    /// The mission item being flown.
+    pub fn current_seq(&self) -> Option<u16> {
+        self.seq
+    }
+
+    fn cruise(&self) -> f32 {
+        self.airspeed.unwrap_or(self.params.airspeed)
+    }
+
+    fn default_orbit(&self, center: Vector3<f32>) -> Orbit {
+        Orbit {
+            center,
+            radius: self.params.loiter_radius,
+            direction: OrbitDirection::Clockwise,
+        }
+    }
+
+    /// One step: `items` is the stored mission, `home` the NED origin, `state` the estimate,
+    /// `dt` the time since the last step (s).
+    pub fn step(
+        &mut self,
+        items: &[MissionItem],
+        home: &Home,
+        state: &NavState,
+        dt: f32,
+    ) -> NavOutput {
+        let mut out = NavOutput {
+            wp_dist_m: f32::NAN,
+            target_bearing: f32::NAN,
+            ..NavOutput::default()
+        };
+        let dt = if dt.is_finite() && dt > 0.0 { dt } else { 0.0 };
+        // A new home moves every NED target: fly the present item again from here.
+        if self.home.is_some_and(|h| h != *home) && self.request.is_none() {
+            match self.active {
+                Active::Waypoint { .. }
+                | Active::Loiter { .. }
+                | Active::Land(_)
+                | Active::Takeoff { .. } => {
+                    if let Some(s) = self.seq {
+                        self.prev_waypoint = None;
+                        self.request = Some(Request::Mission(s));
+                    }
+                }
+                _ => {}
+            }
+        }
+        self.home = Some(*home);
+        let pos = state.pos_ned;
+        match self.request.take() {
+            Some(Request::Mission(s)) => self.walk(items, usize::from(s), home, state, &mut out),
+            Some(Request::Return { land }) => {
+                self.seq = None;
+                self.begin_return(land, &pos);
+            }
+            Some(Request::LoiterAt(c)) => {
+                self.seq = None;
+                let c = c.unwrap_or(pos);
+                self.active = Active::Hold(self.default_orbit(c));
+            }
+            None => {}
+        }
+        self.fly(items, home, state, dt, &mut out);
+        out.current_seq = self.seq;
+        if let Some(t) = out.target {
+            out.wp_dist_m = horizontal_dist(&t, &pos);
+            out.target_bearing = libm::atan2f(t.y - pos.y, t.x - pos.x);
+        }
+        out
+    }
+
+    fn begin_return(&mut self, land: bool, pos: &Vector3<f32>) {
+        self.paths.reset();
+        self.active = Active::Return {
+            phase: ReturnPhase::Home { origin: *pos },
+            land,
+        };
+    }
+
+    fn complete(&mut self, pos: &Vector3<f32>) {
+        self.paths.reset();
+        let center = self.prev_waypoint.unwrap_or(*pos);
+        self.active = Active::Complete(self.default_orbit(center));
+    }
+
+    /// Walks from item `seq` to the next navigation item, running `DO_*` items on the way, and
+    /// starts it.
+    fn walk(
+        &mut self,
+        items: &[MissionItem],
+        mut seq: usize,
+        home: &Home,
+        state: &NavState,
+        out: &mut NavOutput,
+    ) {
+        self.paths.reset();
+        if items.is_empty() {
+            out.warn(NavWarning::NoMission);
+            self.seq = None;
+            self.complete(&state.pos_ned);
+            return;
+        }
+        let mut budget = 4 * items.len() + 8;
+        loop {
+            let Some(item) = items.get(seq) else {
+                self.complete(&state.pos_ned);
+                return;
+            };
+            let s16 = u16::try_from(seq).unwrap_or(u16::MAX);
+            if budget == 0 {
+                out.warn(NavWarning::JumpLoop { seq: s16 });
+                self.complete(&state.pos_ned);
+                return;
+            }
+            budget -= 1;
+            match item.command {
+                DO_JUMP => match jump_target(item, items.len(), self.jumps.get(seq).copied()) {
+                    JumpStep::Jump(t) => {
+                        if let Some(c) = self.jumps.get_mut(seq) {
+                            *c = c.saturating_add(1);
+                        }
+                        seq = t;
+                    }
+                    JumpStep::Next => seq += 1,
+                    JumpStep::Bad => {
+                        out.warn(NavWarning::BadJump { seq: s16 });
+                        seq += 1;
+                    }
+                },
+                DO_CHANGE_SPEED => {
+                    let kind = item.param(0);
+                    let v = item.param(1);
+                    if kind == 0.0 || kind == 1.0 {
+                        if v > 0.0 {
+                            self.airspeed = Some(
+                                v.max(self.params.airspeed_min)
+                                    .min(self.params.airspeed_max),
+                            );
+                        } else if v == -2.0 {
+                            self.airspeed = None;
+                        }
+                    } else {
+                        out.warn(NavWarning::UnsupportedSpeed { seq: s16 });
+                    }
+                    seq += 1;
+                }
+                DO_SET_HOME => {
+                    out.set_home = Some(if item.param(0) == 1.0 {
+                        HomeRequest::Here
+                    } else {
+                        match (items::point(item), items::alt_amsl(item, home)) {
+                            (Some(point), Some(alt_amsl_m)) => {
+                                HomeRequest::At(Home { point, alt_amsl_m })
+                            }
+                            (Some(point), None) => HomeRequest::At(Home {
+                                point,
+                                alt_amsl_m: home.alt_amsl_m,
+                            }),
+                            _ => HomeRequest::Here,
+                        }
+                    });
+                    seq += 1;
+                }
+                c if is_nav(c) => {
+                    self.seq = Some(s16);
+                    self.activate(items, seq, item, home, state);
+                    return;
+                }
+                command => {
+                    out.warn(NavWarning::UnknownCommand { seq: s16, command });
+                    seq += 1;
+                }
+            }
+        }
+    }
+
+    /// The next navigation item after `seq` as the walk would find it (jumps followed, counts
+    /// not spent).
+    fn peek_nav<'a>(&self, items: &'a [MissionItem], seq: usize) -> Option<&'a MissionItem> {
+        let mut jumps = self.jumps;
+        let mut s = seq + 1;
+        for _ in 0..4 * items.len() + 8 {
+            let item = items.get(s)?;
+            match item.command {
+                DO_JUMP => match jump_target(item, items.len(), jumps.get(s).copied()) {
+                    JumpStep::Jump(t) => {
+                        if let Some(c) = jumps.get_mut(s) {
+                            *c = c.saturating_add(1);
+                        }
+                        s = t;
+                    }
+                    _ => s += 1,
+                },
+                c if is_nav(c) => return Some(item),
+                _ => s += 1,
+            }
+        }
+        None
+    }
+
+    fn activate(
+        &mut self,
+        items: &[MissionItem],
+        seq: usize,
+        item: &MissionItem,
+        home: &Home,
+        state: &NavState,
+    ) {
+        let pos = state.pos_ned;
+        let target = items::target_ned(item, home, &pos);
+        let origin = self.prev_waypoint.unwrap_or(pos);
+        self.active = match item.command {
+            NAV_WAYPOINT => {
+                let accept = if item.param(1) > 0.0 {
+                    item.param(1)
+                } else {
+                    self.params.accept_radius
+                };
+                // The corner after this waypoint is rounded when a waypoint or the final
+                // approach of a landing follows.
+                let next = self
+                    .peek_nav(items, seq)
+                    .filter(|n| matches!(n.command, NAV_WAYPOINT | NAV_LAND))
+                    .map(|n| items::target_ned(n, home, &target));
+                Active::Waypoint {
+                    origin,
+                    target,
+                    accept,
+                    airspeed: self.cruise(),
+                    next,
+                }
+            }
+            NAV_LOITER_UNLIM | NAV_LOITER_TURNS | NAV_LOITER_TIME | NAV_LOITER_TO_ALT => {
+                let r = if item.command == NAV_LOITER_TO_ALT {
+                    item.param(1)
+                } else {
+                    item.param(2)
+                };
+                let radius = if r.is_finite() && r.abs() >= 1.0 {
+                    r.abs()
+                } else {
+                    self.params.loiter_radius
+                };
+                let goal = match item.command {
+                    NAV_LOITER_TURNS => LoiterGoal::Turns {
+                        goal: item.param(0).max(0.0) * TAU,
+                        swept: 0.0,
+                        last: None,
+                    },
+                    NAV_LOITER_TIME => LoiterGoal::Time {
+                        goal: item.param(0).max(0.0),
+                        elapsed: 0.0,
+                    },
+                    NAV_LOITER_TO_ALT => LoiterGoal::Altitude,
+                    _ => LoiterGoal::Unlimited,
+                };
+                Active::Loiter {
+                    orbit: Orbit {
+                        center: target,
+                        radius,
+                        direction: OrbitDirection::from_signed_radius(r),
+                    },
+                    goal,
+                    arrived: false,
+                }
+            }
+            NAV_TAKEOFF => {
+                let course = match items::point(item) {
+                    Some(_) if horizontal_dist(&target, &pos) > 20.0 => {
+                        libm::atan2f(target.y - pos.y, target.x - pos.x)
+                    }
+                    _ if item.param(3).is_finite() => wrap_pi(item.param(3) * DEG),
+                    _ => state.heading,
+                };
+                self.runway = Some(course);
+                Active::Takeoff {
+                    start: pos,
+                    course,
+                    height: items::height(item, home).unwrap_or(self.params.rtl_alt),
+                    rolling: state.airspeed.is_nan() || state.airspeed < self.params.takeoff_vr,
+                }
+            }
+            NAV_LAND => {
+                let origin = if horizontal_dist(&origin, &target) > 10.0 {
+                    origin
+                } else {
+                    pos
+                };
+                Active::Land(Landing {
+                    origin,
+                    point: target,
+                    phase: LandPhase::Approach,
+                    ground_time: 0.0,
+                })
+            }
+            // NAV_RETURN_TO_LAUNCH (the only navigation command left).
+            _ => Active::Return {
+                phase: ReturnPhase::Home { origin: pos },
+                land: self.params.rtl_land,
+            },
+        };
+        if !matches!(self.active, Active::Waypoint { .. }) {
+            self.prev_waypoint = None;
+        }
+    }
+
+    /// The current item is done: report it and walk on (or hold, without autocontinue).
+    fn item_done(
+        &mut self,
+        items: &[MissionItem],
+        home: &Home,
+        state: &NavState,
+        hold: Orbit,
+        out: &mut NavOutput,
+    ) {
+        let Some(seq) = self.seq else {
+            return;
+        };
+        out.reached = Some(seq);
+        let autocontinue = items.get(usize::from(seq)).is_some_and(|i| i.autocontinue);
+        if autocontinue {
+            self.walk(items, usize::from(seq) + 1, home, state, out);
+        } else {
+            self.paths.reset();
+            self.active = Active::Hold(hold);
+        }
+    }
+
+    fn fly(
+        &mut self,
+        items: &[MissionItem],
+        home: &Home,
+        state: &NavState,
+        dt: f32,
+        out: &mut NavOutput,
+    ) {
+        let pos = state.pos_ned;
+        let vg = state.ground_speed();
+        let p = self.params;
+        match self.active {
+            Active::Idle => {
+                out.phase = Phase::Idle;
+            }
+            Active::Waypoint {
+                origin,
+                target,
+                accept,
+                airspeed,
+                next,
+            } => {
+                let id = self.seq.unwrap_or(0);
+                let mk = |ned, id| Waypoint {
+                    id,
+                    ned,
+                    airspeed,
+                    accept_radius: accept,
+                };
+                let mut window: heapless::Vec<Waypoint, 3> = heapless::Vec::new();
+                let _ = window.push(mk(origin, u16::MAX));
+                let _ = window.push(mk(target, id));
+                if let Some(n) = next {
+                    let _ = window.push(mk(n, id.wrapping_add(1)));
+                }
+                let step = self.paths.step(&pos, &window);
+                let reached = step.as_ref().and_then(|s| s.reached).is_some();
+                let path = step
+                    .map(|s| s.path)
+                    .unwrap_or(orbit_path(&self.default_orbit(target), airspeed));
+                self.emit(&path, state, Some(target), Phase::Waypoint, out);
+                if reached {
+                    // The new item flies from the next step; this step's commands already
+                    // follow the next leg.
+                    self.prev_waypoint = Some(target);
+                    let hold = self.default_orbit(target);
+                    self.item_done(items, home, state, hold, out);
+                }
+            }
+            Active::Loiter {
+                orbit,
+                mut goal,
+                mut arrived,
+            } => {
+                let path = orbit_path(&orbit, self.cruise());
+                let g = self.emit(&path, state, Some(orbit.center), Phase::Loiter, out);
+                let on_circle = g.cross_track.abs() <= p.accept_radius.max(0.1 * orbit.radius);
+                let mut done = false;
+                if on_circle || arrived {
+                    let first = !arrived;
+                    arrived = true;
+                    let phi = libm::atan2f(pos.y - orbit.center.y, pos.x - orbit.center.x);
+                    match &mut goal {
+                        LoiterGoal::Unlimited => {
+                            if first {
+                                out.reached = self.seq;
+                            }
+                        }
+                        LoiterGoal::Turns { goal, swept, last } => {
+                            if let Some(l) = *last {
+                                *swept += orbit.direction.lambda() * wrap_pi(phi - l);
+                            }
+                            *last = Some(phi);
+                            done = *swept >= *goal;
+                        }
+                        LoiterGoal::Time { goal, elapsed } => {
+                            *elapsed += dt;
+                            done = *elapsed >= *goal;
+                        }
+                        LoiterGoal::Altitude => {
+                            done = (state.height() + orbit.center.z).abs() <= p.alt_accept;
+                        }
+                    }
+                }
+                self.active = Active::Loiter {
+                    orbit,
+                    goal,
+                    arrived,
+                };
+                if done {
+                    self.item_done(items, home, state, orbit, out);
+                }
+            }
+            Active::Takeoff {
+                start,
+                course,
+                height,
+                mut rolling,
+            } => {
+                if rolling && state.airspeed >= p.takeoff_vr {
+                    rolling = false;
+                }
+                let (dn, de) = (libm::cosf(course), libm::sinf(course));
+                let far = start + Vector3::new(dn, de, 0.0) * 1000.0;
+                let line = Path::line_between(&start, &far, self.cruise());
+                let h = state.height() + start.z;
+                out.target = Some(far);
+                if rolling {
+                    out.phase = Phase::TakeoffRoll;
+                    out.commands = Some(Commands {
+                        roll: RollMode::Roll(0.0),
+                        yaw: YawMode::Damper,
+                        lon: LonMode::Pitch {
+                            pitch: 0.0,
+                            throttle: 1.0,
+                        },
+                    });
+                } else {
+                    out.phase = Phase::TakeoffClimb;
+                    let g = line.map(|l| self.guidance.step(&l, &pos, vg));
+                    out.guidance = g;
+                    let roll = match g {
+                        Some(g) if h >= p.takeoff_clear => RollMode::Course(g.course),
+                        _ => RollMode::Roll(0.0),
+                    };
+                    out.commands = Some(Commands {
+                        roll,
+                        yaw: YawMode::Sideslip(0.0),
+                        lon: LonMode::TakeOff {
+                            altitude: height,
+                            airspeed: self.cruise(),
+                            clear_altitude: -start.z + p.takeoff_clear,
+                        },
+                    });
+                }
+                self.active = Active::Takeoff {
+                    start,
+                    course,
+                    height,
+                    rolling,
+                };
+                if !rolling && state.height() >= height - p.alt_accept {
+                    let hold = self.default_orbit(Vector3::new(pos.x, pos.y, -height));
+                    self.item_done(items, home, state, hold, out);
+                }
+            }
+            Active::Land(mut l) => {
+                let before = l.phase;
+                self.fly_landing(&mut l, state, dt, out);
+                self.active = Active::Land(l);
+                if before != LandPhase::Landed && l.phase == LandPhase::Landed {
+                    out.reached = self.seq;
+                }
+            }
+            Active::Return { phase, land } => self.fly_return(phase, land, state, dt, out),
+            Active::Hold(o) | Active::Complete(o) => {
+                let path = orbit_path(&o, self.cruise());
+                let phase = if matches!(self.active, Active::Hold(_)) {
+                    Phase::Hold
+                } else {
+                    Phase::Complete
+                };
+                self.emit(&path, state, Some(o.center), phase, out);
+            }
+        }
+    }
+
+    fn emit(
+        &self,
+        path: &Path,
+        state: &NavState,
+        target: Option<Vector3<f32>>,
+        phase: Phase,
+        out: &mut NavOutput,
+    ) -> GuidanceOutput {
+        let g = self
+            .guidance
+            .step(path, &state.pos_ned, state.ground_speed());
+        out.guidance = Some(g);
+        out.commands = Some(follow(&g));
+        out.target = target;
+        out.phase = phase;
+        g
+    }
+
+    fn fly_landing(&self, l: &mut Landing, state: &NavState, dt: f32, out: &mut NavOutput) {
+        let p = self.params;
+        let pos = state.pos_ned;
+        let hagl = state.height() + l.point.z;
+        let line = Path::line_between(&l.origin, &l.point, p.land_airspeed).unwrap_or(Path::Line {
+            origin: l.point,
+            direction: Vector3::x(),
+            airspeed: p.land_airspeed,
+        });
+        let mut g = self.guidance.step(&line, &pos, state.ground_speed());
+        // Level at the approach's start height until the glide slope, then down it.
+        let to_go = match line {
+            Path::Line { direction, .. } => {
+                let d = Vector3::new(direction.x, direction.y, 0.0);
+                let n = d.norm();
+                if n > 0.0 {
+                    ((l.point - pos).dot(&d) / n).max(0.0)
+                } else {
+                    0.0
+                }
+            }
+            Path::Orbit { .. } => 0.0,
+        };
+        let start_h = -l.origin.z;
+        g.altitude = (-l.point.z + libm::tanf(p.glide_slope) * to_go).min(start_h.max(-l.point.z));
+        out.guidance = Some(g);
+        out.target = Some(l.point);
+        if l.phase == LandPhase::Approach && hagl < p.flare_alt {
+            l.phase = LandPhase::Flare;
+        }
+        if l.phase == LandPhase::Flare {
+            let sink = state.vel_ned.z;
+            if hagl < p.touchdown_alt && sink < TOUCHDOWN_SINK {
+                l.ground_time += dt;
+            } else {
+                l.ground_time = 0.0;
+            }
+            if l.ground_time >= TOUCHDOWN_S {
+                l.phase = LandPhase::Landed;
+            }
+        }
+        match l.phase {
+            LandPhase::Approach => {
+                out.phase = Phase::Approach;
+                out.commands = Some(follow(&g));
+            }
+            LandPhase::Flare => {
+                out.phase = Phase::Flare;
+                // The sink rate aimed for shrinks from the glide's to the touchdown's with
+                // height; pitch up as the aircraft sinks faster than that.
+                let approach_sink = p.land_airspeed * libm::sinf(p.glide_slope);
+                let frac = (hagl / p.flare_alt).clamp(0.0, 1.0);
+                let aim = p.flare_sink + (approach_sink - p.flare_sink).max(0.0) * frac;
+                let sink = state.vel_ned.z;
+                let pitch = if sink.is_finite() {
+                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(-5.0 * DEG, 15.0 * DEG)
+                } else {
+                    p.flare_pitch
+                };
+                out.commands = Some(Commands {
+                    roll: RollMode::Course(g.course),
+                    yaw: YawMode::Sideslip(0.0),
+                    lon: LonMode::Pitch {
+                        pitch,
+                        throttle: 0.0,
+                    },
+                });
+            }
+            LandPhase::Landed => {
+                out.phase = Phase::Landed;
+                out.landed = true;
+                out.commands = Some(Commands {
+                    roll: RollMode::Roll(0.0),
+                    yaw: YawMode::Damper,
+                    lon: LonMode::Pitch {
+                        pitch: 0.0,
+                        throttle: 0.0,
+                    },
+                });
+            }
+        }
+    }
+
+    fn fly_return(
+        &mut self,
+        phase: ReturnPhase,
+        land: bool,
+        state: &NavState,
+        dt: f32,
+        out: &mut NavOutput,
+    ) {
+        let p = self.params;
+        let pos = state.pos_ned;
+        let home_ned = Vector3::new(0.0, 0.0, -p.rtl_alt);
+        let circle = self.default_orbit(home_ned);
+        let next = match phase {
+            ReturnPhase::Home { origin } => {
+                let path = Path::line_between(&origin, &home_ned, self.cruise())
+                    .unwrap_or(orbit_path(&circle, self.cruise()));
+                self.emit(&path, state, Some(home_ned), Phase::Return, out);
+                if horizontal_dist(&pos, &home_ned) <= p.loiter_radius {
+                    // A mission's return item counts as reached at home.
+                    out.reached = self.seq;
+                    ReturnPhase::Circle
+                } else {
+                    phase
+                }
+            }
+            ReturnPhase::Circle => {
+                let g = self.emit(
+                    &orbit_path(&circle, self.cruise()),
+                    state,
+                    Some(home_ned),
+                    Phase::ReturnLoiter,
+                    out,
+                );
+                let settled = g.cross_track.abs() <= p.accept_radius
+                    && (state.height() - p.rtl_alt).abs() <= p.alt_accept;
+                if land && settled {
+                    // Final approach along the runway of the last take-off (or from where
+                    // the aircraft is), starting where the glide slope meets the return
+                    // altitude.
+                    let course = self.runway.unwrap_or_else(|| libm::atan2f(-pos.y, -pos.x));
+                    let run = p.rtl_alt / libm::tanf(p.glide_slope);
+                    let gate = Vector3::new(
+                        -libm::cosf(course) * run,
+                        -libm::sinf(course) * run,
+                        -p.rtl_alt,
+                    );
+                    self.paths.reset();
+                    ReturnPhase::ToFinal { origin: pos, gate }
+                } else {
+                    phase
+                }
+            }
+            ReturnPhase::ToFinal { origin, gate } => {
+                let airspeed = self.cruise();
+                let mk = |id, ned| Waypoint {
+                    id,
+                    ned,
+                    airspeed,
+                    accept_radius: p.accept_radius,
+                };
+                let window = [mk(0, origin), mk(1, gate), mk(2, Vector3::zeros())];
+                let step = self.paths.step(&pos, &window);
+                let reached = step.as_ref().and_then(|s| s.reached).is_some();
+                let path = step
+                    .map(|s| s.path)
+                    .unwrap_or(orbit_path(&circle, airspeed));
+                self.emit(&path, state, Some(gate), Phase::Return, out);
+                if reached {
+                    ReturnPhase::Land(Landing {
+                        origin: gate,
+                        point: Vector3::zeros(),
+                        phase: LandPhase::Approach,
+                        ground_time: 0.0,
+                    })
+                } else {
+                    phase
+                }
+            }
+            ReturnPhase::Land(mut l) => {
+                self.fly_landing(&mut l, state, dt, out);
+                ReturnPhase::Land(l)
+            }
+        };
+        self.active = Active::Return { phase: next, land };
+    }
+}
+
+enum JumpStep {
+    Jump(usize),
+    Next,
+    Bad,
+}
+
+/// What a `DO_JUMP` does given the jumps it has done (`None`: its counter cannot be kept).
+fn jump_target(item: &MissionItem, len: usize, done: Option<u16>) -> JumpStep {
+    let target = item.param(0);
+    let repeat = item.param(1);
+    if !(target.is_finite()
+        && target >= 0.0
+        && target < len as f32
+        && libm::truncf(target) == target)
+    {
+        return JumpStep::Bad;
+    }
+    let Some(done) = done else {
+        return JumpStep::Bad;
+    };
+    // -1: for ever; otherwise a whole number of repeats.
+    let again = if repeat == -1.0 {
+        true
+    } else {
+        repeat.is_finite() && repeat >= 0.0 && f32::from(done) < libm::truncf(repeat)
+    };
+    if again {
+        JumpStep::Jump(target as usize)
+    } else {
+        JumpStep::Next
+    }
+}

@@ -1,0 +1,724 @@
+//! Mission flights of the navigator against the kinematic aircraft of [`super::sim`].
+
+extern crate std;
+
+use super::executor::PARAMS as EXEC_PARAMS;
+use super::items::*;
+use super::path_manager::PARAMS as PATH_PARAMS;
+use super::sim::Kinematic;
+use super::*;
+use crate::control::autopilot::Commands;
+use crate::control::lateral::RollMode;
+use crate::control::longitudinal::LonMode;
+use crate::estimator::Home;
+use crate::gcs::mission::MissionItem;
+use crate::guidance::PARAMS as GUIDANCE_PARAMS;
+use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
+use crate::math::wrap_pi;
+use crate::params::{validate_defs, ParamDef};
+use nalgebra::Vector3;
+use std::vec::Vec;
+
+const REL_ALT_INT: u8 = 6;
+const DT: f32 = 0.05;
+
+fn home() -> Home {
+    Home {
+        point: GeoPoint::from_deg(44.7258357, -93.07501316),
+        alt_amsl_m: 250.0,
+    }
+}
+
+fn item(command: u16, params: [f32; 4], n: f32, e: f32, h: f32) -> MissionItem {
+    let p = offset_point(home().point, n, e);
+    MissionItem {
+        params: params.map(f32::to_bits),
+        x: p.lat_e7,
+        y: p.lon_e7,
+        z: h.to_bits(),
+        command,
+        frame: REL_ALT_INT,
+        autocontinue: true,
+    }
+}
+
+fn wp(n: f32, e: f32, h: f32) -> MissionItem {
+    item(NAV_WAYPOINT, [0.0; 4], n, e, h)
+}
+
+fn do_item(command: u16, params: [f32; 4]) -> MissionItem {
+    MissionItem {
+        params: params.map(f32::to_bits),
+        command,
+        frame: 2, // MAV_FRAME_MISSION
+        autocontinue: true,
+        ..MissionItem::default()
+    }
+}
+
+/// The kinematic aircraft driven by the autopilot commands, standing in for the closed loops:
+/// course and altitude lags as in `sim`, airspeed lag 2 s, a runway at height 0.
+struct Plane {
+    k: Kinematic,
+    climb: f32,
+}
+
+impl Plane {
+    fn flying(n: f32, e: f32, h: f32, heading: f32) -> Self {
+        Self {
+            k: Kinematic::new(Vector3::new(n, e, -h), heading, 17.0),
+            climb: 0.0,
+        }
+    }
+
+    fn state(&self) -> NavState {
+        let v = self.k.ground_velocity();
+        NavState {
+            pos_ned: self.k.pos,
+            vel_ned: Vector3::new(v.x, v.y, -self.climb),
+            heading: self.k.heading,
+            airspeed: self.k.airspeed,
+        }
+    }
+
+    fn height(&self) -> f32 {
+        -self.k.pos.z
+    }
+
+    fn apply(&mut self, c: &Commands, dt: f32) {
+        let h = self.height();
+        let max_rate = 9.80665 / self.k.airspeed.max(5.0);
+        match c.roll {
+            RollMode::Course(chi) if h > 0.5 => {
+                let rate =
+                    (wrap_pi(chi - self.k.course()) / self.k.tau_course).clamp(-max_rate, max_rate);
+                self.k.heading = wrap_pi(self.k.heading + rate * dt);
+            }
+            _ => {}
+        }
+        let va = self.k.airspeed;
+        let (climb, aspd_cmd) = match c.lon {
+            LonMode::Altitude { altitude, airspeed } => (
+                ((altitude - h) / self.k.tau_alt).clamp(-self.k.max_vz, self.k.max_vz),
+                airspeed,
+            ),
+            LonMode::TakeOff {
+                altitude,
+                airspeed,
+                clear_altitude,
+            } => {
+                if h < clear_altitude {
+                    (va * libm::sinf(10f32.to_radians()), airspeed)
+                } else {
+                    (
+                        ((altitude - h) / self.k.tau_alt).clamp(-self.k.max_vz, self.k.max_vz),
+                        airspeed,
+                    )
+                }
+            }
+            LonMode::Pitch { pitch, throttle } => {
+                if throttle > 0.5 {
+                    // Full throttle on the runway: 3 m/s^2.
+                    (0.0, va + 3.0)
+                } else {
+                    // Gliding with the engine idle: 1.8 m/s of sink at zero pitch; the flight
+                    // path follows the pitch with a 0.5 s lag.
+                    let target = va * libm::sinf(pitch) - 1.8;
+                    (
+                        self.climb + (target - self.climb) * dt / 0.5,
+                        (va - 0.3).max(0.0),
+                    )
+                }
+            }
+            _ => (0.0, va),
+        };
+        self.k.airspeed += (aspd_cmd - va).clamp(-0.3, 3.0) * dt;
+        // On the runway: no sinking through it.
+        self.climb = if h <= 0.0 && climb < 0.0 { 0.0 } else { climb };
+        self.k.move_by(self.climb, dt);
+        if self.k.pos.z > 0.0 {
+            self.k.pos.z = 0.0;
+        }
+    }
+}
+
+#[derive(Default)]
+struct Log {
+    reached: Vec<u16>,
+    warnings: Vec<NavWarning>,
+    outs: Vec<(f32, NavOutput, Vector3<f32>)>,
+}
+
+fn fly(
+    nav: &mut Navigator,
+    plane: &mut Plane,
+    items: &[MissionItem],
+    seconds: f32,
+    mut stop: impl FnMut(&NavOutput) -> bool,
+) -> Log {
+    let mut log = Log::default();
+    let mut t = 0.0;
+    while t < seconds {
+        let out = nav.step(items, &home(), &plane.state(), DT);
+        if let Some(r) = out.reached {
+            log.reached.push(r);
+        }
+        log.warnings.extend(out.warnings.iter().copied());
+        if let Some(c) = out.commands {
+            plane.apply(&c, DT);
+        }
+        let done = stop(&out);
+        log.outs.push((t, out, plane.k.pos));
+        if done {
+            break;
+        }
+        t += DT;
+    }
+    log
+}
+
+#[test]
+fn parameter_lists_are_well_formed_and_unique_across_the_autopilot() {
+    let mut all: Vec<ParamDef> = Vec::new();
+    for list in PARAM_LISTS {
+        assert_eq!(validate_defs(list), Ok(()));
+        all.extend_from_slice(list);
+    }
+    all.extend(crate::control::gains::all_params().copied());
+    all.extend_from_slice(crate::estimator::PARAMS);
+    assert_eq!(validate_defs(&all), Ok(()));
+    let p = NavParams::default();
+    for d in EXEC_PARAMS {
+        let v = p.get(d.name).unwrap();
+        assert!((v - d.default).abs() < 1e-5, "{}", d.name);
+    }
+    let mut nav = Navigator::default();
+    for d in GUIDANCE_PARAMS.iter().chain(PATH_PARAMS).chain(EXEC_PARAMS) {
+        assert_eq!(nav.set_param(d.name, d.default), Ok(()), "{}", d.name);
+    }
+    assert_eq!(
+        nav.set_param("NAV_ACC_RAD", 1e6),
+        Err(crate::params::ParamError::OutOfBounds)
+    );
+    assert_eq!(
+        nav.set_param("NO_SUCH", 1.0),
+        Err(crate::params::ParamError::Unknown)
+    );
+}
+
+#[test]
+fn item_altitude_frames() {
+    let h = home();
+    let mut it = wp(100.0, -50.0, 80.0);
+    let t = target_ned(&it, &h, &Vector3::zeros());
+    assert!((t.x - 100.0).abs() < 0.05 && (t.y + 50.0).abs() < 0.05);
+    assert_eq!(t.z, -80.0);
+    // Absolute frame (GLOBAL_INT): 350 m AMSL is 100 m above a home at 250 m.
+    it.frame = 5;
+    it.z = 350f32.to_bits();
+    assert_eq!(target_ned(&it, &h, &Vector3::zeros()).z, -100.0);
+    // NaN altitude: keep the present one; 0/0: the present position.
+    let mut here = item(NAV_LOITER_UNLIM, [0.0; 4], 0.0, 0.0, f32::NAN);
+    here.x = 0;
+    here.y = 0;
+    let t = target_ned(&here, &h, &Vector3::new(5.0, 6.0, -70.0));
+    assert_eq!(t, Vector3::new(5.0, 6.0, -70.0));
+}
+
+/// Three waypoints in a 5 m/s wind: reached in order, current item follows, then the aircraft
+/// circles the last one.
+#[test]
+fn waypoints_reached_in_order_then_circle_the_last() {
+    let items = [
+        wp(400.0, 0.0, 80.0),
+        wp(400.0, 400.0, 100.0),
+        wp(0.0, 400.0, 100.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    plane.k.wind = Vector3::new(-3.0, 4.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 300.0, |_| false);
+    assert_eq!(log.reached, [0, 1, 2]);
+    assert!(log.warnings.is_empty());
+    let currents: Vec<u16> = log.outs.iter().filter_map(|o| o.1.current_seq).collect();
+    assert!(currents.windows(2).all(|w| w[0] <= w[1]));
+    let (_, last, pos) = log.outs.last().unwrap();
+    assert_eq!(last.phase, Phase::Complete);
+    let r = libm::hypotf(pos.x, pos.y - 400.0);
+    assert!((r - 60.0).abs() < 5.0, "circle radius {r}");
+    assert!((-pos.z - 100.0).abs() < 1.0);
+}
+
+/// DO_JUMP back to item 0 with repeat 2: the two waypoints are flown three times, then the
+/// mission goes on to the last one (item 3).
+#[test]
+fn do_jump_repeats_exactly_n_times() {
+    let items = [
+        wp(300.0, 0.0, 80.0),
+        wp(300.0, 300.0, 80.0),
+        do_item(DO_JUMP, [0.0, 2.0, 0.0, 0.0]),
+        wp(0.0, 300.0, 80.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 600.0, |o| {
+        o.phase == Phase::Complete
+    });
+    assert_eq!(log.reached, [0, 1, 0, 1, 0, 1, 3]);
+    // Starting again resets the count.
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 600.0, |o| {
+        o.phase == Phase::Complete
+    });
+    assert_eq!(log.reached, [0, 1, 0, 1, 0, 1, 3]);
+}
+
+#[test]
+fn unknown_and_unsupported_items_are_skipped_with_a_warning() {
+    let servo = MissionItem {
+        command: 183, // MAV_CMD_DO_SET_SERVO: not executed here
+        ..do_item(0, [1.0, 1500.0, 0.0, 0.0])
+    };
+    let items = [
+        wp(300.0, 0.0, 80.0),
+        servo,
+        do_item(9999, [0.0; 4]),
+        do_item(DO_CHANGE_SPEED, [2.0, 3.0, -1.0, 0.0]),
+        wp(300.0, 300.0, 80.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 300.0, |o| {
+        o.phase == Phase::Complete
+    });
+    assert_eq!(log.reached, [0, 4]);
+    assert_eq!(
+        log.warnings,
+        [
+            NavWarning::UnknownCommand {
+                seq: 1,
+                command: 183
+            },
+            NavWarning::UnknownCommand {
+                seq: 2,
+                command: 9999
+            },
+            NavWarning::UnsupportedSpeed { seq: 3 },
+        ]
+    );
+}
+
+#[test]
+fn jump_loop_without_a_navigation_item_ends_the_mission() {
+    let items = [
+        do_item(DO_JUMP, [1.0, -1.0, 0.0, 0.0]),
+        do_item(DO_JUMP, [0.0, -1.0, 0.0, 0.0]),
+    ];
+    let mut nav = Navigator::default();
+    nav.start_mission(0);
+    let plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert!(matches!(out.warnings[..], [NavWarning::JumpLoop { .. }]));
+    assert_eq!(out.phase, Phase::Complete);
+    // A jump to an item that does not exist is skipped.
+    let items = [do_item(DO_JUMP, [7.0, 1.0, 0.0, 0.0]), wp(100.0, 0.0, 80.0)];
+    nav.start_mission(0);
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.warnings[..], [NavWarning::BadJump { seq: 0 }]);
+    assert_eq!(out.current_seq, Some(1));
+    // Nothing to fly.
+    nav.start_mission(0);
+    let out = nav.step(&[], &home(), &plane.state(), DT);
+    assert_eq!(out.warnings[..], [NavWarning::NoMission]);
+}
+
+#[test]
+fn change_speed_and_set_home() {
+    let items = [
+        do_item(DO_CHANGE_SPEED, [0.0, 21.0, -1.0, 0.0]),
+        do_item(DO_SET_HOME, [1.0, 0.0, 0.0, 0.0]),
+        wp(300.0, 0.0, 80.0),
+        do_item(DO_CHANGE_SPEED, [0.0, 99.0, -1.0, 0.0]),
+        wp(300.0, 300.0, 80.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.set_home, Some(HomeRequest::Here));
+    assert_eq!(out.current_seq, Some(2));
+    assert_eq!(out.guidance.unwrap().airspeed, 21.0);
+    // 99 m/s is clamped to NAV_ASPD_MAX.
+    let log = fly(&mut nav, &mut plane, &items, 100.0, |o| {
+        o.current_seq == Some(4)
+    });
+    let last = &log.outs.last().unwrap().1;
+    nav.step(&items, &home(), &plane.state(), DT);
+    let o = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(last.current_seq, Some(4));
+    assert_eq!(o.guidance.unwrap().airspeed, 25.0);
+    // Crossed limits (a minimum above the maximum) are no reason to panic: the maximum wins.
+    let mut nav = Navigator::default();
+    nav.set_param("NAV_ASPD_MIN", 30.0).unwrap();
+    nav.set_param("NAV_ASPD_MAX", 20.0).unwrap();
+    nav.start_mission(0);
+    let o = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(o.guidance.unwrap().airspeed, 20.0);
+}
+
+/// LOITER_TURNS, 2 turns counter-clockwise (radius -80): the angle swept round the centre
+/// between arriving on the circle and the item's end is two turns, in the negative sense.
+#[test]
+fn loiter_turns_counted() {
+    let items = [
+        item(NAV_LOITER_TURNS, [2.0, 0.0, -80.0, 0.0], 500.0, 0.0, 80.0),
+        wp(500.0, 600.0, 80.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    plane.k.wind = Vector3::new(0.0, 4.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 400.0, |o| {
+        o.reached == Some(0)
+    });
+    assert_eq!(log.reached, [0]);
+    let c = log.outs[0].1.target.unwrap();
+    // Swept angle from the first step within 8 m of the circle.
+    let mut swept = 0.0;
+    let mut last: Option<f32> = None;
+    for (_, _, p) in &log.outs {
+        let d = libm::hypotf(p.x - c.x, p.y - c.y);
+        if last.is_none() && (d - 80.0).abs() > 8.0 {
+            continue;
+        }
+        let phi = libm::atan2f(p.y - c.y, p.x - c.x);
+        if let Some(l) = last {
+            swept += wrap_pi(phi - l);
+        }
+        last = Some(phi);
+    }
+    let turns = swept / core::f32::consts::TAU;
+    assert!((turns + 2.0).abs() < 0.05, "turns {turns}");
+}
+
+#[test]
+fn loiter_time_and_to_altitude() {
+    let items = [
+        item(NAV_LOITER_TIME, [30.0, 0.0, 70.0, 0.0], 300.0, 0.0, 80.0),
+        item(NAV_LOITER_TO_ALT, [0.0, 70.0, 0.0, 0.0], 300.0, 0.0, 120.0),
+        item(NAV_LOITER_UNLIM, [0.0, 0.0, 0.0, 0.0], 0.0, 0.0, 120.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 400.0, |_| false);
+    assert_eq!(log.reached, [0, 1, 2]);
+    let at = |seq| {
+        log.outs
+            .iter()
+            .find(|o| o.1.reached == Some(seq))
+            .map(|o| (o.0, o.2))
+            .unwrap()
+    };
+    let arrived = log
+        .outs
+        .iter()
+        .find(|o| {
+            let d = libm::hypotf(o.2.x - 300.0, o.2.y);
+            (d - 70.0).abs() <= 15.0
+        })
+        .unwrap()
+        .0;
+    let (t0, _) = at(0);
+    assert!(
+        (t0 - arrived - 30.0).abs() < 0.2,
+        "loiter time {}",
+        t0 - arrived
+    );
+    let (_, p1) = at(1);
+    assert!((-p1.z - 120.0).abs() <= 5.0);
+    // Unlimited: reached on arrival, never left.
+    let (_, last, _) = log.outs.last().unwrap();
+    assert_eq!((last.current_seq, last.phase), (Some(2), Phase::Loiter));
+}
+
+/// A runway take-off heading east (param4 = 90 deg), no wind: rolls wings level at full
+/// throttle and pitch 0 below the rotation airspeed, then the take-off regime; reached at the
+/// item's altitude (less NAV_ALT_ACC), on the runway's line.
+#[test]
+fn runway_takeoff() {
+    let items = [
+        {
+            let mut t = item(NAV_TAKEOFF, [0.0, 0.0, 0.0, 90.0], 0.0, 0.0, 40.0);
+            t.x = 0;
+            t.y = 0;
+            t
+        },
+        wp(0.0, 1500.0, 60.0),
+    ];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    plane.k.airspeed = 0.0;
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 120.0, |o| {
+        o.reached == Some(0)
+    });
+    assert_eq!(log.reached, [0]);
+    let vr = nav.params().takeoff_vr;
+    let mut rolled = false;
+    for (_, o, p) in &log.outs {
+        let c = o.commands.unwrap();
+        if o.phase == Phase::TakeoffRoll {
+            rolled = true;
+            assert_eq!(c.roll, RollMode::Roll(0.0));
+            assert_eq!(
+                c.lon,
+                LonMode::Pitch {
+                    pitch: 0.0,
+                    throttle: 1.0
+                }
+            );
+            assert_eq!(-p.z, 0.0);
+        } else {
+            assert_eq!(o.phase, Phase::TakeoffClimb);
+            assert!(
+                matches!(c.lon, LonMode::TakeOff { altitude, clear_altitude, .. }
+                if altitude == 40.0 && clear_altitude == 10.0)
+            );
+        }
+        assert!(p.x.abs() < 0.5, "off the runway line by {}", p.x);
+    }
+    assert!(rolled);
+    // Rotation at VR: the first climb step comes with the airspeed at or above it.
+    let first_climb = log
+        .outs
+        .iter()
+        .position(|o| o.1.phase == Phase::TakeoffClimb)
+        .unwrap();
+    assert!(first_climb > 0);
+    let (_, _, end) = log.outs.last().unwrap();
+    assert!(-end.z >= 35.0 && -end.z < 40.0 + 1.0);
+    assert!(plane.k.airspeed >= vr);
+}
+
+/// Landing from a waypoint 900 m north of the land point at 60 m: level until the 6-degree
+/// glide slope, down it, flare, touchdown past the land point (the flare floats), on the line,
+/// `landed` reported after a second on the ground, with the item reached. On the slope the height is the glide's plus the
+/// ramp lag of the model's first-order altitude loop, `Vg tan(gamma) tau` (tau = 2 s), to
+/// within 1 m.
+#[test]
+fn landing_glide_path_reaches_the_land_point() {
+    let items = [
+        wp(900.0, 0.0, 60.0),
+        item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0),
+    ];
+    let mut nav = Navigator::default();
+    // Approaching the waypoint from the north-east, at its altitude.
+    let mut plane = Plane::flying(1300.0, 300.0, 60.0, -2.5);
+    plane.k.wind = Vector3::new(2.0, 1.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 400.0, |o| o.landed);
+    assert_eq!(log.reached, [0, 1]);
+    let tan_g = libm::tanf(6f32.to_radians());
+    let flare = nav.params().flare_alt;
+    let mut on_slope = 0;
+    for (_, o, p) in &log.outs {
+        if o.current_seq == Some(1) && o.phase == Phase::Approach {
+            let to_go = p.x.max(0.0);
+            let glide = tan_g * to_go;
+            // From 10 s after the glide slope is met down to the flare.
+            if glide < 55.0 - 10.0 * 1.5 && glide > flare + 2.0 {
+                on_slope += 1;
+                let vg = o.guidance.map_or(14.0, |_| plane_speed(&log, p));
+                let lag = vg * tan_g * 2.0;
+                assert!(
+                    (-p.z - glide - lag).abs() < 1.0,
+                    "height {} vs glide {glide} + lag {lag} at {to_go} m",
+                    -p.z
+                );
+                assert!(p.y.abs() < 2.0, "cross-track {}", p.y);
+            }
+        }
+    }
+    assert!(on_slope > 200);
+    let flare_at = log.outs.iter().find(|o| o.1.phase == Phase::Flare).unwrap();
+    let ground_at = log.outs.iter().find(|o| o.2.z >= 0.0).unwrap();
+    // The flare begins near the land point (the ramp lag holds the aircraft 3 m above the
+    // glide, so a little after it) and the wheels meet the runway beyond it, within 60 m.
+    assert!(flare_at.2.x.abs() < 30.0, "flare at {}", flare_at.2.x);
+    assert!(
+        ground_at.2.x < 0.0 && ground_at.2.x > -60.0,
+        "wheels on the runway {} m past the land point",
+        -ground_at.2.x
+    );
+    let (_, last, td) = log.outs.last().unwrap();
+    assert!(last.landed);
+    assert_eq!(last.phase, Phase::Landed);
+    assert!(
+        td.x < 0.0 && td.x > -120.0,
+        "touchdown {} m past the land point",
+        -td.x
+    );
+    assert!(td.y.abs() < 3.0);
+    assert!(matches!(
+        last.commands.unwrap().lon,
+        LonMode::Pitch { throttle, .. } if throttle == 0.0
+    ));
+}
+
+/// Ground speed at the logged position `p` (from the next logged position).
+fn plane_speed(log: &Log, p: &Vector3<f32>) -> f32 {
+    let i = log.outs.iter().position(|o| o.2 == *p).unwrap();
+    let q = log.outs.get(i + 1).map_or(*p, |o| o.2);
+    libm::hypotf(q.x - p.x, q.y - p.y) / DT
+}
+
+/// Return mode without landing: home at NAV_RTL_ALT, circling at NAV_LOIT_RAD. With landing:
+/// down the glide slope onto home.
+#[test]
+fn return_and_circle_or_land() {
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(600.0, -400.0, 120.0, 1.0);
+    plane.k.wind = Vector3::new(0.0, -4.0, 0.0);
+    nav.start_return(false);
+    let log = fly(&mut nav, &mut plane, &[], 200.0, |_| false);
+    let (_, last, p) = log.outs.last().unwrap();
+    assert_eq!(last.phase, Phase::ReturnLoiter);
+    assert_eq!(last.current_seq, None);
+    let r = libm::hypotf(p.x, p.y);
+    assert!((r - 60.0).abs() < 5.0, "radius {r}");
+    assert!((-p.z - 60.0).abs() < 1.0);
+
+    nav.start_return(true);
+    let log = fly(&mut nav, &mut plane, &[], 600.0, |o| o.landed);
+    let (_, last, p) = log.outs.last().unwrap();
+    assert!(last.landed, "phase {:?}", last.phase);
+    assert!(libm::hypotf(p.x, p.y) < 120.0, "landed at {p:?}");
+}
+
+#[test]
+fn loiter_here_circles_the_present_position() {
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(200.0, 100.0, 90.0, 0.0);
+    nav.start_loiter(None);
+    let log = fly(&mut nav, &mut plane, &[], 120.0, |_| false);
+    let (_, last, p) = log.outs.last().unwrap();
+    assert_eq!(last.phase, Phase::Hold);
+    let c = last.target.unwrap();
+    assert_eq!(c, Vector3::new(200.0, 100.0, -90.0));
+    let r = libm::hypotf(p.x - c.x, p.y - c.y);
+    assert!((r - 60.0).abs() < 3.0, "radius {r}");
+    assert!((last.wp_dist_m - r).abs() < 1e-3);
+}
+
+/// The item positions come from `ned_offset` about home: a home moved by DO_SET_HOME moves
+/// every target with it on the next step.
+#[test]
+fn a_new_home_moves_the_targets() {
+    let items = [wp(300.0, 0.0, 80.0)];
+    let mut nav = Navigator::default();
+    let plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let a = nav
+        .step(&items, &home(), &plane.state(), DT)
+        .target
+        .unwrap();
+    let mut h2 = home();
+    h2.point = offset_point(home().point, 100.0_f32, 0.0);
+    h2.alt_amsl_m = 260.0;
+    let b = nav.step(&items, &h2, &plane.state(), DT).target.unwrap();
+    let (n, _): (f32, f32) = ned_offset(h2.point, offset_point(home().point, 300.0_f32, 0.0));
+    assert!((a.x - 300.0).abs() < 0.05);
+    assert!((b.x - n).abs() < 0.05 && (b.x - 200.0).abs() < 0.1);
+}
+
+/// A waypoint without autocontinue: reached, then held (circled) rather than left.
+#[test]
+fn no_autocontinue_holds_at_the_waypoint() {
+    let mut first = wp(300.0, 0.0, 80.0);
+    first.autocontinue = false;
+    let items = [first, wp(300.0, 300.0, 80.0)];
+    let mut nav = Navigator::default();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 150.0, |_| false);
+    assert_eq!(log.reached, [0]);
+    let (_, last, p) = log.outs.last().unwrap();
+    assert_eq!((last.phase, last.current_seq), (Phase::Hold, Some(0)));
+    let r = libm::hypotf(p.x - 300.0, p.y);
+    assert!((r - 60.0).abs() < 5.0, "radius {r}");
+    // The firmware moves on with set_current.
+    nav.set_current(1);
+    let log = fly(&mut nav, &mut plane, &items, 100.0, |o| o.reached.is_some());
+    assert_eq!(log.reached, [1]);
+}
+
+/// Items with garbage in every field (NaN and huge parameters, wild frames, jumps anywhere)
+/// and a garbage state: the navigator never panics and never stalls in a step.
+#[test]
+fn garbage_items_and_state_do_not_panic() {
+    let mut seed = 0x2545_f491_u32;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    let specials = [f32::NAN, f32::INFINITY, -1.0, 0.0, 1e30, -2.0, 3.0, 0.5];
+    for _ in 0..200 {
+        let mut items = [MissionItem::default(); 12];
+        for it in items.iter_mut() {
+            let cmds = [
+                NAV_WAYPOINT,
+                NAV_LOITER_UNLIM,
+                NAV_LOITER_TURNS,
+                NAV_LOITER_TIME,
+                NAV_RETURN_TO_LAUNCH,
+                NAV_LAND,
+                NAV_TAKEOFF,
+                NAV_LOITER_TO_ALT,
+                DO_JUMP,
+                DO_CHANGE_SPEED,
+                DO_SET_HOME,
+                0xffff,
+            ];
+            it.command = cmds[(next() % cmds.len() as u32) as usize];
+            it.frame = (next() % 12) as u8;
+            it.x = next() as i32;
+            it.y = next() as i32;
+            it.z = specials[(next() % 8) as usize].to_bits();
+            it.params = core::array::from_fn(|_| {
+                if next() % 2 == 0 {
+                    specials[(next() % 8) as usize].to_bits()
+                } else {
+                    ((next() % 14) as f32).to_bits()
+                }
+            });
+            it.autocontinue = next() % 4 != 0;
+        }
+        let mut nav = Navigator::default();
+        nav.start_mission((next() % 14) as u16);
+        let mut plane = Plane::flying(0.0, 0.0, 50.0, 0.0);
+        let _ = fly(&mut nav, &mut plane, &items, 10.0, |_| false);
+        let bad = NavState {
+            pos_ned: Vector3::new(f32::NAN, 1e30, f32::INFINITY),
+            vel_ned: Vector3::new(f32::NAN, 0.0, 0.0),
+            heading: f32::NAN,
+            airspeed: f32::NAN,
+        };
+        nav.set_current((next() % 14) as u16);
+        let _ = nav.step(&items, &home(), &bad, f32::NAN);
+        let _ = nav.step(&items, &home(), &bad, -1.0);
+        let _ = super::validate::validate_mission(
+            &items,
+            Some(&home()),
+            &MissionLimits::default(),
+            &NavParams::default(),
+        );
+        let _ = super::fence::validate_fence(&items);
+        let _ = breached(&items, &home(), &bad.pos_ned, &FenceParams::default());
+    }
+}
