@@ -4,6 +4,10 @@
 //! stored list only when its last item has arrived, so a failed or cancelled upload keeps the
 //! old plan. Home is not item 0: item 0 is the first thing to fly.
 
+use crate::estimator::Home;
+use crate::navigation::{
+    validate_fence, validate_mission, MissionLimits, NavParams, ValidationWarning,
+};
 use heapless::Vec;
 use mavlink::dialects::common::{
     MavCmd, MavFrame, MavMissionResult, MavMissionType, MISSION_ITEM_INT_DATA,
@@ -296,6 +300,20 @@ pub struct MissionManager {
     /// Last upload that completed, so a repeated last item is answered with the same ACK.
     last_done: Option<(PlanKind, u16, (u8, u8))>,
     changes: u32,
+    rules: PlanRules,
+    warnings: Vec<ValidationWarning, 8>,
+}
+
+/// What a finished upload is checked against before it replaces the stored list: the
+/// navigator's limits and the present home (the vehicle keeps these up to date).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanRules {
+    /// Home, once known (absolute altitudes are checked against it).
+    pub home: Option<Home>,
+    /// Altitude range of mission items.
+    pub limits: MissionLimits,
+    /// The navigator's parameters (approach checks).
+    pub nav: NavParams,
 }
 
 impl Default for MissionManager {
@@ -306,7 +324,7 @@ impl Default for MissionManager {
 
 impl MissionManager {
     /// Empty lists, no transfer.
-    pub const fn new() -> Self {
+    pub fn new() -> Self {
         Self {
             store: MissionStore {
                 mission: Vec::new(),
@@ -317,6 +335,8 @@ impl MissionManager {
             transfer: Transfer::Idle,
             last_done: None,
             changes: 0,
+            rules: PlanRules::default(),
+            warnings: Vec::new(),
         }
     }
 
@@ -447,7 +467,9 @@ impl MissionManager {
         }
         let next = next + 1;
         if next >= count {
-            let result = if self.store.replace(kind, &self.staging).is_ok() {
+            let result = if let Err(r) = self.check(kind) {
+                r
+            } else if self.store.replace(kind, &self.staging).is_ok() {
                 self.changes = self.changes.wrapping_add(1);
                 self.last_done = Some((kind, count, partner));
                 MavMissionResult::MAV_MISSION_ACCEPTED
@@ -539,6 +561,32 @@ impl MissionManager {
             }
         }
         MissionReply::Item(kind, seq)
+    }
+
+    /// Sets what finished uploads are checked against.
+    pub fn set_rules(&mut self, rules: PlanRules) {
+        self.rules = rules;
+    }
+
+    /// The warnings of the last accepted mission upload (each returned once).
+    pub fn take_warnings(&mut self) -> Vec<ValidationWarning, 8> {
+        core::mem::take(&mut self.warnings)
+    }
+
+    /// Checks a complete upload: the mission as the navigator will fly it, the fence as the
+    /// geofence reads it. Rally points are stored as they come.
+    fn check(&mut self, kind: PlanKind) -> Result<(), MavMissionResult> {
+        match kind {
+            PlanKind::Mission => {
+                let r = &self.rules;
+                let v = validate_mission(&self.staging, r.home.as_ref(), &r.limits, &r.nav);
+                v.result.map_err(|e| e.result)?;
+                self.warnings = v.warnings;
+                Ok(())
+            }
+            PlanKind::Fence => validate_fence(&self.staging).map_err(|(_, e)| e),
+            PlanKind::Rally => Ok(()),
+        }
     }
 
     /// `MISSION_ACK` from the ground station: ends a download, or cancels an upload.

@@ -23,6 +23,7 @@ mod tests;
 
 use core::fmt::Write;
 
+use crate::navigation::ValidationWarning;
 use heapless::{Deque, String};
 use mavlink::dialects::common::*;
 use mavlink::{MavHeader, Message};
@@ -295,6 +296,24 @@ impl GroundLink {
         }
     }
 
+    /// Says what an accepted mission will do differently from what its reader may expect.
+    fn mission_warning(&mut self, w: ValidationWarning) {
+        let sev = MavSeverity::MAV_SEVERITY_WARNING;
+        match w {
+            ValidationWarning::NoLanding => {
+                self.send_statustext(sev, "Mission has no landing: it ends circling")
+            }
+            ValidationWarning::WillSkip { seq, command } => self.textf(
+                sev,
+                format_args!("Mission item {seq}: command {command} not supported, skipped"),
+            ),
+            ValidationWarning::ApproachTooShort { seq } => self.textf(
+                sev,
+                format_args!("Mission item {seq}: landing approach too short, arrives high"),
+            ),
+        }
+    }
+
     fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
         let mut s: String<STATUSTEXT_LEN> = String::new();
         // A text that does not fit is cut, never refused.
@@ -419,6 +438,9 @@ impl GroundLink {
             MavMessage::MISSION_ITEM_INT(d) => {
                 if let Some(r) = self.missions.on_item(d, from, now_us) {
                     self.push(Pending::Mission(r, from));
+                }
+                for w in self.missions.take_warnings() {
+                    self.mission_warning(w);
                 }
             }
             // Float items lose precision; this autopilot asks for MISSION_ITEM_INT only.

@@ -1043,6 +1043,18 @@ fn upload(
     t: MavMissionType,
     items: &[MISSION_ITEM_INT_DATA],
 ) -> MavMissionResult {
+    upload_said(l, v, start_us, t, items).0
+}
+
+/// As [`upload`], with the STATUSTEXTs the vehicle sent on the way.
+fn upload_said(
+    l: &mut GroundLink,
+    v: &VehicleSnapshot,
+    start_us: u64,
+    t: MavMissionType,
+    items: &[MISSION_ITEM_INT_DATA],
+) -> (MavMissionResult, Vec<std::string::String>) {
+    let mut said = Vec::new();
     let mut now = start_us;
     let mut out = exchange(
         l,
@@ -1058,9 +1070,10 @@ fn upload(
     );
     for _ in 0..10_000 {
         let mut next = None;
+        said.extend(texts(&out));
         for m in &out {
             match m {
-                MavMessage::MISSION_ACK(a) => return a.mavtype,
+                MavMessage::MISSION_ACK(a) => return (a.mavtype, said),
                 MavMessage::MISSION_REQUEST_INT(r) => {
                     assert_eq!(r.mission_type, t);
                     assert_eq!((r.target_system, r.target_component), GCS);
@@ -1857,4 +1870,51 @@ fn preflight_storage_requests_save_and_resets_defaults() {
     );
     assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
     assert_eq!(l.params().get("RLL_KP"), Some(0.8));
+}
+
+/// An upload is checked as the navigator will fly it before it replaces the stored mission:
+/// an impossible item is refused with the MAVLink code that names its field, the old mission
+/// stays; what will be flown differently is accepted with a warning.
+#[test]
+fn uploads_are_checked_as_the_navigator_will_fly_them() {
+    let mut l = link();
+    let v = healthy();
+    let mission = MavMissionType::MAV_MISSION_TYPE_MISSION;
+    let good = waypoints(3, 0);
+    assert_eq!(
+        upload(&mut l, &v, 0, mission, &good),
+        MavMissionResult::MAV_MISSION_ACCEPTED
+    );
+    let stored = l.missions().store().items(PlanKind::Mission).to_vec();
+    let mut too_high = good.clone();
+    too_high[1].z = 5000.0;
+    assert_eq!(
+        upload(&mut l, &v, 1_000_000, mission, &too_high),
+        MavMissionResult::MAV_MISSION_INVALID_PARAM7
+    );
+    let mut bad_lat = good.clone();
+    bad_lat[2].x = 950_000_000;
+    assert_eq!(
+        upload(&mut l, &v, 2_000_000, mission, &bad_lat),
+        MavMissionResult::MAV_MISSION_INVALID_PARAM5_X
+    );
+    let mut jump = good.clone();
+    jump[2].command = MavCmd::MAV_CMD_DO_JUMP;
+    jump[2].frame = MavFrame::MAV_FRAME_MISSION;
+    jump[2].param1 = 9.0;
+    jump[2].param2 = 1.0;
+    assert_eq!(
+        upload(&mut l, &v, 3_000_000, mission, &jump),
+        MavMissionResult::MAV_MISSION_INVALID_SEQUENCE
+    );
+    assert_eq!(l.missions().store().items(PlanKind::Mission), &stored[..]);
+    let mut odd = good.clone();
+    odd[1].command = MavCmd::MAV_CMD_DO_SET_SERVO;
+    odd[1].frame = MavFrame::MAV_FRAME_MISSION;
+    let (result, mut said) = upload_said(&mut l, &v, 4_000_000, mission, &odd);
+    assert_eq!(result, MavMissionResult::MAV_MISSION_ACCEPTED);
+    said.extend(texts(&poll(&mut l, &v, 4_500_000)));
+    let said = said.join(" | ");
+    assert!(said.contains("item 1: command 183 not supported"), "{said}");
+    assert!(said.contains("no landing"), "{said}");
 }
