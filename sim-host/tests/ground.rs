@@ -136,6 +136,10 @@ fn a_drop_from_thirty_centimetres_settles_on_the_wheels() {
             td.sink_rate_mps()
         );
         assert!(td.time_s > 0.2 && td.time_s < 0.3, "{}", td.time_s);
+        assert!(
+            td.distance_from_m(0.0, 0.0) < 0.15 && td.bounces == 0,
+            "{td:?}"
+        );
         println!(
             "drop dt {dt}: touchdown {:.3} s at {:.3} m/s (free fall {:.3}), deepest {:.1} mm, bounces {}, forward {:.3} m",
             td.time_s,
@@ -330,4 +334,57 @@ fn contact_is_exactly_zero_in_flight_and_trim_is_unchanged() {
     let gc = ground::contact(&p, &s.to_vector(), &Controls::default());
     assert_eq!(gc, ground::GroundContact::default());
     assert!(!p.ground.clear_of_ground(s.pos_ned.z));
+}
+
+#[test]
+fn a_glide_onto_the_runway_records_its_touchdown() {
+    // The trimmed 17 m/s level flight, 3 m above the runway, engine off: it sinks onto the
+    // wheels. The record is the state when the lowest point reached the ground plane.
+    let a = aircraft();
+    let t = trim(&a, &TrimTarget::level());
+    let mut s = t.state;
+    s.pos_ned = Vector3::new(0.0, 0.0, -3.0);
+    let mut plant = Plant::new(&a, s);
+    let env = Environment::default();
+    let glide = Controls {
+        throttle: 0.0,
+        ..t.controls
+    };
+    let dt = 0.005;
+    let mut last_air = plant.clone();
+    while plant.touchdown().is_none() && plant.time_s() < 20.0 {
+        last_air = plant.clone();
+        plant.step(&glide, &env, dt);
+    }
+    let td = *plant.touchdown().expect("touched down");
+    // Between the last airborne state and the one after it.
+    assert!(td.time_s > last_air.time_s() && td.time_s <= plant.time_s());
+    let v_before = last_air.velocity_ned();
+    assert!(
+        (td.vel_ned - v_before).norm() < 0.05,
+        "{:?} vs {v_before}",
+        td.vel_ned
+    );
+    assert!(td.sink_rate_mps() > 0.0 && td.vel_ned.x > 10.0);
+    // Its position lies on the path flown in that step.
+    let along = (td.pos_ned - last_air.position_ned()).norm();
+    assert!(along <= (plant.position_ned() - last_air.position_ned()).norm() + 1e-9);
+    println!(
+        "glide landing: touchdown after {:.2} s, {:.1} m along, sink {:.2} m/s at {:.1} m/s",
+        td.time_s,
+        td.distance_from_m(0.0, 0.0),
+        td.sink_rate_mps(),
+        td.vel_ned.x
+    );
+    // It rolls out and stops on its wheels, right side up.
+    let idle = Controls {
+        throttle: 0.0,
+        ..Controls::default()
+    };
+    for _ in 0..(60.0 / dt) as usize {
+        plant.step(&idle, &env, dt);
+    }
+    assert!(plant.state_vector().iter().all(|v| v.is_finite()));
+    assert!(ground_speed(&plant) < 0.05, "{}", ground_speed(&plant));
+    assert!(plant.weight_on_wheels() && plant.euler().phi.abs() < 0.1);
 }

@@ -271,11 +271,16 @@ fn skid_friction(mu: f64, normal: f64, vn: f64, ve: f64, v_s: f64) -> (f64, f64)
 
 /// Height of the lowest contact point above the ground plane, m (negative when below).
 pub fn clearance_m(p: &ModelParams, x: &StateVector) -> f64 {
-    let q = quat_of(x);
+    // Only the down row of the body-to-NED matrix is needed.
+    let r = quat_of(x).to_rotation_matrix().into_inner();
+    let (r20, r21, r22) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
     p.ground
         .points
         .iter()
-        .map(|pt| p.ground.ground_down_m - x[2] - body_to_ned(&q, &pt.pos_body).z)
+        .map(|pt| {
+            let b = pt.pos_body;
+            p.ground.ground_down_m - x[2] - (r20 * b.x + r21 * b.y + r22 * b.z)
+        })
         .fold(f64::INFINITY, f64::min)
 }
 
