@@ -24,6 +24,8 @@ fn at_rest_the_wheels_carry_the_weight_by_the_lever_rule_and_nothing_creeps() {
     let mut plant = Plant::at_rest_on_ground(&a, 10.0, -5.0, 0.7);
     let p = plant.params().clone();
     let weight = p.mass * p.g;
+    let (_, residual) = ground::rest_state(&p, 10.0, -5.0, 0.7);
+    assert!(residual < 1e-9, "equilibrium residual {residual}");
     let gc = plant.ground_contact();
     assert!(plant.on_ground() && plant.weight_on_wheels());
     // Vertical balance: the normal forces sum to the weight.
@@ -81,6 +83,7 @@ fn at_rest_the_wheels_carry_the_weight_by_the_lever_rule_and_nothing_creeps() {
         plant.step(&idle, &env, 0.005);
     }
     let moved = plant.position_ned() - start;
+    println!("at rest: moved {:.2e} m in 10 s", moved.norm());
     assert!(moved.norm() < 0.01, "moved {moved} m in 10 s");
     assert!(plant.on_ground() && plant.touchdown().is_none() && plant.liftoff_s().is_none());
 }
