@@ -1,9 +1,10 @@
-//! Speed of the plant alone: RK4 steps per second on one core, from level trim.
+//! Speed of the plant alone: RK4 steps per second on one core, from level trim (in the air) and
+//! on the runway (ground contact evaluated at every step).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use sim_host::aircraft::Aircraft;
 use sim_host::analysis::trim::{trim, TrimTarget};
-use sim_host::plant::{Environment, Plant};
+use sim_host::plant::{Controls, Environment, Plant};
 use std::hint::black_box;
 
 fn plant_steps(c: &mut Criterion) {
@@ -22,6 +23,19 @@ fn plant_steps(c: &mut Criterion) {
                 plant.step(black_box(&controls), black_box(&env), 0.005);
             }
             black_box(plant.state_vector()[0])
+        })
+    });
+    // Rolling on the runway at full throttle: every evaluation works through the contact points.
+    let rest = Plant::at_rest_on_ground(&aircraft, 0.0, 0.0, 0.0).state();
+    let mut ground = Plant::at_rest_on_ground(&aircraft, 0.0, 0.0, 0.0);
+    let roll = Controls::new(0.0, 0.0, 0.0, 1.0);
+    group.bench_function("rk4_step_on_ground_dt_0.005", |b| {
+        b.iter(|| {
+            ground.set_state(rest);
+            for _ in 0..STEPS {
+                ground.step(black_box(&roll), black_box(&env), 0.005);
+            }
+            black_box(ground.state_vector()[0])
         })
     });
     group.finish();

@@ -265,6 +265,43 @@ pub struct Environment {
     pub home_alt_msl_m: f64,
 }
 
+/// Landing gear and belly contact with the ground (a taildragger: two main wheels ahead of the
+/// CG, a tail wheel steered by the rudder).
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Ground {
+    /// Left main wheel's ground contact point from the CG, body axes, m.
+    pub main_wheel_left_m: [f64; 3],
+    /// Right main wheel's ground contact point from the CG, body axes, m.
+    pub main_wheel_right_m: [f64; 3],
+    /// Tail wheel's ground contact point from the CG, body axes, m.
+    pub tail_wheel_m: [f64; 3],
+    /// Points of the fuselage and wings that touch in a belly or wing-tip landing, body axes, m.
+    pub belly_points_m: Vec<[f64; 3]>,
+    /// Stiffness of each main wheel's leg and tyre, N/m.
+    pub main_stiffness_Npm: f64,
+    /// Damping of each main wheel, N s/m.
+    pub main_damping_Nspm: f64,
+    /// Stiffness of the tail wheel's spring, N/m.
+    pub tail_stiffness_Npm: f64,
+    /// Damping of the tail wheel, N s/m.
+    pub tail_damping_Nspm: f64,
+    /// Stiffness of a belly point, N/m.
+    pub belly_stiffness_Npm: f64,
+    /// Damping of a belly point, N s/m.
+    pub belly_damping_Nspm: f64,
+    /// Rolling friction coefficient of the wheels (no brakes).
+    pub mu_roll: f64,
+    /// Side friction coefficient of the wheels.
+    pub mu_side: f64,
+    /// Sliding friction coefficient of the belly points.
+    pub mu_belly: f64,
+    /// Slip speed below which friction grows smoothly from zero, m/s.
+    pub slip_speed_mps: f64,
+    /// Tail-wheel heading per rudder deflection (the wheel turns with the rudder).
+    pub tail_steer_per_rudder: f64,
+}
+
 /// The whole aircraft file.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -283,6 +320,8 @@ pub struct Aircraft {
     pub sensors: crate::sensors::SensorConfig,
     /// Environment.
     pub environment: Environment,
+    /// Landing gear and belly contact.
+    pub ground: Ground,
 }
 
 impl Aircraft {
@@ -418,6 +457,96 @@ impl Aircraft {
                 e.home_lon_deg.to_string(),
                 "must be within -180..180 deg",
             ));
+        }
+        self.validate_ground(file)
+    }
+
+    /// Checks the `[ground]` table: a taildragger whose gear stands below the CG.
+    fn validate_ground(&self, file: &Path) -> Result<(), AircraftError> {
+        let bad = |key: &str, value: String, reason: &str| AircraftError::Value {
+            file: file.to_path_buf(),
+            key: format!("ground.{key}"),
+            value,
+            reason: reason.to_string(),
+        };
+        let gr = &self.ground;
+        for (key, v) in [
+            ("main_stiffness_Npm", gr.main_stiffness_Npm),
+            ("tail_stiffness_Npm", gr.tail_stiffness_Npm),
+            ("belly_stiffness_Npm", gr.belly_stiffness_Npm),
+            ("slip_speed_mps", gr.slip_speed_mps),
+        ] {
+            if v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return Err(bad(key, v.to_string(), "must be positive"));
+            }
+        }
+        for (key, v) in [
+            ("main_damping_Nspm", gr.main_damping_Nspm),
+            ("tail_damping_Nspm", gr.tail_damping_Nspm),
+            ("belly_damping_Nspm", gr.belly_damping_Nspm),
+        ] {
+            if v.partial_cmp(&0.0) == Some(std::cmp::Ordering::Less) || !v.is_finite() {
+                return Err(bad(key, v.to_string(), "must not be negative"));
+            }
+        }
+        for (key, v) in [
+            ("mu_roll", gr.mu_roll),
+            ("mu_side", gr.mu_side),
+            ("mu_belly", gr.mu_belly),
+        ] {
+            if !(0.0..=2.0).contains(&v) {
+                return Err(bad(key, v.to_string(), "must be within 0..2"));
+            }
+        }
+        if !(-2.0..=2.0).contains(&gr.tail_steer_per_rudder) {
+            return Err(bad(
+                "tail_steer_per_rudder",
+                gr.tail_steer_per_rudder.to_string(),
+                "must be within -2..2",
+            ));
+        }
+        let point = |key: &str, v: [f64; 3], ok: bool, reason: &str| {
+            if ok {
+                Ok(())
+            } else {
+                Err(bad(key, format!("{v:?}"), reason))
+            }
+        };
+        let (l, r, t) = (gr.main_wheel_left_m, gr.main_wheel_right_m, gr.tail_wheel_m);
+        point(
+            "main_wheel_left_m",
+            l,
+            l[0] > 0.0 && l[1] < 0.0 && l[2] > 0.0,
+            "a taildragger's left main wheel is ahead of (x > 0), left of (y < 0) and below (z > 0) the CG",
+        )?;
+        point(
+            "main_wheel_right_m",
+            r,
+            r[0] > 0.0 && r[1] > 0.0 && r[2] > 0.0,
+            "a taildragger's right main wheel is ahead of (x > 0), right of (y > 0) and below (z > 0) the CG",
+        )?;
+        point(
+            "tail_wheel_m",
+            t,
+            t[0] < 0.0 && t[2] > 0.0,
+            "the tail wheel is behind (x < 0) and below (z > 0) the CG",
+        )?;
+        let max_belly = crate::plant::ground::MAX_CONTACTS - 3;
+        if gr.belly_points_m.len() > max_belly {
+            return Err(bad(
+                "belly_points_m",
+                format!("{} points", gr.belly_points_m.len()),
+                &format!("at most {max_belly} belly points"),
+            ));
+        }
+        for (i, p) in gr.belly_points_m.iter().enumerate() {
+            if p.iter().any(|c| c.abs() > 10.0) {
+                return Err(bad(
+                    &format!("belly_points_m[{i}]"),
+                    format!("{p:?}"),
+                    "must be within 10 m of the CG",
+                ));
+            }
         }
         Ok(())
     }

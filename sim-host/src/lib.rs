@@ -9,6 +9,8 @@
 //! - [`link`]: the simulator end of PX4's simulator MAVLink interface, in lock-step;
 //! - [`analysis`]: trim, linearisation, transfer functions, the linear-versus-nonlinear
 //!   doublet check of the thesis, and linear-systems tools;
+//! - [`mission_file`]: QGroundControl `.plan` and `QGC WPL 110` mission files, read into
+//!   mission, geofence and rally items;
 //! - [`report`]: tables, JSON, CSV and plots shared by every command;
 //! - [`scenario`]: the closed-loop tests of thesis chapter 4 on the nonlinear plant.
 #![warn(missing_docs)]
@@ -19,6 +21,7 @@ pub mod commands;
 pub mod environment;
 pub mod flight;
 pub mod link;
+pub mod mission_file;
 pub mod plant;
 pub mod report;
 pub mod scenario;

@@ -170,3 +170,46 @@ fn cli_exits_non_zero_and_names_the_problem() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent.toml"));
 }
+
+#[test]
+fn ground_table_is_required_and_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    // Without the table.
+    let cut = DEFAULT_AIRCRAFT_TOML
+        .find("\n[ground]")
+        .expect("the shipped file has a [ground] table");
+    let msg = Aircraft::from_file(&write(&dir, &DEFAULT_AIRCRAFT_TOML[..cut]))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("ground"), "{msg}");
+    // An unknown key in it.
+    let text = replace("mu_roll = ", "mu_roll = 0.05\nmu_brake = 0.5");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("ground") && msg.contains("mu_brake"), "{msg}");
+    // A spring that pulls.
+    let text = replace("main_stiffness_Npm = ", "main_stiffness_Npm = -600.0");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("ground.main_stiffness_Npm") && msg.contains("-600"),
+        "{msg}"
+    );
+    // A tail wheel ahead of the CG is not a taildragger.
+    let text = replace("tail_wheel_m = ", "tail_wheel_m = [0.78, 0.0, 0.03]");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("ground.tail_wheel_m") && msg.contains("0.78"),
+        "{msg}"
+    );
+    // A friction coefficient out of range.
+    let text = replace("mu_side = ", "mu_side = 6.0");
+    let msg = Aircraft::from_file(&write(&dir, &text))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("ground.mu_side") && msg.contains('6'), "{msg}");
+}

@@ -1,6 +1,6 @@
 //! Flat-earth rigid-body equations of motion with the engine-speed state.
 
-use super::{aero, propulsion, quat_of, Controls, Environment, ModelParams, StateVector};
+use super::{aero, ground, propulsion, quat_of, Controls, Environment, ModelParams, StateVector};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::{body_to_ned, ned_to_body, AirData};
 use nalgebra::{Quaternion, Vector3};
@@ -20,6 +20,8 @@ pub struct Derivatives {
     pub prop_force_body: Vector3<f64>,
     /// Propulsion moment about the CG, body axes, N m.
     pub prop_moment_body: Vector3<f64>,
+    /// Ground contact (forces, moment, per-point loads; zero in the air).
+    pub ground: ground::GroundContact,
     /// Propulsion details (thrust, torques).
     pub propulsion: propulsion::PropulsionOutput,
     /// Air data relative to the air mass.
@@ -65,10 +67,12 @@ pub fn derivatives(
     let prop = propulsion::propulsion(p, air.va, engine_speed, c.throttle, rho);
     let (fp, mp) = propulsion::forces_and_moments(p, &prop, &omega, engine_speed);
 
-    let specific_force_body = (fa + fp) / p.mass;
+    let gc = ground::contact(p, x, c);
+
+    let specific_force_body = (fa + fp + gc.force_body) / p.mass;
     let gravity_body = ned_to_body(&quat, &Vector3::new(0.0, 0.0, p.g));
     let v_dot = specific_force_body + gravity_body - omega.cross(&v_body);
-    let moment = ma + mp;
+    let moment = ma + mp + gc.moment_body;
     let omega_dot = p.inertia_inv * (moment - omega.cross(&(p.inertia * omega)));
     let pos_dot = body_to_ned(&quat, &v_body);
     // Kinematics of the raw (not yet renormalised) quaternion: q_dot = q (x) (0, omega) / 2.
@@ -91,6 +95,7 @@ pub fn derivatives(
         aero_moment_body: ma,
         prop_force_body: fp,
         prop_moment_body: mp,
+        ground: gc,
         propulsion: prop,
         air,
         rho,

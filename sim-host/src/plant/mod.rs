@@ -8,6 +8,7 @@
 //!                                                           ▼
 //!                          dynamics (flat-earth 6-DOF rigid body) ──► integrator (RK4)
 //! ```
+//! [`ground`] adds the landing gear's contact with the runway (zero in the air).
 //! [`servo`] models the surface servos; simulations put it in front of the plant, trim and
 //! linearisation do not.
 //!
@@ -16,6 +17,7 @@
 
 pub mod aero;
 pub mod dynamics;
+pub mod ground;
 pub mod integrator;
 pub mod propulsion;
 pub mod servo;
@@ -186,6 +188,8 @@ pub struct ModelParams {
     pub home_alt_msl_m: f64,
     /// Home point.
     pub home: GeoPoint,
+    /// Landing gear and belly contact.
+    pub ground: ground::GroundParams,
 }
 
 impl ModelParams {
@@ -225,9 +229,41 @@ impl ModelParams {
             g: a.environment.g_mps2,
             home_alt_msl_m: a.environment.home_alt_msl_m,
             home: GeoPoint::from_deg(a.environment.home_lat_deg, a.environment.home_lon_deg),
+            ground: ground::GroundParams::new(&a.ground),
         }
     }
 }
+
+/// The first contact of a landing: what a landing report reads.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Touchdown {
+    /// Time of the first contact, s (extrapolated inside the step from the state before it).
+    pub time_s: f64,
+    /// Position of the CG at that instant, NED, m.
+    pub pos_ned: Vector3<f64>,
+    /// Inertial velocity at that instant, NED, m/s (`z` is the sink rate, positive down).
+    pub vel_ned: Vector3<f64>,
+    /// Index of the first point that touched ([`ground::GroundParams::points`]).
+    pub point: usize,
+    /// Contacts after airborne phases shorter than [`MIN_FLIGHT_S`] since then (bounces).
+    pub bounces: u32,
+}
+
+impl Touchdown {
+    /// Sink rate at touchdown, m/s (positive down).
+    pub fn sink_rate_mps(&self) -> f64 {
+        self.vel_ned.z
+    }
+
+    /// Horizontal distance of the touchdown point from `(north_m, east_m)`, m.
+    pub fn distance_from_m(&self, north_m: f64, east_m: f64) -> f64 {
+        (self.pos_ned.x - north_m).hypot(self.pos_ned.y - east_m)
+    }
+}
+
+/// Shortest airborne phase after which a contact counts as a new touchdown rather than a
+/// bounce, s.
+pub const MIN_FLIGHT_S: f64 = 1.0;
 
 /// The simulated aircraft: model, state and the last inputs it was stepped with.
 #[derive(Clone, Debug)]
@@ -237,6 +273,12 @@ pub struct Plant {
     controls: Controls,
     env: Environment,
     time_s: f64,
+    /// Some point below the ground plane after the last step.
+    in_contact: bool,
+    /// Start of the current airborne phase (`None` while in contact).
+    airborne_since_s: Option<f64>,
+    touchdown: Option<Touchdown>,
+    liftoff_s: Option<f64>,
 }
 
 impl Plant {
@@ -247,13 +289,33 @@ impl Plant {
 
     /// A plant from already derived parameters.
     pub fn from_params(params: ModelParams, state: State) -> Self {
+        let x = state.to_vector();
+        let in_contact = ground::in_contact(&params, &x);
         Self {
             params,
-            x: state.to_vector(),
+            x,
             controls: Controls::default(),
             env: Environment::default(),
             time_s: 0.0,
+            in_contact,
+            airborne_since_s: (!in_contact).then_some(0.0),
+            touchdown: None,
+            liftoff_s: None,
         }
+    }
+
+    /// A plant at rest on its wheels at `(north_m, east_m)` from home, nose towards
+    /// `heading_rad`, engine stopped, controls neutral: the static equilibrium of the gear
+    /// (see [`ground::rest_state`]).
+    pub fn at_rest_on_ground(
+        aircraft: &Aircraft,
+        north_m: f64,
+        east_m: f64,
+        heading_rad: f64,
+    ) -> Self {
+        let params = ModelParams::new(aircraft);
+        let (state, _) = ground::rest_state(&params, north_m, east_m, heading_rad);
+        Self::from_params(params, state)
     }
 
     /// The model parameters.
@@ -269,6 +331,7 @@ impl Plant {
         self.controls = *controls;
         self.env = *env;
         let p = &self.params;
+        let x0 = self.x;
         integrator::rk4_step(
             |x| dynamics::state_derivative(p, x, controls, env),
             &mut self.x,
@@ -276,6 +339,92 @@ impl Plant {
         );
         dynamics::normalise(&mut self.x, p);
         self.time_s += dt;
+        self.track_contact(&x0, dt);
+    }
+
+    /// Records touchdowns, bounces and lift-off after a step from `x0`.
+    fn track_contact(&mut self, x0: &StateVector, dt: f64) {
+        let now = ground::in_contact(&self.params, &self.x);
+        if now == self.in_contact {
+            return;
+        }
+        self.in_contact = now;
+        if !now {
+            self.airborne_since_s = Some(self.time_s);
+            if self.liftoff_s.is_none() {
+                self.liftoff_s = Some(self.time_s);
+            }
+            return;
+        }
+        let airborne_s = self
+            .airborne_since_s
+            .take()
+            .map_or(0.0, |t0| self.time_s - t0);
+        if airborne_s < MIN_FLIGHT_S && self.touchdown.is_some() {
+            if let Some(td) = self.touchdown.as_mut() {
+                td.bounces += 1;
+            }
+            return;
+        }
+        if airborne_s < MIN_FLIGHT_S && self.liftoff_s.is_some() {
+            // A hop during the take-off run is not a landing.
+            return;
+        }
+        // The instant the lowest point crossed the plane, extrapolated from the last state
+        // before contact with its (contact-free) derivative: the state at the end of the step
+        // has already felt the gear, which at large steps would understate the sink rate.
+        let h0 = ground::clearance_m(&self.params, x0).max(0.0);
+        let x0_dot = dynamics::state_derivative(&self.params, x0, &self.controls, &self.env);
+        let sink0 = body_to_ned(&quat_of(x0), &Vector3::new(x0[3], x0[4], x0[5])).z;
+        let tc = if sink0 > 0.0 {
+            (h0 / sink0).min(dt)
+        } else {
+            dt
+        };
+        let xi = x0 + x0_dot * tc;
+        let s = State::from_vector(&xi);
+        let q = quat_of(&xi);
+        let point = self
+            .params
+            .ground
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, pt)| (i, xi[2] + body_to_ned(&q, &pt.pos_body).z))
+            .fold((0, f64::NEG_INFINITY), |a, b| if b.1 > a.1 { b } else { a })
+            .0;
+        self.touchdown = Some(Touchdown {
+            time_s: self.time_s - dt + tc,
+            pos_ned: s.pos_ned,
+            vel_ned: body_to_ned(&s.attitude, &s.vel_body),
+            point,
+            bounces: 0,
+        });
+    }
+
+    /// The last landing's first contact (after at least [`MIN_FLIGHT_S`] in the air), if any.
+    pub fn touchdown(&self) -> Option<&Touchdown> {
+        self.touchdown.as_ref()
+    }
+
+    /// Time the aircraft first left the ground, s (`None` if it never stood on it).
+    pub fn liftoff_s(&self) -> Option<f64> {
+        self.liftoff_s
+    }
+
+    /// Some point of the airframe touches the ground (after the last step).
+    pub fn on_ground(&self) -> bool {
+        self.in_contact
+    }
+
+    /// The ground's action at the current state and last controls (zero in the air).
+    pub fn ground_contact(&self) -> ground::GroundContact {
+        ground::contact(&self.params, &self.x, &self.controls)
+    }
+
+    /// Weight on wheels: some wheel is pressed onto the ground.
+    pub fn weight_on_wheels(&self) -> bool {
+        self.in_contact && self.ground_contact().weight_on_wheels()
     }
 
     /// Sets the controls and environment the accessors evaluate with (e.g. the trim, before
@@ -285,9 +434,13 @@ impl Plant {
         self.env = *env;
     }
 
-    /// Replaces the state (time unchanged).
+    /// Replaces the state (time unchanged); the contact record starts over from it.
     pub fn set_state(&mut self, state: State) {
         self.x = state.to_vector();
+        self.in_contact = ground::in_contact(&self.params, &self.x);
+        self.airborne_since_s = (!self.in_contact).then_some(self.time_s);
+        self.touchdown = None;
+        self.liftoff_s = None;
     }
 
     /// The state.
