@@ -16,15 +16,24 @@
 use common::actuators::Surfaces;
 use common::control::autopilot::{Autopilot, Commands, Measurements};
 use common::control::gains::{GainSet, DESIGNED, NAMED, STAGE_PARAMS};
-use common::control::lateral::{RollMode, YawMode};
+use common::control::lateral::{RollMode, RUDDER};
 use common::control::longitudinal::LonMode;
 use common::estimator::{EstimatedState, Estimator, EstimatorConfig};
+use common::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
+use common::gcs::mission::{MissionItem, PlanKind, PlanRules};
 use common::gcs::modes::{FlightMode, ModeSet};
 use common::gcs::param_store::Registry;
-use common::gcs::snapshot::{Battery, GpsRaw, Home, LandedState, SensorHealth, VehicleSnapshot};
+use common::gcs::snapshot::{
+    Battery, GpsRaw, Home, LandedState, MissionRunState, NavOutput as NavTelemetry, SensorHealth,
+    VehicleSnapshot,
+};
 use common::gcs::{GroundLink, ManualInput, VehicleRequests};
 use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
+use common::navigation::{
+    breached, FenceParams, HomeRequest, MissionLimits, NavOutput, NavState, Navigator, Phase,
+    PARAM_LISTS,
+};
 use common::params::ParamDef;
 use common::sensors::GpsFix;
 use mavlink::dialects::common::{MavMessage, MavSeverity};
@@ -71,6 +80,12 @@ pub const REGISTRY: Registry = &[
     STAGE_PARAMS[1],
     STAGE_PARAMS[2],
     common::estimator::config::PARAMS,
+    PARAM_LISTS[0],
+    PARAM_LISTS[1],
+    PARAM_LISTS[2],
+    PARAM_LISTS[3],
+    PARAM_LISTS[4],
+    common::failsafe::PARAMS,
     PARAMS,
 ];
 
@@ -112,13 +127,6 @@ pub struct Setpoints {
     pub airspeed: f32,
 }
 
-/// What the rudder does in every stabilised mode: the yaw damper. The airframe has no
-/// sideslip sensor, and the sideslip the estimator derives from the wind triangle is circular
-/// (its wind filter assumes zero sideslip to find the wind), so a sideslip-hold loop on it
-/// would steer by the wind estimate's error: in light turbulence that held 2-3 deg of
-/// sideslip and doubled the course error. The truth feed carries no sideslip either.
-const RUDDER: YawMode = YawMode::Damper;
-
 /// Simulator truth, for logging and for the `SIM_USE_TRUTH` comparison only.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Truth {
@@ -152,6 +160,19 @@ pub struct App {
     truth: Option<Truth>,
     use_truth: bool,
     sticks: Option<ManualInput>,
+    navigator: Navigator,
+    nav: NavOutput,
+    /// The mode the navigator was last started for.
+    nav_for: Option<FlightMode>,
+    mission_seq: u16,
+    mission_state: MissionRunState,
+    failsafes: Failsafes,
+    fs_cfg: FailsafeConfig,
+    fence: FenceParams,
+    limits: MissionLimits,
+    reaction: Reaction,
+    /// Course and altitude held while a GPS failsafe flies wings level.
+    wings_level: Option<(f32, f32)>,
 }
 
 /// Sticks older than this are ignored (the ground station stopped sending), us.
@@ -197,6 +218,17 @@ impl App {
             truth: None,
             use_truth: false,
             sticks: None,
+            navigator: Navigator::default(),
+            nav: NavOutput::default(),
+            nav_for: None,
+            mission_seq: 0,
+            mission_state: MissionRunState::NotStarted,
+            failsafes: Failsafes::new(),
+            fs_cfg: FailsafeConfig::default(),
+            fence: FenceParams::default(),
+            limits: MissionLimits::default(),
+            reaction: Reaction::None,
+            wings_level: None,
         };
         app.apply_params();
         app
@@ -232,14 +264,50 @@ impl App {
         self.armed
     }
 
-    /// Mode being flown.
+    /// Mode being flown: the pilot's choice, or what a failsafe put in its place.
     pub fn mode(&self) -> FlightMode {
+        self.flown_mode()
+    }
+
+    /// The mode the pilot (or ground station) chose.
+    pub fn chosen_mode(&self) -> FlightMode {
         self.mode
     }
 
-    /// What the guided modes hold.
+    /// What a failsafe has the aircraft do instead of the chosen mode.
+    pub fn failsafe_reaction(&self) -> Reaction {
+        self.reaction
+    }
+
+    /// The navigator's last output (phase, mission item, guidance errors).
+    pub fn navigation(&self) -> &NavOutput {
+        &self.nav
+    }
+
+    fn flown_mode(&self) -> FlightMode {
+        match self.reaction {
+            Reaction::None => self.mode,
+            Reaction::WingsLevel => FlightMode::Altitude,
+            Reaction::Loiter => FlightMode::Loiter,
+            Reaction::Return => FlightMode::Return,
+        }
+    }
+
+    /// What the autopilot is holding: the guided modes' set points, or in a navigation mode
+    /// what guidance commands (its altitude as AMSL).
     pub fn setpoints(&self) -> Setpoints {
-        self.setpoints
+        if !self.flown_mode().needs_navigator() {
+            return self.setpoints;
+        }
+        let home_alt = self.estimator.state().home.map_or(0.0, |h| h.alt_amsl_m);
+        match self.nav.guidance {
+            Some(g) => Setpoints {
+                course: g.course,
+                alt_amsl_m: g.altitude + home_alt,
+                airspeed: g.airspeed,
+            },
+            None => self.setpoints,
+        }
     }
 
     /// The last surface commands.
@@ -376,6 +444,7 @@ impl App {
                     (now_us - t) as f32 * 1e-6
                 });
             self.last_control_us = Some(now_us);
+            self.check_failsafes(now_us);
             self.control(dt);
         }
         self.poll_gcs(now_us);
@@ -426,7 +495,36 @@ impl App {
             self.autopilot.handover(self.surfaces);
             return;
         }
-        let commands = match self.mode {
+        let flown = self.flown_mode();
+        if let (Reaction::WingsLevel, Some((_, alt))) = (self.reaction, self.wings_level) {
+            let commands = Commands {
+                roll: RollMode::Roll(0.0),
+                yaw: RUDDER,
+                lon: LonMode::Altitude {
+                    altitude: alt,
+                    airspeed: sp.airspeed,
+                },
+            };
+            self.surfaces = self.autopilot.step(&m, &commands, dt).surfaces;
+            return;
+        }
+        if flown.needs_navigator() {
+            let commands = match self.navigate(flown, dt) {
+                Some(c) => c,
+                // No home yet (refused before, so only after a reset): hold what we have.
+                None => Commands {
+                    roll: RollMode::Roll(0.0),
+                    yaw: RUDDER,
+                    lon: LonMode::Altitude {
+                        altitude: sp.alt_amsl_m,
+                        airspeed: sp.airspeed,
+                    },
+                },
+            };
+            self.surfaces = self.autopilot.step(&m, &commands, dt).surfaces;
+            return;
+        }
+        let commands = match flown {
             FlightMode::Stabilized => Commands {
                 // Sticks command attitude within the loops' limits; centred: wings level.
                 roll: RollMode::Roll(sticks.map_or(0.0, |s| s.roll * gains.lateral.roll_max)),
@@ -452,12 +550,125 @@ impl App {
                     airspeed: sp.airspeed,
                 },
             },
-            // Manual without a pilot's stick holds the trim; the navigation modes are refused
-            // before they get here.
             _ => Commands::OFF,
         };
         let out = self.autopilot.step(&m, &commands, dt);
         self.surfaces = out.surfaces;
+    }
+
+    /// Runs the navigator for a navigation mode: starts it when the mode has changed, steps
+    /// it, reports mission progress. `None` until home is set.
+    fn navigate(&mut self, flown: FlightMode, dt: f32) -> Option<Commands> {
+        let e = self.estimator.state();
+        let home = e.home?;
+        if self.nav_for != Some(flown) {
+            self.nav_for = Some(flown);
+            match flown {
+                FlightMode::Mission => {
+                    self.navigator.set_current(self.mission_seq);
+                    self.mission_state = MissionRunState::Active;
+                }
+                FlightMode::Loiter => self.navigator.start_loiter(None),
+                FlightMode::Return => self
+                    .navigator
+                    .start_return(self.navigator.params().rtl_land),
+                FlightMode::Land => self.navigator.start_return(true),
+                _ => self.navigator.start_mission(0),
+            }
+        }
+        let takeoff = [takeoff_item(self.navigator.params().rtl_alt)];
+        let items: &[MissionItem] = match flown {
+            FlightMode::Mission => self.gcs.missions().store().items(PlanKind::Mission),
+            FlightMode::Takeoff => &takeoff,
+            _ => &[],
+        };
+        let out = self
+            .navigator
+            .step(items, &home, &NavState::from_estimate(&e), dt);
+        if flown == FlightMode::Mission {
+            let current = out.current_seq.filter(|&c| c != self.mission_seq);
+            if let Some(c) = out.current_seq {
+                self.mission_seq = c;
+            }
+            self.gcs.mission_progress(current, out.reached);
+            if out.phase == Phase::Complete || out.phase == Phase::Landed {
+                self.mission_state = MissionRunState::Complete;
+            }
+        }
+        for w in &out.warnings {
+            self.nav_warning(w);
+        }
+        if let Some(req) = out.set_home {
+            let here = match req {
+                HomeRequest::Here => common::estimator::Home {
+                    point: e.position,
+                    alt_amsl_m: e.alt_amsl_m,
+                },
+                HomeRequest::At(h) => h,
+            };
+            self.estimator.set_home(here);
+        }
+        if out.landed && self.armed {
+            self.armed = false;
+            self.gcs
+                .send_statustext(MavSeverity::MAV_SEVERITY_INFO, "Landed, disarmed");
+        }
+        let commands = out.commands.map(|c| amsl_commands(c, home.alt_amsl_m));
+        self.nav = out;
+        commands
+    }
+
+    fn nav_warning(&mut self, w: &common::navigation::NavWarning) {
+        use common::navigation::NavWarning as W;
+        let text = match w {
+            W::UnknownCommand { .. } => "Mission: unsupported item skipped",
+            W::BadJump { .. } => "Mission: DO_JUMP to a missing item skipped",
+            W::JumpLoop { .. } => "Mission: DO_JUMP loop with nothing to fly, mission ended",
+            W::UnsupportedSpeed { .. } => "Mission: speed change not supported, skipped",
+            W::NoMission => "Mission: nothing to fly",
+        };
+        self.gcs
+            .send_statustext(MavSeverity::MAV_SEVERITY_WARNING, text);
+    }
+
+    /// Watches the failsafes at the control rate and acts on their reaction.
+    fn check_failsafes(&mut self, now_us: u64) {
+        let e = self.estimator.state();
+        let flying = self.armed && in_air(&e);
+        let fence_breached = match e.home {
+            Some(h) => breached(
+                self.gcs.missions().store().items(PlanKind::Fence),
+                &h,
+                &e.pos_ned,
+                &self.fence,
+            )
+            .is_some(),
+            None => false,
+        };
+        let inputs = FailsafeInputs {
+            t_s: now_us as f64 * 1e-6,
+            flying,
+            gcs_heard_s: self.gcs.gcs_last_seen_us().map(|t| t as f64 * 1e-6),
+            gps_ok: e.health.gps.healthy,
+            airspeed_ok: e.health.pitot.healthy,
+            fence_breached,
+        };
+        let (reaction, events) = self.failsafes.update(&self.fs_cfg, &inputs);
+        for ev in events {
+            let sev = if ev.raises() {
+                MavSeverity::MAV_SEVERITY_CRITICAL
+            } else {
+                MavSeverity::MAV_SEVERITY_INFO
+            };
+            self.gcs.send_statustext(sev, ev.text());
+        }
+        if reaction == Reaction::WingsLevel && self.wings_level.is_none() {
+            self.wings_level = Some((e.course, e.alt_amsl_m));
+        }
+        if reaction != Reaction::WingsLevel {
+            self.wings_level = None;
+        }
+        self.reaction = reaction;
     }
 
     /// Acts on what the ground station asked for.
@@ -467,6 +678,11 @@ impl App {
         if let Some(a) = r.arm {
             if a.arm != self.armed {
                 self.armed = a.arm;
+                if !a.arm {
+                    self.navigator.stop();
+                    self.nav_for = None;
+                    self.failsafes.acknowledge();
+                }
                 self.gcs.send_statustext(
                     MavSeverity::MAV_SEVERITY_INFO,
                     if a.arm { "Armed" } else { "Disarmed" },
@@ -482,7 +698,19 @@ impl App {
                     self.setpoints.course = e.course;
                     self.setpoints.alt_amsl_m = e.alt_amsl_m;
                 }
+                if self.mode == FlightMode::Mission {
+                    self.mission_state = MissionRunState::Paused;
+                }
                 self.mode = mode;
+                self.nav_for = None;
+            }
+            // Choosing a mode, even the same one, takes over from a failsafe's return.
+            self.failsafes.acknowledge();
+        }
+        if let Some(seq) = r.mission_seq {
+            self.mission_seq = seq;
+            if self.nav_for == Some(FlightMode::Mission) {
+                self.navigator.set_current(seq);
             }
         }
         if let Some(alt) = r.altitude {
@@ -557,6 +785,17 @@ impl App {
             }
         }
         self.estimator.set_config(cfg);
+        for list in PARAM_LISTS {
+            for d in *list {
+                if let Some(v) = store.get(d.name) {
+                    // Each name belongs to exactly one of these; the others refuse it.
+                    let _ = self.navigator.set_param(d.name, v);
+                    let _ = self.limits.set(d.name, v);
+                    let _ = self.fence.set(d.name, v);
+                }
+            }
+        }
+        self.fs_cfg = FailsafeConfig::from_params(|n| store.get(n));
         self.use_truth = store.get("SIM_USE_TRUTH").unwrap_or(0.0) >= 0.5;
         if let Some(v) = store.get("FW_AIRSPD_TRIM") {
             if self.params_seen == Some(0) || self.mode == FlightMode::Manual {
@@ -566,6 +805,12 @@ impl App {
     }
 
     fn poll_gcs(&mut self, now_us: u64) {
+        let rules = PlanRules {
+            home: self.estimator.state().home,
+            limits: self.limits,
+            nav: *self.navigator.params(),
+        };
+        self.gcs.missions_mut().set_rules(rules);
         let snapshot = self.snapshot();
         let (tx, buf, dropped) = (
             &mut self.gcs_tx,
@@ -623,14 +868,25 @@ impl App {
         }
         if e.position_valid {
             modes = modes.with(FlightMode::Hold);
+            if home.valid {
+                for m in [
+                    FlightMode::Mission,
+                    FlightMode::Loiter,
+                    FlightMode::Return,
+                    FlightMode::Takeoff,
+                    FlightMode::Land,
+                ] {
+                    modes = modes.with(m);
+                }
+            }
         }
-        let in_air = e.airspeed > 8.0 && home.valid && e.alt_amsl_m - home.alt_amsl_m > 5.0;
+        let in_air = in_air(&e);
         VehicleSnapshot {
             boot_complete: self.last_time_us.is_some(),
             hil: true,
             armed: self.armed,
-            failsafe: false,
-            mode: self.mode,
+            failsafe: self.failsafes.active(),
+            mode: self.flown_mode(),
             modes_available: modes,
             landed: if in_air {
                 LandedState::InAir
@@ -663,11 +919,74 @@ impl App {
                 present: false,
                 ..Battery::default()
             },
-            nav: Default::default(),
-            mission_seq: 0,
-            mission_state: Default::default(),
+            nav: self.nav_telemetry(&e),
+            mission_seq: self.mission_seq,
+            mission_state: self.mission_state,
             cpu_load: 0.0,
         }
+    }
+}
+
+impl App {
+    /// NAV_CONTROLLER_OUTPUT from the navigator's last step (zeros outside navigation modes).
+    fn nav_telemetry(&self, e: &EstimatedState) -> NavTelemetry {
+        if !self.flown_mode().needs_navigator() {
+            return NavTelemetry::default();
+        }
+        let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+        let g = self.nav.guidance;
+        NavTelemetry {
+            roll_cmd: 0.0,
+            pitch_cmd: 0.0,
+            course_cmd: g.map_or(0.0, |g| common::math::wrap_two_pi(g.course)),
+            target_bearing: finite(common::math::wrap_two_pi(self.nav.target_bearing)),
+            wp_dist_m: finite(self.nav.wp_dist_m),
+            alt_error_m: g.map_or(0.0, |g| finite(g.altitude + e.pos_ned.z)),
+            airspeed_error_m_s: g.map_or(0.0, |g| finite(g.airspeed - e.airspeed)),
+            xtrack_error_m: g.map_or(0.0, |g| finite(g.cross_track)),
+        }
+    }
+}
+
+/// Armed flight is told from the ground by airspeed and height (there is no weight-on-wheels
+/// switch): above 8 m/s and 5 m above home.
+fn in_air(e: &EstimatedState) -> bool {
+    let height = e.home.map_or(0.0, |h| e.alt_amsl_m - h.alt_amsl_m);
+    e.airspeed > 8.0 && height > 5.0
+}
+
+/// The navigator's commands carry heights above home; the autopilot flies altitudes above
+/// mean sea level (the estimator's datum).
+fn amsl_commands(mut c: Commands, home_alt_amsl_m: f32) -> Commands {
+    c.lon = match c.lon {
+        LonMode::Altitude { altitude, airspeed } => LonMode::Altitude {
+            altitude: altitude + home_alt_amsl_m,
+            airspeed,
+        },
+        LonMode::TakeOff {
+            altitude,
+            airspeed,
+            clear_altitude,
+        } => LonMode::TakeOff {
+            altitude: altitude + home_alt_amsl_m,
+            airspeed,
+            clear_altitude: clear_altitude + home_alt_amsl_m,
+        },
+        other => other,
+    };
+    c
+}
+
+/// The Takeoff mode's one item: climb out along the present heading to the return altitude.
+fn takeoff_item(height_m: f32) -> MissionItem {
+    MissionItem {
+        params: [0, 0, 0, f32::NAN.to_bits()],
+        x: 0,
+        y: 0,
+        z: height_m.to_bits(),
+        command: mavlink::dialects::common::MavCmd::MAV_CMD_NAV_TAKEOFF as u16,
+        frame: mavlink::dialects::common::MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT as u8,
+        autocontinue: true,
     }
 }
 

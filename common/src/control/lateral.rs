@@ -152,6 +152,14 @@ pub enum RollMode {
     Course(f32),
 }
 
+/// What the rudder does in every mode the autopilot flies by itself: the yaw damper. The
+/// airframe has no sideslip sensor, and the sideslip the estimator derives from the wind
+/// triangle is circular (its wind filter assumes zero sideslip to find the wind), so a
+/// sideslip-hold loop on it steers by the wind estimate's error: in light turbulence that held
+/// 2-3 deg of sideslip and made the course error five times that of a flight on truth
+/// (`docs/RESULTS-SITL.md`).
+pub const RUDDER: YawMode = YawMode::Damper;
+
 /// What the rudder does.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -162,6 +170,9 @@ pub enum YawMode {
     Damper,
     /// Hold this sideslip angle, rad (normally 0), with the yaw damper.
     Sideslip(f32),
+    /// The rudder at this deflection, rad (UMN sign, limited to the rudder limit): ground
+    /// steering through the tail wheel, computed by the caller.
+    Rudder(f32),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -398,6 +409,20 @@ impl Lateral {
             }
             YawMode::Damper => (YawKind::Damper, 0.0),
             YawMode::Sideslip(b) => (YawKind::Sideslip, b),
+            YawMode::Rudder(d) => {
+                if !d.is_finite() {
+                    rejected.set(InputFlags::COMMAND, true);
+                    self.yaw_resume = true;
+                    return true;
+                }
+                // The loops restart from here when a flying mode takes over again.
+                self.yaw_kind = YawKind::Off;
+                self.yaw_resume = false;
+                self.slip.reset();
+                self.washout.reset();
+                self.rudder = d.clamp(-g.rudder_max, g.rudder_max);
+                return false;
+            }
         };
         let mut bad = InputFlags::empty();
         bad.set(InputFlags::YAW_RATE, !m.yaw_rate.is_finite());

@@ -679,6 +679,17 @@ impl Ins {
         self.reopen_attitude(bias_sigma);
     }
 
+    /// Moves the NED origin: every position (present and stored) shifts by `delta`, m.
+    pub fn shift_origin(&mut self, delta: &Vector3<f32>) {
+        if !delta.iter().all(|c| c.is_finite()) {
+            return;
+        }
+        self.p += delta;
+        for s in self.history.iter_mut() {
+            s.p += delta;
+        }
+    }
+
     /// Makes the baro offset agree with one barometric altitude (`home_alt - baro_alt`) after
     /// a lock-out, with its uncertainty back to the vertical position's.
     pub fn reset_baro_offset(&mut self, home_minus_baro: f32) {

@@ -673,6 +673,25 @@ impl Estimator {
             && h.gps.healthy
     }
 
+    /// Moves home (`DO_SET_HOME`, `MAV_CMD_DO_SET_HOME`): positions are from then on NED
+    /// from `home`, altitudes unchanged. Refused (false) for an invalid point or altitude, or
+    /// before the first fix has set a home.
+    pub fn set_home(&mut self, home: Home) -> bool {
+        let Some(old) = self.home else {
+            return false;
+        };
+        if !home.point.is_valid()
+            || !(GPS_ALT_RANGE_M.0..=GPS_ALT_RANGE_M.1).contains(&home.alt_amsl_m)
+        {
+            return false;
+        }
+        let (n, e): (f32, f32) = ned_offset(home.point, old.point);
+        self.ins
+            .shift_origin(&Vector3::new(n, e, home.alt_amsl_m - old.alt_amsl_m));
+        self.home = Some(home);
+        true
+    }
+
     /// Averaged normalised GPS velocity innovation (about 1 when the estimate agrees with GPS).
     pub fn gps_innovation_ratio(&self) -> f32 {
         self.vel_nis

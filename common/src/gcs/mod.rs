@@ -168,6 +168,7 @@ enum Pending {
     ParamValue(u16),
     Mission(MissionReply, (u8, u8)),
     MissionCurrent(Option<u16>),
+    ItemReached(u16),
     AutopilotVersion,
     AvailableMode(u8),
     CurrentMode,
@@ -835,6 +836,17 @@ impl GroundLink {
         MavResult::MAV_RESULT_ACCEPTED
     }
 
+    /// The vehicle's mission progress: a new current item (MISSION_CURRENT at once, besides
+    /// the 1 Hz stream) and an item finished (MISSION_ITEM_REACHED), as PX4 reports them.
+    pub fn mission_progress(&mut self, current: Option<u16>, reached: Option<u16>) {
+        if let Some(seq) = reached {
+            self.push(Pending::ItemReached(seq));
+        }
+        if let Some(seq) = current {
+            self.push(Pending::MissionCurrent(Some(seq)));
+        }
+    }
+
     /// Asks the vehicle to make `seq` current and confirms with MISSION_CURRENT; false (and a
     /// STATUSTEXT) when there is no such item.
     fn set_mission_current(&mut self, seq: u16) -> bool {
@@ -998,6 +1010,9 @@ impl GroundLink {
                 seq.unwrap_or(v.mission_seq),
                 self.missions.store().mission.len() as u16,
                 self.mission_ids(),
+            )),
+            Pending::ItemReached(seq) => out(MavMessage::MISSION_ITEM_REACHED(
+                MISSION_ITEM_REACHED_DATA { seq },
             )),
             Pending::AutopilotVersion => out(self.autopilot_version()),
             Pending::AvailableMode(i) => {

@@ -191,6 +191,18 @@ impl FlightMode {
         )
     }
 
+    /// Whether the navigator flies this mode (a path, not a set point).
+    pub const fn needs_navigator(self) -> bool {
+        matches!(
+            self,
+            FlightMode::Mission
+                | FlightMode::Loiter
+                | FlightMode::Return
+                | FlightMode::Takeoff
+                | FlightMode::Land
+        )
+    }
+
     /// Whether the outer loops hold the vehicle (heartbeat STABILIZE flag).
     pub const fn stabilized(self) -> bool {
         !matches!(self, FlightMode::Manual)

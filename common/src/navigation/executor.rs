@@ -40,7 +40,7 @@
 use super::items::{self, *};
 use super::path_manager::{PathManager, Waypoint};
 use crate::control::autopilot::Commands;
-use crate::control::lateral::{RollMode, YawMode};
+use crate::control::lateral::{RollMode, YawMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::gcs::mission::{MissionItem, MISSION_CAPACITY};
@@ -188,9 +188,26 @@ pub const PARAMS: &[ParamDef] = &[
         0.05,
         5.0,
         "m",
-        "Touchdown: height above the land point under this for 1 s",
+        "Touchdown: height above the land point under this for 1 s (or rolling slower than 5 m/s)",
+    ),
+    ParamDef::real(
+        "NAV_STEER_K",
+        1.5,
+        0.0,
+        10.0,
+        "rad/rad",
+        "Ground steering: rudder (tail wheel) per radian of course error on the runway",
     ),
 ];
+
+/// Ground speed under which a flaring aircraft counts as rolling on the runway, m/s: the
+/// estimated height alone carries the barometer's and GPS's offsets (tenths of a metre).
+const ROLLING_SPEED: f32 = 5.0;
+/// Largest steering deflection, rad.
+const STEER_MAX: f32 = 0.4;
+/// Ground speed under which a landed aircraft has stopped and may be disarmed, m/s: until
+/// then it is steered, since a taildragger rolling free swings round (a ground loop).
+const STOPPED_SPEED: f32 = 1.0;
 
 /// Time on the ground that makes a touchdown, s.
 const TOUCHDOWN_S: f32 = 1.0;
@@ -235,6 +252,8 @@ pub struct NavParams {
     pub flare_k: f32,
     /// Touchdown height, m.
     pub touchdown_alt: f32,
+    /// Ground steering gain, rad of rudder per rad of course error.
+    pub steer_k: f32,
 }
 
 impl Default for NavParams {
@@ -257,6 +276,7 @@ impl Default for NavParams {
             flare_sink: 0.0,
             flare_k: 0.0,
             touchdown_alt: 0.0,
+            steer_k: 0.0,
         };
         for d in PARAMS {
             // Defaults lie inside their bounds (checked by the tests).
@@ -308,6 +328,7 @@ impl NavParams {
             "NAV_FLR_SINK" => &mut self.flare_sink,
             "NAV_FLR_K" => &mut self.flare_k,
             "NAV_LND_TD_M" => &mut self.touchdown_alt,
+            "NAV_STEER_K" => &mut self.steer_k,
             _ => return None,
         })
     }
@@ -441,7 +462,7 @@ pub struct NavOutput {
     pub set_home: Option<HomeRequest>,
     /// What the navigator is doing.
     pub phase: Phase,
-    /// On the ground after a landing: the firmware may disarm.
+    /// Stopped on the ground after a landing: the firmware may disarm.
     pub landed: bool,
 }
 
@@ -582,7 +603,7 @@ fn orbit_path(o: &Orbit, airspeed: f32) -> Path {
 fn follow(g: &GuidanceOutput) -> Commands {
     Commands {
         roll: RollMode::Course(g.course),
-        yaw: YawMode::Sideslip(0.0),
+        yaw: RUDDER,
         lon: LonMode::Altitude {
             altitude: g.altitude,
             airspeed: g.airspeed,
@@ -1097,13 +1118,17 @@ impl Navigator {
                 let (dn, de) = (libm::cosf(course), libm::sinf(course));
                 let far = start + Vector3::new(dn, de, 0.0) * 1000.0;
                 let line = Path::line_between(&start, &far, self.cruise());
-                let h = state.height() + start.z;
                 out.target = Some(far);
                 if rolling {
                     out.phase = Phase::TakeoffRoll;
+                    // Along the runway line: the course to hold comes from the line's vector
+                    // field, so a drift sideways is steered back, not just stopped.
+                    let course = line
+                        .map(|l| self.guidance.step(&l, &pos, vg).course)
+                        .unwrap_or(course);
                     out.commands = Some(Commands {
                         roll: RollMode::Roll(0.0),
-                        yaw: YawMode::Damper,
+                        yaw: self.steer(course, state),
                         lon: LonMode::Pitch {
                             pitch: 0.0,
                             throttle: 1.0,
@@ -1113,13 +1138,15 @@ impl Navigator {
                     out.phase = Phase::TakeoffClimb;
                     let g = line.map(|l| self.guidance.step(&l, &pos, vg));
                     out.guidance = g;
+                    // Along the runway line from lift-off: near the line the vector field asks
+                    // for a few degrees of course, so little bank close to the ground.
                     let roll = match g {
-                        Some(g) if h >= p.takeoff_clear => RollMode::Course(g.course),
-                        _ => RollMode::Roll(0.0),
+                        Some(g) => RollMode::Course(g.course),
+                        None => RollMode::Roll(0.0),
                     };
                     out.commands = Some(Commands {
                         roll,
-                        yaw: YawMode::Sideslip(0.0),
+                        yaw: RUDDER,
                         lon: LonMode::TakeOff {
                             altitude: height,
                             airspeed: self.cruise(),
@@ -1177,6 +1204,18 @@ impl Navigator {
         g
     }
 
+    /// Tail-wheel steering towards `course` (rad): on the runway the heading is the course.
+    fn steer(&self, course: f32, state: &NavState) -> YawMode {
+        let err = wrap_pi(course - state.heading);
+        // Positive rudder (trailing edge left) turns the nose left.
+        let d = -self.params.steer_k * err;
+        YawMode::Rudder(if d.is_finite() {
+            d.clamp(-STEER_MAX, STEER_MAX)
+        } else {
+            0.0
+        })
+    }
+
     fn fly_landing(&self, l: &mut Landing, state: &NavState, dt: f32, out: &mut NavOutput) {
         let p = self.params;
         let pos = state.pos_ned;
@@ -1209,7 +1248,8 @@ impl Navigator {
         }
         if l.phase == LandPhase::Flare {
             let sink = state.vel_ned.z;
-            if hagl < p.touchdown_alt && sink < TOUCHDOWN_SINK {
+            let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
+            if on_ground && sink < TOUCHDOWN_SINK {
                 l.ground_time += dt;
             } else {
                 l.ground_time = 0.0;
@@ -1236,9 +1276,11 @@ impl Navigator {
                 } else {
                     p.flare_pitch
                 };
+                // The rudder steers from the flare on: in the air it lines the nose up with
+                // the runway, on the wheels it holds the roll-out on the line.
                 out.commands = Some(Commands {
                     roll: RollMode::Course(g.course),
-                    yaw: YawMode::Sideslip(0.0),
+                    yaw: self.steer(g.course, state),
                     lon: LonMode::Pitch {
                         pitch,
                         throttle: 0.0,
@@ -1247,10 +1289,10 @@ impl Navigator {
             }
             LandPhase::Landed => {
                 out.phase = Phase::Landed;
-                out.landed = true;
+                out.landed = state.ground_speed() < STOPPED_SPEED;
                 out.commands = Some(Commands {
                     roll: RollMode::Roll(0.0),
-                    yaw: YawMode::Damper,
+                    yaw: self.steer(g.path_course, state),
                     lon: LonMode::Pitch {
                         pitch: 0.0,
                         throttle: 0.0,

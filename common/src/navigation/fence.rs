@@ -23,11 +23,11 @@ const CIRCLE_EXCLUSION: u16 = MavCmd::MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION as u16;
 /// Parameters of the geofence.
 pub const PARAMS: &[ParamDef] = &[ParamDef::real(
     "GF_MAX_ALT_M",
-    120.0,
+    0.0,
     0.0,
     10000.0,
     "m",
-    "Highest height above home inside the fence (0: no altitude limit)",
+    "Highest height above home inside the fence (0, the default as in PX4: no altitude limit)",
 )];
 
 /// The geofence's settings.
@@ -245,7 +245,8 @@ mod tests {
     fn concave_polygon_and_altitude() {
         assert_eq!(validate_defs(PARAMS), Ok(()));
         let f = l_shape();
-        let p = FenceParams::default();
+        assert_eq!(FenceParams::default().max_alt, 0.0);
+        let p = FenceParams { max_alt: 120.0 };
         let h = home();
         assert_eq!(validate_fence(&f), Ok(()));
         assert_eq!(breached(&f, &h, &at(100.0, 100.0, 50.0), &p), None);

@@ -520,7 +520,9 @@ fn landing_glide_path_reaches_the_land_point() {
     let mut plane = Plane::flying(1300.0, 300.0, 60.0, -2.5);
     plane.k.wind = Vector3::new(2.0, 1.0, 0.0);
     nav.start_mission(0);
-    let log = fly(&mut nav, &mut plane, &items, 400.0, |o| o.landed);
+    let log = fly(&mut nav, &mut plane, &items, 400.0, |o| {
+        o.phase == Phase::Landed
+    });
     assert_eq!(log.reached, [0, 1]);
     let tan_g = libm::tanf(6f32.to_radians());
     let flare = nav.params().flare_alt;
@@ -555,8 +557,10 @@ fn landing_glide_path_reaches_the_land_point() {
         -ground_at.2.x
     );
     let (_, last, td) = log.outs.last().unwrap();
-    assert!(last.landed);
     assert_eq!(last.phase, Phase::Landed);
+    // The kinematic model rolls on at its speed: on the ground, but not stopped, so not yet
+    // to be disarmed (a taildragger rolling free swings round).
+    assert!(!last.landed);
     assert!(
         td.x < 0.0 && td.x > -120.0,
         "touchdown {} m past the land point",
@@ -593,9 +597,11 @@ fn return_and_circle_or_land() {
     assert!((-p.z - 60.0).abs() < 1.0);
 
     nav.start_return(true);
-    let log = fly(&mut nav, &mut plane, &[], 600.0, |o| o.landed);
+    let log = fly(&mut nav, &mut plane, &[], 600.0, |o| {
+        o.phase == Phase::Landed
+    });
     let (_, last, p) = log.outs.last().unwrap();
-    assert!(last.landed, "phase {:?}", last.phase);
+    assert_eq!(last.phase, Phase::Landed);
     assert!(libm::hypotf(p.x, p.y) < 120.0, "landed at {p:?}");
 }
 

@@ -22,6 +22,7 @@
 //! identity) to the autopilot's ground link. It waits for each COMMAND_ACK before the next
 //! sensor frame, so a command takes effect at the same frame on every transport.
 
+pub mod missions;
 pub mod onboard;
 pub mod record;
 pub mod runner;

@@ -12,6 +12,7 @@ use common::estimator::EstimatedState;
 use common::gcs::modes::FlightMode;
 use common::link::framing::LinkStats;
 use common::math::wrap_pi;
+use common::navigation::Phase;
 use firmware::app::{Setpoints, SimLinkHealth};
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -87,6 +88,37 @@ pub struct Sample {
     pub rudder: f64,
     /// Commanded throttle.
     pub throttle: f64,
+    /// Cross-track error of the path being followed, m (NaN outside navigation modes).
+    pub xtrack: f64,
+    /// The navigator's phase (`common::navigation::Phase` as its index).
+    pub nav_phase: u8,
+    /// Mission item being flown (-1: none).
+    pub mission_seq: i32,
+}
+
+/// What the navigator was doing at one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NavView {
+    /// Cross-track error, m (NaN without a path).
+    pub xtrack: f64,
+    /// Phase.
+    pub phase: Phase,
+    /// Mission item.
+    pub seq: Option<u16>,
+}
+
+impl NavView {
+    /// The view of an autopilot's navigator (only a navigation mode has a path).
+    pub fn of(nav: &common::navigation::NavOutput, navigating: bool) -> Self {
+        Self {
+            xtrack: match (navigating, nav.guidance) {
+                (true, Some(g)) => f64::from(g.cross_track),
+                _ => f64::NAN,
+            },
+            phase: if navigating { nav.phase } else { Phase::Idle },
+            seq: nav.current_seq,
+        }
+    }
 }
 
 impl Sample {
@@ -104,6 +136,7 @@ impl Sample {
         mode: FlightMode,
         armed: bool,
         s: &Surfaces,
+        nav: &NavView,
     ) -> Self {
         let (eu, course, _) = truth_angles(truth);
         Self {
@@ -141,6 +174,9 @@ impl Sample {
             aileron: f64::from(s.aileron),
             rudder: f64::from(s.rudder),
             throttle: f64::from(s.throttle),
+            xtrack: nav.xtrack,
+            nav_phase: nav.phase as u8,
+            mission_seq: nav.seq.map_or(-1, i32::from),
         }
     }
 }
@@ -485,6 +521,9 @@ pub fn csv_headers() -> Vec<String> {
         "aileron_deg",
         "rudder_deg",
         "throttle",
+        "xtrack_m",
+        "nav_phase",
+        "mission_seq",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -527,6 +566,9 @@ pub fn csv_row(s: &Sample) -> Vec<f64> {
         s.aileron * DEG,
         s.rudder * DEG,
         s.throttle,
+        s.xtrack,
+        f64::from(s.nav_phase),
+        f64::from(s.mission_seq),
     ]
 }
 

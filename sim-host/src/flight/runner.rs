@@ -1,7 +1,7 @@
 //! The flight loop.
 
 use super::onboard::Onboard;
-use super::record::{summarise, FlightSummary, Sample};
+use super::record::{summarise, FlightSummary, NavView, Sample};
 use super::script::{GroundStation, Script};
 use crate::aircraft::Aircraft;
 use crate::analysis::trim::{trim_with, TrimTarget};
@@ -43,6 +43,9 @@ pub struct FlightConfig {
     /// goes to `remote` (QGroundControl listens on 127.0.0.1:14550) and to any station that
     /// sends to `bind`, whose frames reach the autopilot's ground link.
     pub ground_link: Option<(String, String)>,
+    /// Start at rest on the runway at home, pointing this way (rad from north), instead of
+    /// the hand launch at 100 m. Engine off until the autopilot is armed.
+    pub runway_heading: Option<f64>,
 }
 
 impl Default for FlightConfig {
@@ -60,6 +63,7 @@ impl Default for FlightConfig {
             script,
             link_timeout: Duration::from_secs(5),
             ground_link: None,
+            runway_heading: None,
         }
     }
 }
@@ -143,12 +147,23 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             trim.residual_norm
         )));
     }
-    // Trimmed in the air mass: the steady wind carries the aircraft, so the airspeed is the
-    // trim's 17 m/s whatever the wind.
-    let mut start = trim.state;
-    start.vel_body += ned_to_body(&start.attitude, &Vector3::from(cfg.wind_ned));
-    let mut plant = Plant::from_params(params.clone(), start);
-    let trim_controls = trim.controls;
+    let (mut plant, trim_controls) = match cfg.runway_heading {
+        // On the wheels, engine off, surfaces at trim until the autopilot takes over.
+        Some(hdg) => (
+            Plant::at_rest_on_ground(aircraft, 0.0, 0.0, hdg),
+            Controls {
+                throttle: 0.0,
+                ..trim.controls
+            },
+        ),
+        None => {
+            // Trimmed in the air mass: the steady wind carries the aircraft, so the airspeed
+            // is the trim's 17 m/s whatever the wind.
+            let mut start = trim.state;
+            start.vel_body += ned_to_body(&start.attitude, &Vector3::from(cfg.wind_ned));
+            (Plant::from_params(params.clone(), start), trim.controls)
+        }
+    };
     let mut servos = ServoBank::new(&aircraft.actuators, &trim_controls);
     let mut wind = Wind::new(Vector3::from(cfg.wind_ned), cfg.turbulence, cfg.seed);
     let q0 = plant.attitude();
@@ -231,7 +246,8 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             trim_controls
         };
         let view = onboard.with_app(link, |app| {
-            (app.estimate(), app.setpoints(), app.mode(), app.armed())
+            let nav = NavView::of(app.navigation(), app.mode().needs_navigator());
+            (app.estimate(), app.setpoints(), app.mode(), nav)
         });
         samples.push(Sample::new(
             t_s,
@@ -245,6 +261,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             view.2,
             answer.armed,
             &answer.surfaces,
+            &view.3,
         ));
 
         for _ in 0..substeps {

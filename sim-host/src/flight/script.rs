@@ -1,12 +1,16 @@
-//! The scripted ground station: parameters, arming (retried each second until the autopilot
-//! accepts), then timed commands, each a COMMAND_LONG answered by a COMMAND_ACK.
+//! The scripted ground station: a heartbeat every second (as QGroundControl sends it),
+//! parameters, the mission and geofence uploaded with the mission protocol, arming (retried
+//! each second until the autopilot accepts), then timed commands, each a COMMAND_LONG answered
+//! by a COMMAND_ACK.
 
 use super::onboard::Onboard;
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::Transport;
 use common::link::framing::{FrameParser, Sender};
 use mavlink::dialects::common::{
-    MavCmd, MavMessage, MavParamType, MavResult, COMMAND_LONG_DATA, PARAM_SET_DATA,
+    MavAutopilot, MavCmd, MavMessage, MavMissionResult, MavMissionType, MavModeFlag, MavParamType,
+    MavResult, MavState, MavType, COMMAND_LONG_DATA, HEARTBEAT_DATA, MISSION_COUNT_DATA,
+    MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
 };
 use serde::Serialize;
 
@@ -18,6 +22,10 @@ pub const GCS_COMPONENT_ID: u8 = 190;
 pub const PX4_ALTCTL: u8 = 2;
 /// PX4 main mode POSCTL (the autopilot's "Hold": course, altitude and airspeed hold).
 pub const PX4_POSCTL: u8 = 3;
+/// PX4 main mode AUTO.
+pub const PX4_AUTO: u8 = 4;
+/// PX4 AUTO sub-mode LOITER.
+pub const PX4_AUTO_LOITER: u8 = 3;
 
 /// One ground-station command.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -32,6 +40,14 @@ pub enum Action {
     Airspeed(f32),
     /// `MAV_CMD_CONDITION_YAW` relative to the current course setpoint, deg (positive right).
     Turn(f32),
+    /// `MAV_CMD_MISSION_START`: fly the uploaded mission from its current item.
+    MissionStart,
+    /// `MAV_CMD_NAV_RETURN_TO_LAUNCH`.
+    Return,
+    /// `MAV_CMD_DO_SET_MODE` AUTO.LOITER: circle here.
+    Loiter,
+    /// Stop sending heartbeats (the ground link is lost).
+    Silence,
 }
 
 /// A command at a time after arming.
@@ -54,6 +70,12 @@ pub struct Script {
     pub arm_retry_s: f64,
     /// Commands after arming, in time order.
     pub steps: Vec<ScriptStep>,
+    /// Mission uploaded (MISSION_COUNT, then each item on request) before arming.
+    #[serde(skip)]
+    pub mission: Vec<MISSION_ITEM_INT_DATA>,
+    /// Geofence uploaded before arming.
+    #[serde(skip)]
+    pub fence: Vec<MISSION_ITEM_INT_DATA>,
 }
 
 impl Script {
@@ -79,6 +101,8 @@ impl Script {
                 s(220.0, Action::AltitudeAboveHome(190.0)),
                 s(245.0, Action::AltitudeAboveHome(200.0)),
             ],
+            mission: Vec::new(),
+            fence: Vec::new(),
         }
     }
 
@@ -113,6 +137,13 @@ pub struct GroundStation {
     pub commands: Vec<CommandRecord>,
     /// STATUSTEXT messages from the autopilot: time, text.
     pub texts: Vec<(f64, String)>,
+    /// Uploads: what (mission or fence), time, the final MISSION_ACK result.
+    pub uploads: Vec<(String, f64, String)>,
+    /// MISSION_ITEM_REACHED: time, item.
+    pub reached: Vec<(f64, u16)>,
+    uploaded: bool,
+    next_heartbeat_s: f64,
+    silent: bool,
 }
 
 impl GroundStation {
@@ -129,6 +160,11 @@ impl GroundStation {
             next_step: 0,
             commands: Vec::new(),
             texts: Vec::new(),
+            uploads: Vec::new(),
+            reached: Vec::new(),
+            uploaded: false,
+            next_heartbeat_s: 0.0,
+            silent: false,
         }
     }
 
@@ -162,6 +198,26 @@ impl GroundStation {
                 self.send(t_s, link, onboard, &msg);
             }
         }
+        if !self.silent && t_s >= self.next_heartbeat_s {
+            self.next_heartbeat_s = t_s + 1.0;
+            self.send(t_s, link, onboard, &gcs_heartbeat());
+        }
+        if !self.uploaded {
+            self.uploaded = true;
+            for (what, kind) in [
+                ("mission", MavMissionType::MAV_MISSION_TYPE_MISSION),
+                ("fence", MavMissionType::MAV_MISSION_TYPE_FENCE),
+            ] {
+                let items = match kind {
+                    MavMissionType::MAV_MISSION_TYPE_FENCE => self.script.fence.clone(),
+                    _ => self.script.mission.clone(),
+                };
+                if !items.is_empty() {
+                    let r = self.upload(t_s, link, onboard, kind, &items);
+                    self.uploads.push((what.to_string(), t_s, format!("{r:?}")));
+                }
+            }
+        }
         match self.armed_at_s {
             None if t_s >= self.next_arm_s => {
                 self.next_arm_s = t_s + self.script.arm_retry_s;
@@ -177,6 +233,10 @@ impl GroundStation {
                         break;
                     }
                     self.next_step += 1;
+                    if step.action == Action::Silence {
+                        self.silent = true;
+                        continue;
+                    }
                     let (what, msg) = self.encode(&step.action.clone());
                     self.command(t_s, &what, link, onboard, &msg);
                 }
@@ -214,7 +274,76 @@ impl GroundStation {
                     [deg.abs(), 0.0, if deg < 0.0 { -1.0 } else { 1.0 }, 1.0],
                 ),
             ),
+            Action::MissionStart => (
+                "mission start".into(),
+                command(MavCmd::MAV_CMD_MISSION_START, [0.0; 4]),
+            ),
+            Action::Return => (
+                "return".into(),
+                command(MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH, [0.0; 4]),
+            ),
+            Action::Loiter => (
+                "mode Loiter".into(),
+                command(
+                    MavCmd::MAV_CMD_DO_SET_MODE,
+                    [1.0, f32::from(PX4_AUTO), f32::from(PX4_AUTO_LOITER), 0.0],
+                ),
+            ),
+            Action::Silence => ("silence".into(), gcs_heartbeat()),
         }
+    }
+
+    /// The mission protocol's upload: MISSION_COUNT, each item as the autopilot requests it,
+    /// until its MISSION_ACK.
+    fn upload<T: Transport, O: Onboard<T>>(
+        &mut self,
+        t_s: f64,
+        link: &mut Lockstep<T>,
+        onboard: &mut O,
+        kind: MavMissionType,
+        items: &[MISSION_ITEM_INT_DATA],
+    ) -> MavMissionResult {
+        let count = MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+            count: items.len() as u16,
+            target_system: 1,
+            target_component: 1,
+            mission_type: kind,
+            opaque_id: 0,
+        });
+        let mut answer = self.exchange(t_s, link, onboard, &count);
+        // Each round trip is answered at once in-process; the bound only stops a runaway.
+        for _ in 0..4 * items.len() + 4 {
+            let mut next = None;
+            for m in &answer {
+                match m {
+                    MavMessage::MISSION_ACK(a) if a.mission_type == kind => return a.mavtype,
+                    MavMessage::MISSION_REQUEST_INT(r) if r.mission_type == kind => {
+                        next = Some(r.seq)
+                    }
+                    _ => {}
+                }
+            }
+            let Some(item) = next.and_then(|seq| items.get(usize::from(seq))) else {
+                break;
+            };
+            let mut item = item.clone();
+            item.mission_type = kind;
+            item.target_system = 1;
+            item.target_component = 1;
+            answer = self.exchange(t_s, link, onboard, &MavMessage::MISSION_ITEM_INT(item));
+        }
+        MavMissionResult::MAV_MISSION_ERROR
+    }
+
+    fn exchange<T: Transport, O: Onboard<T>>(
+        &mut self,
+        t_s: f64,
+        link: &mut Lockstep<T>,
+        onboard: &mut O,
+        msg: &MavMessage,
+    ) -> Vec<MavMessage> {
+        let raw = self.sender.encode(msg);
+        self.send_bytes(t_s, link, onboard, raw.raw_bytes())
     }
 
     fn command<T: Transport, O: Onboard<T>>(
@@ -229,8 +358,11 @@ impl GroundStation {
             MavMessage::COMMAND_LONG(c) => Some(c.command),
             _ => None,
         };
-        let acks = self.send(t_s, link, onboard, msg);
-        let result = acks.into_iter().find(|(c, _)| Some(*c) == cmd).map(|x| x.1);
+        let answer = self.exchange(t_s, link, onboard, msg);
+        let result = answer.iter().find_map(|m| match m {
+            MavMessage::COMMAND_ACK(a) if Some(a.command) == cmd => Some(a.result),
+            _ => None,
+        });
         self.commands.push(CommandRecord {
             t_s,
             what: what.to_string(),
@@ -245,19 +377,19 @@ impl GroundStation {
         link: &mut Lockstep<T>,
         onboard: &mut O,
         msg: &MavMessage,
-    ) -> Vec<(MavCmd, MavResult)> {
-        let raw = self.sender.encode(msg);
-        self.send_bytes(t_s, link, onboard, raw.raw_bytes())
+    ) {
+        self.exchange(t_s, link, onboard, msg);
     }
 
-    /// Hands `bytes` to the autopilot's ground link and reads everything it has to say.
+    /// Hands `bytes` to the autopilot's ground link and reads everything it has to say; texts
+    /// and reached items are logged.
     fn send_bytes<T: Transport, O: Onboard<T>>(
         &mut self,
         t_s: f64,
         link: &mut Lockstep<T>,
         onboard: &mut O,
         bytes: &[u8],
-    ) -> Vec<(MavCmd, MavResult)> {
+    ) -> Vec<MavMessage> {
         let mut answer = Vec::new();
         onboard.with_app(link, |app| {
             if !bytes.is_empty() {
@@ -265,18 +397,33 @@ impl GroundStation {
             }
             app.drain_gcs(&mut |b| answer.extend_from_slice(b));
         });
-        let mut acks = Vec::new();
-        let texts = &mut self.texts;
-        self.parser.push(&answer, |f| match &f.message {
-            MavMessage::COMMAND_ACK(a) => acks.push((a.command, a.result)),
-            MavMessage::STATUSTEXT(s) => {
-                let text = s.text.to_str().unwrap_or("").to_string();
-                texts.push((t_s, text));
+        let mut messages = Vec::new();
+        let (texts, reached) = (&mut self.texts, &mut self.reached);
+        self.parser.push(&answer, |f| {
+            match &f.message {
+                MavMessage::STATUSTEXT(s) => {
+                    let text = s.text.to_str().unwrap_or("").to_string();
+                    texts.push((t_s, text));
+                }
+                MavMessage::MISSION_ITEM_REACHED(r) => reached.push((t_s, r.seq)),
+                _ => {}
             }
-            _ => {}
+            messages.push(f.message.clone());
         });
-        acks
+        messages
     }
+}
+
+/// QGroundControl's heartbeat.
+fn gcs_heartbeat() -> MavMessage {
+    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 0,
+        mavtype: MavType::MAV_TYPE_GCS,
+        autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+        base_mode: MavModeFlag::empty(),
+        system_status: MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    })
 }
 
 fn mode_name(main: u8) -> &'static str {

@@ -1,0 +1,128 @@
+//! Missions written as a planner would write them: MAVLink `MISSION_ITEM_INT`s with global
+//! positions, built from offsets in metres from the simulator's home (the runway).
+
+use common::math::geodetic::{offset_point, GeoPoint};
+use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
+
+/// A point of a mission: metres north and east of home, height above home.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// North of home, m.
+    pub north_m: f64,
+    /// East of home, m.
+    pub east_m: f64,
+    /// Height above home, m.
+    pub height_m: f64,
+}
+
+/// Builds items in sequence against one home.
+pub struct MissionBuilder {
+    home: GeoPoint,
+    items: Vec<MISSION_ITEM_INT_DATA>,
+}
+
+impl MissionBuilder {
+    /// An empty mission around `home`.
+    pub fn new(home: GeoPoint) -> Self {
+        Self {
+            home,
+            items: Vec::new(),
+        }
+    }
+
+    /// Appends an item at `at` (or frame-less when `None`) with `params` 1-4.
+    pub fn item(mut self, cmd: MavCmd, params: [f32; 4], at: Option<Spot>) -> Self {
+        let (frame, x, y, z) = match at {
+            Some(s) => {
+                let p = offset_point(self.home, s.north_m, s.east_m);
+                (
+                    MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                    p.lat_e7,
+                    p.lon_e7,
+                    s.height_m as f32,
+                )
+            }
+            None => (MavFrame::MAV_FRAME_MISSION, 0, 0, 0.0),
+        };
+        self.items.push(MISSION_ITEM_INT_DATA {
+            param1: params[0],
+            param2: params[1],
+            param3: params[2],
+            param4: params[3],
+            x,
+            y,
+            z,
+            seq: self.items.len() as u16,
+            command: cmd,
+            target_system: 1,
+            target_component: 1,
+            frame,
+            current: 0,
+            autocontinue: 1,
+            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
+        });
+        self
+    }
+
+    /// A waypoint (default acceptance radius).
+    pub fn waypoint(self, north_m: f64, east_m: f64, height_m: f64) -> Self {
+        self.item(
+            MavCmd::MAV_CMD_NAV_WAYPOINT,
+            [0.0, 0.0, 0.0, f32::NAN],
+            Some(Spot {
+                north_m,
+                east_m,
+                height_m,
+            }),
+        )
+    }
+
+    /// The items.
+    pub fn build(self) -> Vec<MISSION_ITEM_INT_DATA> {
+        self.items
+    }
+}
+
+/// The default mission, flown by `cargo run --release -p sim-host`: take off from the runway
+/// at home heading north, climb to 60 m, fly a 600 m x 400 m rectangle clockwise, circle its
+/// north-west corner twice (radius 80 m), then come back past home to the south and land on
+/// the runway heading north, touching down at home.
+pub fn default_mission(home: GeoPoint) -> Vec<MISSION_ITEM_INT_DATA> {
+    let h = 60.0;
+    MissionBuilder::new(home)
+        .item(
+            MavCmd::MAV_CMD_NAV_TAKEOFF,
+            [0.0, 0.0, 0.0, 0.0],
+            Some(Spot {
+                north_m: 300.0,
+                east_m: 0.0,
+                height_m: h,
+            }),
+        )
+        .waypoint(600.0, 0.0, h)
+        .waypoint(600.0, 400.0, h)
+        .waypoint(0.0, 400.0, h)
+        .waypoint(0.0, 0.0, h)
+        .item(
+            MavCmd::MAV_CMD_NAV_LOITER_TURNS,
+            [2.0, 0.0, 80.0, 0.0],
+            Some(Spot {
+                north_m: 600.0,
+                east_m: 0.0,
+                height_m: h,
+            }),
+        )
+        .waypoint(300.0, -150.0, 40.0)
+        .waypoint(-450.0, -150.0, 40.0)
+        .waypoint(-450.0, 0.0, 40.0)
+        .item(
+            MavCmd::MAV_CMD_NAV_LAND,
+            [0.0, 0.0, 0.0, f32::NAN],
+            Some(Spot {
+                north_m: 0.0,
+                east_m: 0.0,
+                height_m: 0.0,
+            }),
+        )
+        .build()
+}
