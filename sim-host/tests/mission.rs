@@ -1,44 +1,94 @@
-//! Navigation flown end to end: missions uploaded through the ground link, flown by the
-//! firmware on its own estimates, from the runway to the runway.
+//! Navigation flown end to end: the default mission uploaded through the ground link by the
+//! scripted ground station (MISSION_COUNT, MISSION_REQUEST_INT, MISSION_ITEM_INT, MISSION_ACK),
+//! started with MAV_CMD_MISSION_START and flown by the firmware on its own estimates, from the
+//! runway to the runway.
 
 use sim_host::aircraft::Aircraft;
 use sim_host::commands::fly::{fly_report, FlyOptions};
-use sim_host::flight::missions::default_mission;
-use sim_host::flight::record::write_log_and_plots;
-use sim_host::flight::{Action, FlightConfig, Script, ScriptStep};
+use sim_host::environment::wind::Turbulence;
+use sim_host::flight::missions::{default_mission, runway_mission};
+use sim_host::flight::record::MissionSummary;
+use sim_host::flight::FlightOutcome;
 use sim_host::plant::ModelParams;
 
 fn aircraft() -> Aircraft {
     Aircraft::ultrastick25e().expect("built-in aircraft")
 }
 
-#[test]
-fn explore_default_mission() {
+fn fly_default(wind_ned: [f64; 3], turbulence: Turbulence, seed: u64) -> FlightOutcome {
     let a = aircraft();
-    let home = ModelParams::new(&a).home;
-    let cfg = FlightConfig {
-        duration_s: 400.0,
-        runway_heading: Some(0.0),
-        script: Script {
-            steps: vec![ScriptStep {
-                after_arm_s: 1.0,
-                action: Action::MissionStart,
-            }],
-            mission: default_mission(home),
-            ..Script::thesis()
-        },
-        ..FlightConfig::default()
+    let cfg = sim_host::flight::FlightConfig {
+        wind_ned,
+        turbulence,
+        seed,
+        ..runway_mission(default_mission(ModelParams::new(&a).home))
     };
-    let o = fly_report(&a, &cfg, &FlyOptions::default())
+    // The firmware's own parameters, as a user gets it.
+    fly_report(&a, &cfg, &FlyOptions::default())
         .expect("flight")
-        .outcome;
-    let _ = write_log_and_plots(std::path::Path::new("/tmp/mission"), &o.samples);
-    for s in o.samples.iter().step_by(500) {
-        println!(
-            "t {:6.1} arm {} mode {} ph {:2} seq {:2} N {:7.1} E {:7.1} alt {:6.1} spalt {:6.1} va {:5.1} xt {:6.1} thr {:.2} pitch {:5.1}",
-            s.t, s.armed as u8, s.mode, s.nav_phase, s.mission_seq, s.north, s.east, s.alt, s.sp_alt, s.airspeed, s.xtrack, s.throttle, s.pitch.to_degrees()
-        );
-    }
-    println!("commands {:?}", o.summary.commands);
-    println!("texts {:?}", o.summary.texts);
+        .outcome
+}
+
+/// What every landing of the default mission must show: every navigation item reached in
+/// order, a touchdown within 20 m of the landing point at a sink rate a small aircraft's
+/// landing gear takes (under 1.5 m/s, about half its 0.3 m drop test's 2.4 m/s), disarmed.
+fn landed_as_planned(o: &FlightOutcome) -> MissionSummary {
+    let m = o.summary.mission.clone().expect("a mission was flown");
+    eprintln!("{m:#?}");
+    assert_eq!(
+        o.summary
+            .uploads
+            .iter()
+            .map(|u| u.2.as_str())
+            .collect::<Vec<_>>(),
+        ["MAV_MISSION_ACCEPTED"]
+    );
+    assert!(
+        m.all_reached,
+        "reached {:?} of {:?}",
+        m.reached, m.nav_items
+    );
+    assert_eq!(m.reached, m.nav_items, "in order, each once");
+    let td = m.touchdown.expect("touched down");
+    assert!(
+        td.distance_m < 20.0,
+        "touchdown {:.1} m away",
+        td.distance_m
+    );
+    assert!(
+        td.sink_rate_mps < 1.5,
+        "sink rate {:.2} m/s",
+        td.sink_rate_mps
+    );
+    let last = o.samples.last().expect("samples");
+    assert!(!last.armed, "disarmed after the landing");
+    m
+}
+
+#[test]
+fn the_default_mission_flies_from_runway_to_runway_in_calm_air() {
+    let o = fly_default([0.0; 3], Turbulence::None, 1);
+    let m = landed_as_planned(&o);
+    assert!(m.xtrack_rms_m < 0.5, "cross-track {:.2} m", m.xtrack_rms_m);
+    assert!(m.alt_rms_m < 1.5, "altitude {:.2} m", m.alt_rms_m);
+    assert!(
+        m.airspeed_rms_mps < 1.0,
+        "airspeed {:.2} m/s",
+        m.airspeed_rms_mps
+    );
+}
+
+#[test]
+fn the_default_mission_flies_in_a_5_mps_wind_with_light_turbulence() {
+    // From the north-north-east (towards -3, -4): a headwind and crosswind on the landing,
+    // as a pilot would choose the runway direction.
+    let o = fly_default([-3.0, -4.0, 0.0], Turbulence::Light, 7);
+    let m = landed_as_planned(&o);
+    assert!(m.xtrack_rms_m < 2.0, "cross-track {:.2} m", m.xtrack_rms_m);
+    assert!(m.alt_rms_m < 1.5, "altitude {:.2} m", m.alt_rms_m);
+    assert!(
+        m.airspeed_rms_mps < 1.0,
+        "airspeed {:.2} m/s",
+        m.airspeed_rms_mps
+    );
 }

@@ -203,6 +203,9 @@ pub const PARAMS: &[ParamDef] = &[
 /// Ground speed under which a flaring aircraft counts as rolling on the runway, m/s: the
 /// estimated height alone carries the barometer's and GPS's offsets (tenths of a metre).
 const ROLLING_SPEED: f32 = 5.0;
+/// How closely the course must point at the next item before a finished loiter is left,
+/// rad (15 deg).
+const EXIT_COURSE_TOL: f32 = 0.26;
 /// Largest steering deflection, rad.
 const STEER_MAX: f32 = 0.4;
 /// Ground speed under which a landed aircraft has stopped and may be disarmed, m/s: until
@@ -464,6 +467,8 @@ pub struct NavOutput {
     pub phase: Phase,
     /// Stopped on the ground after a landing: the firmware may disarm.
     pub landed: bool,
+    /// The path of a waypoint or loiter item is a straight line (not a fillet or circle).
+    pub straight: bool,
 }
 
 impl NavOutput {
@@ -863,6 +868,36 @@ impl Navigator {
 
     /// The next navigation item after `seq` as the walk would find it (jumps followed, counts
     /// not spent).
+    /// True when the course over ground points within [`EXIT_COURSE_TOL`] of the next
+    /// navigation item that has a position (or when there is none, when it lies within one
+    /// and a half radii of the circle's centre, or with no ground speed to tell).
+    fn heading_for_next(
+        &self,
+        items: &[MissionItem],
+        home: &Home,
+        state: &NavState,
+        orbit: &Orbit,
+    ) -> bool {
+        let Some(seq) = self.seq else {
+            return true;
+        };
+        let pos = state.pos_ned;
+        let Some(next) = self
+            .peek_nav(items, usize::from(seq))
+            .filter(|n| items::point(n).is_some())
+        else {
+            return true;
+        };
+        let t = items::target_ned(next, home, &pos);
+        let vg = state.ground_speed();
+        if vg < 3.0 || horizontal_dist(&t, &orbit.center) < 1.5 * orbit.radius {
+            return true;
+        }
+        let bearing = libm::atan2f(t.y - pos.y, t.x - pos.x);
+        let course = libm::atan2f(state.vel_ned.y, state.vel_ned.x);
+        libm::fabsf(wrap_pi(bearing - course)) <= EXIT_COURSE_TOL
+    }
+
     fn peek_nav<'a>(&self, items: &'a [MissionItem], seq: usize) -> Option<&'a MissionItem> {
         let mut jumps = self.jumps;
         let mut s = seq + 1;
@@ -1102,6 +1137,12 @@ impl Navigator {
                     goal,
                     arrived,
                 };
+                // Leave the circle where it heads for the next point (PX4's and ArduPilot's
+                // exit): leaving anywhere else turns the aircraft round on the next leg, up
+                // to two turn radii off it.
+                if done && !self.heading_for_next(items, home, state, &orbit) {
+                    done = false;
+                }
                 if done {
                     self.item_done(items, home, state, orbit, out);
                 }
@@ -1201,6 +1242,7 @@ impl Navigator {
         out.commands = Some(follow(&g));
         out.target = target;
         out.phase = phase;
+        out.straight = matches!(path, Path::Line { .. });
         g
     }
 

@@ -400,7 +400,8 @@ mod tests {
     /// Flies the kinematic aircraft round the rectangle 0-(400,0)-(400,300)-(0,300) (clockwise
     /// seen from above) for `laps`, with the given fillet radius; statistics from lap 2 on.
     fn fly_rectangle(turn_radius: f32, laps: usize) -> Lap {
-        fly_rect(turn_radius, laps, Guidance::default())
+        // The kinematic aircraft's course lag is 1 s: the lead and line gain that match it.
+        fly_rect(turn_radius, laps, Guidance::for_course_lag(1.0, 0.03))
     }
 
     fn fly_rect(turn_radius: f32, laps: usize, g: Guidance) -> Lap {

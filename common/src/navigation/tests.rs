@@ -12,6 +12,7 @@ use crate::control::lateral::RollMode;
 use crate::control::longitudinal::LonMode;
 use crate::estimator::Home;
 use crate::gcs::mission::MissionItem;
+use crate::guidance::Guidance;
 use crate::guidance::PARAMS as GUIDANCE_PARAMS;
 use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
 use crate::math::wrap_pi;
@@ -192,7 +193,7 @@ fn parameter_lists_are_well_formed_and_unique_across_the_autopilot() {
         let v = p.get(d.name).unwrap();
         assert!((v - d.default).abs() < 1e-5, "{}", d.name);
     }
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     for d in GUIDANCE_PARAMS.iter().chain(PATH_PARAMS).chain(EXEC_PARAMS) {
         assert_eq!(nav.set_param(d.name, d.default), Ok(()), "{}", d.name);
     }
@@ -234,7 +235,7 @@ fn waypoints_reached_in_order_then_circle_the_last() {
         wp(400.0, 400.0, 100.0),
         wp(0.0, 400.0, 100.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     plane.k.wind = Vector3::new(-3.0, 4.0, 0.0);
     nav.start_mission(0);
@@ -260,7 +261,7 @@ fn do_jump_repeats_exactly_n_times() {
         do_item(DO_JUMP, [0.0, 2.0, 0.0, 0.0]),
         wp(0.0, 300.0, 80.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 600.0, |o| {
@@ -288,7 +289,7 @@ fn unknown_and_unsupported_items_are_skipped_with_a_warning() {
         do_item(DO_CHANGE_SPEED, [2.0, 3.0, -1.0, 0.0]),
         wp(300.0, 300.0, 80.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 300.0, |o| {
@@ -317,7 +318,7 @@ fn jump_loop_without_a_navigation_item_ends_the_mission() {
         do_item(DO_JUMP, [1.0, -1.0, 0.0, 0.0]),
         do_item(DO_JUMP, [0.0, -1.0, 0.0, 0.0]),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     nav.start_mission(0);
     let plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     let out = nav.step(&items, &home(), &plane.state(), DT);
@@ -344,7 +345,7 @@ fn change_speed_and_set_home() {
         do_item(DO_CHANGE_SPEED, [0.0, 99.0, -1.0, 0.0]),
         wp(300.0, 300.0, 80.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     nav.start_mission(0);
     let out = nav.step(&items, &home(), &plane.state(), DT);
@@ -361,7 +362,7 @@ fn change_speed_and_set_home() {
     assert_eq!(last.current_seq, Some(4));
     assert_eq!(o.guidance.unwrap().airspeed, 25.0);
     // Crossed limits (a minimum above the maximum) are no reason to panic: the maximum wins.
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     nav.set_param("NAV_ASPD_MIN", 30.0).unwrap();
     nav.set_param("NAV_ASPD_MAX", 20.0).unwrap();
     nav.start_mission(0);
@@ -377,7 +378,7 @@ fn loiter_turns_counted() {
         item(NAV_LOITER_TURNS, [2.0, 0.0, -80.0, 0.0], 500.0, 0.0, 80.0),
         wp(500.0, 600.0, 80.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     plane.k.wind = Vector3::new(0.0, 4.0, 0.0);
     nav.start_mission(0);
@@ -411,7 +412,7 @@ fn loiter_time_and_to_altitude() {
         item(NAV_LOITER_TO_ALT, [0.0, 70.0, 0.0, 0.0], 300.0, 0.0, 120.0),
         item(NAV_LOITER_UNLIM, [0.0, 0.0, 0.0, 0.0], 0.0, 0.0, 120.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 400.0, |_| false);
@@ -459,7 +460,7 @@ fn runway_takeoff() {
         },
         wp(0.0, 1500.0, 60.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
     plane.k.airspeed = 0.0;
     nav.start_mission(0);
@@ -515,7 +516,7 @@ fn landing_glide_path_reaches_the_land_point() {
         wp(900.0, 0.0, 60.0),
         item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0),
     ];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     // Approaching the waypoint from the north-east, at its altitude.
     let mut plane = Plane::flying(1300.0, 300.0, 60.0, -2.5);
     plane.k.wind = Vector3::new(2.0, 1.0, 0.0);
@@ -584,7 +585,7 @@ fn plane_speed(log: &Log, p: &Vector3<f32>) -> f32 {
 /// down the glide slope onto home.
 #[test]
 fn return_and_circle_or_land() {
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(600.0, -400.0, 120.0, 1.0);
     plane.k.wind = Vector3::new(0.0, -4.0, 0.0);
     nav.start_return(false);
@@ -607,7 +608,7 @@ fn return_and_circle_or_land() {
 
 #[test]
 fn loiter_here_circles_the_present_position() {
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(200.0, 100.0, 90.0, 0.0);
     nav.start_loiter(None);
     let log = fly(&mut nav, &mut plane, &[], 120.0, |_| false);
@@ -625,7 +626,7 @@ fn loiter_here_circles_the_present_position() {
 #[test]
 fn a_new_home_moves_the_targets() {
     let items = [wp(300.0, 0.0, 80.0)];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     nav.start_mission(0);
     let a = nav
@@ -647,7 +648,7 @@ fn no_autocontinue_holds_at_the_waypoint() {
     let mut first = wp(300.0, 0.0, 80.0);
     first.autocontinue = false;
     let items = [first, wp(300.0, 300.0, 80.0)];
-    let mut nav = Navigator::default();
+    let mut nav = navigator();
     let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 150.0, |_| false);
@@ -705,7 +706,7 @@ fn garbage_items_and_state_do_not_panic() {
             });
             it.autocontinue = next() % 4 != 0;
         }
-        let mut nav = Navigator::default();
+        let mut nav = navigator();
         nav.start_mission((next() % 14) as u16);
         let mut plane = Plane::flying(0.0, 0.0, 50.0, 0.0);
         let _ = fly(&mut nav, &mut plane, &items, 10.0, |_| false);
@@ -727,4 +728,41 @@ fn garbage_items_and_state_do_not_panic() {
         let _ = super::fence::validate_fence(&items);
         let _ = breached(&items, &home(), &bad.pos_ned, &FenceParams::default());
     }
+}
+
+/// A finished loiter is left where the course points at the next waypoint, so the next leg
+/// starts on its line: without that exit the aircraft turns round on the leg, up to two turn
+/// radii off it.
+#[test]
+fn a_finished_loiter_is_left_heading_for_the_next_point() {
+    let items = [
+        item(NAV_LOITER_TURNS, [1.0, 0.0, 80.0, 0.0], 300.0, 0.0, 80.0),
+        item(NAV_WAYPOINT, [0.0; 4], 300.0, 1200.0, 80.0),
+    ];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 300.0, |o| {
+        o.reached == Some(1)
+    });
+    assert_eq!(log.reached, [0, 1]);
+    let worst = log
+        .outs
+        .iter()
+        .filter(|o| o.1.current_seq == Some(1))
+        .filter_map(|o| o.1.guidance.map(|g| g.cross_track.abs()))
+        .fold(0.0_f32, f32::max);
+    assert!(
+        worst < 10.0,
+        "cross-track on the leg after the loiter {worst} m"
+    );
+}
+
+/// A navigator with the guidance matched to the kinematic aircraft's 1 s course lag.
+fn navigator() -> Navigator {
+    Navigator::new(
+        NavParams::default(),
+        Guidance::for_course_lag(1.0, 0.03),
+        PathManager::default(),
+    )
 }

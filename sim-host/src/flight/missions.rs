@@ -126,3 +126,24 @@ pub fn default_mission(home: GeoPoint) -> Vec<MISSION_ITEM_INT_DATA> {
         )
         .build()
 }
+
+/// A flight of `mission` from the runway at home (heading north, engine off), as a pilot
+/// with QGroundControl flies it: the mission is uploaded, the autopilot armed once its
+/// estimator has converged, the mission started a second later; the flight ends when the
+/// autopilot has landed and disarmed (or after 900 s).
+pub fn runway_mission(mission: Vec<MISSION_ITEM_INT_DATA>) -> super::FlightConfig {
+    super::FlightConfig {
+        duration_s: 900.0,
+        stop_when_landed: true,
+        runway_heading: Some(0.0),
+        script: super::Script {
+            steps: vec![super::ScriptStep {
+                after_arm_s: 1.0,
+                action: super::Action::MissionStart,
+            }],
+            mission,
+            ..super::Script::thesis()
+        },
+        ..super::FlightConfig::default()
+    }
+}

@@ -88,35 +88,68 @@ pub struct Sample {
     pub rudder: f64,
     /// Commanded throttle.
     pub throttle: f64,
-    /// Cross-track error of the path being followed, m (NaN outside navigation modes).
+    /// Cross-track error of the true position from the path being followed, m (NaN outside
+    /// navigation modes).
     pub xtrack: f64,
+    /// The same error as the navigator sees it, from the estimated position, m.
+    pub est_xtrack: f64,
     /// The navigator's phase (`common::navigation::Phase` as its index).
     pub nav_phase: u8,
     /// Mission item being flown (-1: none).
     pub mission_seq: i32,
+    /// The path followed is a straight leg.
+    pub straight: bool,
 }
 
 /// What the navigator was doing at one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NavView {
-    /// Cross-track error, m (NaN without a path).
+    /// Cross-track error from the estimated position, m (NaN without a path).
     pub xtrack: f64,
+    /// Unit vector (north, east) along which a position error adds to the cross-track error:
+    /// right of a line, outward from a circle's centre.
+    pub across: (f64, f64),
     /// Phase.
     pub phase: Phase,
     /// Mission item.
     pub seq: Option<u16>,
+    /// On a straight leg.
+    pub straight: bool,
 }
 
 impl NavView {
-    /// The view of an autopilot's navigator (only a navigation mode has a path).
-    pub fn of(nav: &common::navigation::NavOutput, navigating: bool) -> Self {
+    /// The view of an autopilot's navigator (only a navigation mode has a path); `pos_ned` is
+    /// the estimated position the navigator flew on.
+    pub fn of(
+        nav: &common::navigation::NavOutput,
+        navigating: bool,
+        pos_ned: &Vector3<f32>,
+    ) -> Self {
+        let across = match (nav.straight, nav.guidance, nav.target) {
+            (true, Some(g), _) => {
+                let c = f64::from(g.path_course);
+                (-c.sin(), c.cos())
+            }
+            (false, _, Some(t)) => {
+                let (dn, de) = (f64::from(pos_ned.x - t.x), f64::from(pos_ned.y - t.y));
+                let r = dn.hypot(de);
+                if r > 1e-6 {
+                    (dn / r, de / r)
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+            _ => (0.0, 0.0),
+        };
         Self {
+            across,
             xtrack: match (navigating, nav.guidance) {
                 (true, Some(g)) => f64::from(g.cross_track),
                 _ => f64::NAN,
             },
             phase: if navigating { nav.phase } else { Phase::Idle },
             seq: nav.current_seq,
+            straight: navigating && nav.straight,
         }
     }
 }
@@ -139,6 +172,10 @@ impl Sample {
         nav: &NavView,
     ) -> Self {
         let (eu, course, _) = truth_angles(truth);
+        // The true position's error from the path: the estimate's, plus the estimate's own
+        // error across the path.
+        let (dn, de) = (truth.pos_ned.x - est_ne.0, truth.pos_ned.y - est_ne.1);
+        let xtrack = nav.xtrack + dn * nav.across.0 + de * nav.across.1;
         Self {
             t,
             armed,
@@ -174,9 +211,11 @@ impl Sample {
             aileron: f64::from(s.aileron),
             rudder: f64::from(s.rudder),
             throttle: f64::from(s.throttle),
-            xtrack: nav.xtrack,
+            xtrack,
+            est_xtrack: nav.xtrack,
             nav_phase: nav.phase as u8,
             mission_seq: nav.seq.map_or(-1, i32::from),
+            straight: nav.straight,
         }
     }
 }
@@ -270,6 +309,164 @@ pub struct FlightSummary {
     pub sim_rx: LinkStatsJson,
     /// The autopilot's counters of what it received.
     pub autopilot_rx: AutopilotRx,
+    /// Mission and geofence uploads: what, when, the MISSION_ACK result.
+    pub uploads: Vec<(String, f64, String)>,
+    /// How the mission went, when one was uploaded.
+    pub mission: Option<MissionSummary>,
+}
+
+/// How a mission was flown: tracking errors of the truth against what guidance asked for.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MissionSummary {
+    /// Items uploaded.
+    pub items: usize,
+    /// The navigation items (waypoints, loiters, take-off, landing): each must be reached.
+    pub nav_items: Vec<u16>,
+    /// MISSION_ITEM_REACHED as the ground station received them, in order.
+    pub reached: Vec<u16>,
+    /// Every navigation item reached.
+    pub all_reached: bool,
+    /// Cross-track error on straight legs (waypoint items, fillets excluded), RMS, m.
+    pub xtrack_rms_m: f64,
+    /// Largest cross-track error on straight legs, m.
+    pub xtrack_max_m: f64,
+    /// Cross-track error while circling a loiter item, RMS, m.
+    pub orbit_xtrack_rms_m: f64,
+    /// Altitude error (guidance's altitude minus the true altitude) over the waypoint and loiter
+    /// items, RMS, m.
+    pub alt_rms_m: f64,
+    /// Airspeed error (commanded minus true) over the same items, RMS, m/s.
+    pub airspeed_rms_mps: f64,
+    /// Armed time, s.
+    pub flight_time_s: f64,
+    /// Energy the motor drew (the UMN motor-power curve at the commanded throttle), Wh.
+    pub energy_wh: f64,
+    /// The landing, when there was one.
+    pub touchdown: Option<TouchdownSummary>,
+}
+
+/// The first contact of a landing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct TouchdownSummary {
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// Where, north of home, m.
+    pub north_m: f64,
+    /// Where, east of home, m.
+    pub east_m: f64,
+    /// Horizontal distance from the mission's landing point, m (NaN without a NAV_LAND).
+    pub distance_m: f64,
+    /// Along the landing direction (positive: past the point), m.
+    pub along_m: f64,
+    /// Sink rate, m/s.
+    pub sink_rate_mps: f64,
+    /// Ground speed, m/s.
+    pub ground_speed_mps: f64,
+    /// Bounces after the first contact.
+    pub bounces: u32,
+}
+
+/// Cross-track error within which a loiter counts as arrived on its circle, m (the
+/// navigator's default acceptance radius, `NAV_ACC_RAD`).
+const ORBIT_ARRIVAL_M: f64 = 15.0;
+
+/// Figures of a mission flight. `land_point` is the NAV_LAND item north and east of home.
+pub fn mission_summary(
+    mission: &[mavlink::dialects::common::MISSION_ITEM_INT_DATA],
+    land_point: Option<(f64, f64)>,
+    samples: &[Sample],
+    reached: &[u16],
+    touchdown: Option<&crate::plant::Touchdown>,
+    energy_j: f64,
+    frame_s: f64,
+) -> MissionSummary {
+    use mavlink::dialects::common::MavCmd as C;
+    let nav_items: Vec<u16> = mission
+        .iter()
+        .filter(|i| {
+            matches!(
+                i.command,
+                C::MAV_CMD_NAV_WAYPOINT
+                    | C::MAV_CMD_NAV_LOITER_TURNS
+                    | C::MAV_CMD_NAV_LOITER_TIME
+                    | C::MAV_CMD_NAV_LOITER_TO_ALT
+                    | C::MAV_CMD_NAV_TAKEOFF
+                    | C::MAV_CMD_NAV_LAND
+            )
+        })
+        .map(|i| i.seq)
+        .collect();
+    let rms = |v: &[f64]| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+        }
+    };
+    let leg: Vec<f64> = samples
+        .iter()
+        .filter(|s| s.armed && s.straight && s.nav_phase == Phase::Waypoint as u8)
+        .map(|s| s.xtrack)
+        .filter(|x| x.is_finite())
+        .collect();
+    // On the circle: from the first sample of each loiter within the acceptance radius (the
+    // executor's own test for arrival) to the end of that loiter.
+    let mut orbit = Vec::new();
+    let mut on_circle = false;
+    for s in samples {
+        if !(s.armed && s.nav_phase == Phase::Loiter as u8 && s.xtrack.is_finite()) {
+            on_circle = false;
+            continue;
+        }
+        on_circle |= s.xtrack.abs() <= ORBIT_ARRIVAL_M;
+        if on_circle {
+            orbit.push(s.xtrack);
+        }
+    }
+    let cruising = samples.iter().filter(|s| {
+        s.armed && (s.nav_phase == Phase::Waypoint as u8 || s.nav_phase == Phase::Loiter as u8)
+    });
+    let (alt, va): (Vec<f64>, Vec<f64>) = cruising
+        .map(|s| (s.sp_alt - s.alt, s.sp_airspeed - s.airspeed))
+        .unzip();
+    let touchdown = touchdown.map(|t| {
+        let (n, e) = (t.pos_ned.x, t.pos_ned.y);
+        let (distance_m, along_m) = match land_point {
+            Some((ln, le)) => {
+                let v = t.vel_ned;
+                let h = v.x.hypot(v.y).max(1e-9);
+                (
+                    (n - ln).hypot(e - le),
+                    ((n - ln) * v.x + (e - le) * v.y) / h,
+                )
+            }
+            None => (f64::NAN, f64::NAN),
+        };
+        TouchdownSummary {
+            time_s: t.time_s,
+            north_m: n,
+            east_m: e,
+            distance_m,
+            along_m,
+            sink_rate_mps: t.sink_rate_mps(),
+            ground_speed_mps: t.vel_ned.x.hypot(t.vel_ned.y),
+            bounces: t.bounces,
+        }
+    });
+    MissionSummary {
+        items: mission.len(),
+        all_reached: nav_items.iter().all(|i| reached.contains(i)),
+        nav_items,
+        reached: reached.to_vec(),
+        xtrack_rms_m: rms(&leg),
+        xtrack_max_m: leg.iter().fold(0.0, |m, x| m.max(x.abs())),
+        orbit_xtrack_rms_m: rms(&orbit),
+        alt_rms_m: rms(&alt),
+        airspeed_rms_mps: rms(&va),
+        flight_time_s: samples.iter().filter(|s| s.armed).count() as f64 * frame_s,
+        energy_wh: energy_j / 3600.0,
+        touchdown,
+    }
 }
 
 /// [`LinkStats`] for JSON.
@@ -453,6 +650,8 @@ pub(crate) fn summarise(
 ) -> FlightSummary {
     let sim_s = frames as f64 * frame_s;
     FlightSummary {
+        uploads: gcs.uploads.clone(),
+        mission: None,
         frames,
         armed_frames,
         sim_s,
@@ -522,8 +721,10 @@ pub fn csv_headers() -> Vec<String> {
         "rudder_deg",
         "throttle",
         "xtrack_m",
+        "est_xtrack_m",
         "nav_phase",
         "mission_seq",
+        "straight",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -567,8 +768,10 @@ pub fn csv_row(s: &Sample) -> Vec<f64> {
         s.rudder * DEG,
         s.throttle,
         s.xtrack,
+        s.est_xtrack,
         f64::from(s.nav_phase),
         f64::from(s.mission_seq),
+        b(s.straight),
     ]
 }
 

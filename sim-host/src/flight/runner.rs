@@ -1,15 +1,16 @@
 //! The flight loop.
 
 use super::onboard::Onboard;
-use super::record::{summarise, FlightSummary, NavView, Sample};
+use super::record::{mission_summary, summarise, FlightSummary, NavView, Sample};
 use super::script::{GroundStation, Script};
 use crate::aircraft::Aircraft;
 use crate::analysis::trim::{trim_with, TrimTarget};
 use crate::environment::wind::{Turbulence, Wind};
 use crate::link::lockstep::{LinkError, Lockstep};
 use crate::link::transport::Transport;
+use crate::plant::propulsion::polyval;
 use crate::plant::{Controls, Environment, ModelParams, Plant, ServoBank};
-use crate::sensors::{SensorSuite, Truth};
+use crate::sensors::{SensorFaults, SensorSuite, Truth};
 use common::link::simlink::{encode_hil_gps, encode_hil_sensor};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
@@ -33,6 +34,11 @@ pub struct FlightConfig {
     pub seed: u64,
     /// Pace the flight to the wall clock.
     pub realtime: bool,
+    /// With `realtime`: simulated seconds per wall second (1: real time).
+    pub speed: f64,
+    /// End the flight once the autopilot, having flown, has disarmed on the ground (after a
+    /// landing), instead of at `duration_s`.
+    pub stop_when_landed: bool,
     /// Show a progress bar.
     pub progress: bool,
     /// The ground station's script.
@@ -46,6 +52,52 @@ pub struct FlightConfig {
     /// Start at rest on the runway at home, pointing this way (rad from north), instead of
     /// the hand launch at 100 m. Engine off until the autopilot is armed.
     pub runway_heading: Option<f64>,
+    /// Sensor faults injected over windows of simulated time.
+    pub faults: Vec<FaultWindow>,
+}
+
+/// A sensor fault over a window of simulated time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaultWindow {
+    /// Which sensor fails.
+    pub fault: Fault,
+    /// From, s of simulated time.
+    pub from_s: f64,
+    /// Until, s (exclusive).
+    pub to_s: f64,
+}
+
+/// A sensor the simulator can fail.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// No GPS fixes.
+    GpsLost,
+    /// No differential pressure.
+    PitotFailed,
+    /// No magnetometer.
+    MagFailed,
+    /// No barometer.
+    BaroFailed,
+}
+
+impl FlightConfig {
+    /// The faults active at `t_s`.
+    pub fn faults_at(&self, t_s: f64) -> SensorFaults {
+        let mut f = SensorFaults::default();
+        for w in self
+            .faults
+            .iter()
+            .filter(|w| (w.from_s..w.to_s).contains(&t_s))
+        {
+            match w.fault {
+                Fault::GpsLost => f.gps_lost = true,
+                Fault::PitotFailed => f.pitot_failed = true,
+                Fault::MagFailed => f.mag_failed = true,
+                Fault::BaroFailed => f.baro_failed = true,
+            }
+        }
+        f
+    }
 }
 
 impl Default for FlightConfig {
@@ -59,11 +111,14 @@ impl Default for FlightConfig {
             turbulence: Turbulence::None,
             seed: 1,
             realtime: false,
+            speed: 1.0,
+            stop_when_landed: false,
             progress: false,
             script,
             link_timeout: Duration::from_secs(5),
             ground_link: None,
             runway_heading: None,
+            faults: Vec::new(),
         }
     }
 }
@@ -92,6 +147,9 @@ fn validate(cfg: &FlightConfig, frame_s: f64) -> Result<(), FlightError> {
     let bad = |m: String| Err(FlightError::Config(m));
     if !(cfg.duration_s.is_finite() && cfg.duration_s > 0.0) {
         return bad(format!("duration {} s: must be positive", cfg.duration_s));
+    }
+    if !(cfg.speed.is_finite() && cfg.speed > 0.0) {
+        return bad(format!("speed {}: must be a positive factor", cfg.speed));
     }
     if !(cfg.dt_s.is_finite() && cfg.dt_s > 0.0 && cfg.dt_s <= frame_s) {
         return bad(format!(
@@ -203,6 +261,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     let start = Instant::now();
     let mut samples = Vec::with_capacity(frames as usize + 1);
     let mut armed_frames = 0u64;
+    let mut energy_j = 0.0;
     for k in 0..frames {
         let time_us = sensors.next_time_us();
         let t_s = time_us as f64 * 1e-6;
@@ -214,6 +273,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             specific_force_body: plant.specific_force_body(),
             airspeed_mps: plant.air_data().va,
         };
+        sensors.faults = cfg.faults_at(t_s);
         let (frame, fix) = sensors.sample(&truth);
         let alt_amsl = home_alt - truth.pos_ned.z;
         let mut msgs = Vec::with_capacity(3);
@@ -238,15 +298,31 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         }
         gcs.poll(t_s, link, onboard);
         let answer = link.exchange(time_us, &msgs)?;
+        if cfg.stop_when_landed
+            && armed_frames > 0
+            && !answer.armed
+            && plant.on_ground()
+            && plant.velocity_ned().norm() < 1.0
+        {
+            break;
+        }
         let command = if answer.armed {
             armed_frames += 1;
+            let pr = &params.prop;
+            energy_j += polyval(
+                &pr.motor_power_poly_throttle_W,
+                f64::from(answer.surfaces.throttle),
+            )
+            .clamp(pr.motor_power_clamp_W[0], pr.motor_power_clamp_W[1])
+                * frame_s;
             Controls::from(answer.surfaces)
         } else {
             // The safety pilot holds the trim until the autopilot is armed.
             trim_controls
         };
         let view = onboard.with_app(link, |app| {
-            let nav = NavView::of(app.navigation(), app.mode().needs_navigator());
+            let e = app.estimate();
+            let nav = NavView::of(app.navigation(), app.mode().needs_navigator(), &e.pos_ned);
             (app.estimate(), app.setpoints(), app.mode(), nav)
         });
         samples.push(Sample::new(
@@ -272,7 +348,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         env.wind_ned = wind.step(frame_s, plant.air_data().va, -plant.position_ned().z, &q);
 
         if cfg.realtime {
-            let due = Duration::from_secs_f64((k + 1) as f64 * frame_s);
+            let due = Duration::from_secs_f64((k + 1) as f64 * frame_s / cfg.speed);
             if let Some(wait) = due.checked_sub(start.elapsed()) {
                 std::thread::sleep(wait);
             }
@@ -285,11 +361,11 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
     let health = onboard.with_app(link, |app| (app.sim_health(), app.sim_link_stats()));
-    let summary = summarise(
+    let mut summary = summarise(
         cfg,
         &samples,
         &gcs,
-        frames,
+        samples.len() as u64,
         frame_s,
         armed_frames,
         wall_s,
@@ -297,6 +373,33 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         health,
         home_alt,
     );
+    if !cfg.script.mission.is_empty() {
+        let land_point = cfg
+            .script
+            .mission
+            .iter()
+            .rev()
+            .find(|i| i.command == mavlink::dialects::common::MavCmd::MAV_CMD_NAV_LAND)
+            .map(|i| {
+                ned_offset::<f64>(
+                    home,
+                    common::math::geodetic::GeoPoint {
+                        lat_e7: i.x,
+                        lon_e7: i.y,
+                    },
+                )
+            });
+        let reached: Vec<u16> = gcs.reached.iter().map(|r| r.1).collect();
+        summary.mission = Some(mission_summary(
+            &cfg.script.mission,
+            land_point,
+            &samples,
+            &reached,
+            plant.touchdown(),
+            energy_j,
+            frame_s,
+        ));
+    }
     Ok(FlightOutcome { samples, summary })
 }
 

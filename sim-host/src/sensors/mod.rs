@@ -12,4 +12,4 @@ mod config;
 mod models;
 
 pub use config::{GpsConfig, SensorConfig};
-pub use models::{SensorSuite, Truth};
+pub use models::{SensorFaults, SensorSuite, Truth};
