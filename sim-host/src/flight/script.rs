@@ -48,6 +48,8 @@ pub enum Action {
     Loiter,
     /// Stop sending heartbeats (the ground link is lost).
     Silence,
+    /// Send heartbeats again, the first at once (the ground link is back).
+    Resume,
 }
 
 /// A command at a time after arming.
@@ -233,9 +235,17 @@ impl GroundStation {
                         break;
                     }
                     self.next_step += 1;
-                    if step.action == Action::Silence {
-                        self.silent = true;
-                        continue;
+                    match step.action {
+                        Action::Silence => {
+                            self.silent = true;
+                            continue;
+                        }
+                        Action::Resume => {
+                            self.silent = false;
+                            self.next_heartbeat_s = t_s;
+                            continue;
+                        }
+                        _ => {}
                     }
                     let (what, msg) = self.encode(&step.action.clone());
                     self.command(t_s, &what, link, onboard, &msg);
@@ -290,6 +300,7 @@ impl GroundStation {
                 ),
             ),
             Action::Silence => ("silence".into(), gcs_heartbeat()),
+            Action::Resume => ("resume".into(), gcs_heartbeat()),
         }
     }
 

@@ -1,0 +1,474 @@
+//! Failsafes flown end to end: each fault is injected in the simulator (sensors) or at the
+//! scripted ground station (heartbeats), during the default mission flown from the runway by
+//! the firmware on its own estimates. Each test checks the reaction (mode, navigator phase,
+//! STATUSTEXT, what the aircraft physically does) against the parameter values and the
+//! physics, then the recovery.
+
+use common::failsafe::Event;
+use common::navigation::Phase;
+use sim_host::aircraft::Aircraft;
+use sim_host::commands::fly::{fly_report, FlyOptions};
+use sim_host::flight::missions::{default_mission, runway_mission};
+use sim_host::flight::script::{PX4_ALTCTL, PX4_AUTO};
+use sim_host::flight::{Action, Fault, FaultWindow, FlightConfig, FlightOutcome, Sample, ScriptStep};
+use sim_host::plant::ModelParams;
+
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+fn aircraft() -> Aircraft {
+    Aircraft::ultrastick25e().expect("built-in aircraft")
+}
+
+/// The firmware's default value of a parameter (what a user flies without changing it).
+fn default_of(name: &str) -> f64 {
+    firmware::app::REGISTRY
+        .iter()
+        .flat_map(|l| l.iter())
+        .find(|d| d.name == name)
+        .map(|d| f64::from(d.default))
+        .unwrap_or_else(|| panic!("no parameter {name}"))
+}
+
+/// The default mission from the runway, with `steps` after the mission start (1 s after
+/// arming) and the flight's other settings from `cfg`.
+fn mission_flight(steps: Vec<ScriptStep>, tweak: impl FnOnce(&mut FlightConfig)) -> FlightOutcome {
+    let a = aircraft();
+    let mut cfg = runway_mission(default_mission(ModelParams::new(&a).home));
+    cfg.script.steps.extend(steps);
+    tweak(&mut cfg);
+    fly_report(&a, &cfg, &FlyOptions::default())
+        .expect("flight")
+        .outcome
+}
+
+fn step(after_arm_s: f64, action: Action) -> ScriptStep {
+    ScriptStep {
+        after_arm_s,
+        action,
+    }
+}
+
+fn armed_at(o: &FlightOutcome) -> f64 {
+    o.summary.armed_at_s.expect("armed")
+}
+
+/// When the autopilot first said `text` at or after `from_s`.
+fn said(o: &FlightOutcome, text: &str, from_s: f64) -> Option<f64> {
+    o.summary
+        .texts
+        .iter()
+        .find(|(t, s)| *t >= from_s && s == text)
+        .map(|(t, _)| *t)
+}
+
+fn phase_is(s: &Sample, p: Phase) -> bool {
+    s.nav_phase == p as u8
+}
+
+fn between(o: &FlightOutcome, from_s: f64, to_s: f64) -> impl Iterator<Item = &Sample> {
+    o.samples.iter().filter(move |s| s.t >= from_s && s.t < to_s)
+}
+
+/// One line every `every_s` seconds, for `--nocapture`.
+fn trace(o: &FlightOutcome, every_s: f64) {
+    let mut next = 0.0;
+    for s in &o.samples {
+        if s.t >= next {
+            next = s.t + every_s;
+            eprintln!(
+                "t {:6.1} arm {} mode {} phase {:2} seq {:2} n {:7.1} e {:7.1} alt {:5.1} roll {:6.1} va {:5.1} est_va {:5.1} dr_err {:5.1}",
+                s.t,
+                u8::from(s.armed),
+                s.mode,
+                s.nav_phase,
+                s.mission_seq,
+                s.north,
+                s.east,
+                s.alt,
+                s.roll / DEG,
+                s.airspeed,
+                s.est_airspeed,
+                (s.est_north - s.north).hypot(s.est_east - s.east),
+            );
+        }
+    }
+    for (t, text) in &o.summary.texts {
+        eprintln!("{t:7.2} {text}");
+    }
+}
+
+/// The landing every recovered mission ends with: on the runway within 20 m of the land point
+/// (the mission tests' figure), at a sink rate the gear takes, disarmed.
+fn lands_on_the_runway(o: &FlightOutcome) {
+    let m = o.summary.mission.clone().expect("a mission was flown");
+    let td = m.touchdown.expect("touched down");
+    eprintln!("touchdown {td:?}");
+    assert!(
+        td.distance_m < 20.0,
+        "touchdown {:.1} m from the land point",
+        td.distance_m
+    );
+    assert!(td.sink_rate_mps < 1.5, "sink rate {:.2} m/s", td.sink_rate_mps);
+    let land_seq = *m.nav_items.last().expect("a landing item");
+    assert!(
+        m.reached.contains(&land_seq),
+        "landing item {land_seq} reported reached: {:?}",
+        m.reached
+    );
+    assert!(!o.samples.last().expect("samples").armed, "disarmed");
+}
+
+/// Circling a centre: the spread of the distance to it and the angle swept round it.
+fn circling(samples: &[&Sample], center: (f64, f64)) -> (f64, f64, f64) {
+    let r: Vec<f64> = samples
+        .iter()
+        .map(|s| (s.north - center.0).hypot(s.east - center.1))
+        .collect();
+    let mut swept = 0.0;
+    for w in samples.windows(2) {
+        let a0 = (w[0].east - center.1).atan2(w[0].north - center.0);
+        let a1 = (w[1].east - center.1).atan2(w[1].north - center.0);
+        swept += common::math::wrap_pi(a1 - a0);
+    }
+    let min = r.iter().cloned().fold(f64::INFINITY, f64::min);
+    let max = r.iter().cloned().fold(0.0, f64::max);
+    (min, max, swept)
+}
+
+#[test]
+fn ground_link_loss_returns_home_circles_and_the_pilot_resumes_the_mission() {
+    // Heartbeats stop on the first long leg; the link comes back while the aircraft circles
+    // home, and the pilot restarts the mission two seconds later.
+    let (silence_s, resume_s) = (40.0, 150.0);
+    let rtl_alt = 80.0;
+    let o = mission_flight(
+        vec![
+            step(silence_s, Action::Silence),
+            step(resume_s, Action::Resume),
+            step(resume_s + 2.0, Action::MissionStart),
+        ],
+        |c| {
+            // A return altitude above the mission's 60 m, so holding it is told apart from
+            // holding the mission's altitude.
+            c.script.params.push(("NAV_RTL_ALT".into(), rtl_alt as f32));
+        },
+    );
+    trace(&o, 2.0);
+    let t_arm = armed_at(&o);
+    let (t_silent, t_back, t_restart) = (
+        t_arm + silence_s,
+        t_arm + resume_s,
+        t_arm + resume_s + 2.0,
+    );
+    let timeout = default_of("FS_GCS_TOUT_S");
+    let radius = default_of("NAV_LOIT_RAD");
+
+    let before = o.samples.iter().rfind(|s| s.t < t_silent).expect("samples");
+    assert!(
+        phase_is(before, Phase::Waypoint) && before.mode == PX4_AUTO,
+        "on a mission leg when the link is lost: {before:?}"
+    );
+    // The last heartbeat went out at most 1 s (the station's period) before the silence.
+    let returning = |s: &&Sample| {
+        s.mode == PX4_AUTO && (phase_is(s, Phase::Return) || phase_is(s, Phase::ReturnLoiter))
+    };
+    let t_return = o
+        .samples
+        .iter()
+        .filter(|s| s.t >= t_silent)
+        .find(returning)
+        .expect("returns")
+        .t;
+    assert!(
+        (t_silent + timeout - 1.0..=t_silent + timeout + 1.0).contains(&t_return),
+        "return {:.2} s after the last heartbeat window opened (FS_GCS_TOUT_S {timeout} s)",
+        t_return - t_silent
+    );
+    let t_text = said(&o, Event::GcsLost.text(), t_silent).expect("ground link lost reported");
+    assert!(
+        (t_text - t_return).abs() <= 0.1,
+        "reported at {t_text:.2} s, returning from {t_return:.2} s"
+    );
+    // The return holds until the pilot picks a mode, heartbeats or not.
+    assert!(
+        between(&o, t_return, t_restart).all(|s| returning(&s)),
+        "returning from the loss until the mission restart"
+    );
+    let t_circle = o
+        .samples
+        .iter()
+        .find(|s| s.t > t_return && phase_is(s, Phase::ReturnLoiter))
+        .expect("circles home")
+        .t;
+    // One lap to settle on the circle, then it must be on it.
+    let lap_s = 2.0 * std::f64::consts::PI * radius / default_of("NAV_ASPD");
+    let on_circle: Vec<&Sample> = between(&o, t_circle + lap_s, t_restart).collect();
+    assert!(
+        on_circle.len() as f64 > 1.5 * lap_s * 100.0,
+        "at least 1.5 laps (of {lap_s:.1} s) to look at, {} samples",
+        on_circle.len()
+    );
+    let (r_min, r_max, swept) = circling(&on_circle, (0.0, 0.0));
+    eprintln!(
+        "return: at {:.1} s, circling home from {t_circle:.1} s; radius {r_min:.1}..{r_max:.1} m, swept {:.0} deg",
+        t_return,
+        swept / DEG
+    );
+    assert!(
+        r_min > radius - 10.0 && r_max < radius + 10.0,
+        "circle radius {r_min:.1}..{r_max:.1} m, NAV_LOIT_RAD {radius} m"
+    );
+    assert!(swept.abs() > 2.0 * std::f64::consts::PI, "swept {:.0} deg", swept / DEG);
+    let (alt_min, alt_max) = on_circle
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+            (lo.min(s.alt), hi.max(s.alt))
+        });
+    assert!(
+        alt_min > rtl_alt - 3.0 && alt_max < rtl_alt + 3.0,
+        "altitude {alt_min:.1}..{alt_max:.1} m while circling, NAV_RTL_ALT {rtl_alt} m"
+    );
+    let t_regained = said(&o, Event::GcsRegained.text(), t_back).expect("link back reported");
+    assert!(t_regained - t_back < 0.5, "regained {:.2} s late", t_regained - t_back);
+    // Restarted: the mission goes on from the leg it left, and lands.
+    let after = o
+        .samples
+        .iter()
+        .find(|s| s.t > t_restart + 0.1)
+        .expect("samples after the restart");
+    assert!(
+        after.mode == PX4_AUTO && phase_is(after, Phase::Waypoint) && after.mission_seq == before.mission_seq,
+        "mission resumed at item {}: {after:?}",
+        before.mission_seq
+    );
+    lands_on_the_runway(&o);
+}
+
+#[test]
+fn gps_loss_flies_wings_level_then_circles_and_the_mission_resumes() {
+    let (from_s, lost_s) = (45.0, 25.0);
+    let o = mission_flight(Vec::new(), |c| {
+        c.wind_ned = [-3.0, -4.0, 0.0];
+        c.faults.push(FaultWindow {
+            fault: Fault::GpsLost,
+            from_s,
+            to_s: from_s + lost_s,
+        });
+    });
+    trace(&o, 1.0);
+    let to_s = from_s + lost_s;
+    let gps_tout = default_of("EST_GPS_TOUT");
+    let wl_s = default_of("FS_GPS_WL_S");
+    let before = o.samples.iter().rfind(|s| s.t < from_s).expect("samples");
+    assert!(phase_is(before, Phase::Waypoint), "on a leg: {before:?}");
+    let t_lost = said(&o, Event::GpsLost.text(), from_s).expect("GPS loss reported");
+    // GPS fixes come at 5-10 Hz: the estimator notices within its timeout plus a fix period.
+    assert!(
+        t_lost - from_s <= gps_tout + 0.3,
+        "GPS loss noticed {:.2} s after the last fix (EST_GPS_TOUT {gps_tout} s)",
+        t_lost - from_s
+    );
+    let at_loss = o.samples.iter().find(|s| s.t >= t_lost).expect("samples");
+    let wings_level: Vec<&Sample> = between(&o, t_lost + 0.05, t_lost + wl_s - 0.05).collect();
+    assert!(
+        wings_level.iter().all(|s| s.mode == PX4_ALTCTL),
+        "Altitude mode while wings level"
+    );
+    // Roll out from whatever bank the leg had in 3 s, then within 5 deg of level.
+    let roll_max = between(&o, t_lost + 3.0, t_lost + wl_s - 0.05)
+        .map(|s| s.roll.abs())
+        .fold(0.0, f64::max);
+    let alt_err = wings_level
+        .iter()
+        .map(|s| (s.alt - at_loss.alt).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "wings level: largest roll {:.1} deg, altitude {:.1} m off the {:.1} m held",
+        roll_max / DEG,
+        alt_err,
+        at_loss.alt
+    );
+    assert!(roll_max < 5.0 * DEG, "roll {:.1} deg", roll_max / DEG);
+    assert!(alt_err < 3.0, "altitude off by {alt_err:.1} m");
+    let t_loiter = said(&o, Event::GpsLoiter.text(), t_lost).expect("circling reported");
+    assert!(
+        (t_loiter - t_lost - wl_s).abs() <= 0.1,
+        "circling {:.2} s after the loss, FS_GPS_WL_S {wl_s} s",
+        t_loiter - t_lost
+    );
+    let t_back = said(&o, Event::GpsRegained.text(), to_s).expect("GPS back reported");
+    assert!(t_back - to_s < 0.5, "GPS back noticed {:.2} s late", t_back - to_s);
+    let hold: Vec<&Sample> = between(&o, t_loiter + 0.05, t_back - 0.05).collect();
+    assert!(
+        hold.iter().all(|s| s.mode == PX4_AUTO && phase_is(s, Phase::Hold)),
+        "circling in AUTO (Hold phase) until GPS is back"
+    );
+    let bank_mean = hold.iter().map(|s| s.roll).sum::<f64>() / hold.len() as f64;
+    eprintln!("circling: mean roll {:.1} deg", bank_mean / DEG);
+    // The drift of the dead-reckoned position, just before the first fix is back.
+    let last_dr = o.samples.iter().rfind(|s| s.t < to_s).expect("samples");
+    let drift = (last_dr.est_north - last_dr.north).hypot(last_dr.est_east - last_dr.east);
+    let fix_err = (before.est_north - before.north).hypot(before.est_east - before.east);
+    eprintln!("dead reckoning: {drift:.1} m off after {lost_s} s (GPS-aided {fix_err:.1} m)");
+    let after = o.samples.iter().find(|s| s.t > t_back + 0.1).expect("samples");
+    assert!(
+        after.mode == PX4_AUTO && phase_is(after, Phase::Waypoint) && after.mission_seq == before.mission_seq,
+        "mission resumed at item {}: {after:?}",
+        before.mission_seq
+    );
+    lands_on_the_runway(&o);
+}
+
+#[test]
+fn pitot_failure_flies_on_synthetic_airspeed_to_the_landing() {
+    let from_s = 45.0;
+    let o = mission_flight(Vec::new(), |c| {
+        c.wind_ned = [-3.0, -4.0, 0.0];
+        c.faults.push(FaultWindow {
+            fault: Fault::PitotFailed,
+            from_s,
+            to_s: 1e9,
+        });
+    });
+    trace(&o, 2.0);
+    let t_fail = said(&o, Event::AirspeedFailed.text(), from_s).expect("failure reported");
+    let tout = default_of("EST_SENS_TOUT");
+    assert!(
+        t_fail - from_s <= tout + 0.1,
+        "noticed {:.2} s after the last sample",
+        t_fail - from_s
+    );
+    let flying: Vec<&Sample> = o
+        .samples
+        .iter()
+        .filter(|s| s.t > t_fail && s.armed && s.alt > 5.0)
+        .collect();
+    let err: Vec<f64> = flying.iter().map(|s| s.est_airspeed - s.airspeed).collect();
+    let max = err.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    let rms = (err.iter().map(|e| e * e).sum::<f64>() / err.len() as f64).sqrt();
+    eprintln!("synthetic airspeed: error RMS {rms:.2} m/s, largest {max:.2} m/s");
+    assert!(max < 1.5, "synthetic airspeed off by {max:.2} m/s");
+    assert!(rms < 0.5, "synthetic airspeed RMS error {rms:.2} m/s");
+    assert!(
+        o.summary.texts.iter().all(|(_, t)| t != Event::AirspeedRegained.text()),
+        "the sensor never came back"
+    );
+    assert!(
+        o.samples.iter().filter(|s| s.t > t_fail && s.armed).all(|s| s.mode == PX4_AUTO),
+        "no change of mode"
+    );
+    let m = o.summary.mission.clone().expect("mission");
+    assert!(m.all_reached, "reached {:?} of {:?}", m.reached, m.nav_items);
+    lands_on_the_runway(&o);
+}
+
+#[test]
+fn geofence_breach_returns_home_within_a_turn_radius_of_the_fence() {
+    let a = aircraft();
+    let home = ModelParams::new(&a).home;
+    // A box round the runway and the first leg whose east side (250 m) the rectangle's second
+    // leg (north 600 m, east 0 to 400 m) crosses.
+    let (north, east) = ([-600.0, 800.0], [-250.0, 250.0]);
+    let corners = [
+        (north[0], east[0]),
+        (north[1], east[0]),
+        (north[1], east[1]),
+        (north[0], east[1]),
+    ];
+    let fence = fence_polygon(home, &corners);
+    let mut cfg = runway_mission(default_mission(home));
+    cfg.script.fence = fence;
+    cfg.duration_s = 170.0;
+    let o = fly_report(&a, &cfg, &FlyOptions::default())
+        .expect("flight")
+        .outcome;
+    trace(&o, 2.0);
+    assert_eq!(
+        o.summary.uploads.iter().map(|u| u.2.as_str()).collect::<Vec<_>>(),
+        ["MAV_MISSION_ACCEPTED", "MAV_MISSION_ACCEPTED"],
+        "mission and fence accepted"
+    );
+    let outside = |s: &Sample| {
+        s.north < north[0] || s.north > north[1] || s.east < east[0] || s.east > east[1]
+    };
+    let t_out = o.samples.iter().find(|s| outside(s)).expect("crosses the fence").t;
+    let t_text = said(&o, Event::FenceBreached.text(), 0.0).expect("breach reported");
+    assert!(
+        (t_text - t_out).abs() < 1.0,
+        "breach reported at {t_text:.2} s, the aircraft crossed at {t_out:.2} s"
+    );
+    let returning = o.samples.iter().find(|s| s.t >= t_text).expect("samples");
+    assert!(
+        returning.mode == PX4_AUTO && phase_is(returning, Phase::Return),
+        "returning at the breach: {returning:?}"
+    );
+    // Beyond the fence by at most a turn at the bank limit, plus a second's flight before
+    // the turn is established.
+    let va = default_of("NAV_ASPD");
+    let bank = default_of("LIM_ROLL_DEG") * DEG;
+    let allowed = va * va / (9.81 * bank.tan()) + va;
+    let beyond = o
+        .samples
+        .iter()
+        .map(|s| (s.east - east[1]).max(east[0] - s.east).max(s.north - north[1]).max(north[0] - s.north))
+        .fold(f64::NEG_INFINITY, f64::max);
+    eprintln!("beyond the fence by {beyond:.1} m at most (allowed {allowed:.1} m)");
+    assert!(beyond < allowed, "{beyond:.1} m beyond the fence, allowed {allowed:.1} m");
+    let t_in = said(&o, Event::FenceCleared.text(), t_text).expect("back inside reported");
+    assert!(
+        between(&o, t_in + 1.0, f64::INFINITY).all(|s| !outside(s)),
+        "stays inside once back"
+    );
+    let rtl_alt = default_of("NAV_RTL_ALT");
+    let radius = default_of("NAV_LOIT_RAD");
+    let t_circle = o
+        .samples
+        .iter()
+        .find(|s| s.t > t_text && phase_is(s, Phase::ReturnLoiter))
+        .expect("circles home")
+        .t;
+    let lap_s = 2.0 * std::f64::consts::PI * radius / va;
+    let on_circle: Vec<&Sample> = between(&o, t_circle + lap_s, f64::INFINITY).collect();
+    assert!(
+        on_circle.iter().all(|s| s.mode == PX4_AUTO && phase_is(s, Phase::ReturnLoiter)),
+        "still circling home"
+    );
+    let (r_min, r_max, swept) = circling(&on_circle, (0.0, 0.0));
+    eprintln!("circling home: radius {r_min:.1}..{r_max:.1} m, swept {:.0} deg", swept / DEG);
+    assert!(
+        r_min > radius - 10.0 && r_max < radius + 10.0,
+        "circle radius {r_min:.1}..{r_max:.1} m, NAV_LOIT_RAD {radius} m"
+    );
+    assert!(swept.abs() > 1.5 * std::f64::consts::PI, "swept {:.0} deg", swept / DEG);
+    assert!(
+        on_circle.iter().all(|s| (s.alt - rtl_alt).abs() < 3.0),
+        "at NAV_RTL_ALT {rtl_alt} m"
+    );
+}
+
+/// An inclusion polygon through `corners` (north, east of home, m), one fence item per vertex.
+fn fence_polygon(
+    home: common::math::geodetic::GeoPoint,
+    corners: &[(f64, f64)],
+) -> Vec<mavlink::dialects::common::MISSION_ITEM_INT_DATA> {
+    use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
+    corners
+        .iter()
+        .enumerate()
+        .map(|(i, &(n, e))| {
+            let p = common::math::geodetic::offset_point(home, n, e);
+            MISSION_ITEM_INT_DATA {
+                param1: corners.len() as f32,
+                x: p.lat_e7,
+                y: p.lon_e7,
+                seq: i as u16,
+                command: MavCmd::MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION,
+                target_system: 1,
+                target_component: 1,
+                frame: MavFrame::MAV_FRAME_GLOBAL,
+                mission_type: MavMissionType::MAV_MISSION_TYPE_FENCE,
+                ..Default::default()
+            }
+        })
+        .collect()
+}
