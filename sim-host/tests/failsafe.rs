@@ -47,9 +47,9 @@ fn mission_flight(steps: Vec<ScriptStep>, tweak: impl FnOnce(&mut FlightConfig))
         .outcome
 }
 
-/// The mission tests' wind: 5 m/s from the north-north-east (a headwind and crosswind on the
-/// landing) in light turbulence. The dead reckoning and the synthetic airspeed lean on the
-/// wind estimate, which calm air would leave untested.
+/// The mission tests' wind, 5 m/s from the north-north-east (a headwind and crosswind on the
+/// landing), in light turbulence, on the calm flights' seed. The dead reckoning and the
+/// synthetic airspeed lean on the wind estimate, which calm air would leave untested.
 fn windy(c: &mut FlightConfig) {
     c.wind_ned = [-3.0, -4.0, 0.0];
     c.turbulence = Turbulence::Light;
@@ -169,8 +169,9 @@ fn circling(samples: &[&Sample], center: (f64, f64)) -> (f64, f64, f64) {
 
 #[test]
 fn ground_link_loss_returns_home_circles_and_the_pilot_resumes_the_mission() {
-    // Heartbeats stop on the first long leg; the link comes back while the aircraft circles
-    // home, and the pilot restarts the mission two seconds later.
+    // Heartbeats stop on the rectangle's second leg (eastbound, 600 m north of home); the link
+    // comes back while the aircraft circles home, and the pilot restarts the mission two
+    // seconds later.
     let (silence_s, resume_s) = (40.0, 150.0);
     let rtl_alt = 80.0;
     let o = mission_flight(
@@ -210,7 +211,7 @@ fn ground_link_loss_returns_home_circles_and_the_pilot_resumes_the_mission() {
         .t;
     assert!(
         (t_silent + timeout - 1.0..=t_silent + timeout + 1.0).contains(&t_return),
-        "return {:.2} s after the last heartbeat window opened (FS_GCS_TOUT_S {timeout} s)",
+        "return {:.2} s after the heartbeats stopped (the last 0 to 1 s before; FS_GCS_TOUT_S {timeout} s)",
         t_return - t_silent
     );
     let t_text = said(&o, Event::GcsLost.text(), t_silent).expect("ground link lost reported");
@@ -283,6 +284,34 @@ fn ground_link_loss_returns_home_circles_and_the_pilot_resumes_the_mission() {
     lands_on_the_runway(&o, true);
 }
 
+/// The return's altitude is a height above home, and home is the runway the aircraft took
+/// off from: on another sensor-noise seed the return must circle at the same height above
+/// the field.
+#[test]
+#[ignore = "home's altitude is the first GPS fix's (5.5 m vertical noise): on seed 7 home is 10.7 m above the runway and the return circles that much too high"]
+fn ground_link_return_circles_at_nav_rtl_alt_above_the_field_on_any_seed() {
+    let o = mission_flight(vec![step(40.0, Action::Silence)], |c| {
+        c.seed = 7;
+        c.duration_s = 150.0;
+    });
+    let rtl_alt = default_of("NAV_RTL_ALT");
+    let radius = default_of("NAV_LOIT_RAD");
+    let t_circle = o
+        .samples
+        .iter()
+        .find(|s| phase_is(s, Phase::ReturnLoiter))
+        .expect("circles home")
+        .t;
+    let lap_s = 2.0 * std::f64::consts::PI * radius / default_of("NAV_ASPD");
+    let on_circle: Vec<&Sample> = between(&o, t_circle + lap_s, f64::INFINITY).collect();
+    assert!(!on_circle.is_empty(), "a lap on the circle");
+    let mean = on_circle.iter().map(|s| s.alt).sum::<f64>() / on_circle.len() as f64;
+    assert!(
+        (mean - rtl_alt).abs() < 3.0,
+        "circling {mean:.1} m above the runway, NAV_RTL_ALT {rtl_alt} m"
+    );
+}
+
 #[test]
 fn gps_loss_flies_wings_level_then_circles_and_the_mission_resumes() {
     let (from_s, lost_s) = (45.0, 25.0);
@@ -335,6 +364,7 @@ fn gps_loss_flies_wings_level_then_circles_and_the_mission_resumes() {
         .filter(|s| s.t > 30.0 && s.t < from_s && phase_is(s, Phase::Waypoint))
         .map(|s| (s.sp_alt - s.alt).abs())
         .fold(0.0, f64::max);
+    eprintln!("the legs before the loss: altitude off by {leg_err:.1} m at most");
     assert!(
         alt_err < leg_err + 1.0,
         "altitude off by {alt_err:.1} m, the legs before by {leg_err:.1} m"
@@ -358,7 +388,19 @@ fn gps_loss_flies_wings_level_then_circles_and_the_mission_resumes() {
         "circling in AUTO (Hold phase) until GPS is back"
     );
     let bank_mean = hold.iter().map(|s| s.roll).sum::<f64>() / hold.len() as f64;
-    eprintln!("circling: mean roll {:.1} deg", bank_mean / DEG);
+    let va = default_of("NAV_ASPD");
+    let bank_calm = (va * va / (9.81 * default_of("NAV_LOIT_RAD"))).atan();
+    eprintln!(
+        "circling: mean roll {:.1} deg ({:.1} deg in calm air)",
+        bank_mean / DEG,
+        bank_calm / DEG
+    );
+    // Circling, not flying on: the NAV_LOIT_RAD circle's bank, more downwind, less upwind.
+    assert!(
+        bank_mean.abs() > bank_calm - 10.0 * DEG,
+        "mean roll {:.1} deg while circling",
+        bank_mean / DEG
+    );
     // The drift of the dead-reckoned position, just before the first fix is back.
     let last_dr = o.samples.iter().rfind(|s| s.t < to_s).expect("samples");
     let drift = (last_dr.est_north - last_dr.north).hypot(last_dr.est_east - last_dr.east);
