@@ -357,6 +357,13 @@ fn gps_loss_flies_wings_level_then_circles_and_the_mission_resumes() {
         at_loss.alt
     );
     assert!(roll_max < 5.0 * DEG, "roll {:.1} deg", roll_max / DEG);
+    let end_wl = wings_level.last().expect("wings-level samples");
+    eprintln!(
+        "wings level: heading {:.1} deg, then {:.1} deg after {:.1} s",
+        at_loss.yaw / DEG,
+        end_wl.yaw / DEG,
+        end_wl.t - at_loss.t
+    );
     // As well as the mission's legs held their altitude in the same air before the loss.
     let leg_err = o
         .samples
