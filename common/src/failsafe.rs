@@ -101,7 +101,7 @@ pub enum Reaction {
     /// Fly the chosen mode.
     #[default]
     None,
-    /// Wings level, hold the altitude and the course of the moment it began.
+    /// Wings level (roll held at zero) at the altitude of the moment it began.
     WingsLevel,
     /// Circle the current (dead-reckoned) position.
     Loiter,
@@ -142,7 +142,7 @@ impl Event {
             Event::GpsLost => "Failsafe: GPS lost, wings level on dead reckoning",
             Event::GpsLoiter => "Failsafe: GPS still lost, circling",
             Event::GpsRegained => "GPS regained, resuming",
-            Event::AirspeedFailed => "Failsafe: airspeed sensor failed, synthetic airspeed",
+            Event::AirspeedFailed => "Failsafe: airspeed sensor failed, synthetic speed",
             Event::AirspeedRegained => "Airspeed sensor regained",
             Event::FenceBreached => "Failsafe: geofence breached",
             Event::FenceCleared => "Back inside the geofence",
@@ -280,6 +280,25 @@ mod tests {
             gps_ok: true,
             airspeed_ok: true,
             fence_breached: false,
+        }
+    }
+
+    #[test]
+    fn every_text_fits_one_statustext() {
+        use Event::*;
+        for e in [
+            GcsLost,
+            GcsRegained,
+            GpsLost,
+            GpsLoiter,
+            GpsRegained,
+            AirspeedFailed,
+            AirspeedRegained,
+            FenceBreached,
+            FenceCleared,
+        ] {
+            // STATUSTEXT carries 50 characters.
+            assert!(e.text().len() <= 50, "{e:?}: {}", e.text());
         }
     }
 

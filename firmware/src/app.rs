@@ -171,8 +171,8 @@ pub struct App {
     fence: FenceParams,
     limits: MissionLimits,
     reaction: Reaction,
-    /// Course and altitude held while a GPS failsafe flies wings level.
-    wings_level: Option<(f32, f32)>,
+    /// Altitude (AMSL, m) held while a GPS failsafe flies wings level.
+    wings_level: Option<f32>,
 }
 
 /// Sticks older than this are ignored (the ground station stopped sending), us.
@@ -496,7 +496,7 @@ impl App {
             return;
         }
         let flown = self.flown_mode();
-        if let (Reaction::WingsLevel, Some((_, alt))) = (self.reaction, self.wings_level) {
+        if let (Reaction::WingsLevel, Some(alt)) = (self.reaction, self.wings_level) {
             let commands = Commands {
                 roll: RollMode::Roll(0.0),
                 yaw: RUDDER,
@@ -663,7 +663,7 @@ impl App {
             self.gcs.send_statustext(sev, ev.text());
         }
         if reaction == Reaction::WingsLevel && self.wings_level.is_none() {
-            self.wings_level = Some((e.course, e.alt_amsl_m));
+            self.wings_level = Some(e.alt_amsl_m);
         }
         if reaction != Reaction::WingsLevel {
             self.wings_level = None;
@@ -676,6 +676,21 @@ impl App {
         let r: VehicleRequests = self.gcs.take_requests();
         let e = self.estimator.state();
         if let Some(a) = r.arm {
+            if a.arm && !self.armed && !in_air(&e) {
+                // Home is where the aircraft is armed, as in PX4: the first fix set it from one
+                // GPS altitude (5 m of vertical noise); the estimate at arming has averaged
+                // GPS and barometer for as long as the estimator took to converge, and the
+                // landing aims at this height.
+                if let Some(h) = e.home {
+                    let here = common::estimator::Home {
+                        point: e.position,
+                        alt_amsl_m: e.alt_amsl_m,
+                    };
+                    if here != h {
+                        self.estimator.set_home(here);
+                    }
+                }
+            }
             if a.arm != self.armed {
                 self.armed = a.arm;
                 if !a.arm {

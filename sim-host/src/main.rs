@@ -6,7 +6,7 @@ use sim_host::aircraft::Aircraft;
 use sim_host::analysis::doublet::DoubletConfig;
 use sim_host::commands::{self, render, Format};
 use sim_host::report::to_json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -115,6 +115,16 @@ enum Command {
     /// Fly the firmware against the plant over the simulator link, commanded by a scripted
     /// ground station: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet.
     Fly(FlyArgs),
+    /// Fly the default mission (calm air, and a 5 m/s wind with light turbulence over five
+    /// seeds) and write the navigation results with ground-track plots.
+    Navigation {
+        /// Markdown file to write (notes below its `---` line are kept).
+        #[arg(long, default_value = "docs/NAVIGATION.md")]
+        out: PathBuf,
+        /// Directory for the ground-track PNGs.
+        #[arg(long, default_value = "docs/img")]
+        img: PathBuf,
+    },
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.
@@ -170,6 +180,14 @@ struct FlyArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
+    /// Fly a mission from the runway instead of the thesis's script: a QGroundControl `.plan`
+    /// or `QGC WPL 110` file (mission and geofence are uploaded), or `default` for the
+    /// built-in take-off, rectangle, orbit, return and landing.
+    #[arg(long, value_name = "FILE|default")]
+    mission: Option<PathBuf>,
+    /// Wall-clock pace with --realtime: simulated seconds per wall second.
+    #[arg(long, default_value_t = 1.0)]
+    speed: f64,
 }
 
 fn parse_wind(s: &str) -> Result<[f64; 3], String> {
@@ -322,6 +340,24 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Fly(args)) => fly_command(&aircraft, args),
+        Some(Command::Navigation { out, img }) => {
+            let existing = std::fs::read_to_string(&out).ok();
+            let command = format!(
+                "cargo run --release -p sim-host -- navigation --out {} --img {}",
+                out.display(),
+                img.display()
+            );
+            let md = commands::navigation::navigation_markdown(
+                &aircraft,
+                &command,
+                &img,
+                existing.as_deref(),
+            )?;
+            std::fs::write(&out, md)
+                .with_context(|| format!("cannot write `{}`", out.display()))?;
+            emit(&format!("wrote {}\n", out.display()))?;
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Validation { out, out_dir }) => {
             let md = commands::validation::validation_markdown(&aircraft, Some(&out_dir))?;
             if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -351,20 +387,46 @@ fn emit(text: &str) -> anyhow::Result<()> {
     }
 }
 
+/// The flight configuration of `--mission`: the built-in default mission or a mission file.
+fn mission_config(
+    aircraft: &Aircraft,
+    which: &Path,
+) -> anyhow::Result<sim_host::flight::FlightConfig> {
+    use sim_host::flight::missions::{default_mission, runway_mission};
+    let home = sim_host::plant::ModelParams::new(aircraft).home;
+    if which == Path::new("default") {
+        return Ok(runway_mission(default_mission(home)));
+    }
+    let file = sim_host::mission_file::read_mission_file(which)?;
+    anyhow::ensure!(
+        !file.mission.is_empty(),
+        "`{}`: the mission has no items",
+        which.display()
+    );
+    let mut cfg = runway_mission(file.mission);
+    cfg.script.fence = file.fence;
+    Ok(cfg)
+}
+
 fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
     use sim_host::flight::FlightConfig;
+    let base = match &a.mission {
+        Some(m) => mission_config(aircraft, m)?,
+        None => FlightConfig::default(),
+    };
     let mut cfg = FlightConfig {
         wind_ned: a.wind,
         turbulence: a.turbulence,
         seed: a.seed,
         realtime: a.realtime,
+        speed: a.speed,
         progress: true,
         dt_s: a.dt,
         // With --realtime, QGroundControl can watch: telemetry to 14550, as from PX4 SITL.
         ground_link: a
             .realtime
             .then(|| ("127.0.0.1:18570".into(), "127.0.0.1:14550".into())),
-        ..FlightConfig::default()
+        ..base
     };
     if let Some(d) = a.duration {
         cfg.duration_s = d;
@@ -446,14 +508,13 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
 fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
     let cfg = sim_host::flight::FlightConfig {
         progress: true,
-        ..Default::default()
+        ..mission_config(aircraft, Path::new("default"))?
     };
     let opts = commands::fly::FlyOptions {
         out: Some(PathBuf::from("out/fly")),
-        upload_gains: Some(sim_host::analysis::design::computed_gain_set(aircraft)?),
         ..Default::default()
     };
-    emit("Flying the firmware in-process: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet")?;
+    emit("Flying the firmware in-process, on its own estimates: upload the default mission, arm, take off from the runway, a 600 m x 400 m rectangle, two turns around a corner, approach and landing")?;
     let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
     emit(&render(
         &commands::fly::summary_tables(&r.outcome),

@@ -136,7 +136,7 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "NAV_LND_SLP_DEG",
-        6.0,
+        5.0,
         1.0,
         20.0,
         "deg",
@@ -152,7 +152,7 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "NAV_FLR_ALT",
-        4.0,
+        1.5,
         0.5,
         20.0,
         "m",
@@ -189,6 +189,22 @@ pub const PARAMS: &[ParamDef] = &[
         5.0,
         "m",
         "Touchdown: height above the land point under this for 1 s (or rolling slower than 5 m/s)",
+    ),
+    ParamDef::real(
+        "NAV_FLR_THR",
+        0.0,
+        0.0,
+        1.0,
+        "",
+        "Throttle at the start of the flare, faded to zero at touchdown height (keeps the energy a gusty flare needs)",
+    ),
+    ParamDef::real(
+        "NAV_APP_LEAD_S",
+        3.0,
+        0.0,
+        20.0,
+        "s",
+        "Approach: the glide slope's altitude is commanded this far ahead (ground speed x time), making up the altitude loop's lag on the descending ramp",
     ),
     ParamDef::real(
         "NAV_STEER_K",
@@ -257,6 +273,10 @@ pub struct NavParams {
     pub touchdown_alt: f32,
     /// Ground steering gain, rad of rudder per rad of course error.
     pub steer_k: f32,
+    /// Approach altitude lead, s.
+    pub approach_lead: f32,
+    /// Flare throttle at the flare height, 0..1.
+    pub flare_throttle: f32,
 }
 
 impl Default for NavParams {
@@ -280,6 +300,8 @@ impl Default for NavParams {
             flare_k: 0.0,
             touchdown_alt: 0.0,
             steer_k: 0.0,
+            approach_lead: 0.0,
+            flare_throttle: 0.0,
         };
         for d in PARAMS {
             // Defaults lie inside their bounds (checked by the tests).
@@ -332,6 +354,8 @@ impl NavParams {
             "NAV_FLR_K" => &mut self.flare_k,
             "NAV_LND_TD_M" => &mut self.touchdown_alt,
             "NAV_STEER_K" => &mut self.steer_k,
+            "NAV_APP_LEAD_S" => &mut self.approach_lead,
+            "NAV_FLR_THR" => &mut self.flare_throttle,
             _ => return None,
         })
     }
@@ -1282,7 +1306,15 @@ impl Navigator {
             Path::Orbit { .. } => 0.0,
         };
         let start_h = -l.origin.z;
-        g.altitude = (-l.point.z + libm::tanf(p.glide_slope) * to_go).min(start_h.max(-l.point.z));
+        // A P altitude loop follows a ramp with a steady lag (rate / velocity constant: some
+        // 6 m on a 6 deg slope at 14 m/s on the Ultra Stick), so the command leads the slope.
+        let lead = (p.approach_lead * state.ground_speed()).max(0.0);
+        let ahead = if lead.is_finite() {
+            (to_go - lead).max(0.0)
+        } else {
+            to_go
+        };
+        g.altitude = (-l.point.z + libm::tanf(p.glide_slope) * ahead).min(start_h.max(-l.point.z));
         out.guidance = Some(g);
         out.target = Some(l.point);
         if l.phase == LandPhase::Approach && hagl < p.flare_alt {
@@ -1314,7 +1346,7 @@ impl Navigator {
                 let aim = p.flare_sink + (approach_sink - p.flare_sink).max(0.0) * frac;
                 let sink = state.vel_ned.z;
                 let pitch = if sink.is_finite() {
-                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(-5.0 * DEG, 15.0 * DEG)
+                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(p.flare_pitch, 15.0 * DEG)
                 } else {
                     p.flare_pitch
                 };
@@ -1325,7 +1357,7 @@ impl Navigator {
                     yaw: self.steer(g.course, state),
                     lon: LonMode::Pitch {
                         pitch,
-                        throttle: 0.0,
+                        throttle: p.flare_throttle * frac,
                     },
                 });
             }

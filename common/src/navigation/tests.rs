@@ -760,8 +760,15 @@ fn a_finished_loiter_is_left_heading_for_the_next_point() {
 
 /// A navigator with the guidance matched to the kinematic aircraft's 1 s course lag.
 fn navigator() -> Navigator {
+    // The glide geometry is checked without the approach lead (the test's altitude lag is
+    // part of the expectation).
+    let mut p = NavParams::default();
+    p.set("NAV_APP_LEAD_S", 0.0).expect("in range");
+    // The glide geometry these tests were written for: 6 deg, flare from 4 m.
+    p.set("NAV_LND_SLP_DEG", 6.0).expect("in range");
+    p.set("NAV_FLR_ALT", 4.0).expect("in range");
     Navigator::new(
-        NavParams::default(),
+        p,
         Guidance::for_course_lag(1.0, 0.03),
         PathManager::default(),
     )

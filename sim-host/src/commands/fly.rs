@@ -2,7 +2,7 @@
 //! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
 
 use crate::aircraft::Aircraft;
-use crate::flight::record::write_log_and_plots;
+use crate::flight::record::{write_log_and_plots, MissionSummary};
 use crate::flight::{fly, spawn_firmware, FlightConfig, FlightOutcome, InprocOnboard, Onboard};
 use crate::link::lockstep::Lockstep;
 use crate::link::tlog::TlogWriter;
@@ -316,8 +316,62 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
             },
         ]);
     }
-    tables.push(seg);
+    if !s.segments.is_empty() {
+        tables.push(seg);
+    }
+    if let Some(m) = &s.mission {
+        tables.push(mission_table(m));
+    }
     tables
+}
+
+/// The figures of a mission flight.
+pub fn mission_table(m: &MissionSummary) -> Table {
+    let mut t = Table::new("Mission", &["quantity", "value"]);
+    let mut row = |q: &str, v: String| {
+        t.row([q.to_string(), v]);
+    };
+    row(
+        "items reached",
+        format!(
+            "{} of {} navigation items{}",
+            m.reached.len(),
+            m.nav_items.len(),
+            if m.all_reached { ", all" } else { "" }
+        ),
+    );
+    row(
+        "cross-track, straight legs (m)",
+        format!(
+            "{} RMS, {} max",
+            sig(m.xtrack_rms_m, 3),
+            sig(m.xtrack_max_m, 3)
+        ),
+    );
+    row(
+        "cross-track, on loiter circles (m)",
+        format!("{} RMS", sig(m.orbit_xtrack_rms_m, 3)),
+    );
+    row("altitude error (m)", format!("{} RMS", sig(m.alt_rms_m, 3)));
+    row(
+        "airspeed error (m/s)",
+        format!("{} RMS", sig(m.airspeed_rms_mps, 3)),
+    );
+    row("flight time (s)", format!("{:.1}", m.flight_time_s));
+    row("motor energy (Wh)", format!("{:.2}", m.energy_wh));
+    match &m.touchdown {
+        Some(td) => {
+            row(
+                "touchdown",
+                format!(
+                    "{:.1} m from the landing point ({:+.1} m along), sink {:.2} m/s, {:.1} m/s over ground, {} bounce(s)",
+                    td.distance_m, td.along_m, td.sink_rate_mps, td.ground_speed_mps, td.bounces
+                ),
+            );
+        }
+        None => row("touchdown", "none".into()),
+    }
+    t
 }
 
 /// Where the hand-written notes of a results file begin; `sim-host fly --report` keeps

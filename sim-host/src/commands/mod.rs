@@ -5,6 +5,7 @@ pub mod design;
 pub mod doublet;
 pub mod fly;
 pub mod linearize;
+pub mod navigation;
 pub mod scenario;
 pub mod trim;
 pub mod validation;

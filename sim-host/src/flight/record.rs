@@ -905,7 +905,8 @@ pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec
                     .dashed()
                 }],
             )],
-        ),
+        )
+        .map(),
     )?);
     Ok(files)
 }

@@ -298,14 +298,11 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         }
         gcs.poll(t_s, link, onboard);
         let answer = link.exchange(time_us, &msgs)?;
-        if cfg.stop_when_landed
+        let landed = cfg.stop_when_landed
             && armed_frames > 0
             && !answer.armed
             && plant.on_ground()
-            && plant.velocity_ned().norm() < 1.0
-        {
-            break;
-        }
+            && plant.velocity_ned().norm() < 1.0;
         let command = if answer.armed {
             armed_frames += 1;
             let pr = &params.prop;
@@ -339,6 +336,16 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             &answer.surfaces,
             &view.3,
         ));
+        if landed {
+            // The frame that disarmed is logged; the stations read what came with it.
+            gcs.poll(t_s, link, onboard);
+            if let Some(b) = bridge.as_mut() {
+                onboard.with_app(link, |app| {
+                    let _ = b.service(app);
+                });
+            }
+            break;
+        }
 
         for _ in 0..substeps {
             let seen = servos.step(&command, dt);

@@ -81,6 +81,8 @@ pub struct Figure {
     pub width: u32,
     /// Height of one panel in pixels.
     pub panel_height: u32,
+    /// One metre is as long on both axes (a map).
+    pub equal_aspect: bool,
 }
 
 impl Figure {
@@ -92,7 +94,16 @@ impl Figure {
             panels,
             width: 1000,
             panel_height: 220,
+            equal_aspect: false,
         }
+    }
+
+    /// A map: square, one unit as long on both axes (ground tracks).
+    pub fn map(mut self) -> Self {
+        self.equal_aspect = true;
+        self.width = 900;
+        self.panel_height = 860;
+        self
     }
 
     /// Renders the figure to a PNG file.
@@ -108,8 +119,17 @@ impl Figure {
         let areas = root.split_evenly((n, 1));
         let palette = [BLUE, RED, RGBColor(0, 140, 0), MAGENTA, CYAN, BLACK];
         for (pi, (panel, area)) in self.panels.iter().zip(areas.iter()).enumerate() {
-            let (x0, x1) = range(panel.series.iter().flat_map(|s| s.x.iter().copied()));
-            let (y0, y1) = range(panel.series.iter().flat_map(|s| s.y.iter().copied()));
+            let (mut x0, mut x1) = range(panel.series.iter().flat_map(|s| s.x.iter().copied()));
+            let (mut y0, mut y1) = range(panel.series.iter().flat_map(|s| s.y.iter().copied()));
+            if self.equal_aspect {
+                // The plotting area, less the label areas and margins.
+                let w = f64::from(self.width.saturating_sub(96).max(1));
+                let h = f64::from(self.panel_height.saturating_sub(56).max(1));
+                let scale = ((x1 - x0) / w).max((y1 - y0) / h);
+                let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+                (x0, x1) = (cx - 0.5 * scale * w, cx + 0.5 * scale * w);
+                (y0, y1) = (cy - 0.5 * scale * h, cy + 0.5 * scale * h);
+            }
             let mut chart = ChartBuilder::on(area)
                 .margin(8)
                 .x_label_area_size(if pi + 1 == n { 40 } else { 22 })

@@ -1,0 +1,189 @@
+//! `sim-host navigation`: the default mission flown from the runway to the runway, in calm air
+//! and in a 5 m/s wind with light turbulence over several seeds, on the autopilot's own
+//! estimates; tables of the mission figures and ground-track plots for `docs/NAVIGATION.md`.
+
+use super::fly::{fly_report, mission_table, FlyOptions, NOTES_MARKER};
+use crate::aircraft::Aircraft;
+use crate::environment::wind::Turbulence;
+use crate::flight::missions::{default_mission, runway_mission};
+use crate::flight::record::{MissionSummary, Sample};
+use crate::flight::FlightOutcome;
+use crate::plant::ModelParams;
+use crate::report::{sig, Figure, Panel, Series};
+use anyhow::Context;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The windy case: 5 m/s towards (-3, -4), from the north-north-east: a headwind and a
+/// crosswind on the northbound landing, as a pilot would pick the runway direction.
+pub const WIND_NED: [f64; 3] = [-3.0, -4.0, 0.0];
+/// Seeds of the windy flights (turbulence and sensor noise).
+pub const SEEDS: [u64; 5] = [7, 1, 2, 3, 4];
+
+/// Targets of the windy flights on estimates, and of the calm one.
+pub const TARGETS: &str = "cross-track RMS on straight legs under 2 m (0.5 m in calm air), \
+altitude error RMS under 1.5 m, airspeed error RMS under 1 m/s, every waypoint reached, \
+touchdown within 20 m of the landing point at under 1.5 m/s of sink";
+
+/// Flies the default mission once.
+pub fn fly_default(
+    aircraft: &Aircraft,
+    wind_ned: [f64; 3],
+    turbulence: Turbulence,
+    seed: u64,
+) -> anyhow::Result<FlightOutcome> {
+    let cfg = crate::flight::FlightConfig {
+        wind_ned,
+        turbulence,
+        seed,
+        ..runway_mission(default_mission(ModelParams::new(aircraft).home))
+    };
+    Ok(fly_report(aircraft, &cfg, &FlyOptions::default())?.outcome)
+}
+
+/// Whether a flight meets the targets (`calm`: the calm-air cross-track target).
+pub fn meets_targets(m: &MissionSummary, calm: bool) -> bool {
+    let xt = if calm { 0.5 } else { 2.0 };
+    m.all_reached
+        && m.xtrack_rms_m < xt
+        && m.alt_rms_m < 1.5
+        && m.airspeed_rms_mps < 1.0
+        && m.touchdown
+            .is_some_and(|t| t.distance_m < 20.0 && t.sink_rate_mps < 1.5)
+}
+
+fn ground_track(samples: &[Sample], title: &str, path: &Path) -> anyhow::Result<()> {
+    let p: Vec<&Sample> = samples.iter().step_by(10).collect();
+    let truth = Series::new(
+        "truth",
+        p.iter().map(|s| s.east).collect(),
+        p.iter().map(|s| s.north).collect(),
+    );
+    let valid: Vec<&&Sample> = p.iter().filter(|s| s.est_north.is_finite()).collect();
+    let est = Series::new(
+        "estimate",
+        valid.iter().map(|s| s.est_east).collect(),
+        valid.iter().map(|s| s.est_north).collect(),
+    )
+    .dashed();
+    Figure::new(
+        title,
+        "east (m)",
+        vec![Panel::new("north (m)", vec![truth, est])],
+    )
+    .map()
+    .save_png(path)
+}
+
+/// Flies the cases and writes the document's generated part; the notes below
+/// [`NOTES_MARKER`] in an existing `out` file are kept. Plots go to `img_dir`.
+pub fn navigation_markdown(
+    aircraft: &Aircraft,
+    command: &str,
+    img_dir: &Path,
+    existing: Option<&str>,
+) -> anyhow::Result<String> {
+    std::fs::create_dir_all(img_dir)
+        .with_context(|| format!("cannot create `{}`", img_dir.display()))?;
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Navigation: the default mission from the runway to the runway\n\n\
+         Produced by `{command}`. Each flight is the firmware's `App` in-process, lock-step, on \
+         its own estimator: the scripted ground station uploads the default mission \
+         (`sim_host::flight::missions::default_mission`) with the mission protocol, arms once the \
+         estimator has converged on the runway, and sends MAV_CMD_MISSION_START; the flight \
+         ends when the autopilot has landed, stopped and disarmed. The mission: take-off \
+         heading north to 60 m, a 600 m x 400 m rectangle flown clockwise, two turns of 80 m \
+         radius around its north-west corner, a descent to 40 m on the way back, a base leg \
+         450 m south of the runway and a final approach northbound, landing at home. Gains: \
+         the firmware's defaults (the thesis's designed set).\n\n\
+         Errors are those of the true aircraft (the simulator's truth) against what guidance \
+         asked for; cross-track on straight legs excludes the fillets (the rounded corners), \
+         on circles it counts from arrival on the circle. Targets: {TARGETS}.\n"
+    );
+    let calm = fly_default(aircraft, [0.0; 3], Turbulence::None, 1)?;
+    let calm_m = calm
+        .summary
+        .mission
+        .clone()
+        .context("the calm flight flew no mission")?;
+    let calm_png = img_dir.join("mission-calm.png");
+    ground_track(&calm.samples, "Default mission, calm air", &calm_png)?;
+    let _ = writeln!(
+        md,
+        "## Calm air (seed 1)\n\n{}\n![ground track, calm air]({})\n",
+        mission_table(&calm_m).render_markdown(),
+        rel(&calm_png)
+    );
+    let _ = writeln!(
+        md,
+        "Meets the calm-air targets: {}.\n",
+        if meets_targets(&calm_m, true) {
+            "yes"
+        } else {
+            "**no**"
+        }
+    );
+    let _ = writeln!(
+        md,
+        "## 5 m/s wind from the north-north-east, light Dryden turbulence\n\n\
+         Wind (NED, towards) ({}, {}, {}) m/s. One flight per seed; the first one's ground track \
+         is plotted.\n\n\
+         | seed | waypoints | cross-track RMS (max) m | loiter cross-track RMS m | altitude RMS m | airspeed RMS m/s | touchdown from the point m | sink m/s | flight s | energy Wh | meets targets |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|",
+        WIND_NED[0], WIND_NED[1], WIND_NED[2]
+    );
+    for (i, seed) in SEEDS.iter().enumerate() {
+        let o = fly_default(aircraft, WIND_NED, Turbulence::Light, *seed)?;
+        let m = o.summary.mission.clone().context("no mission flown")?;
+        if i == 0 {
+            let png = img_dir.join("mission-wind.png");
+            ground_track(
+                &o.samples,
+                "Default mission, 5 m/s wind, light turbulence",
+                &png,
+            )?;
+        }
+        let (d, sink) = m.touchdown.map_or(("none".into(), "-".into()), |t| {
+            (
+                format!("{:.1}", t.distance_m),
+                format!("{:.2}", t.sink_rate_mps),
+            )
+        });
+        let _ = writeln!(
+            md,
+            "| {seed} | {}/{} | {} ({}) | {} | {} | {} | {d} | {sink} | {:.0} | {:.2} | {} |",
+            m.reached.len(),
+            m.nav_items.len(),
+            sig(m.xtrack_rms_m, 3),
+            sig(m.xtrack_max_m, 3),
+            sig(m.orbit_xtrack_rms_m, 3),
+            sig(m.alt_rms_m, 3),
+            sig(m.airspeed_rms_mps, 3),
+            m.flight_time_s,
+            m.energy_wh,
+            if meets_targets(&m, false) {
+                "yes"
+            } else {
+                "**no**"
+            }
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\n![ground track, 5 m/s wind and light turbulence]({})\n",
+        rel(&img_dir.join("mission-wind.png"))
+    );
+    let notes = existing
+        .and_then(|e| e.find(NOTES_MARKER).map(|i| &e[i..]))
+        .unwrap_or("\n---\n\n*Everything above the line is written by the command named at the top; notes below it are kept.*\n");
+    md.push_str(notes.trim_start_matches('\n'));
+    Ok(md)
+}
+
+/// A plot's path as the document links it (relative to `docs/`).
+fn rel(p: &Path) -> String {
+    let s = p.to_string_lossy().replace('\\', "/");
+    s.strip_prefix("docs/").map_or(s.clone(), str::to_string)
+}
