@@ -112,6 +112,8 @@ pub struct SimLinkHealth {
     pub rejected_gps: u32,
     /// Sensor frames whose time did not advance.
     pub stale_frames: u32,
+    /// RC_CHANNELS frames without a usable signal.
+    pub rejected_rc: u32,
     /// Bytes to the ground station dropped because its buffer was full.
     pub gcs_bytes_dropped: u32,
 }
@@ -416,6 +418,16 @@ impl App {
                         m,
                         time_us: d.time_usec,
                     });
+                }
+            }
+            MavMessage::RC_CHANNELS(d) => {
+                // The radio: the sticks of the manual and stabilised modes, like a ground
+                // station's MANUAL_CONTROL; a frame without signal is ignored and the sticks
+                // time out.
+                let t = self.last_time_us.unwrap_or(0);
+                match simlink::decode_rc_channels(d, t) {
+                    Some(m) => self.sticks = Some(m),
+                    None => self.health.rejected_rc += 1,
                 }
             }
             MavMessage::HEARTBEAT(_) => {}

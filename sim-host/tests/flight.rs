@@ -572,3 +572,56 @@ fn the_inproc_onboard_reaches_the_flying_application() {
     assert_eq!(app.armed(), o.samples.last().expect("sample").armed);
     assert_eq!(app.sim_health().sensor_frames as u64, o.summary.frames);
 }
+
+/// The simulator's radio flies Stabilized: RC_CHANNELS on the simulator link (PX4's channel
+/// order, 1000-2000 us) are the sticks, and half right roll stick holds half the roll limit
+/// (`LIM_ROLL_DEG` 45 deg: 22.5 deg) in the true aircraft, centred sticks wings level.
+#[test]
+fn the_radio_flies_stabilized_through_rc_channels() {
+    use sim_host::flight::RcSticks;
+    let sticks = |from_s, roll| RcSticks {
+        from_s,
+        roll,
+        pitch: 0.0,
+        throttle: 0.6,
+        yaw: 0.0,
+    };
+    let cfg = FlightConfig {
+        duration_s: 40.0,
+        script: Script {
+            steps: vec![ScriptStep {
+                after_arm_s: 0.0,
+                action: Action::Mode(7),
+            }],
+            ..Script::thesis()
+        },
+        rc_sticks: vec![sticks(0.0, 0.0), sticks(25.0, 0.5)],
+        ..FlightConfig::default()
+    };
+    let o = fly_report(&aircraft(), &cfg, &FlyOptions::default())
+        .expect("flight")
+        .outcome;
+    accepted(&o);
+    let mean_roll_deg = |from: f64, to: f64| {
+        let v: Vec<f64> = o
+            .samples
+            .iter()
+            .filter(|s| s.t >= from && s.t < to)
+            .map(|s| s.roll.to_degrees())
+            .collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let level = mean_roll_deg(18.0, 24.0);
+    let banked = mean_roll_deg(32.0, 40.0);
+    eprintln!("roll: sticks centred {level:.2} deg, half right {banked:.2} deg");
+    assert!(level.abs() < 1.0, "wings level {level:.2} deg");
+    assert!((banked - 22.5).abs() < 1.5, "half stick {banked:.2} deg");
+    let armed_at = o.summary.armed_at_s.expect("armed");
+    assert!(
+        o.samples
+            .iter()
+            .filter(|s| s.t > armed_at + 1.0)
+            .all(|s| s.mode == 7),
+        "Stabilized throughout"
+    );
+}

@@ -13,11 +13,12 @@
 //! finite or not physically plausible is dropped and counted, never passed on.
 
 use crate::actuators::Surfaces;
+use crate::gcs::ManualInput;
 use crate::math::geodetic::GeoPoint;
 use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use mavlink::dialects::common::{
     HilActuatorControlsFlags, HilSensorUpdatedFlags, MavModeFlag, HIL_ACTUATOR_CONTROLS_DATA,
-    HIL_GPS_DATA, HIL_SENSOR_DATA,
+    HIL_GPS_DATA, HIL_SENSOR_DATA, RC_CHANNELS_DATA,
 };
 use nalgebra::Vector3;
 
@@ -230,6 +231,57 @@ pub fn encode_hil_gps(time_us: u64, fix: &GpsFix) -> HIL_GPS_DATA {
     }
 }
 
+/// Pulse widths a radio channel may take, us: outside them the receiver sends no signal or its
+/// failsafe values.
+pub const RC_PWM_RANGE_US: (u16, u16) = (800, 2200);
+
+fn pwm_to_unit(pwm: u16, centre: f32) -> f32 {
+    ((f32::from(pwm) - centre) / 500.0).clamp(-1.0, 1.0)
+}
+
+/// The sticks from `RC_CHANNELS` (the simulator's radio, or a receiver), PX4's default channel
+/// order: 1 roll (2000 us full right), 2 pitch (2000 us full back, nose up), 3 throttle
+/// (1000 us idle, 2000 us full), 4 yaw (2000 us full right); 1500 us centre. `None` with fewer
+/// than four channels, a pulse outside [`RC_PWM_RANGE_US`] (0 and UINT16_MAX mark a channel not
+/// sent), or an RSSI of 0 (no signal; 255 means unknown and is accepted).
+pub fn decode_rc_channels(d: &RC_CHANNELS_DATA, time_us: u64) -> Option<ManualInput> {
+    let ch = [d.chan1_raw, d.chan2_raw, d.chan3_raw, d.chan4_raw];
+    let ok = d.chancount >= 4
+        && d.rssi != 0
+        && ch
+            .iter()
+            .all(|c| (RC_PWM_RANGE_US.0..=RC_PWM_RANGE_US.1).contains(c));
+    ok.then(|| ManualInput {
+        roll: pwm_to_unit(ch[0], 1500.0),
+        pitch: pwm_to_unit(ch[1], 1500.0),
+        throttle: ((f32::from(ch[2]) - 1000.0) / 1000.0).clamp(0.0, 1.0),
+        yaw: pwm_to_unit(ch[3], 1500.0),
+        time_us,
+    })
+}
+
+/// `RC_CHANNELS` for stick positions (simulator side): roll, pitch, yaw in -1..1 (right, back,
+/// right positive), throttle 0..1; the inverse of [`decode_rc_channels`].
+pub fn encode_rc_channels(
+    time_us: u64,
+    roll: f32,
+    pitch: f32,
+    throttle: f32,
+    yaw: f32,
+) -> RC_CHANNELS_DATA {
+    let pwm = |v: f32, centre: f32| (centre + 500.0 * v).round().clamp(1000.0, 2000.0) as u16;
+    RC_CHANNELS_DATA {
+        time_boot_ms: (time_us / 1000) as u32,
+        chan1_raw: pwm(roll.clamp(-1.0, 1.0), 1500.0),
+        chan2_raw: pwm(pitch.clamp(-1.0, 1.0), 1500.0),
+        chan3_raw: pwm(2.0 * throttle.clamp(0.0, 1.0), 1000.0),
+        chan4_raw: pwm(yaw.clamp(-1.0, 1.0), 1500.0),
+        chancount: 4,
+        rssi: 255,
+        ..RC_CHANNELS_DATA::DEFAULT
+    }
+}
+
 /// Decodes a `HIL_GPS` frame (autopilot side); `None` for an implausible fix.
 pub fn decode_hil_gps(d: &HIL_GPS_DATA) -> Option<GpsFix> {
     let position = GeoPoint {
@@ -409,5 +461,34 @@ mod tests {
         let mut disarmed = d;
         disarmed.mode = MavModeFlag::empty();
         assert_eq!(decode_actuators(&disarmed).surfaces.throttle, 0.0);
+    }
+}
+
+#[cfg(test)]
+mod rc_tests {
+    use super::*;
+
+    #[test]
+    fn rc_channels_round_trip_and_refuse_a_lost_signal() {
+        let d = encode_rc_channels(2_000_000, 0.5, -0.25, 0.75, -1.0);
+        // PX4's default order and pulse widths.
+        assert_eq!(
+            [d.chan1_raw, d.chan2_raw, d.chan3_raw, d.chan4_raw],
+            [1750, 1375, 1750, 1000]
+        );
+        let m = decode_rc_channels(&d, 7).expect("valid");
+        assert_eq!(
+            (m.roll, m.pitch, m.throttle, m.yaw, m.time_us),
+            (0.5, -0.25, 0.75, -1.0, 7)
+        );
+        let mut lost = d.clone();
+        lost.rssi = 0;
+        assert_eq!(decode_rc_channels(&lost, 7), None);
+        let mut unsent = d.clone();
+        unsent.chan3_raw = u16::MAX;
+        assert_eq!(decode_rc_channels(&unsent, 7), None);
+        let mut few = d.clone();
+        few.chancount = 3;
+        assert_eq!(decode_rc_channels(&few, 7), None);
     }
 }

@@ -981,7 +981,8 @@ pub fn results_markdown(report: &ScenarioReport, command: &str, aircraft: &Aircr
          hand.\n\nThese scenarios fly the control laws on the plant's exact state. The same laws flown \
          by the firmware over MAVLink on its own estimator (estimator accuracy in light \
          turbulence, and chapter 4's figures on the estimate against the truth) are in \
-         [RESULTS-SITL.md](RESULTS-SITL.md).\n\n"
+         [RESULTS-SITL.md](RESULTS-SITL.md); missions from the runway to the runway, with \
+         ground tracks, in [NAVIGATION.md](NAVIGATION.md).\n\n"
     ));
     s.push_str(include_str!("scenario_setup.md"));
     s.push_str("\n## Scenarios\n\n| scenario | loop | command | length (s) |\n|---|---|---|---|\n");

@@ -30,7 +30,7 @@ pub mod script;
 
 pub use onboard::{spawn_firmware, InprocOnboard, Onboard, ThreadOnboard};
 pub use record::{FlightSummary, Sample};
-pub use runner::{fly, Fault, FaultWindow, FlightConfig, FlightError, FlightOutcome};
+pub use runner::{fly, Fault, FaultWindow, FlightConfig, FlightError, FlightOutcome, RcSticks};
 pub use script::{Action, Script, ScriptStep};
 
 use crate::environment::wind::Turbulence;

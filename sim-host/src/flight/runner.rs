@@ -11,7 +11,7 @@ use crate::link::transport::Transport;
 use crate::plant::propulsion::polyval;
 use crate::plant::{Controls, Environment, ModelParams, Plant, ServoBank};
 use crate::sensors::{SensorFaults, SensorSuite, Truth};
-use common::link::simlink::{encode_hil_gps, encode_hil_sensor};
+use common::link::simlink::{encode_hil_gps, encode_hil_sensor, encode_rc_channels};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
 use common::math::{course_and_speed, ned_to_body, Euler};
@@ -54,6 +54,24 @@ pub struct FlightConfig {
     pub runway_heading: Option<f64>,
     /// Sensor faults injected over windows of simulated time.
     pub faults: Vec<FaultWindow>,
+    /// The pilot's radio: stick positions from a time on, sent as RC_CHANNELS at 50 Hz on
+    /// the simulator link (none: no radio).
+    pub rc_sticks: Vec<RcSticks>,
+}
+
+/// Stick positions held from a time on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RcSticks {
+    /// From, s of simulated time.
+    pub from_s: f64,
+    /// Roll stick, -1..1, right positive.
+    pub roll: f32,
+    /// Pitch stick, -1..1, back (nose up) positive.
+    pub pitch: f32,
+    /// Throttle, 0..1.
+    pub throttle: f32,
+    /// Yaw stick, -1..1, right positive.
+    pub yaw: f32,
 }
 
 /// A sensor fault over a window of simulated time.
@@ -119,6 +137,7 @@ impl Default for FlightConfig {
             ground_link: None,
             runway_heading: None,
             faults: Vec::new(),
+            rc_sticks: Vec::new(),
         }
     }
 }
@@ -279,6 +298,13 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         let mut msgs = Vec::with_capacity(3);
         if let Some(f) = fix {
             msgs.push(MavMessage::HIL_GPS(encode_hil_gps(time_us, &f)));
+        }
+        if k % 2 == 0 {
+            if let Some(r) = cfg.rc_sticks.iter().rev().find(|r| r.from_s <= t_s) {
+                msgs.push(MavMessage::RC_CHANNELS(encode_rc_channels(
+                    time_us, r.roll, r.pitch, r.throttle, r.yaw,
+                )));
+            }
         }
         msgs.push(MavMessage::HIL_STATE_QUATERNION(truth_frame(
             time_us, &truth, &plant, alt_amsl,
