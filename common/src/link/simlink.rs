@@ -269,7 +269,7 @@ pub fn encode_rc_channels(
     throttle: f32,
     yaw: f32,
 ) -> RC_CHANNELS_DATA {
-    let pwm = |v: f32, centre: f32| (centre + 500.0 * v).round().clamp(1000.0, 2000.0) as u16;
+    let pwm = |v: f32, centre: f32| libm::roundf(centre + 500.0 * v).clamp(1000.0, 2000.0) as u16;
     RC_CHANNELS_DATA {
         time_boot_ms: (time_us / 1000) as u32,
         chan1_raw: pwm(roll.clamp(-1.0, 1.0), 1500.0),
