@@ -144,7 +144,7 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "NAV_LND_ASPD",
-        14.0,
+        15.0,
         8.0,
         30.0,
         "m/s",
@@ -1350,11 +1350,17 @@ impl Navigator {
                 } else {
                     p.flare_pitch
                 };
-                // The rudder steers from the flare on: in the air it lines the nose up with
-                // the runway, on the wheels it holds the roll-out on the line.
+                // The rudder steers the tail wheel once the wheels are about to touch; in the
+                // air it stays the yaw damper, so the aircraft keeps its crab in a crosswind
+                // (lining the nose up with the runway there would let it drift downwind).
+                let yaw = if hagl < p.touchdown_alt {
+                    self.steer(g.course, state)
+                } else {
+                    RUDDER
+                };
                 out.commands = Some(Commands {
                     roll: RollMode::Course(g.course),
-                    yaw: self.steer(g.course, state),
+                    yaw,
                     lon: LonMode::Pitch {
                         pitch,
                         throttle: p.flare_throttle * frac,
