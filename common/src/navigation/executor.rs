@@ -176,7 +176,7 @@ pub const PARAMS: &[ParamDef] = &[
     ),
     ParamDef::real(
         "NAV_FLR_K",
-        0.05,
+        0.15,
         0.0,
         1.0,
         "rad s/m",
