@@ -9,15 +9,14 @@ use common::navigation::Phase;
 use sim_host::aircraft::Aircraft;
 use sim_host::commands::fly::{fly_report, FlyOptions};
 use sim_host::environment::wind::Turbulence;
-use sim_host::flight::missions::{default_mission, runway_mission};
+use sim_host::flight::missions::{default_mission, fence_inclusion_polygon, runway_mission};
 use sim_host::flight::script::{PX4_ALTCTL, PX4_AUTO};
 use sim_host::flight::{
     Action, Fault, FaultWindow, FlightConfig, FlightOutcome, Sample, ScriptStep,
 };
 use sim_host::plant::ModelParams;
 
-/// Characters of one STATUSTEXT (`text`, char[50], in the MAVLink common dialect).
-const STATUSTEXT_LEN: usize = 50;
+use common::gcs::STATUSTEXT_LEN;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
@@ -539,7 +538,7 @@ fn geofence_breach_returns_home_within_a_turn_radius_of_the_fence() {
         (north[1], east[1]),
         (north[0], east[1]),
     ];
-    let fence = fence_polygon(home, &corners);
+    let fence = fence_inclusion_polygon(home, &corners);
     let mut cfg = runway_mission(default_mission(home));
     cfg.script.fence = fence;
     cfg.duration_s = 170.0;
@@ -634,31 +633,4 @@ fn geofence_breach_returns_home_within_a_turn_radius_of_the_fence() {
         on_circle.iter().all(|s| (s.alt - rtl_alt).abs() < 3.0),
         "at NAV_RTL_ALT {rtl_alt} m"
     );
-}
-
-/// An inclusion polygon through `corners` (north, east of home, m), one fence item per vertex.
-fn fence_polygon(
-    home: common::math::geodetic::GeoPoint,
-    corners: &[(f64, f64)],
-) -> Vec<mavlink::dialects::common::MISSION_ITEM_INT_DATA> {
-    use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
-    corners
-        .iter()
-        .enumerate()
-        .map(|(i, &(n, e))| {
-            let p = common::math::geodetic::offset_point(home, n, e);
-            MISSION_ITEM_INT_DATA {
-                param1: corners.len() as f32,
-                x: p.lat_e7,
-                y: p.lon_e7,
-                seq: i as u16,
-                command: MavCmd::MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION,
-                target_system: 1,
-                target_component: 1,
-                frame: MavFrame::MAV_FRAME_GLOBAL,
-                mission_type: MavMissionType::MAV_MISSION_TYPE_FENCE,
-                ..Default::default()
-            }
-        })
-        .collect()
 }

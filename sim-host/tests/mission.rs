@@ -4,30 +4,16 @@
 //! runway to the runway.
 
 use sim_host::aircraft::Aircraft;
-use sim_host::commands::fly::{fly_report, FlyOptions};
 use sim_host::commands::navigation;
 use sim_host::environment::wind::Turbulence;
-use sim_host::flight::missions::{default_mission, runway_mission};
 use sim_host::flight::record::MissionSummary;
 use sim_host::flight::FlightOutcome;
-use sim_host::plant::ModelParams;
 
-fn aircraft() -> Aircraft {
-    Aircraft::ultrastick25e().expect("built-in aircraft")
-}
-
+/// The default mission from the runway, with the firmware's parameters and the ground
+/// station's mission tuning, as `sim-host navigation` flies it.
 fn fly_default(wind_ned: [f64; 3], turbulence: Turbulence, seed: u64) -> FlightOutcome {
-    let a = aircraft();
-    let cfg = sim_host::flight::FlightConfig {
-        wind_ned,
-        turbulence,
-        seed,
-        ..runway_mission(default_mission(ModelParams::new(&a).home))
-    };
-    // The firmware's own parameters, as a user gets it.
-    fly_report(&a, &cfg, &FlyOptions::default())
-        .expect("flight")
-        .outcome
+    let a = Aircraft::ultrastick25e().expect("built-in aircraft");
+    navigation::fly_default(&a, wind_ned, turbulence, seed).expect("flight")
 }
 
 /// What every landing of the default mission must show: every navigation item reached in

@@ -6,10 +6,10 @@ use super::fly::{fly_report, mission_table, FlyOptions, NOTES_MARKER};
 use crate::aircraft::Aircraft;
 use crate::environment::wind::Turbulence;
 use crate::flight::missions::{default_mission, runway_mission};
-use crate::flight::record::{MissionSummary, Sample};
+use crate::flight::record::{ground_track_figure, MissionSummary, Sample};
 use crate::flight::FlightOutcome;
 use crate::plant::ModelParams;
-use crate::report::{sig, Figure, Panel, Series};
+use crate::report::sig;
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -53,26 +53,7 @@ pub fn meets_targets(m: &MissionSummary, calm: bool) -> bool {
 }
 
 fn ground_track(samples: &[Sample], title: &str, path: &Path) -> anyhow::Result<()> {
-    let p: Vec<&Sample> = samples.iter().step_by(10).collect();
-    let truth = Series::new(
-        "truth",
-        p.iter().map(|s| s.east).collect(),
-        p.iter().map(|s| s.north).collect(),
-    );
-    let valid: Vec<&&Sample> = p.iter().filter(|s| s.est_north.is_finite()).collect();
-    let est = Series::new(
-        "estimate",
-        valid.iter().map(|s| s.est_east).collect(),
-        valid.iter().map(|s| s.est_north).collect(),
-    )
-    .dashed();
-    Figure::new(
-        title,
-        "east (m)",
-        vec![Panel::new("north (m)", vec![truth, est])],
-    )
-    .map()
-    .save_png(path)
+    ground_track_figure(samples, title).save_png(path)
 }
 
 /// Flies the cases and writes the document's generated part; the notes below

@@ -32,35 +32,15 @@ impl MissionBuilder {
 
     /// Appends an item at `at` (or frame-less when `None`) with `params` 1-4.
     pub fn item(mut self, cmd: MavCmd, params: [f32; 4], at: Option<Spot>) -> Self {
-        let (frame, x, y, z) = match at {
-            Some(s) => {
-                let p = offset_point(self.home, s.north_m, s.east_m);
-                (
-                    MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
-                    p.lat_e7,
-                    p.lon_e7,
-                    s.height_m as f32,
-                )
-            }
-            None => (MavFrame::MAV_FRAME_MISSION, 0, 0, 0.0),
-        };
-        self.items.push(MISSION_ITEM_INT_DATA {
-            param1: params[0],
-            param2: params[1],
-            param3: params[2],
-            param4: params[3],
-            x,
-            y,
-            z,
-            seq: self.items.len() as u16,
-            command: cmd,
-            target_system: 1,
-            target_component: 1,
-            frame,
-            current: 0,
-            autocontinue: 1,
-            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
-        });
+        let seq = self.items.len() as u16;
+        self.items.push(global_item(
+            self.home,
+            seq,
+            cmd,
+            params,
+            at,
+            MavMissionType::MAV_MISSION_TYPE_MISSION,
+        ));
         self
     }
 
@@ -81,6 +61,72 @@ impl MissionBuilder {
     pub fn build(self) -> Vec<MISSION_ITEM_INT_DATA> {
         self.items
     }
+}
+
+/// One item of any list: at `at` (global frame, altitude relative to home), or frame-less.
+fn global_item(
+    home: GeoPoint,
+    seq: u16,
+    cmd: MavCmd,
+    params: [f32; 4],
+    at: Option<Spot>,
+    kind: MavMissionType,
+) -> MISSION_ITEM_INT_DATA {
+    let (frame, x, y, z) = match at {
+        Some(s) => {
+            let p = offset_point(home, s.north_m, s.east_m);
+            (
+                MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                p.lat_e7,
+                p.lon_e7,
+                s.height_m as f32,
+            )
+        }
+        None => (MavFrame::MAV_FRAME_MISSION, 0, 0, 0.0),
+    };
+    MISSION_ITEM_INT_DATA {
+        param1: params[0],
+        param2: params[1],
+        param3: params[2],
+        param4: params[3],
+        x,
+        y,
+        z,
+        seq,
+        command: cmd,
+        target_system: 1,
+        target_component: 1,
+        frame,
+        current: 0,
+        autocontinue: 1,
+        mission_type: kind,
+    }
+}
+
+/// A geofence inclusion polygon through `corners` (north, east of home, m): one
+/// `NAV_FENCE_POLYGON_VERTEX_INCLUSION` item per vertex, `param1` the vertex count.
+pub fn fence_inclusion_polygon(
+    home: GeoPoint,
+    corners: &[(f64, f64)],
+) -> Vec<MISSION_ITEM_INT_DATA> {
+    corners
+        .iter()
+        .enumerate()
+        .map(|(i, &(north_m, east_m))| {
+            global_item(
+                home,
+                i as u16,
+                MavCmd::MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION,
+                [corners.len() as f32, 0.0, 0.0, 0.0],
+                Some(Spot {
+                    north_m,
+                    east_m,
+                    height_m: 0.0,
+                }),
+                MavMissionType::MAV_MISSION_TYPE_FENCE,
+            )
+        })
+        .collect()
 }
 
 /// The default mission, flown by `cargo run --release -p sim-host`: take off from the runway

@@ -685,6 +685,29 @@ pub(crate) fn summarise(
     }
 }
 
+/// The ground track, truth and estimate, as a map (one metre as long on both axes), at 10 Hz.
+pub fn ground_track_figure(samples: &[Sample], title: &str) -> Figure {
+    let p: Vec<&Sample> = samples.iter().step_by(10).collect();
+    let truth = Series::new(
+        "truth",
+        p.iter().map(|s| s.east).collect(),
+        p.iter().map(|s| s.north).collect(),
+    );
+    let valid: Vec<&&Sample> = p.iter().filter(|s| s.est_north.is_finite()).collect();
+    let est = Series::new(
+        "estimate",
+        valid.iter().map(|s| s.est_east).collect(),
+        valid.iter().map(|s| s.est_north).collect(),
+    )
+    .dashed();
+    Figure::new(
+        title,
+        "east (m)",
+        vec![Panel::new("north (m)", vec![truth, est])],
+    )
+    .map()
+}
+
 /// Column names of the CSV log (degrees for angles, as a user reads them).
 pub fn csv_headers() -> Vec<String> {
     [
@@ -889,24 +912,7 @@ pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec
     )?);
     files.push(fig(
         "ground_track.png",
-        Figure::new(
-            "Ground track",
-            "east (m)",
-            vec![Panel::new(
-                "north (m)",
-                vec![Series::new("truth", col(&|s| s.east), col(&|s| s.north)), {
-                    let valid: Vec<&&Sample> =
-                        p.iter().filter(|s| s.est_north.is_finite()).collect();
-                    Series::new(
-                        "estimate",
-                        valid.iter().map(|s| s.est_east).collect(),
-                        valid.iter().map(|s| s.est_north).collect(),
-                    )
-                    .dashed()
-                }],
-            )],
-        )
-        .map(),
+        ground_track_figure(samples, "Ground track"),
     )?);
     Ok(files)
 }

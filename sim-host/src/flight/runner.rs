@@ -8,7 +8,7 @@ use crate::analysis::trim::{trim_with, TrimTarget};
 use crate::environment::wind::{Turbulence, Wind};
 use crate::link::lockstep::{LinkError, Lockstep};
 use crate::link::transport::Transport;
-use crate::plant::propulsion::polyval;
+use crate::plant::propulsion::motor_power_w;
 use crate::plant::{Controls, Environment, ModelParams, Plant, ServoBank};
 use crate::sensors::{SensorFaults, SensorSuite, Truth};
 use common::link::simlink::{encode_hil_gps, encode_hil_sensor, encode_rc_channels};
@@ -331,13 +331,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             && plant.velocity_ned().norm() < 1.0;
         let command = if answer.armed {
             armed_frames += 1;
-            let pr = &params.prop;
-            energy_j += polyval(
-                &pr.motor_power_poly_throttle_W,
-                f64::from(answer.surfaces.throttle),
-            )
-            .clamp(pr.motor_power_clamp_W[0], pr.motor_power_clamp_W[1])
-                * frame_s;
+            energy_j += motor_power_w(&params, f64::from(answer.surfaces.throttle)) * frame_s;
             Controls::from(answer.surfaces)
         } else {
             // The safety pilot holds the trim until the autopilot is armed.

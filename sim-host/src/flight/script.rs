@@ -197,12 +197,12 @@ impl GroundStation {
                     param_id: name.as_str().into(),
                     param_type: MavParamType::MAV_PARAM_TYPE_REAL32,
                 });
-                self.send(t_s, link, onboard, &msg);
+                self.exchange(t_s, link, onboard, &msg);
             }
         }
         if !self.silent && t_s >= self.next_heartbeat_s {
             self.next_heartbeat_s = t_s + 1.0;
-            self.send(t_s, link, onboard, &gcs_heartbeat());
+            self.exchange(t_s, link, onboard, &gcs_heartbeat());
         }
         if !self.uploaded {
             self.uploaded = true;
@@ -236,19 +236,17 @@ impl GroundStation {
                     }
                     self.next_step += 1;
                     match step.action {
-                        Action::Silence => {
-                            self.silent = true;
-                            continue;
-                        }
+                        Action::Silence => self.silent = true,
                         Action::Resume => {
                             self.silent = false;
                             self.next_heartbeat_s = t_s;
-                            continue;
                         }
-                        _ => {}
+                        _ => {
+                            if let Some((what, msg)) = self.encode(&step.action.clone()) {
+                                self.command(t_s, &what, link, onboard, &msg);
+                            }
+                        }
                     }
-                    let (what, msg) = self.encode(&step.action.clone());
-                    self.command(t_s, &what, link, onboard, &msg);
                 }
             }
             None => {}
@@ -257,8 +255,9 @@ impl GroundStation {
         self.send_bytes(t_s, link, onboard, &[]);
     }
 
-    fn encode(&self, a: &Action) -> (String, MavMessage) {
-        match *a {
+    /// The COMMAND_LONG of a command action (`None` for the station's own link actions).
+    fn encode(&self, a: &Action) -> Option<(String, MavMessage)> {
+        Some(match *a {
             Action::Mode(main) => (
                 format!("mode {}", mode_name(main)),
                 command(
@@ -299,9 +298,8 @@ impl GroundStation {
                     [1.0, f32::from(PX4_AUTO), f32::from(PX4_AUTO_LOITER), 0.0],
                 ),
             ),
-            Action::Silence => ("silence".into(), gcs_heartbeat()),
-            Action::Resume => ("resume".into(), gcs_heartbeat()),
-        }
+            Action::Silence | Action::Resume => return None,
+        })
     }
 
     /// The mission protocol's upload: MISSION_COUNT, each item as the autopilot requests it,
@@ -380,16 +378,6 @@ impl GroundStation {
             result: result.map_or("none".into(), |r| format!("{r:?}")),
         });
         result
-    }
-
-    fn send<T: Transport, O: Onboard<T>>(
-        &mut self,
-        t_s: f64,
-        link: &mut Lockstep<T>,
-        onboard: &mut O,
-        msg: &MavMessage,
-    ) {
-        self.exchange(t_s, link, onboard, msg);
     }
 
     /// Hands `bytes` to the autopilot's ground link and reads everything it has to say; texts

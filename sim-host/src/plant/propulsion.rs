@@ -25,6 +25,13 @@ pub fn polyval<const N: usize>(coeffs: &[f64; N], x: f64) -> f64 {
     coeffs.iter().fold(0.0, |acc, c| acc * x + c)
 }
 
+/// Shaft power the motor delivers at `throttle` (0..1), W: the UMN power curve, clamped.
+pub fn motor_power_w(p: &ModelParams, throttle: f64) -> f64 {
+    let pr = &p.prop;
+    polyval(&pr.motor_power_poly_throttle_W, throttle)
+        .clamp(pr.motor_power_clamp_W[0], pr.motor_power_clamp_W[1])
+}
+
 /// Thrust, torques and engine acceleration at airspeed `va`, engine speed `omega` and `throttle`.
 pub fn propulsion(
     p: &ModelParams,
@@ -42,8 +49,7 @@ pub fn propulsion(
     let w2 = omega * omega;
     let thrust_n = ct * rho * p.thrust_factor * w2;
     let prop_torque_nm = cp * rho * p.torque_factor * w2;
-    let power_w = polyval(&pr.motor_power_poly_throttle_W, throttle)
-        .clamp(pr.motor_power_clamp_W[0], pr.motor_power_clamp_W[1]);
+    let power_w = motor_power_w(p, throttle);
     let motor_torque_nm = power_w / omega_c;
     PropulsionOutput {
         thrust_n,
