@@ -31,7 +31,7 @@ use common::gcs::{GroundLink, ManualInput, VehicleRequests};
 use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
 use common::navigation::{
-    breached, FenceParams, HomeRequest, MissionLimits, NavOutput, NavState, Navigator, Phase,
+    self, breached, FenceParams, HomeRequest, MissionLimits, NavOutput, NavState, Navigator, Phase,
     PARAM_LISTS,
 };
 use common::params::ParamDef;
@@ -456,19 +456,20 @@ impl App {
                     (now_us - t) as f32 * 1e-6
                 });
             self.last_control_us = Some(now_us);
-            self.check_failsafes(now_us);
-            self.control(dt);
+            // One estimate for the whole control step.
+            let e = self.estimator.state();
+            self.check_failsafes(now_us, &e);
+            self.control(dt, &e);
         }
         self.poll_gcs(now_us);
     }
 
-    fn measurements(&self) -> Measurements {
+    fn measurements(&self, e: &EstimatedState) -> Measurements {
         if self.use_truth {
             if let Some(t) = self.truth {
                 return t.m;
             }
         }
-        let e = self.estimator.state();
         Measurements {
             roll: e.euler.phi,
             pitch: e.euler.theta,
@@ -487,8 +488,8 @@ impl App {
         }
     }
 
-    fn control(&mut self, dt: f32) {
-        let m = self.measurements();
+    fn control(&mut self, dt: f32, e: &EstimatedState) {
+        let m = self.measurements(e);
         let sp = self.setpoints;
         let gains = *self.autopilot.gains();
         let level = gains.longitudinal;
@@ -521,7 +522,7 @@ impl App {
             return;
         }
         if flown.needs_navigator() {
-            let commands = match self.navigate(flown, dt) {
+            let commands = match self.navigate(flown, dt, e) {
                 Some(c) => c,
                 // No home yet (refused before, so only after a reset): hold what we have.
                 None => Commands {
@@ -570,8 +571,7 @@ impl App {
 
     /// Runs the navigator for a navigation mode: starts it when the mode has changed, steps
     /// it, reports mission progress. `None` until home is set.
-    fn navigate(&mut self, flown: FlightMode, dt: f32) -> Option<Commands> {
-        let e = self.estimator.state();
+    fn navigate(&mut self, flown: FlightMode, dt: f32, e: &EstimatedState) -> Option<Commands> {
         let home = e.home?;
         if self.nav_for != Some(flown) {
             self.nav_for = Some(flown);
@@ -596,7 +596,7 @@ impl App {
         };
         let out = self
             .navigator
-            .step(items, &home, &NavState::from_estimate(&e), dt);
+            .step(items, &home, &NavState::from_estimate(e), dt);
         if flown == FlightMode::Mission {
             let current = out.current_seq.filter(|&c| c != self.mission_seq);
             if let Some(c) = out.current_seq {
@@ -608,7 +608,8 @@ impl App {
             }
         }
         for w in &out.warnings {
-            self.nav_warning(w);
+            self.gcs
+                .send_statustext(MavSeverity::MAV_SEVERITY_WARNING, w.text());
         }
         if let Some(req) = out.set_home {
             let here = match req {
@@ -630,23 +631,9 @@ impl App {
         commands
     }
 
-    fn nav_warning(&mut self, w: &common::navigation::NavWarning) {
-        use common::navigation::NavWarning as W;
-        let text = match w {
-            W::UnknownCommand { .. } => "Mission: unsupported item skipped",
-            W::BadJump { .. } => "Mission: DO_JUMP to a missing item skipped",
-            W::JumpLoop { .. } => "Mission: DO_JUMP loop with nothing to fly, mission ended",
-            W::UnsupportedSpeed { .. } => "Mission: speed change not supported, skipped",
-            W::NoMission => "Mission: nothing to fly",
-        };
-        self.gcs
-            .send_statustext(MavSeverity::MAV_SEVERITY_WARNING, text);
-    }
-
     /// Watches the failsafes at the control rate and acts on their reaction.
-    fn check_failsafes(&mut self, now_us: u64) {
-        let e = self.estimator.state();
-        let flying = self.armed && in_air(&e);
+    fn check_failsafes(&mut self, now_us: u64, e: &EstimatedState) {
+        let flying = self.armed && in_air(e);
         let fence_breached = match e.home {
             Some(h) => breached(
                 self.gcs.missions().store().items(PlanKind::Fence),
@@ -805,23 +792,37 @@ impl App {
             ),
         }
         let store = self.gcs.params();
-        let mut cfg = *self.estimator.config();
-        for d in common::estimator::config::PARAMS {
-            if let Some(v) = store.get(d.name) {
-                let _ = cfg.set(d.name, v);
-            }
-        }
-        self.estimator.set_config(cfg);
-        for list in PARAM_LISTS {
-            for d in *list {
+        // Stored values are within their bounds, so no stage refuses them.
+        let load = |defs: &[ParamDef], set: &mut dyn FnMut(&str, f32)| {
+            for d in defs {
                 if let Some(v) = store.get(d.name) {
-                    // Each name belongs to exactly one of these; the others refuse it.
-                    let _ = self.navigator.set_param(d.name, v);
-                    let _ = self.limits.set(d.name, v);
-                    let _ = self.fence.set(d.name, v);
+                    set(d.name, v);
                 }
             }
+        };
+        let mut cfg = *self.estimator.config();
+        load(common::estimator::config::PARAMS, &mut |n, v| {
+            let _ = cfg.set(n, v);
+        });
+        self.estimator.set_config(cfg);
+        let nav = &mut self.navigator;
+        for defs in [
+            common::guidance::PARAMS,
+            navigation::path_manager::PARAMS,
+            navigation::executor::PARAMS,
+        ] {
+            load(defs, &mut |n, v| {
+                let _ = nav.set_param(n, v);
+            });
         }
+        let limits = &mut self.limits;
+        load(navigation::validate::PARAMS, &mut |n, v| {
+            let _ = limits.set(n, v);
+        });
+        let fence = &mut self.fence;
+        load(navigation::fence::PARAMS, &mut |n, v| {
+            let _ = fence.set(n, v);
+        });
         self.fs_cfg = FailsafeConfig::from_params(|n| store.get(n));
         self.use_truth = store.get("SIM_USE_TRUTH").unwrap_or(0.0) >= 0.5;
         if let Some(v) = store.get("FW_AIRSPD_TRIM") {
@@ -832,13 +833,14 @@ impl App {
     }
 
     fn poll_gcs(&mut self, now_us: u64) {
+        let e = self.estimator.state();
         let rules = PlanRules {
-            home: self.estimator.state().home,
+            home: e.home,
             limits: self.limits,
             nav: *self.navigator.params(),
         };
         self.gcs.missions_mut().set_rules(rules);
-        let snapshot = self.snapshot();
+        let snapshot = self.snapshot_of(&e);
         let (tx, buf, dropped) = (
             &mut self.gcs_tx,
             &mut self.gcs_out,
@@ -854,7 +856,10 @@ impl App {
 
     /// What the ground link reports and checks.
     pub fn snapshot(&self) -> VehicleSnapshot {
-        let e = self.estimator.state();
+        self.snapshot_of(&self.estimator.state())
+    }
+
+    fn snapshot_of(&self, e: &EstimatedState) -> VehicleSnapshot {
         let h = &e.health;
         let health = SensorHealth {
             gyro_ok: h.imu.healthy,
@@ -907,7 +912,7 @@ impl App {
                 }
             }
         }
-        let in_air = in_air(&e);
+        let in_air = in_air(e);
         VehicleSnapshot {
             boot_complete: self.last_time_us.is_some(),
             hil: true,
@@ -946,7 +951,7 @@ impl App {
                 present: false,
                 ..Battery::default()
             },
-            nav: self.nav_telemetry(&e),
+            nav: self.nav_telemetry(e),
             mission_seq: self.mission_seq,
             mission_state: self.mission_state,
             cpu_load: 0.0,

@@ -426,6 +426,19 @@ pub enum NavWarning {
     NoMission,
 }
 
+impl NavWarning {
+    /// The text the ground station shows (one STATUSTEXT).
+    pub fn text(&self) -> &'static str {
+        match self {
+            NavWarning::UnknownCommand { .. } => "Mission: unsupported item skipped",
+            NavWarning::BadJump { .. } => "Mission: DO_JUMP to a missing item skipped",
+            NavWarning::JumpLoop { .. } => "Mission: DO_JUMP loop, nothing to fly; ended",
+            NavWarning::UnsupportedSpeed { .. } => "Mission: speed change not supported, skipped",
+            NavWarning::NoMission => "Mission: nothing to fly",
+        }
+    }
+}
+
 /// Where the home should move (`DO_SET_HOME`); the firmware applies it to the estimator.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HomeRequest {

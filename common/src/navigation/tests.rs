@@ -23,14 +23,16 @@ use std::vec::Vec;
 const REL_ALT_INT: u8 = 6;
 const DT: f32 = 0.05;
 
-fn home() -> Home {
+/// The home of the navigation tests.
+pub(crate) fn home() -> Home {
     Home {
         point: GeoPoint::from_deg(44.7258357, -93.07501316),
         alt_amsl_m: 250.0,
     }
 }
 
-fn item(command: u16, params: [f32; 4], n: f32, e: f32, h: f32) -> MissionItem {
+/// An item `n`, `e` m from [`home`], `h` m above it.
+pub(crate) fn item(command: u16, params: [f32; 4], n: f32, e: f32, h: f32) -> MissionItem {
     let p = offset_point(home().point, n, e);
     MissionItem {
         params: params.map(f32::to_bits),
@@ -772,4 +774,17 @@ fn navigator() -> Navigator {
         Guidance::for_course_lag(1.0, 0.03),
         PathManager::default(),
     )
+}
+
+#[test]
+fn warning_texts_fit_one_statustext() {
+    for w in [
+        NavWarning::UnknownCommand { seq: 0, command: 0 },
+        NavWarning::BadJump { seq: 0 },
+        NavWarning::JumpLoop { seq: 0 },
+        NavWarning::UnsupportedSpeed { seq: 0 },
+        NavWarning::NoMission,
+    ] {
+        assert!(w.text().len() <= crate::gcs::STATUSTEXT_LEN, "{w:?}");
+    }
 }
