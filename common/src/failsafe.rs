@@ -134,6 +134,19 @@ pub enum Event {
 }
 
 impl Event {
+    /// Every event.
+    pub const ALL: [Event; 9] = [
+        Event::GcsLost,
+        Event::GcsRegained,
+        Event::GpsLost,
+        Event::GpsLoiter,
+        Event::GpsRegained,
+        Event::AirspeedFailed,
+        Event::AirspeedRegained,
+        Event::FenceBreached,
+        Event::FenceCleared,
+    ];
+
     /// The text the ground station shows.
     pub fn text(self) -> &'static str {
         match self {
@@ -285,20 +298,12 @@ mod tests {
 
     #[test]
     fn every_text_fits_one_statustext() {
-        use Event::*;
-        for e in [
-            GcsLost,
-            GcsRegained,
-            GpsLost,
-            GpsLoiter,
-            GpsRegained,
-            AirspeedFailed,
-            AirspeedRegained,
-            FenceBreached,
-            FenceCleared,
-        ] {
-            // STATUSTEXT carries 50 characters.
-            assert!(e.text().len() <= 50, "{e:?}: {}", e.text());
+        for e in Event::ALL {
+            assert!(
+                e.text().len() <= crate::gcs::STATUSTEXT_LEN,
+                "{e:?}: {}",
+                e.text()
+            );
         }
     }
 

@@ -445,6 +445,27 @@ impl Ins {
         best
     }
 
+    /// Moves the stored states from time `after` on as the present one moved: rotated by
+    /// `rot`, velocity by `dv`, position by `dp`.
+    fn shift_stored(
+        &mut self,
+        after: f64,
+        rot: &UnitQuaternion<f32>,
+        dv: &Vector3<f32>,
+        dp: &Vector3<f32>,
+    ) {
+        for k in 0..self.len {
+            let i = (self.head + HISTORY - k) % HISTORY;
+            if let Some(s) = self.history.get_mut(i) {
+                if s.t >= after {
+                    s.q = rot * s.q;
+                    s.v += dv;
+                    s.p += dp;
+                }
+            }
+        }
+    }
+
     /// Applies an error-state correction to the present state and to the stored states after
     /// `t_meas` (so the next delayed fix compares like with like). Returns whether the
     /// present state accepted it.
@@ -463,16 +484,7 @@ impl Ins {
             cov,
         );
         if ok {
-            for k in 0..self.len {
-                let i = (self.head + HISTORY - k) % HISTORY;
-                if let Some(s) = self.history.get_mut(i) {
-                    if s.t >= t_meas - 1e-4 {
-                        s.q = rot * s.q;
-                        s.v += dv;
-                        s.p += dp;
-                    }
-                }
-            }
+            self.shift_stored(t_meas - 1e-4, &rot, &dv, &dp);
         }
         ok
     }
@@ -662,13 +674,7 @@ impl Ins {
         }
         self.p = now;
         self.v = *vel;
-        for k in 0..self.len {
-            let i = (self.head + HISTORY - k) % HISTORY;
-            if let Some(s) = self.history.get_mut(i) {
-                s.p += dp;
-                s.v += dv;
-            }
-        }
+        self.shift_stored(f64::NEG_INFINITY, &UnitQuaternion::identity(), &dv, &dp);
         let offset = libm::sqrtf(self.cov[(IBO, IBO)] + noise.vertical * noise.vertical);
         self.reset_nav_covariance(
             noise.horizontal,
@@ -685,9 +691,12 @@ impl Ins {
             return;
         }
         self.p += delta;
-        for s in self.history.iter_mut() {
-            s.p += delta;
-        }
+        self.shift_stored(
+            f64::NEG_INFINITY,
+            &UnitQuaternion::identity(),
+            &Vector3::zeros(),
+            delta,
+        );
     }
 
     /// Makes the baro offset agree with one barometric altitude (`home_alt - baro_alt`) after

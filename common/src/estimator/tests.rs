@@ -56,9 +56,16 @@ impl Flight {
 
     /// One 50 Hz step with some sensors silent.
     fn step_with(&mut self, on: On) -> Truth {
+        self.step_full(on, Vector3::zeros())
+    }
+
+    /// One 50 Hz step with some sensors silent and `extra` added to the accelerometer's
+    /// reading (a throw or a gust the trajectory does not know about).
+    fn step_full(&mut self, on: On, extra: Vector3<f32>) -> Truth {
         self.traj.step(self.dt);
         let tr = self.traj.truth();
-        let s = self.sim.sample(&tr);
+        let mut s = self.sim.sample(&tr);
+        s.imu.accel += extra;
         if on.imu {
             self.est.update_imu(&s.imu, self.dt as f32);
         }
@@ -81,21 +88,10 @@ impl Flight {
         self.step_with(On::ALL)
     }
 
-    /// One 50 Hz step with `extra` added to the accelerometer's reading (a throw or a gust
-    /// that the trajectory does not know about: the attitude it suggests is wrong).
+    /// One 50 Hz step with `extra` added to the accelerometer's reading (the attitude it
+    /// suggests is wrong).
     fn step_shaken(&mut self, extra: Vector3<f32>) -> Truth {
-        self.traj.step(self.dt);
-        let tr = self.traj.truth();
-        let mut s = self.sim.sample(&tr);
-        s.imu.accel += extra;
-        self.est.update_imu(&s.imu, self.dt as f32);
-        self.est.update_mag(&s.mag);
-        self.est.update_baro(&s.baro);
-        self.est.update_pitot(&s.pitot);
-        if let Some(g) = s.gps {
-            self.est.update_gps(&g);
-        }
-        tr
+        self.step_full(On::ALL, extra)
     }
 
     fn run_until(&mut self, t: f64) -> Truth {

@@ -204,12 +204,7 @@ mod tests {
     use crate::math::geodetic::offset_point;
     use crate::params::validate_defs;
 
-    fn home() -> Home {
-        Home {
-            point: GeoPoint::from_deg(44.7258357, -93.07501316),
-            alt_amsl_m: 250.0,
-        }
-    }
+    use crate::navigation::tests::home;
 
     fn vertex_item(command: u16, count: f32, n: f32, e: f32) -> MissionItem {
         let p = offset_point(home().point, n, e);

@@ -216,28 +216,9 @@ fn check_item(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::geodetic::{offset_point, GeoPoint};
     use crate::params::validate_defs;
 
-    fn home() -> Home {
-        Home {
-            point: GeoPoint::from_deg(44.7258357, -93.07501316),
-            alt_amsl_m: 250.0,
-        }
-    }
-
-    fn item(command: u16, params: [f32; 4], n: f32, e: f32, h: f32) -> MissionItem {
-        let p = offset_point(home().point, n, e);
-        MissionItem {
-            params: params.map(f32::to_bits),
-            x: p.lat_e7,
-            y: p.lon_e7,
-            z: h.to_bits(),
-            command,
-            frame: 6,
-            autocontinue: true,
-        }
-    }
+    use crate::navigation::tests::{home, item};
 
     fn wp(n: f32, e: f32, h: f32) -> MissionItem {
         item(NAV_WAYPOINT, [0.0; 4], n, e, h)
