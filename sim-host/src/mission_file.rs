@@ -17,6 +17,7 @@
 //! Every rejection names the file, the place (a JSON path such as `mission.items[3].params[4]`,
 //! or `line 5, column 9`) and the value.
 
+use common::math::geodetic::GeoPoint;
 use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
 use num_traits::FromPrimitive;
 use serde_json::Value;
@@ -534,13 +535,14 @@ pub fn parse_plan(text: &str, file: &Path) -> Result<MissionFile, MissionFileErr
         if let Some(points) = rp.get("points") {
             for (i, v) in cx.array(points, "rallyPoints.points")?.iter().enumerate() {
                 let p = cx.position(v, &format!("rallyPoints.points[{i}]"), 3)?;
+                let g = GeoPoint::from_deg(p[0], p[1]);
                 rally.push(item(
                     rally.len(),
                     MavCmd::MAV_CMD_NAV_RALLY_POINT,
                     MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
                     [0.0; 4],
-                    deg_e7(p[0]),
-                    deg_e7(p[1]),
+                    g.lat_e7,
+                    g.lon_e7,
                     p[2] as f32,
                     true,
                     MavMissionType::MAV_MISSION_TYPE_RALLY,
@@ -557,11 +559,6 @@ pub fn parse_plan(text: &str, file: &Path) -> Result<MissionFile, MissionFileErr
     })
 }
 
-/// degE7 of a range-checked angle.
-fn deg_e7(deg: f64) -> i32 {
-    (deg * 1e7).round() as i32
-}
-
 fn fence_item(
     seq: usize,
     command: MavCmd,
@@ -569,13 +566,14 @@ fn fence_item(
     lat: f64,
     lon: f64,
 ) -> MISSION_ITEM_INT_DATA {
+    let g = GeoPoint::from_deg(lat, lon);
     item(
         seq,
         command,
         MavFrame::MAV_FRAME_GLOBAL,
         [param1, 0.0, 0.0, 0.0],
-        deg_e7(lat),
-        deg_e7(lon),
+        g.lat_e7,
+        g.lon_e7,
         0.0,
         true,
         MavMissionType::MAV_MISSION_TYPE_FENCE,

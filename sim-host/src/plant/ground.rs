@@ -212,7 +212,7 @@ fn contact_near_ground(g: &GroundParams, x: &StateVector, c: &Controls) -> Groun
     let mut force_ned = Vector3::zeros();
     for (i, pt) in g.points.iter().enumerate() {
         let rp = pt.pos_body;
-        let depth = x[2] + r[(2, 0)] * rp.x + r[(2, 1)] * rp.y + r[(2, 2)] * rp.z - g.ground_down_m;
+        let depth = depth_m(g, x, &r, &rp);
         if depth <= 0.0 {
             continue;
         }
@@ -271,17 +271,18 @@ fn skid_friction(mu: f64, normal: f64, vn: f64, ve: f64, v_s: f64) -> (f64, f64)
 
 /// Height of the lowest contact point above the ground plane, m (negative when below).
 pub fn clearance_m(p: &ModelParams, x: &StateVector) -> f64 {
-    // Only the down row of the body-to-NED matrix is needed.
     let r = quat_of(x).to_rotation_matrix().into_inner();
-    let (r20, r21, r22) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
     p.ground
         .points
         .iter()
-        .map(|pt| {
-            let b = pt.pos_body;
-            p.ground.ground_down_m - x[2] - (r20 * b.x + r21 * b.y + r22 * b.z)
-        })
+        .map(|pt| -depth_m(&p.ground, x, &r, &pt.pos_body))
         .fold(f64::INFINITY, f64::min)
+}
+
+/// How far the body point `rp` is below the ground plane, m (negative above it), with `r`
+/// the body-to-NED matrix of the state `x` (only its down row is needed).
+fn depth_m(g: &GroundParams, x: &StateVector, r: &Matrix3<f64>, rp: &Vector3<f64>) -> f64 {
+    x[2] + r[(2, 0)] * rp.x + r[(2, 1)] * rp.y + r[(2, 2)] * rp.z - g.ground_down_m
 }
 
 /// True when some contact point is below the ground plane (cheap while airborne).
