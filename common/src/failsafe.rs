@@ -13,7 +13,7 @@
 //!
 //! Each failsafe is reported once when it is raised and once when its cause clears.
 
-use crate::params::ParamDef;
+use crate::params::{default_of, ParamDef};
 
 /// Parameters of the failsafes.
 pub const PARAMS: &[ParamDef] = &[
@@ -57,9 +57,9 @@ pub struct FailsafeConfig {
 impl Default for FailsafeConfig {
     fn default() -> Self {
         Self {
-            gcs_timeout_s: 5.0,
-            gps_wings_level_s: 10.0,
-            fence_returns: true,
+            gcs_timeout_s: default_of(PARAMS, "FS_GCS_TOUT_S"),
+            gps_wings_level_s: default_of(PARAMS, "FS_GPS_WL_S"),
+            fence_returns: default_of(PARAMS, "GF_ACTION") >= 0.5,
         }
     }
 }

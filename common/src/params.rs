@@ -107,6 +107,41 @@ impl ParamDef {
     }
 }
 
+/// Looks a parameter up in `defs` and checks a candidate value against it.
+pub fn check_param(defs: &[ParamDef], name: &str, value: f32) -> Result<f32, ParamError> {
+    defs.iter()
+        .find(|d| d.name == name)
+        .ok_or(ParamError::Unknown)?
+        .check(value)
+}
+
+/// The default of a parameter of `defs` (0 when absent, which the tests rule out).
+pub const fn default_of(defs: &[ParamDef], name: &str) -> f32 {
+    let mut i = 0;
+    while i < defs.len() {
+        if str_eq(defs[i].name, name) {
+            return defs[i].default;
+        }
+        i += 1;
+    }
+    0.0
+}
+
+const fn str_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
 /// Checks that a list of definitions is well formed: names short, ASCII, unique; defaults
 /// inside their bounds. Used by each stage's tests.
 pub fn validate_defs(defs: &[ParamDef]) -> Result<(), &'static str> {

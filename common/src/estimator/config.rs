@@ -1,6 +1,6 @@
 //! The estimator's parameters and the typed configuration built from them.
 
-use crate::params::{ParamDef, ParamError};
+use crate::params::{check_param, ParamDef, ParamError};
 
 /// Every tunable number of the estimator. Defaults follow the Ultra Stick 25e's sensor set
 /// (UMN SIL sensor model, GPS of the bolderflight set) and are justified in `docs/ESTIMATOR.md`.
@@ -408,11 +408,7 @@ impl EstimatorConfig {
     /// Sets one parameter by name after checking it against its definition; a refused value
     /// leaves the configuration unchanged.
     pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        let def = PARAMS
-            .iter()
-            .find(|d| d.name == name)
-            .ok_or(ParamError::Unknown)?;
-        let v = def.check(value)?;
+        let v = check_param(PARAMS, name, value)?;
         // Integer parameters: `check` guarantees a whole number within bounds.
         match name {
             "EST_MAX_REJECT" => self.max_rejections = v as u32,

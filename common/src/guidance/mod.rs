@@ -36,7 +36,7 @@
 //! Altitudes here are heights above home, m, up: the datum the firmware gives the autopilot.
 
 use crate::math::wrap_pi;
-use crate::params::{ParamDef, ParamError};
+use crate::params::{check_param, default_of, ParamDef, ParamError};
 use core::f32::consts::{FRAC_PI_2, PI};
 use nalgebra::Vector3;
 
@@ -77,41 +77,6 @@ pub const PARAMS: &[ParamDef] = &[
         "Course-loop time constant the orbit lead makes up for (0: no lead)",
     ),
 ];
-
-/// Looks a parameter up in `defs` and checks a candidate value against it.
-pub(crate) fn check_param(defs: &[ParamDef], name: &str, value: f32) -> Result<f32, ParamError> {
-    defs.iter()
-        .find(|d| d.name == name)
-        .ok_or(ParamError::Unknown)?
-        .check(value)
-}
-
-/// The default of a parameter of `defs` (0 when absent, which the tests rule out).
-pub(crate) const fn default_of(defs: &[ParamDef], name: &str) -> f32 {
-    let mut i = 0;
-    while i < defs.len() {
-        if str_eq(defs[i].name, name) {
-            return defs[i].default;
-        }
-        i += 1;
-    }
-    0.0
-}
-
-const fn str_eq(a: &str, b: &str) -> bool {
-    let (a, b) = (a.as_bytes(), b.as_bytes());
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
 
 /// The vector fields' gains, in SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -11,8 +11,8 @@
 use super::items::{FENCE_POLYGON_EXCLUSION, FENCE_POLYGON_INCLUSION};
 use crate::estimator::Home;
 use crate::gcs::mission::MissionItem;
-use crate::guidance::{check_param, default_of};
 use crate::math::geodetic::{ned_offset, GeoPoint};
+use crate::params::{check_param, default_of};
 use crate::params::{ParamDef, ParamError};
 use mavlink::dialects::common::{MavCmd, MavMissionResult};
 use nalgebra::Vector3;

@@ -26,7 +26,8 @@
 //!
 //! The caller shifts the window by one after each `reached` event.
 
-use crate::guidance::{check_param, default_of, OrbitDirection, Path};
+use crate::guidance::{OrbitDirection, Path};
+use crate::params::{check_param, default_of};
 use crate::params::{ParamDef, ParamError};
 use nalgebra::{Vector2, Vector3};
 

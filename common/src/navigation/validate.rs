@@ -5,8 +5,8 @@ use super::executor::NavParams;
 use super::items::{self, *};
 use crate::estimator::Home;
 use crate::gcs::mission::MissionItem;
-use crate::guidance::{check_param, default_of};
 use crate::math::geodetic::ned_offset;
+use crate::params::{check_param, default_of};
 use crate::params::{ParamDef, ParamError};
 use mavlink::dialects::common::MavMissionResult;
 
