@@ -149,6 +149,22 @@ fn lands_on_the_runway(o: &FlightOutcome, calm: bool) {
     );
 }
 
+/// Just after `t_s` the mission flies on from the waypoint `before` was flying.
+fn resumes_the_mission(o: &FlightOutcome, t_s: f64, before: &Sample) {
+    let after = o
+        .samples
+        .iter()
+        .find(|s| s.t > t_s + 0.1)
+        .expect("samples after the recovery");
+    assert!(
+        after.mode == PX4_AUTO
+            && phase_is(after, Phase::Waypoint)
+            && after.mission_seq == before.mission_seq,
+        "mission resumed at item {}: {after:?}",
+        before.mission_seq
+    );
+}
+
 /// Circling a centre: the spread of the distance to it and the angle swept round it.
 fn circling(samples: &[&Sample], center: (f64, f64)) -> (f64, f64, f64) {
     let r: Vec<f64> = samples
@@ -268,18 +284,7 @@ fn ground_link_loss_returns_home_circles_and_the_pilot_resumes_the_mission() {
         t_regained - t_back
     );
     // Restarted: the mission goes on from the leg it left, and lands.
-    let after = o
-        .samples
-        .iter()
-        .find(|s| s.t > t_restart + 0.1)
-        .expect("samples after the restart");
-    assert!(
-        after.mode == PX4_AUTO
-            && phase_is(after, Phase::Waypoint)
-            && after.mission_seq == before.mission_seq,
-        "mission resumed at item {}: {after:?}",
-        before.mission_seq
-    );
+    resumes_the_mission(&o, t_restart, before);
     lands_on_the_runway(&o, true);
 }
 
@@ -417,18 +422,7 @@ fn gps_loss_flies_wings_level_then_circles_and_the_mission_resumes() {
         drift < 1.5 * lost_s,
         "dead-reckoned position {drift:.1} m off after {lost_s} s"
     );
-    let after = o
-        .samples
-        .iter()
-        .find(|s| s.t > t_back + 0.1)
-        .expect("samples");
-    assert!(
-        after.mode == PX4_AUTO
-            && phase_is(after, Phase::Waypoint)
-            && after.mission_seq == before.mission_seq,
-        "mission resumed at item {}: {after:?}",
-        before.mission_seq
-    );
+    resumes_the_mission(&o, t_back, before);
     lands_on_the_runway(&o, false);
 }
 
