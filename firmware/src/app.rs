@@ -995,6 +995,15 @@ fn amsl_commands(mut c: Commands, home_alt_amsl_m: f32) -> Commands {
             altitude: altitude + home_alt_amsl_m,
             airspeed,
         },
+        LonMode::Glide {
+            altitude,
+            airspeed,
+            climb_rate,
+        } => LonMode::Glide {
+            altitude: altitude + home_alt_amsl_m,
+            airspeed,
+            climb_rate,
+        },
         LonMode::TakeOff {
             altitude,
             airspeed,

@@ -167,7 +167,8 @@ struct FlyArgs {
     out: PathBuf,
     /// Gain set loaded before arming (SYS_GAIN_SET): 0 designed, 1 designed_t310,
     /// 2 designed_appe, 3 minnesota, 4 minnesota_appe. Without it the "computed" set
-    /// (`sim-host design`) is uploaded parameter by parameter, as a ground station would.
+    /// (`sim-host design`) is uploaded parameter by parameter, as a ground station would;
+    /// with `--mission` the firmware's defaults (the designed set) fly.
     #[arg(long)]
     gains: Option<u32>,
     /// Fly on the simulator's truth instead of the estimator (SIM_USE_TRUTH = 1).
@@ -449,9 +450,11 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         out: Some(a.out.clone()),
         plots: true,
         gain_set: a.gains,
-        upload_gains: match a.gains {
-            Some(_) => None,
-            None => Some(sim_host::analysis::design::computed_gain_set(aircraft)?),
+        // The thesis's scripted flight flies the gains designed here; a mission flies the
+        // firmware's defaults, as `sim-host navigation` and a fresh autopilot do.
+        upload_gains: match (a.gains, &a.mission) {
+            (None, None) => Some(sim_host::analysis::design::computed_gain_set(aircraft)?),
+            _ => None,
         },
         use_truth: a.truth,
     };

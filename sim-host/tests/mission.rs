@@ -68,10 +68,10 @@ fn the_default_mission_flies_from_runway_to_runway_in_calm_air() {
 /// In a 5 m/s wind from the north-north-east (a headwind and crosswind on the landing) with
 /// light Dryden turbulence, on estimates: what holds on every seed of `docs/NAVIGATION.md`
 /// (every waypoint reached, altitude within 1.5 m and airspeed within 1 m/s RMS, landed,
-/// stopped and disarmed) and on all but one (straight legs within 2 m RMS) is asserted here.
-/// The touchdown is only held to within 50 m of the point (on a 100 m strip): the 20 m and
-/// 1.5 m/s touchdown target is met on two seeds of five (see the ignored test below and the
-/// document).
+/// stopped and disarmed) and on all but one or two of twenty (straight legs within 2 m RMS,
+/// touchdown within 20 m of the point) is asserted here on the first seed the document
+/// plotted before it flew twenty. The sink-rate target (under 1.5 m/s) is met on 17 seeds of
+/// 20; the ignored test below holds every target on every seed.
 #[test]
 fn the_default_mission_flies_in_a_5_mps_wind_with_light_turbulence() {
     let o = fly_default(navigation::WIND_NED, Turbulence::Light, 7);
@@ -92,7 +92,7 @@ fn the_default_mission_flies_in_a_5_mps_wind_with_light_turbulence() {
     );
     let td = m.touchdown.expect("touched down");
     assert!(
-        td.distance_m < 50.0,
+        td.distance_m < 20.0,
         "touchdown {:.1} m away",
         td.distance_m
     );
@@ -100,7 +100,7 @@ fn the_default_mission_flies_in_a_5_mps_wind_with_light_turbulence() {
 }
 
 #[test]
-#[ignore = "touchdown distance and sink-rate targets not met on every seed in turbulence: see docs/NAVIGATION.md"]
+#[ignore = "15 of 20 seeds meet every target in turbulence (sink rate, touchdown distance, cross-track): see docs/NAVIGATION.md"]
 fn the_default_mission_meets_every_target_in_wind_and_turbulence() {
     for seed in navigation::SEEDS {
         let o = fly_default(navigation::WIND_NED, Turbulence::Light, seed);

@@ -467,7 +467,7 @@ mod tests {
                         1 => YawMode::Damper,
                         _ => YawMode::Sideslip(val(0.2)),
                     },
-                    lon: match k % 7 {
+                    lon: match k % 8 {
                         0 => LonMode::Off,
                         1 => LonMode::Pitch {
                             pitch: val(1.0),
@@ -481,6 +481,11 @@ mod tests {
                             altitude: val(300.0),
                             airspeed: val(30.0),
                             clear_altitude: val(50.0),
+                        },
+                        4 => LonMode::Glide {
+                            altitude: val(300.0),
+                            airspeed: val(30.0),
+                            climb_rate: val(5.0),
                         },
                         _ => LonMode::Altitude {
                             altitude: val(300.0),

@@ -222,6 +222,18 @@ pub enum LonMode {
         /// Airspeed, m/s.
         airspeed: f32,
     },
+    /// As [`LonMode::Altitude`] for an altitude command that moves at `climb_rate` (a glide
+    /// slope): in the hold regime the pitch command carries the flight-path angle that rate
+    /// asks for, `asin(climb_rate / airspeed)`, so the altitude loop no longer lags the ramp
+    /// by the error its proportional gain needs to make that pitch.
+    Glide {
+        /// Altitude, m (same datum as the measured altitude).
+        altitude: f32,
+        /// Airspeed, m/s.
+        airspeed: f32,
+        /// Rate at which `altitude` moves, m/s, up positive.
+        climb_rate: f32,
+    },
     /// As [`LonMode::Altitude`], starting in the take-off regime while below `clear_altitude`.
     TakeOff {
         /// Altitude, m.
@@ -353,7 +365,8 @@ pub struct LongitudinalOutput {
 enum PitchSource {
     Fixed(f32),
     Airspeed(f32),
-    Altitude(f32),
+    /// Altitude command and the pitch feed-forward added to the loop's output, rad.
+    Altitude(f32, f32),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -375,7 +388,7 @@ impl PitchSource {
         match self {
             PitchSource::Fixed(_) => SourceKind::Fixed,
             PitchSource::Airspeed(_) => SourceKind::Airspeed,
-            PitchSource::Altitude(_) => SourceKind::Altitude,
+            PitchSource::Altitude(..) => SourceKind::Altitude,
         }
     }
 }
@@ -509,6 +522,7 @@ impl Longitudinal {
         };
 
         let mut rejected = InputFlags::empty();
+        let mut pitch_ff = 0.0;
         let (alt_c, aspd_c, clear) = match mode {
             LonMode::Off => {
                 self.pitch.reset();
@@ -534,6 +548,19 @@ impl Longitudinal {
                 (0.0, 0.0, None)
             }
             LonMode::Altitude { altitude, airspeed } => (altitude, airspeed, None),
+            LonMode::Glide {
+                altitude,
+                airspeed,
+                climb_rate,
+            } => {
+                // A bad rate or airspeed only loses the feed-forward; the loop still holds
+                // the altitude command.
+                let ratio = climb_rate / airspeed;
+                if ratio.is_finite() {
+                    pitch_ff = libm::asinf(ratio.clamp(-1.0, 1.0)).clamp(-g.pitch_max, g.pitch_max);
+                }
+                (altitude, airspeed, None)
+            }
             LonMode::TakeOff {
                 altitude,
                 airspeed,
@@ -575,7 +602,7 @@ impl Longitudinal {
                         ThrottleSource::Fixed(g.throttle_max),
                     ),
                     Regime::AltitudeHold => (
-                        PitchSource::Altitude(alt_c),
+                        PitchSource::Altitude(alt_c, pitch_ff),
                         ThrottleSource::Airspeed(aspd_c),
                     ),
                     Regime::Descent => (
@@ -631,7 +658,7 @@ impl Longitudinal {
                 bad.set(InputFlags::AIRSPEED, !m.airspeed.is_finite());
                 (aspd_f, v)
             }
-            PitchSource::Altitude(v) => {
+            PitchSource::Altitude(v, _) => {
                 bad.set(InputFlags::ALTITUDE, !m.altitude.is_finite());
                 (alt_f, v)
             }
@@ -672,9 +699,9 @@ impl Longitudinal {
                 self.aspd_pitch
                     .step(v - feedback, Derivative::None, g.trim_pitch, dt)
             }
-            PitchSource::Altitude(v) => {
+            PitchSource::Altitude(v, ff) => {
                 self.alt
-                    .step(v - feedback, Derivative::None, g.trim_pitch, dt)
+                    .step(v - feedback, Derivative::None, g.trim_pitch + ff, dt)
             }
         };
         let e = wrap_pi(theta_c - m.pitch);
@@ -849,6 +876,47 @@ mod tests {
             }
         }
         assert!(saw_hold);
+    }
+
+    /// On a glide slope the pitch command carries the flight-path angle of the command's
+    /// rate, `asin(climb_rate / airspeed)`, on top of what the altitude loop asks for; a rate
+    /// that is not a number loses only that feed-forward.
+    #[test]
+    fn glide_feeds_the_flight_path_angle_forward() {
+        let g = DESIGNED.longitudinal;
+        let run = |mode: LonMode| {
+            let mut lon = Longitudinal::new(&g, 1.0);
+            let mut o = LongitudinalOutput::default();
+            // Ten seconds: the engagement's bumpless offset has faded.
+            for _ in 0..500 {
+                o = lon.step(&meas(0.0, 40.0, 15.0), mode, DT);
+            }
+            o
+        };
+        let hold = run(LonMode::Altitude {
+            altitude: 41.0,
+            airspeed: 15.0,
+        });
+        let glide = |climb_rate| {
+            run(LonMode::Glide {
+                altitude: 41.0,
+                airspeed: 15.0,
+                climb_rate,
+            })
+        };
+        let down = glide(-1.3);
+        assert_eq!(hold.regime, Some(Regime::AltitudeHold));
+        assert_eq!(down.regime, Some(Regime::AltitudeHold));
+        let gamma = libm::asinf(-1.3 / 15.0);
+        assert!(
+            (down.pitch_cmd - hold.pitch_cmd - gamma).abs() < 1e-4,
+            "{} vs {} + {gamma}",
+            down.pitch_cmd,
+            hold.pitch_cmd
+        );
+        let bad = glide(f32::NAN);
+        assert!((bad.pitch_cmd - hold.pitch_cmd).abs() < 1e-6);
+        assert!(bad.rejected.is_empty());
     }
 
     #[test]

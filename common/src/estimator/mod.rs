@@ -165,13 +165,14 @@ pub struct EstimatedState {
     pub body_rates: Vector3<f32>,
     /// Estimated gyro bias, rad/s.
     pub gyro_bias: Vector3<f32>,
-    /// Position from home in NED, m.
+    /// Position from home in NED, m; down is the barometer's fall since home was set.
     pub pos_ned: Vector3<f32>,
     /// Horizontal position.
     pub position: GeoPoint,
     /// Altitude above mean sea level, m (barometric until the first GPS fix).
     pub alt_amsl_m: f32,
-    /// The NED origin, once set.
+    /// The NED origin, once set; its altitude is `alt_amsl_m + pos_ned.z`, so it moves as
+    /// the estimator learns the barometer's offset.
     pub home: Option<Home>,
     /// Velocity over ground in NED, m/s.
     pub vel_ned: Vector3<f32>,
@@ -220,6 +221,8 @@ pub struct Estimator {
     baro_alt: Option<f32>,
     density: f32,
     home: Option<Home>,
+    /// The barometer offset when home was set: heights above home follow the barometer.
+    home_baro_offset: f32,
     mag_nis: f32,
     vel_nis: f32,
     aided_fixes: u32,
@@ -259,6 +262,7 @@ impl Estimator {
             baro_alt: None,
             density: DEFAULT_DENSITY,
             home: None,
+            home_baro_offset: 0.0,
             mag_nis: 0.0,
             vel_nis: 0.0,
             aided_fixes: 0,
@@ -502,7 +506,11 @@ impl Estimator {
                 .baro
                 .gate(f.gated, f.fused == 0, LOCKOUT_SAMPLES)
             {
+                // A barometer that jumped is not believed: heights above home carry on from
+                // where they were.
+                let before = self.ins.baro_offset();
                 self.ins.reset_baro_offset(home.alt_amsl_m - alt);
+                self.home_baro_offset += self.ins.baro_offset() - before;
             }
         }
     }
@@ -609,6 +617,7 @@ impl Estimator {
                 baro_offset,
                 &noise,
             );
+            self.home_baro_offset = self.ins.baro_offset();
             self.ins.reopen_attitude(c.gyro_bias_init);
             self.restart_gps_monitor();
             return;
@@ -689,6 +698,7 @@ impl Estimator {
         self.ins
             .shift_origin(&Vector3::new(n, e, home.alt_amsl_m - old.alt_amsl_m));
         self.home = Some(home);
+        self.home_baro_offset = self.ins.baro_offset();
         true
     }
 
@@ -730,6 +740,22 @@ impl Estimator {
             Some(h) => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
             None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
         };
+        // Height above home is the barometer's rise since home was set (as on PX4 and
+        // ArduPilot), not the GPS-aided altitude's: while GPS averages its altitude noise
+        // down, the altitude above sea level moves by a metre or more, and a home fixed on
+        // that scale would move the runway under a landing. Home's reported altitude moves
+        // instead, by what the estimator has since learnt of the barometer's offset.
+        let drift = self.ins.baro_offset() - self.home_baro_offset;
+        let (pos, home) = match self.home {
+            Some(h) if drift.is_finite() => (
+                Vector3::new(pos.x, pos.y, pos.z - drift),
+                Some(Home {
+                    alt_amsl_m: h.alt_amsl_m - drift,
+                    ..h
+                }),
+            ),
+            other => (pos, other),
+        };
         EstimatedState {
             time_s: self.t,
             attitude: q,
@@ -739,7 +765,7 @@ impl Estimator {
             pos_ned: pos,
             position,
             alt_amsl_m,
-            home: self.home,
+            home,
             vel_ned: vel,
             airspeed,
             airspeed_synthetic,

@@ -807,3 +807,57 @@ fn a_failed_pitot_leaves_a_synthetic_airspeed() {
     }
     assert!(!f.est.state().airspeed_synthetic);
 }
+
+/// Height above home is the barometer's rise since home was set: sitting on the runway after
+/// arming, it stays at the barometer's noise while the GPS-aided altitude above sea level
+/// still wanders as GPS averages its vertical noise down (which a home fixed on that scale
+/// would carry into every landing).
+#[test]
+fn height_above_home_follows_the_barometer() {
+    let segs = [at_speed(level(120.0), 0.0)];
+    let mut f = Flight {
+        dt: DT,
+        est: Estimator::default(),
+        traj: Trajectory::new(
+            &segs,
+            0.0,
+            Vector3::zeros(),
+            1.0,
+            Vector3::new(0.0, 0.0, -260.0),
+        ),
+        sim: SensorSim::new(11),
+    };
+    f.run_until(20.0);
+    let armed = f.est.state();
+    assert!(f.est.set_home(Home {
+        point: armed.position,
+        alt_amsl_m: armed.alt_amsl_m,
+    }));
+    let (mut height, mut amsl) = (Rms::default(), Rms::default());
+    while f.traj.truth().t < 119.0 {
+        f.step();
+        let st = f.est.state();
+        height.add(f64::from(-st.pos_ned.z));
+        amsl.add(f64::from(st.alt_amsl_m - armed.alt_amsl_m));
+        let home = st.home.expect("home set");
+        // One definition: height above home is the altitude above sea level less home's.
+        assert!((st.alt_amsl_m - home.alt_amsl_m + st.pos_ned.z).abs() < 1e-3);
+    }
+    println!(
+        "height above home: {:.3} m RMS ({:.3} max); altitude since arming {:.3} m RMS ({:.3} max)",
+        height.rms(),
+        height.max,
+        amsl.rms(),
+        amsl.max
+    );
+    assert!(
+        height.max < 0.3,
+        "height above home wandered {} m",
+        height.max
+    );
+    assert!(
+        amsl.max > 2.0 * height.max,
+        "the altitude above sea level moved {} m: nothing to tell apart",
+        amsl.max
+    );
+}

@@ -24,10 +24,16 @@
 //!   throttle to the clear height, then climb) to the item's altitude; the course is held along
 //!   the runway once above the clear height.
 //! - Landing flies the line from the previous waypoint (or from where the item began) to the
-//!   land point, level until it meets the glide slope, then down it; below the flare height
-//!   the throttle is closed and the pitch follows a sink rate that shrinks with height; a
-//!   second on the ground (height under `NAV_LND_TD_M`, sinking slower than 0.5 m/s) is the
-//!   touchdown: [`NavOutput::landed`] for the firmware to disarm.
+//!   land point, level until it meets the glide slope, then down it (`LonMode::Glide`: the
+//!   slope's flight-path angle fed forward, a slow integral of the height error, no diving
+//!   back onto the slope). The slope aims short of the point by the flare's own length, so
+//!   the wheels, not the slope, meet the ground at the point. Below the flare height the
+//!   throttle is closed and the pitch follows a sink rate that shrinks with height; once the
+//!   wheels have touched (low and no longer sinking) the pitch goes to 0, as in a wheel
+//!   landing, so the ground's kick on the main wheels does not bounce the aircraft back into
+//!   the air; a second on the ground (height under `NAV_LND_TD_M`, sinking slower than
+//!   0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
+//!   stopped.
 //! - Items with an item-relative altitude frame are heights above home; absolute (AMSL) frames
 //!   are converted with the home altitude; a non-global frame or a NaN altitude keeps the
 //!   present altitude, a latitude/longitude of 0/0 the present position.
@@ -200,12 +206,20 @@ pub const PARAMS: &[ParamDef] = &[
         "Throttle at the start of the flare, faded to zero at touchdown height (keeps the energy a gusty flare needs)",
     ),
     ParamDef::real(
-        "NAV_APP_LEAD_S",
-        3.0,
+        "NAV_APP_DIVE_M",
+        1.0,
+        0.1,
+        50.0,
+        "m",
+        "Approach: the altitude command lies at most this far below the present height (above the slope the aircraft closes it gently instead of diving)",
+    ),
+    ParamDef::real(
+        "NAV_APP_I",
+        0.1,
         0.0,
-        20.0,
-        "s",
-        "Approach: the glide slope's altitude is commanded this far ahead (ground speed x time), making up the altitude loop's lag on the descending ramp",
+        1.0,
+        "1/s",
+        "Approach: integral gain on the height error below or above the glide slope (removes the proportional altitude loop's steady offset there)",
     ),
     ParamDef::real(
         "NAV_STEER_K",
@@ -216,6 +230,9 @@ pub const PARAMS: &[ParamDef] = &[
         "Ground steering: rudder (tail wheel) per radian of course error on the runway",
     ),
 ];
+
+/// Largest height the approach's integral may add to or take off the glide slope, m.
+const SLOPE_TRIM_MAX_M: f32 = 3.0;
 
 /// Ground speed under which a flaring aircraft counts as rolling on the runway, m/s: the
 /// estimated height alone carries the barometer's and GPS's offsets (tenths of a metre).
@@ -274,8 +291,10 @@ pub struct NavParams {
     pub touchdown_alt: f32,
     /// Ground steering gain, rad of rudder per rad of course error.
     pub steer_k: f32,
-    /// Approach altitude lead, s.
-    pub approach_lead: f32,
+    /// Approach integral gain on the height error, 1/s.
+    pub approach_i: f32,
+    /// Largest height the approach's command lies below the present height, m.
+    pub approach_dive: f32,
     /// Flare throttle at the flare height, 0..1.
     pub flare_throttle: f32,
 }
@@ -301,7 +320,8 @@ impl Default for NavParams {
             flare_k: 0.0,
             touchdown_alt: 0.0,
             steer_k: 0.0,
-            approach_lead: 0.0,
+            approach_i: 0.0,
+            approach_dive: 0.0,
             flare_throttle: 0.0,
         };
         for d in PARAMS {
@@ -355,7 +375,8 @@ impl NavParams {
             "NAV_FLR_K" => &mut self.flare_k,
             "NAV_LND_TD_M" => &mut self.touchdown_alt,
             "NAV_STEER_K" => &mut self.steer_k,
-            "NAV_APP_LEAD_S" => &mut self.approach_lead,
+            "NAV_APP_I" => &mut self.approach_i,
+            "NAV_APP_DIVE_M" => &mut self.approach_dive,
             "NAV_FLR_THR" => &mut self.flare_throttle,
             _ => return None,
         })
@@ -551,6 +572,26 @@ struct Landing {
     point: Vector3<f32>,
     phase: LandPhase,
     ground_time: f32,
+    /// The approach's integral of the height error, m (added to the altitude command).
+    slope_trim: f32,
+    /// The wheels have touched (low and no longer sinking): the flare is over and the pitch
+    /// is held at 0 (a taildragger's main wheels, ahead of the centre of gravity, pitch it up
+    /// as they touch; holding the flare's attitude there lifts it off again).
+    touched: bool,
+}
+
+impl Landing {
+    /// An approach from `origin` to the touchdown `point` (both NED from home).
+    fn new(origin: Vector3<f32>, point: Vector3<f32>) -> Self {
+        Self {
+            origin,
+            point,
+            phase: LandPhase::Approach,
+            ground_time: 0.0,
+            slope_trim: 0.0,
+            touched: false,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -651,6 +692,28 @@ fn follow(g: &GuidanceOutput) -> Commands {
             altitude: g.altitude,
             airspeed: g.airspeed,
         },
+    }
+}
+
+/// How far past the point where the glide slope meets the flare height the flare carries
+/// the aircraft at `ground_speed` (m/s) along the approach, m. The flare's sink rate falls
+/// linearly with height from the slope's `s_a` to the touchdown's `s_t` over the flare
+/// height `h_f`: height decays as `e^(-t/tau)` towards `-s_t tau` with `tau = h_f /
+/// (s_a - s_t)`, reaching the ground after `tau ln(s_a / s_t)`.
+fn flare_overrun(p: &NavParams, ground_speed: f32) -> f32 {
+    let tan_slope = libm::tanf(p.glide_slope);
+    let s_a = ground_speed * tan_slope;
+    let s_t = p.flare_sink;
+    if !(s_a > s_t && s_t > 0.0 && tan_slope > 0.0 && p.flare_alt > 0.0) {
+        return 0.0;
+    }
+    let tau = p.flare_alt / (s_a - s_t);
+    let flare_m = ground_speed * tau * libm::logf(s_a / s_t);
+    let overrun = flare_m - p.flare_alt / tan_slope;
+    if overrun.is_finite() {
+        overrun.max(0.0)
+    } else {
+        0.0
     }
 }
 
@@ -760,8 +823,10 @@ impl Navigator {
             ..NavOutput::default()
         };
         let dt = if dt.is_finite() && dt > 0.0 { dt } else { 0.0 };
-        // A new home moves every NED target: fly the present item again from here.
-        if self.home.is_some_and(|h| h != *home) && self.request.is_none() {
+        // A new home point moves every NED target: fly the present item again from here. Its
+        // altitude alone moves as the estimator learns the barometer's offset (heights above
+        // home follow the barometer); that moves no point a mission flies to.
+        if self.home.is_some_and(|h| h.point != home.point) && self.request.is_none() {
             match self.active {
                 Active::Waypoint { .. }
                 | Active::Loiter { .. }
@@ -1046,12 +1111,7 @@ impl Navigator {
                 } else {
                     pos
                 };
-                Active::Land(Landing {
-                    origin,
-                    point: target,
-                    phase: LandPhase::Approach,
-                    ground_time: 0.0,
-                })
+                Active::Land(Landing::new(origin, target))
             }
             // NAV_RETURN_TO_LAUNCH (the only navigation command left).
             _ => Active::Return {
@@ -1306,29 +1366,42 @@ impl Navigator {
             airspeed: p.land_airspeed,
         });
         let mut g = self.guidance.step(&line, &pos, state.ground_speed());
-        // Level at the approach's start height until the glide slope, then down it.
-        let to_go = match line {
+        // Level at the approach's start height until the glide slope, then down it, the
+        // command moving at the slope's rate over the ground so the autopilot can fly the
+        // flight-path angle that rate asks for.
+        let (to_go, along_speed) = match line {
             Path::Line { direction, .. } => {
                 let d = Vector3::new(direction.x, direction.y, 0.0);
                 let n = d.norm();
                 if n > 0.0 {
-                    ((l.point - pos).dot(&d) / n).max(0.0)
+                    (
+                        ((l.point - pos).dot(&d) / n).max(0.0),
+                        state.vel_ned.dot(&d) / n,
+                    )
                 } else {
-                    0.0
+                    (0.0, 0.0)
                 }
             }
-            Path::Orbit { .. } => 0.0,
+            Path::Orbit { .. } => (0.0, 0.0),
         };
         let start_h = -l.origin.z;
-        // A P altitude loop follows a ramp with a steady lag (rate / velocity constant: some
-        // 6 m on a 6 deg slope at 14 m/s on the Ultra Stick), so the command leads the slope.
-        let lead = (p.approach_lead * state.ground_speed()).max(0.0);
-        let ahead = if lead.is_finite() {
-            (to_go - lead).max(0.0)
+        let tan_slope = libm::tanf(p.glide_slope);
+        // The slope aims short of the point by as far as the flare carries past where the
+        // slope meets the flare height, so that the wheels touch at the point.
+        let along = if along_speed.is_finite() {
+            along_speed.max(0.0)
         } else {
-            to_go
+            0.0
         };
-        g.altitude = (-l.point.z + libm::tanf(p.glide_slope) * ahead).min(start_h.max(-l.point.z));
+        let ahead = (to_go - flare_overrun(&p, along)).max(0.0);
+        let on_slope = -l.point.z + tan_slope * ahead;
+        let top = start_h.max(-l.point.z);
+        g.altitude = on_slope.min(top);
+        let climb_rate = if ahead > 0.0 && on_slope < top && along_speed.is_finite() {
+            -tan_slope * along_speed.max(0.0)
+        } else {
+            0.0
+        };
         out.guidance = Some(g);
         out.target = Some(l.point);
         if l.phase == LandPhase::Approach && hagl < p.flare_alt {
@@ -1338,6 +1411,7 @@ impl Navigator {
             let sink = state.vel_ned.z;
             let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
             if on_ground && sink < TOUCHDOWN_SINK {
+                l.touched = true;
                 l.ground_time += dt;
             } else {
                 l.ground_time = 0.0;
@@ -1349,17 +1423,38 @@ impl Navigator {
         match l.phase {
             LandPhase::Approach => {
                 out.phase = Phase::Approach;
-                out.commands = Some(follow(&g));
+                // The altitude loop is proportional: on the slope it settles below it by what
+                // its gain needs to make the pitch the slower approach flies at (a metre on
+                // the Ultra Stick). A slow integral of the height error takes that out.
+                let err = g.altitude - state.height();
+                if climb_rate != 0.0 && err.is_finite() {
+                    l.slope_trim = (l.slope_trim + p.approach_i * err * dt)
+                        .clamp(-SLOPE_TRIM_MAX_M, SLOPE_TRIM_MAX_M);
+                }
+                // Caught high by a gust near the ground, the aircraft is not dived back onto
+                // the slope (that arrives at the flare sinking fast): the command stays within
+                // `NAV_APP_DIVE_M` below the present height, and the landing is long instead.
+                let cmd = (g.altitude + l.slope_trim).max(state.height() - p.approach_dive);
+                out.commands = Some(Commands {
+                    lon: LonMode::Glide {
+                        altitude: cmd,
+                        airspeed: g.airspeed,
+                        climb_rate,
+                    },
+                    ..follow(&g)
+                });
             }
             LandPhase::Flare => {
                 out.phase = Phase::Flare;
                 // The sink rate aimed for shrinks from the glide's to the touchdown's with
                 // height; pitch up as the aircraft sinks faster than that.
-                let approach_sink = p.land_airspeed * libm::sinf(p.glide_slope);
+                let approach_sink = along * tan_slope;
                 let frac = (hagl / p.flare_alt).clamp(0.0, 1.0);
                 let aim = p.flare_sink + (approach_sink - p.flare_sink).max(0.0) * frac;
                 let sink = state.vel_ned.z;
-                let pitch = if sink.is_finite() {
+                let pitch = if l.touched {
+                    0.0
+                } else if sink.is_finite() {
                     (p.flare_pitch + p.flare_k * (sink - aim)).clamp(p.flare_pitch, 15.0 * DEG)
                 } else {
                     p.flare_pitch
@@ -1464,12 +1559,7 @@ impl Navigator {
                     .unwrap_or(orbit_path(&circle, airspeed));
                 self.emit(&path, state, Some(gate), Phase::Return, out);
                 if reached {
-                    ReturnPhase::Land(Landing {
-                        origin: gate,
-                        point: Vector3::zeros(),
-                        phase: LandPhase::Approach,
-                        ground_time: 0.0,
-                    })
+                    ReturnPhase::Land(Landing::new(gate, Vector3::zeros()))
                 } else {
                     phase
                 }
