@@ -124,6 +124,10 @@ enum Command {
         /// Directory for the ground-track PNGs.
         #[arg(long, default_value = "docs/img")]
         img: PathBuf,
+        /// Results document whose missions section is rewritten with the summary (the rest
+        /// of it, `sim-host scenario all --results`'s, is kept).
+        #[arg(long, default_value = "docs/RESULTS.md")]
+        results: PathBuf,
     },
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
@@ -304,6 +308,12 @@ fn run() -> anyhow::Result<ExitCode> {
                     &format!("sim-host {cmdline}"),
                     &aircraft,
                 );
+                // The missions section belongs to `sim-host navigation`: kept as it is.
+                let old = std::fs::read_to_string(path).unwrap_or_default();
+                let md = match sim_host::report::section(&old, commands::navigation::SECTION) {
+                    Some(missions) => format!("{}\n\n{missions}\n", md.trim_end()),
+                    None => md,
+                };
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir)
                         .with_context(|| format!("cannot create `{}`", dir.display()))?;
@@ -341,22 +351,32 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Fly(args)) => fly_command(&aircraft, args),
-        Some(Command::Navigation { out, img }) => {
+        Some(Command::Navigation { out, img, results }) => {
             let existing = std::fs::read_to_string(&out).ok();
             let command = format!(
-                "cargo run --release -p sim-host -- navigation --out {} --img {}",
+                "cargo run --release -p sim-host -- navigation --out {} --img {} --results {}",
                 out.display(),
-                img.display()
+                img.display(),
+                results.display()
             );
-            let md = commands::navigation::navigation_markdown(
+            let docs = commands::navigation::navigation_markdown(
                 &aircraft,
                 &command,
                 &img,
                 existing.as_deref(),
             )?;
-            std::fs::write(&out, md)
+            std::fs::write(&out, docs.navigation)
                 .with_context(|| format!("cannot write `{}`", out.display()))?;
             emit(&format!("wrote {}\n", out.display()))?;
+            let old = std::fs::read_to_string(&results).unwrap_or_default();
+            let md = sim_host::report::splice_section(
+                &old,
+                commands::navigation::SECTION,
+                &docs.results_section,
+            );
+            std::fs::write(&results, md)
+                .with_context(|| format!("cannot write `{}`", results.display()))?;
+            emit(&format!("wrote {}\n", results.display()))?;
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Validation { out, out_dir }) => {

@@ -29,7 +29,7 @@
 //!   back onto the slope). The slope aims short of the point by the flare's own length, so
 //!   the wheels, not the slope, meet the ground at the point. Below the flare height the
 //!   throttle is closed and the pitch follows a sink rate that shrinks with height; once the
-//!   wheels have touched (low and no longer sinking) the pitch goes to 0, as in a wheel
+//!   wheels have touched (low and rising again) the pitch goes to 0, as in a wheel
 //!   landing, so the ground's kick on the main wheels does not bounce the aircraft back into
 //!   the air; a second on the ground (height under `NAV_LND_TD_M`, sinking slower than
 //!   0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
@@ -250,6 +250,9 @@ const STOPPED_SPEED: f32 = 1.0;
 const TOUCHDOWN_S: f32 = 1.0;
 /// Sink rate under which the aircraft counts as on the ground, m/s.
 const TOUCHDOWN_SINK: f32 = 0.5;
+/// Climb rate that, below the touchdown height, shows the wheels have touched and kicked the
+/// aircraft up, m/s.
+const BOUNCE_CLIMB: f32 = 0.3;
 
 /// The executor's parameters in SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -574,7 +577,7 @@ struct Landing {
     ground_time: f32,
     /// The approach's integral of the height error, m (added to the altitude command).
     slope_trim: f32,
-    /// The wheels have touched (low and no longer sinking): the flare is over and the pitch
+    /// The wheels have touched (low and rising again): the flare is over and the pitch
     /// is held at 0 (a taildragger's main wheels, ahead of the centre of gravity, pitch it up
     /// as they touch; holding the flare's attitude there lifts it off again).
     touched: bool,
@@ -1410,8 +1413,12 @@ impl Navigator {
         if l.phase == LandPhase::Flare {
             let sink = state.vel_ned.z;
             let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
-            if on_ground && sink < TOUCHDOWN_SINK {
+            // Rising again this close to the ground is the wheels' kick (or a gust about to
+            // balloon the aircraft): from then on the flare's pitch-up is over.
+            if hagl < p.touchdown_alt && sink < -BOUNCE_CLIMB {
                 l.touched = true;
+            }
+            if on_ground && sink < TOUCHDOWN_SINK {
                 l.ground_time += dt;
             } else {
                 l.ground_time = 0.0;

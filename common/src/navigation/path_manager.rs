@@ -31,10 +31,14 @@ use crate::params::{check_param, default_of};
 use crate::params::{ParamDef, ParamError};
 use nalgebra::{Vector2, Vector3};
 
-/// Parameters of the path manager.
+/// Parameters of the path manager. The default fillet radius is the Ultra Stick's turn over
+/// ground with the wind behind it: 17 m/s of airspeed and 5 m/s of wind make 22 m/s, and at
+/// 35 degrees of bank (the 45-degree limit less room for gusts and the course loop)
+/// `22^2 / (g tan 35)` is 70 m. A 50 m fillet held the bank on its limit downwind and let one
+/// gust carry the aircraft 20 m outside the corner.
 pub const PARAMS: &[ParamDef] = &[ParamDef::real(
     "NAV_TURN_RAD",
-    50.0,
+    70.0,
     5.0,
     500.0,
     "m",
@@ -294,7 +298,14 @@ mod tests {
     fn params_well_formed() {
         assert_eq!(validate_defs(PARAMS), Ok(()));
         let mut m = PathManager::default();
-        assert_eq!(m.turn_radius(), 50.0);
+        // The default is the turn over ground of 22 m/s (17 m/s of airspeed, 5 m/s of wind
+        // behind) at 35 degrees of bank.
+        let r = 22.0f32 * 22.0 / (9.80665 * libm::tanf(35f32.to_radians()));
+        assert!(
+            (m.turn_radius() - r).abs() < 1.0,
+            "{} vs {r}",
+            m.turn_radius()
+        );
         assert_eq!(m.set("NAV_TURN_RAD", 1.0), Err(ParamError::OutOfBounds));
         assert_eq!(m.set("NAV_TURN_RAD", 60.0), Ok(()));
         assert_eq!(m.turn_radius(), 60.0);

@@ -59,6 +59,17 @@ fn ground_track(samples: &[Sample], title: &str, path: &Path) -> anyhow::Result<
     ground_track_figure(samples, title).save_png(path)
 }
 
+/// Name of the section `sim-host navigation` writes into `docs/RESULTS.md`.
+pub const SECTION: &str = "missions";
+
+/// What `sim-host navigation` writes.
+pub struct NavigationDocs {
+    /// The whole of `docs/NAVIGATION.md`.
+    pub navigation: String,
+    /// The missions section of `docs/RESULTS.md`: the summary of the same flights.
+    pub results_section: String,
+}
+
 /// Flies the cases and writes the document's generated part; the notes below
 /// [`NOTES_MARKER`] in an existing `out` file are kept. Plots go to `img_dir`.
 pub fn navigation_markdown(
@@ -66,7 +77,7 @@ pub fn navigation_markdown(
     command: &str,
     img_dir: &Path,
     existing: Option<&str>,
-) -> anyhow::Result<String> {
+) -> anyhow::Result<NavigationDocs> {
     std::fs::create_dir_all(img_dir)
         .with_context(|| format!("cannot create `{}`", img_dir.display()))?;
     let mut md = String::new();
@@ -167,7 +178,65 @@ pub fn navigation_markdown(
         .and_then(|e| e.find(NOTES_MARKER).map(|i| &e[i..]))
         .unwrap_or("\n---\n\n*Everything above the line is written by the command named at the top; notes below it are kept.*\n");
     md.push_str(notes.trim_start_matches('\n'));
-    Ok(md)
+    let results_section = results_summary(command, &calm_m, &windy, img_dir);
+    Ok(NavigationDocs {
+        navigation: md,
+        results_section,
+    })
+}
+
+/// The missions section of `docs/RESULTS.md`: calm air and the windy seeds in two rows.
+fn results_summary(
+    command: &str,
+    calm: &MissionSummary,
+    windy: &[MissionSummary],
+    img_dir: &Path,
+) -> String {
+    let n = windy.len();
+    let max = |f: &dyn Fn(&MissionSummary) -> f64| windy.iter().map(f).fold(f64::NAN, f64::max);
+    let count = |f: &dyn Fn(&MissionSummary) -> bool| windy.iter().filter(|m| f(m)).count();
+    let tds: Vec<_> = windy.iter().filter_map(|m| m.touchdown).collect();
+    let along_lo = tds.iter().map(|t| t.along_m).fold(f64::NAN, f64::min);
+    let along_hi = tds.iter().map(|t| t.along_m).fold(f64::NAN, f64::max);
+    let sink_hi = tds.iter().map(|t| t.sink_rate_mps).fold(f64::NAN, f64::max);
+    let calm_td = calm.touchdown.map_or("none".to_string(), |t| {
+        format!("{:.1} m ({:+.1} along)", t.distance_m, t.along_m)
+    });
+    let calm_sink = calm
+        .touchdown
+        .map_or("-".to_string(), |t| format!("{:.2}", t.sink_rate_mps));
+    let yes = |b: bool| if b { "yes" } else { "**no**" };
+    format!(
+        "## Missions from the runway to the runway\n\n\
+         Written by `{command}`; the flights, every seed and the notes are in \
+         [NAVIGATION.md](NAVIGATION.md). The firmware flies the default mission (take-off, a \
+         rectangle with an orbit, return, landing) on its own estimates over the simulator \
+         link. Targets: {TARGETS}.\n\n\
+         | case | waypoints | straight-leg cross-track RMS (m) | altitude RMS (m) | airspeed RMS (m/s) | touchdown | sink (m/s) | meets targets |\n\
+         |---|---|---|---|---|---|---|---|\n\
+         | calm air | {}/{} | {} | {} | {} | {calm_td} | {calm_sink} | {} |\n\
+         | 5 m/s wind, light turbulence, {n} seeds | all on {} | {} at most; under 2 on {} | {} at most | {} at most | {:+.1} to {:+.1} m along; within 20 m on {} | {:.2} at most; under 1.5 on {} | on {} of {n} |\n\n\
+         ![ground track, calm air]({}) ![ground track, wind and turbulence]({})\n",
+        calm.reached.len(),
+        calm.nav_items.len(),
+        sig(calm.xtrack_rms_m, 3),
+        sig(calm.alt_rms_m, 3),
+        sig(calm.airspeed_rms_mps, 3),
+        yes(meets_targets(calm, true)),
+        count(&|m| m.all_reached),
+        sig(max(&|m| m.xtrack_rms_m), 3),
+        count(&|m| m.xtrack_rms_m < 2.0),
+        sig(max(&|m| m.alt_rms_m), 3),
+        sig(max(&|m| m.airspeed_rms_mps), 3),
+        along_lo,
+        along_hi,
+        count(&|m| m.touchdown.is_some_and(|t| t.distance_m < 20.0)),
+        sink_hi,
+        count(&|m| m.touchdown.is_some_and(|t| t.sink_rate_mps < 1.5)),
+        count(&|m| meets_targets(m, false)),
+        rel(&img_dir.join("mission-calm.png")),
+        rel(&img_dir.join("mission-wind.png")),
+    )
 }
 
 /// How many of the windy flights meet each target, and the spread of their touchdowns.

@@ -29,6 +29,34 @@ pub fn sig(x: f64, digits: usize) -> String {
     format!("{:.*}", decimals, x)
 }
 
+/// The opening marker of a section `name` that a command writes into a document another
+/// command owns (`docs/RESULTS.md` carries the missions of `sim-host navigation`).
+fn section_markers(name: &str) -> (String, String) {
+    (
+        format!("<!-- begin {name} (generated; do not edit) -->"),
+        format!("<!-- end {name} -->"),
+    )
+}
+
+/// The section `name` of `doc`, markers included, if it has one.
+pub fn section<'a>(doc: &'a str, name: &str) -> Option<&'a str> {
+    let (begin, end) = section_markers(name);
+    let i = doc.find(&begin)?;
+    let j = doc[i..].find(&end)? + i + end.len();
+    Some(&doc[i..j])
+}
+
+/// `doc` with its section `name` replaced by `body` (between the markers), or with the
+/// section appended when it has none.
+pub fn splice_section(doc: &str, name: &str, body: &str) -> String {
+    let (begin, end) = section_markers(name);
+    let block = format!("{begin}\n{}\n{end}", body.trim_end());
+    match section(doc, name) {
+        Some(old) => doc.replacen(old, &block, 1),
+        None => format!("{}\n\n{block}\n", doc.trim_end()),
+    }
+}
+
 /// Relative difference `(ours - reference) / |reference|` in percent.
 pub fn pct(ours: f64, reference: f64) -> f64 {
     100.0 * (ours - reference) / reference.abs()
@@ -45,5 +73,21 @@ mod tests {
         assert_eq!(sig(826.677, 5), "826.68");
         assert_eq!(sig(1.2e-7, 3), "1.20e-7");
         assert!((pct(1.01, 1.0) - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn sections_are_replaced_in_place_or_appended() {
+        let doc = "# Title\n\nText.\n";
+        let one = splice_section(doc, "missions", "first\n");
+        assert!(one.starts_with("# Title\n\nText.\n\n<!-- begin missions"));
+        assert_eq!(
+            section(&one, "missions").map(|s| s.contains("first")),
+            Some(true)
+        );
+        let more = format!("{one}\nAfter.\n");
+        let two = splice_section(&more, "missions", "second");
+        assert!(!two.contains("first") && two.contains("second"));
+        assert!(two.ends_with("<!-- end missions -->\n\nAfter.\n"), "{two}");
+        assert_eq!(section(doc, "missions"), None);
     }
 }
