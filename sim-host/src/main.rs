@@ -193,6 +193,34 @@ struct FlyArgs {
     /// Wall-clock pace with --realtime: simulated seconds per wall second.
     #[arg(long, default_value_t = 1.0)]
     speed: f64,
+    /// Set an autopilot parameter before arming (PARAM_SET from the ground station), after
+    /// the mission's own tuning; repeatable: `--param NAV_LND_SLP_DEG=6`.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    params: Vec<(String, f32)>,
+}
+
+/// `NAME=VALUE` for `--param`, checked against the autopilot's parameters (name, bounds).
+fn parse_param(s: &str) -> Result<(String, f32), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected NAME=VALUE"))?;
+    let v: f32 = value
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: value `{value}`: {e}"))?;
+    let name = name.trim();
+    let def = firmware::app::REGISTRY
+        .iter()
+        .flat_map(|list| list.iter())
+        .find(|d| d.name == name)
+        .ok_or_else(|| format!("`{s}`: the autopilot has no parameter `{name}`"))?;
+    def.check(v).map_err(|e| {
+        format!(
+            "`{s}`: {name} refuses {v} ({e:?}; bounds {} to {} {})",
+            def.min, def.max, def.unit
+        )
+    })?;
+    Ok((name.to_string(), v))
 }
 
 fn parse_wind(s: &str) -> Result<[f64; 3], String> {
@@ -452,6 +480,7 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
     if let Some(d) = a.duration {
         cfg.duration_s = d;
     }
+    cfg.script.params.extend(a.params.iter().cloned());
     if let Some(g) = a.gains {
         let names: Vec<&str> = common::control::gains::NAMED
             .iter()

@@ -36,3 +36,27 @@ fn linearize_json_and_unknown_trim() {
     assert!(!ok);
     assert!(err.contains("unknown trim `loop`"), "{err}");
 }
+
+/// A parameter the autopilot does not have, or a value outside its bounds, is refused before
+/// anything flies, with the name, the value and the bounds (`NAV_LND_SLP_DEG`: 1 to 20 deg).
+#[test]
+fn fly_refuses_a_parameter_the_autopilot_would_refuse() {
+    let (ok, _, err) = run(&["fly", "--mission", "default", "--param", "NAV_FOO=1"]);
+    assert!(!ok);
+    assert!(err.contains("no parameter `NAV_FOO`"), "{err}");
+    let (ok, _, err) = run(&[
+        "fly",
+        "--mission",
+        "default",
+        "--param",
+        "NAV_LND_SLP_DEG=60",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("NAV_LND_SLP_DEG refuses 60") && err.contains("bounds 1 to 20 deg"),
+        "{err}"
+    );
+    let (ok, _, err) = run(&["fly", "--param", "NAV_LND_SLP_DEG=steep"]);
+    assert!(!ok);
+    assert!(err.contains("value `steep`"), "{err}");
+}

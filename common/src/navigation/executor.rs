@@ -231,8 +231,11 @@ pub const PARAMS: &[ParamDef] = &[
     ),
 ];
 
-/// Largest height the approach's integral may add to or take off the glide slope, m.
-const SLOPE_TRIM_MAX_M: f32 = 3.0;
+/// Largest height the approach's integral may add to or take off the glide slope, m, and the
+/// largest height error it integrates: it is there for the metre the proportional loop
+/// leaves on the slope, not for a gust's (winding up on those flew the aircraft under the
+/// slope once it was back on it).
+const SLOPE_TRIM_MAX_M: f32 = 1.5;
 
 /// Ground speed under which a flaring aircraft counts as rolling on the runway, m/s: the
 /// estimated height alone carries the barometer's and GPS's offsets (tenths of a metre).
@@ -1434,7 +1437,7 @@ impl Navigator {
                 // its gain needs to make the pitch the slower approach flies at (a metre on
                 // the Ultra Stick). A slow integral of the height error takes that out.
                 let err = g.altitude - state.height();
-                if climb_rate != 0.0 && err.is_finite() {
+                if climb_rate != 0.0 && libm::fabsf(err) < SLOPE_TRIM_MAX_M {
                     l.slope_trim = (l.slope_trim + p.approach_i * err * dt)
                         .clamp(-SLOPE_TRIM_MAX_M, SLOPE_TRIM_MAX_M);
                 }
