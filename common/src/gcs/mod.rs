@@ -299,20 +299,7 @@ impl GroundLink {
 
     /// Says what an accepted mission will do differently from what its reader may expect.
     fn mission_warning(&mut self, w: ValidationWarning) {
-        let sev = MavSeverity::MAV_SEVERITY_WARNING;
-        match w {
-            ValidationWarning::NoLanding => {
-                self.send_statustext(sev, "Mission has no landing: it ends circling")
-            }
-            ValidationWarning::WillSkip { seq, command } => self.textf(
-                sev,
-                format_args!("Mission item {seq}: command {command} not supported, skipped"),
-            ),
-            ValidationWarning::ApproachTooShort { seq } => self.textf(
-                sev,
-                format_args!("Mission item {seq}: landing approach too short, arrives high"),
-            ),
-        }
+        self.textf(MavSeverity::MAV_SEVERITY_WARNING, format_args!("{w}"));
     }
 
     fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {

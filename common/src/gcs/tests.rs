@@ -1915,6 +1915,6 @@ fn uploads_are_checked_as_the_navigator_will_fly_them() {
     assert_eq!(result, MavMissionResult::MAV_MISSION_ACCEPTED);
     said.extend(texts(&poll(&mut l, &v, 4_500_000)));
     let said = said.join(" | ");
-    assert!(said.contains("item 1: command 183 not supported"), "{said}");
+    assert!(said.contains("Item 1: command 183 unsupported"), "{said}");
     assert!(said.contains("no landing"), "{said}");
 }

@@ -91,6 +91,22 @@ pub enum ValidationWarning {
     },
 }
 
+/// The text the ground station shows (one STATUSTEXT, 50 characters even for the largest
+/// sequence numbers and commands).
+impl core::fmt::Display for ValidationWarning {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ValidationWarning::NoLanding => f.write_str("Mission has no landing: it ends circling"),
+            ValidationWarning::WillSkip { seq, command } => {
+                write!(f, "Item {seq}: command {command} unsupported, skipped")
+            }
+            ValidationWarning::ApproachTooShort { seq } => {
+                write!(f, "Item {seq}: approach too short, arrives high")
+            }
+        }
+    }
+}
+
 /// The outcome of a check.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Validation {
@@ -216,6 +232,23 @@ fn check_item(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every warning fits one STATUSTEXT whole, with the largest numbers it can carry.
+    #[test]
+    fn warnings_fit_one_statustext() {
+        use core::fmt::Write as _;
+        for w in [
+            ValidationWarning::NoLanding,
+            ValidationWarning::WillSkip {
+                seq: u16::MAX,
+                command: u16::MAX,
+            },
+            ValidationWarning::ApproachTooShort { seq: u16::MAX },
+        ] {
+            let mut s: heapless::String<{ crate::gcs::STATUSTEXT_LEN }> = heapless::String::new();
+            assert!(write!(s, "{w}").is_ok(), "{w:?} does not fit: {s}");
+        }
+    }
     use crate::params::validate_defs;
 
     use crate::navigation::tests::{home, item};
