@@ -66,48 +66,14 @@ fn the_default_mission_flies_from_runway_to_runway_in_calm_air() {
 }
 
 /// In a 5 m/s wind from the north-north-east (a headwind and crosswind on the landing) with
-/// light Dryden turbulence, on estimates: what holds on every seed of `docs/NAVIGATION.md`
-/// (every waypoint reached, straight legs within 2 m, altitude within 1.5 m and airspeed
-/// within 1 m/s RMS, landed under 1.5 m/s, stopped and disarmed) and on all but one of each
-/// twenty (touchdown within 20 m of the point) is asserted here, on the seed the document plotted before it
-/// flew twenty. Every target is met on 38 seeds of 40 (two land 20.1 and 20.5 m long); the
-/// ignored test below holds every target on every seed.
+/// light Dryden turbulence, on estimates, on every one of the forty seeds of
+/// `docs/NAVIGATION.md` (a landing in turbulence is judged on its spread, not on one gust):
+/// every waypoint in order, straight legs within 2 m, altitude within 1.5 m and airspeed
+/// within 1 m/s RMS, touchdown within 20 m of the point under 1.5 m/s, stopped and disarmed.
 #[test]
-fn the_default_mission_flies_in_a_5_mps_wind_with_light_turbulence() {
-    let o = fly_default(navigation::WIND_NED, Turbulence::Light, 7);
-    let m = o.summary.mission.clone().expect("a mission was flown");
-    eprintln!("{m:#?}");
-    assert!(
-        m.all_reached,
-        "reached {:?} of {:?}",
-        m.reached, m.nav_items
-    );
-    assert_eq!(m.reached, m.nav_items, "in order, each once");
-    assert!(m.xtrack_rms_m < 2.0, "cross-track {:.2} m", m.xtrack_rms_m);
-    assert!(m.alt_rms_m < 1.5, "altitude {:.2} m", m.alt_rms_m);
-    assert!(
-        m.airspeed_rms_mps < 1.0,
-        "airspeed {:.2} m/s",
-        m.airspeed_rms_mps
-    );
-    let td = m.touchdown.expect("touched down");
-    assert!(
-        td.distance_m < 20.0,
-        "touchdown {:.1} m away",
-        td.distance_m
-    );
-    assert!(
-        td.sink_rate_mps < 1.5,
-        "sink rate {:.2} m/s",
-        td.sink_rate_mps
-    );
-    assert!(!o.samples.last().expect("samples").armed, "disarmed");
-}
-
-#[test]
-#[ignore = "38 of 40 seeds meet every target in turbulence (two land 20.1 and 20.5 m long): see docs/NAVIGATION.md"]
-fn the_default_mission_meets_every_target_in_wind_and_turbulence() {
+fn the_default_mission_meets_every_target_in_wind_and_turbulence_on_forty_seeds() {
     for &seed in navigation::SEEDS.iter().chain(&navigation::CHECK_SEEDS) {
+        eprintln!("seed {seed}");
         let o = fly_default(navigation::WIND_NED, Turbulence::Light, seed);
         let m = landed_as_planned(&o);
         assert!(

@@ -28,11 +28,12 @@
 //!   slope's flight-path angle fed forward, a slow integral of the height error, no diving
 //!   back onto the slope). The slope aims short of the point by the flare's own length, so
 //!   the wheels, not the slope, meet the ground at the point. Below the flare height the
-//!   throttle is closed and the pitch follows a sink rate that shrinks with height; once the
-//!   wheels have touched (low and rising again) the pitch goes to 0, as in a wheel
-//!   landing, so the ground's kick on the main wheels does not bounce the aircraft back into
-//!   the air; a second on the ground (height under `NAV_LND_TD_M`, sinking slower than
-//!   0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
+//!   throttle is closed and the pitch follows a sink rate that shrinks with height (past the
+//!   point a faster one, so that a gust's extra speed does not float the aircraft far down
+//!   the runway); once the wheels have touched (low and rising again) the pitch goes to 0, as
+//!   in a wheel landing, so the ground's kick on the main wheels does not bounce the aircraft
+//!   back into the air; a second on the ground (height under `NAV_LND_TD_M`, sinking slower
+//!   than 0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
 //!   stopped.
 //! - Items with an item-relative altitude frame are heights above home; absolute (AMSL) frames
 //!   are converted with the home altitude; a non-global frame or a NaN altitude keeps the
@@ -190,6 +191,14 @@ pub const PARAMS: &[ParamDef] = &[
         "Flare pitch per m/s of sink rate above the aim",
     ),
     ParamDef::real(
+        "NAV_FLR_PAST_K",
+        0.05,
+        0.0,
+        1.0,
+        "1/s",
+        "Flare past the land point: sink rate aimed for rises this much per metre past it (0: no steering)",
+    ),
+    ParamDef::real(
         "NAV_LND_TD_M",
         0.5,
         0.05,
@@ -253,6 +262,9 @@ const STOPPED_SPEED: f32 = 1.0;
 const TOUCHDOWN_S: f32 = 1.0;
 /// Sink rate under which the aircraft counts as on the ground, m/s.
 const TOUCHDOWN_SINK: f32 = 0.5;
+/// Fastest sink a flare that has floated past the land point aims for, m/s: two thirds of the
+/// 1.5 m/s a small aircraft's landing gear is held to.
+const PAST_SINK_MAX: f32 = 1.0;
 /// Climb rate that, below the touchdown height, shows the wheels have touched and kicked the
 /// aircraft up, m/s.
 const BOUNCE_CLIMB: f32 = 0.3;
@@ -301,6 +313,8 @@ pub struct NavParams {
     pub approach_i: f32,
     /// Largest height the approach's command lies below the present height, m.
     pub approach_dive: f32,
+    /// Flare's sink aim per metre past the land point, 1/s.
+    pub flare_past_k: f32,
     /// Flare throttle at the flare height, 0..1.
     pub flare_throttle: f32,
 }
@@ -328,6 +342,7 @@ impl Default for NavParams {
             steer_k: 0.0,
             approach_i: 0.0,
             approach_dive: 0.0,
+            flare_past_k: 0.0,
             flare_throttle: 0.0,
         };
         for d in PARAMS {
@@ -383,6 +398,7 @@ impl NavParams {
             "NAV_STEER_K" => &mut self.steer_k,
             "NAV_APP_I" => &mut self.approach_i,
             "NAV_APP_DIVE_M" => &mut self.approach_dive,
+            "NAV_FLR_PAST_K" => &mut self.flare_past_k,
             "NAV_FLR_THR" => &mut self.flare_throttle,
             _ => return None,
         })
@@ -1375,21 +1391,19 @@ impl Navigator {
         // Level at the approach's start height until the glide slope, then down it, the
         // command moving at the slope's rate over the ground so the autopilot can fly the
         // flight-path angle that rate asks for.
-        let (to_go, along_speed) = match line {
+        let (signed_to_go, along_speed) = match line {
             Path::Line { direction, .. } => {
                 let d = Vector3::new(direction.x, direction.y, 0.0);
                 let n = d.norm();
                 if n > 0.0 {
-                    (
-                        ((l.point - pos).dot(&d) / n).max(0.0),
-                        state.vel_ned.dot(&d) / n,
-                    )
+                    ((l.point - pos).dot(&d) / n, state.vel_ned.dot(&d) / n)
                 } else {
                     (0.0, 0.0)
                 }
             }
             Path::Orbit { .. } => (0.0, 0.0),
         };
+        let to_go = signed_to_go.max(0.0);
         let start_h = -l.origin.z;
         let tan_slope = libm::tanf(p.glide_slope);
         // The slope aims short of the point by as far as the flare carries past where the
@@ -1461,11 +1475,23 @@ impl Navigator {
                 let approach_sink = along * tan_slope;
                 let frac = (hagl / p.flare_alt).clamp(0.0, 1.0);
                 let aim = p.flare_sink + (approach_sink - p.flare_sink).max(0.0) * frac;
+                // Floating past the point (a gust's extra speed at the flare), the flare gives
+                // up on the gentlest touchdown for a nearer one: a faster sink aimed for the
+                // farther past, up to `PAST_SINK_MAX`, and the nose may come down to level.
+                let past = -signed_to_go;
+                let (aim, floor) = if past > 0.0 && p.flare_past_k > 0.0 {
+                    (
+                        (aim + p.flare_past_k * past).min(PAST_SINK_MAX.max(aim)),
+                        0.0,
+                    )
+                } else {
+                    (aim, p.flare_pitch)
+                };
                 let sink = state.vel_ned.z;
                 let pitch = if l.touched {
                     0.0
                 } else if sink.is_finite() {
-                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(p.flare_pitch, 15.0 * DEG)
+                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(floor, 15.0 * DEG)
                 } else {
                     p.flare_pitch
                 };
