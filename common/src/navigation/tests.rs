@@ -814,3 +814,97 @@ fn warning_texts_fit_one_statustext() {
         assert!(w.text().len() <= crate::gcs::STATUSTEXT_LEN, "{w:?}");
     }
 }
+
+/// A landing begun high above the glide slope closes the gap without diving: on the approach
+/// the altitude command never lies more than `NAV_APP_DIVE_M` below the aircraft, and the
+/// aircraft is on the slope (within 1 m) before the flare.
+#[test]
+fn a_high_approach_comes_down_to_the_slope_without_diving() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let dive = nav.params().approach_dive;
+    // 300 m out at 33 m, heading for the point: the 6-degree slope there is some 5 m lower, a
+    // gap the model's altitude loop (2 s) closes at 0.5 m/s with the 1 m limit, in 10 s.
+    let mut plane = Plane::flying(300.0, 0.0, 33.0, core::f32::consts::PI);
+    nav.start_mission(0);
+    let mut prev_height = 33.0;
+    let mut saw_limit = false;
+    let log = fly(&mut nav, &mut plane, &items, 120.0, |o| {
+        o.phase == Phase::Flare
+    });
+    for (_, o, p) in &log.outs {
+        if o.phase != Phase::Approach {
+            continue;
+        }
+        let Some(LonMode::Glide { altitude, .. }) = o.commands.map(|c| c.lon) else {
+            panic!("approach without a glide command: {:?}", o.commands);
+        };
+        // The command was made from the height before this step.
+        assert!(
+            altitude >= prev_height - dive - 1e-3,
+            "command {altitude} m with the aircraft at {prev_height} m"
+        );
+        if let Some(g) = o.guidance {
+            saw_limit |= altitude > g.altitude + 1.0;
+        }
+        prev_height = -p.z;
+    }
+    assert!(
+        saw_limit,
+        "the slope was never more than 1 m below the command"
+    );
+    let (_, last_approach, p) = log
+        .outs
+        .iter()
+        .rev()
+        .find(|o| o.1.phase == Phase::Approach)
+        .expect("an approach");
+    let slope = last_approach.guidance.expect("guidance").altitude;
+    assert!(
+        (-p.z - slope).abs() < 1.0,
+        "{} m vs the slope's {slope} m",
+        -p.z
+    );
+}
+
+/// A flare that has floated past the land point aims for a faster sink and may lower the
+/// nose below the flare's pitch: 15 m past at 1 m, `NAV_FLR_PAST_K` 0.05 asks for 0.75 m/s
+/// more sink than the schedule (up to 1 m/s), each m/s of it `NAV_FLR_K` (0.15 rad) less
+/// pitch, down to level at most; without it the pitch stays at or above `NAV_FLR_PTCH_DEG`.
+#[test]
+fn a_flare_past_the_point_pitches_down_for_the_runway() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let pitch_past = |k: f32| {
+        let mut nav = navigator();
+        nav.set_param("NAV_FLR_PAST_K", k).expect("in range");
+        let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
+        nav.start_mission(0);
+        fly(&mut nav, &mut plane, &items, 120.0, |o| {
+            o.phase == Phase::Flare
+        });
+        // Floated on: 15 m past the point, 1 m up, sinking as the flare left it.
+        plane.k.pos = Vector3::new(-15.0, 0.0, -1.0);
+        let state = plane.state();
+        let out = nav.step(&items, &home(), &state, DT);
+        assert_eq!(out.phase, Phase::Flare);
+        match out.commands.map(|c| c.lon) {
+            Some(LonMode::Pitch { pitch, .. }) => (pitch, state.ground_speed(), *nav.params()),
+            other => panic!("flare without a pitch command: {other:?}"),
+        }
+    };
+    let (plain, v, p) = pitch_past(0.0);
+    let (steered, _, _) = pitch_past(0.05);
+    assert!(plain >= p.flare_pitch, "{plain} below the flare pitch");
+    // The schedule at 1 m of the flare's height: from the slope's sink to the touchdown's.
+    let s_a = v * libm::tanf(p.glide_slope);
+    let aim = p.flare_sink + (s_a - p.flare_sink) * (1.0 / p.flare_alt);
+    let aim_past = (aim + 0.05 * 15.0).min(aim.max(1.0));
+    let expected = (plain - p.flare_k * (aim_past - aim)).max(0.0);
+    assert!(
+        steered < plain && (steered - expected).abs() < 0.05f32.to_radians(),
+        "steered {} deg, expected {} deg (plain {} deg)",
+        steered.to_degrees(),
+        expected.to_degrees(),
+        plain.to_degrees()
+    );
+}
