@@ -1417,8 +1417,8 @@ impl Navigator {
         let on_slope = -l.point.z + tan_slope * ahead;
         let top = start_h.max(-l.point.z);
         g.altitude = on_slope.min(top);
-        let climb_rate = if ahead > 0.0 && on_slope < top && along_speed.is_finite() {
-            -tan_slope * along_speed.max(0.0)
+        let climb_rate = if ahead > 0.0 && on_slope < top {
+            -tan_slope * along
         } else {
             0.0
         };
