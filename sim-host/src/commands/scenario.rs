@@ -565,14 +565,24 @@ fn requirement_rows(report: &ScenarioReport, set: &str) -> Vec<(String, String, 
     rows
 }
 
+/// A claim's verdict.
+fn verdict(holds: bool) -> &'static str {
+    if holds {
+        "Holds"
+    } else {
+        "Does not hold"
+    }
+}
+
 /// The thesis's claims (REFERENCE.md "Claims to check"), each with the numbers and a verdict.
 fn claims(report: &ScenarioReport) -> String {
-    let (d, mn) = ("designed", "minnesota");
-    let get = |sc: &str, noisy: bool, set: &str| {
-        report
-            .get(sc, noisy)
-            .and_then(|r| r.metrics_of(set))
-            .cloned()
+    // Each claim sets the designed gains against Minnesota's on one scenario.
+    let both = |sc: &str, noisy: bool| {
+        let r = report.get(sc, noisy)?;
+        Some((
+            r.metrics_of("designed")?.clone(),
+            r.metrics_of("minnesota")?.clone(),
+        ))
     };
     let mut s = String::new();
     let mut claim = |title: &str, body: Option<String>| {
@@ -585,16 +595,13 @@ fn claims(report: &ScenarioReport) -> String {
     claim(
         "The designed roll loop responds faster than Minnesota's (Figure 4-1).",
         (|| {
-            let (a, b) = (
-                get("roll_doublet", false, d)?,
-                get("roll_doublet", false, mn)?,
-            );
+            let (a, b) = both("roll_doublet", false)?;
             let (ra, rb) = (a.rise_time_s?, b.rise_time_s?);
             Some(format!(
                 "{}: slowest 10-90 % rise {} s designed against {} s Minnesota (roll_doublet). \
                  The price: overshoot {} % against {} %. 2 % settling: {} designed, {} \
                  Minnesota (whose slow integrator still leaves {} deg after 5 s).",
-                if ra < rb { "Holds" } else { "Does not hold" },
+                verdict(ra < rb),
                 sig(ra, 3),
                 sig(rb, 3),
                 sig(a.overshoot_pct, 3),
@@ -608,24 +615,18 @@ fn claims(report: &ScenarioReport) -> String {
     claim(
         "The designed heading loop responds faster than Minnesota's (Figures 4-4, 4-6).",
         (|| {
-            let (a, b) = (
-                get("heading_doublet", false, d)?,
-                get("heading_doublet", false, mn)?,
-            );
+            let (a, b) = both("heading_doublet", false)?;
             let (ra, rb) = (
                 first_seg(&a)?.metrics.rise_time_s?,
                 first_seg(&b)?.metrics.rise_time_s?,
             );
-            let (c, e) = (
-                get("heading_rectangle", false, d)?,
-                get("heading_rectangle", false, mn)?,
-            );
+            let (c, e) = both("heading_rectangle", false)?;
             Some(format!(
                 "{} for the 30 deg step of the doublet: rise {} s designed, {} s Minnesota; but \
                  overshoot {} % against {} %. In the rectangle (90 deg turns, roll-limited at \
                  45 deg) the designed set is {}: rise {} against {}, overshoot {} % against \
                  {} % (the thesis: higher overshoot, faster). Both end each leg within {} deg.",
-                if ra < rb { "Holds" } else { "Does not hold" },
+                verdict(ra < rb),
                 sig(ra, 3),
                 sig(rb, 3),
                 sig(a.overshoot_pct, 3),
@@ -649,24 +650,14 @@ fn claims(report: &ScenarioReport) -> String {
     claim(
         "The designed pitch loop has less overshoot (Figure 4-9).",
         (|| {
-            let (a, b) = (
-                get("pitch_doublet", false, d)?,
-                get("pitch_doublet", false, mn)?,
-            );
-            let (c, e) = (
-                get("pitch_multistep", false, d)?,
-                get("pitch_multistep", false, mn)?,
-            );
+            let (a, b) = both("pitch_doublet", false)?;
+            let (c, e) = both("pitch_multistep", false)?;
             Some(format!(
                 "{}: worst overshoot over the doublet {} % designed against {} % Minnesota (first \
                  step from trim {} % against {} %); multi-step {} % against {} %. The two pitch \
                  loops (kp -0.97/-0.84, ki -0.1/-0.23, kd -0.072/-0.08) fly almost alike on this \
                  plant, as Figure 4-11 shows for the multi-step.",
-                if a.overshoot_pct < b.overshoot_pct && c.overshoot_pct < e.overshoot_pct {
-                    "Holds"
-                } else {
-                    "Does not hold"
-                },
+                verdict(a.overshoot_pct < b.overshoot_pct && c.overshoot_pct < e.overshoot_pct),
                 sig(a.overshoot_pct, 3),
                 sig(b.overshoot_pct, 3),
                 sig(first_seg(&a)?.metrics.overshoot_pct, 2),
@@ -680,14 +671,8 @@ fn claims(report: &ScenarioReport) -> String {
         "The designed altitude loop is better in rise time, overshoot and settling time \
          (Figures 4-12, 4-13).",
         (|| {
-            let (a, b) = (
-                get("altitude_step", false, d)?,
-                get("altitude_step", false, mn)?,
-            );
-            let (c, e) = (
-                get("altitude_doublet", false, d)?,
-                get("altitude_doublet", false, mn)?,
-            );
+            let (a, b) = both("altitude_step", false)?;
+            let (c, e) = both("altitude_doublet", false)?;
             let rise = a.rise_time_s.zip(b.rise_time_s).is_some_and(|(x, y)| x < y);
             let os = a.overshoot_pct < b.overshoot_pct;
             let settle = match (a.settling_time_s, b.settling_time_s) {
@@ -702,11 +687,7 @@ fn claims(report: &ScenarioReport) -> String {
                  behind the 2 rad/s feedback filter and the throttle cycles between {} and {} for \
                  the whole hold (steady error {} m). \
                  10 m doublet: worst overshoot {} % designed against {} % Minnesota.",
-                if rise && os && settle {
-                    "Holds"
-                } else {
-                    "Does not hold"
-                },
+                verdict(rise && os && settle),
                 f(a.rise_time_s, 3),
                 f(b.rise_time_s, 3),
                 if rise { "better" } else { "not better" },
@@ -728,14 +709,8 @@ fn claims(report: &ScenarioReport) -> String {
         "In software-in-the-loop the designed roll loop shows ripples that Minnesota's does not \
          (Figure 4-8).",
         (|| {
-            let (a, b) = (
-                get("roll_doublet", true, d)?,
-                get("roll_doublet", true, mn)?,
-            );
-            let (c, e) = (
-                get("roll_doublet_slip_hold", true, d)?,
-                get("roll_doublet_slip_hold", true, mn)?,
-            );
+            let (a, b) = both("roll_doublet", true)?;
+            let (c, e) = both("roll_doublet_slip_hold", true)?;
             let held = a.ripple_rms > b.ripple_rms;
             Some(format!(
                 "{} With servos, the two-sample delay, noise 1e-3 and the yaw damper on the \
@@ -773,7 +748,7 @@ fn claims(report: &ScenarioReport) -> String {
         "Climb of 100 m then level: both sets reach it in about 20 s, the designed one with \
          less overshoot (Figure 4-15).",
         (|| {
-            let (a, b) = (get("climb", false, d)?, get("climb", false, mn)?);
+            let (a, b) = both("climb", false)?;
             let (ta, tb) = (a.time_to_2pct_s?, b.time_to_2pct_s?);
             let w = CLIMB_WINDOW_S;
             let inside = |t: f64| (w[0]..=w[1]).contains(&t);
@@ -836,11 +811,7 @@ fn claims(report: &ScenarioReport) -> String {
                     "{}: over the {compared} runs that fly stably, noise changes the overshoot \
                      by at most {} percentage points ({}); the tables below give every figure \
                      with and without noise.",
-                    if worst.0 < 2.0 {
-                        "Holds"
-                    } else {
-                        "Does not hold"
-                    },
+                    verdict(worst.0 < 2.0),
                     sig(worst.0, 2),
                     worst.1
                 )
