@@ -5,6 +5,7 @@
 //! The simulated airplane sits on the ground at home, at rest: the estimator converges there
 //! (as before a real flight), which is what the pre-arm checks wait for.
 
+use common::gcs::client::{command_long, gcs_heartbeat};
 use common::link::framing::{Frame, FrameParser, Sender};
 use common::link::simlink::{encode_hil_gps, encode_hil_sensor, SensorFrame};
 use common::math::atmosphere::standard_atmosphere;
@@ -160,11 +161,7 @@ impl Gcs {
             sender: Sender::new(255, 190),
             inbox: Vec::new(),
         };
-        g.send(&MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-            mavtype: MavType::MAV_TYPE_GCS,
-            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
-            ..Default::default()
-        }));
+        g.send(&gcs_heartbeat());
         g
     }
 
@@ -203,19 +200,7 @@ impl Gcs {
     }
 
     fn command(&mut self, cmd: MavCmd, p: [f32; 7]) -> Option<MavResult> {
-        self.send(&MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-            target_system: 1,
-            target_component: 1,
-            command: cmd,
-            confirmation: 0,
-            param1: p[0],
-            param2: p[1],
-            param3: p[2],
-            param4: p[3],
-            param5: p[4],
-            param6: p[5],
-            param7: p[6],
-        }));
+        self.send(&command_long(cmd, p));
         self.wait(2.0, |m| match m {
             MavMessage::COMMAND_ACK(a) if a.command == cmd => Some(a.result),
             _ => None,

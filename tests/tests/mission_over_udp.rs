@@ -16,6 +16,7 @@
 //! keep the autopilot's link-loss failsafe (`FS_GCS_TOUT_S`, 5 s of the autopilot's time)
 //! from returning the aircraft home: a station that fell silent would fail the test.
 
+use common::gcs::client::{command_long, gcs_heartbeat};
 use common::math::geodetic::{ned_offset, GeoPoint};
 use common::math::Euler;
 use mavlink::dialects::common::*;
@@ -121,14 +122,7 @@ impl Station {
     }
 
     fn heartbeat(&mut self) {
-        self.send(&MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-            custom_mode: 0,
-            mavtype: MavType::MAV_TYPE_GCS,
-            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
-            base_mode: MavModeFlag::empty(),
-            system_status: MavState::MAV_STATE_ACTIVE,
-            mavlink_version: 3,
-        }));
+        self.send(&gcs_heartbeat());
         self.heartbeat_ms = self.autopilot_ms;
         self.heartbeat_wall = Instant::now();
     }
@@ -230,19 +224,7 @@ impl Station {
     }
 
     fn command(&mut self, cmd: MavCmd, p: [f32; 7]) -> Option<MavResult> {
-        self.send(&MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-            target_system: TARGET.0,
-            target_component: TARGET.1,
-            command: cmd,
-            confirmation: 0,
-            param1: p[0],
-            param2: p[1],
-            param3: p[2],
-            param4: p[3],
-            param5: p[4],
-            param6: p[5],
-            param7: p[6],
-        }));
+        self.send(&command_long(cmd, p));
         self.wait(2.0, |m| match m {
             MavMessage::COMMAND_ACK(a) if a.command == cmd => Some(a.result),
             _ => None,

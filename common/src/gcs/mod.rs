@@ -11,6 +11,7 @@
 //! PX4's `custom_mode` encoding (see [`modes`]). `docs/GROUND-STATION.md` describes the
 //! behaviour a ground station sees.
 
+pub mod client;
 pub mod mission;
 pub mod modes;
 pub mod param_store;

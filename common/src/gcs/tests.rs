@@ -84,21 +84,7 @@ fn poll(l: &mut GroundLink, v: &VehicleSnapshot, now: u64) -> Vec<MavMessage> {
     out
 }
 
-fn cmd_long(command: MavCmd, p: [f32; 7]) -> MavMessage {
-    MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-        param1: p[0],
-        param2: p[1],
-        param3: p[2],
-        param4: p[3],
-        param5: p[4],
-        param6: p[5],
-        param7: p[6],
-        command,
-        target_system: 1,
-        target_component: 1,
-        confirmation: 0,
-    })
-}
+use super::client::command_long as cmd_long;
 
 fn acks(out: &[MavMessage]) -> Vec<(MavCmd, MavResult)> {
     out.iter()
@@ -1779,16 +1765,7 @@ fn heartbeat_reports_truth_not_requests_and_tracks_gcs() {
     let mut l = link();
     let v = healthy();
     assert_eq!(l.gcs_last_seen_us(), None);
-    l.handle(
-        &hdr(),
-        &MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-            mavtype: MavType::MAV_TYPE_GCS,
-            autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
-            ..Default::default()
-        }),
-        42,
-        &v,
-    );
+    l.handle(&hdr(), &super::client::gcs_heartbeat(), 42, &v);
     assert_eq!(l.gcs_last_seen_us(), Some(42));
     // Loiter accepted, but the vehicle has not switched: the heartbeat still says Manual and
     // CURRENT_MODE shows the intention.

@@ -6,11 +6,11 @@
 use super::onboard::Onboard;
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::Transport;
+use common::gcs::client::{command_long, gcs_heartbeat};
 use common::link::framing::{FrameParser, Sender};
 use mavlink::dialects::common::{
-    MavAutopilot, MavCmd, MavMessage, MavMissionResult, MavMissionType, MavModeFlag, MavParamType,
-    MavResult, MavState, MavType, COMMAND_LONG_DATA, HEARTBEAT_DATA, MISSION_COUNT_DATA,
-    MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
+    MavCmd, MavMessage, MavMissionResult, MavMissionType, MavParamType, MavResult,
+    MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
 };
 use serde::Serialize;
 
@@ -413,18 +413,6 @@ impl GroundStation {
     }
 }
 
-/// QGroundControl's heartbeat.
-fn gcs_heartbeat() -> MavMessage {
-    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-        custom_mode: 0,
-        mavtype: MavType::MAV_TYPE_GCS,
-        autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
-        base_mode: MavModeFlag::empty(),
-        system_status: MavState::MAV_STATE_ACTIVE,
-        mavlink_version: 3,
-    })
-}
-
 fn mode_name(main: u8) -> &'static str {
     match main {
         PX4_ALTCTL => "Altitude",
@@ -433,15 +421,7 @@ fn mode_name(main: u8) -> &'static str {
     }
 }
 
+/// A command with its first four parameters, the rest 0.
 fn command(cmd: MavCmd, p: [f32; 4]) -> MavMessage {
-    MavMessage::COMMAND_LONG(COMMAND_LONG_DATA {
-        command: cmd,
-        param1: p[0],
-        param2: p[1],
-        param3: p[2],
-        param4: p[3],
-        target_system: 1,
-        target_component: 1,
-        ..Default::default()
-    })
+    command_long(cmd, [p[0], p[1], p[2], p[3], 0.0, 0.0, 0.0])
 }
