@@ -178,29 +178,16 @@ impl FlightMode {
         }
     }
 
-    /// Whether the mode needs a position estimate (GPS) to be flown.
+    /// Whether the mode needs a position estimate (GPS) to be flown: the navigator's modes
+    /// and Hold, which holds a course over ground.
     pub const fn needs_position(self) -> bool {
-        matches!(
-            self,
-            FlightMode::Hold
-                | FlightMode::Mission
-                | FlightMode::Loiter
-                | FlightMode::Return
-                | FlightMode::Takeoff
-                | FlightMode::Land
-        )
+        self.needs_navigator() || matches!(self, FlightMode::Hold)
     }
 
-    /// Whether the navigator flies this mode (a path, not a set point).
+    /// Whether the navigator flies this mode (a path, not a set point): the modes in which
+    /// the vehicle chooses its own path.
     pub const fn needs_navigator(self) -> bool {
-        matches!(
-            self,
-            FlightMode::Mission
-                | FlightMode::Loiter
-                | FlightMode::Return
-                | FlightMode::Takeoff
-                | FlightMode::Land
-        )
+        self.auto()
     }
 
     /// Whether the outer loops hold the vehicle (heartbeat STABILIZE flag).
