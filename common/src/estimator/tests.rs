@@ -54,6 +54,23 @@ impl Flight {
         }
     }
 
+    /// Standing still on the ground for `seconds` at 260 m, heading `heading` rad, no wind:
+    /// before arming.
+    fn at_rest(seconds: f64, heading: f64, seed: u64) -> Self {
+        Self {
+            dt: DT,
+            est: Estimator::default(),
+            traj: Trajectory::new(
+                &[at_speed(level(seconds), 0.0)],
+                0.0,
+                Vector3::zeros(),
+                heading,
+                Vector3::new(0.0, 0.0, -260.0),
+            ),
+            sim: SensorSim::new(seed),
+        }
+    }
+
     /// One 50 Hz step with some sensors silent.
     fn step_with(&mut self, on: On) -> Truth {
         self.step_full(on, Vector3::zeros())
@@ -327,19 +344,7 @@ fn convergence_flag_waits_for_a_good_estimate() {
 #[test]
 fn converges_at_rest_on_the_ground() {
     // Pre-arm: sitting still, no wind, pitot reading noise around zero.
-    let segs = [at_speed(level(30.0), 0.0)];
-    let mut f = Flight {
-        dt: DT,
-        est: Estimator::default(),
-        traj: Trajectory::new(
-            &segs,
-            0.0,
-            Vector3::zeros(),
-            2.7,
-            Vector3::new(0.0, 0.0, -260.0),
-        ),
-        sim: SensorSim::new(5),
-    };
+    let mut f = Flight::at_rest(30.0, 2.7, 5);
     let tr = f.run_until(29.0);
     let st = f.est.state();
     let (r, p, y) = f.attitude_errors(&tr);
@@ -814,19 +819,7 @@ fn a_failed_pitot_leaves_a_synthetic_airspeed() {
 /// would carry into every landing).
 #[test]
 fn height_above_home_follows_the_barometer() {
-    let segs = [at_speed(level(120.0), 0.0)];
-    let mut f = Flight {
-        dt: DT,
-        est: Estimator::default(),
-        traj: Trajectory::new(
-            &segs,
-            0.0,
-            Vector3::zeros(),
-            1.0,
-            Vector3::new(0.0, 0.0, -260.0),
-        ),
-        sim: SensorSim::new(11),
-    };
+    let mut f = Flight::at_rest(120.0, 1.0, 11);
     f.run_until(20.0);
     let armed = f.est.state();
     assert!(f.est.set_home(Home {
