@@ -277,18 +277,21 @@ fn figure(r: &ScenarioResult) -> Figure {
         return Figure::new(r.scenario.name, "time (s)", Vec::new());
     };
     let t: Vec<f64> = first.samples.iter().map(|s| s.t).collect();
+    // One series per gain set of the quantity `f` reads from a sample.
+    let per_set = |f: fn(&crate::scenario::sim::Sample) -> f64| -> Vec<Series> {
+        r.runs
+            .iter()
+            .map(|run| {
+                Series::new(
+                    run.gains.clone(),
+                    t.clone(),
+                    run.samples.iter().map(f).collect(),
+                )
+            })
+            .collect()
+    };
     // The command goes last so each gain set keeps the same colour in every panel.
-    let mut resp: Vec<Series> = r
-        .runs
-        .iter()
-        .map(|run| {
-            Series::new(
-                run.gains.clone(),
-                t.clone(),
-                run.samples.iter().map(|s| s.response).collect(),
-            )
-        })
-        .collect();
+    let mut resp = per_set(|s| s.response);
     resp.push(
         Series::new(
             "command",
@@ -302,35 +305,13 @@ fn figure(r: &ScenarioResult) -> Figure {
         Axis::Sideslip => ("rudder", |s| s.rudder_deg),
         Axis::Pitch | Axis::Altitude => ("elevator", |s| s.elevator_deg),
     };
-    let surf = r
-        .runs
-        .iter()
-        .map(|run| {
-            Series::new(
-                run.gains.clone(),
-                t.clone(),
-                run.samples.iter().map(sfn).collect(),
-            )
-        })
-        .collect();
+    let surf = per_set(sfn);
     let mut panels = vec![
         Panel::new(format!("{} ({unit})", axis.quantity()), resp),
         Panel::new(format!("{sname} (deg)"), surf),
     ];
     if axis == Axis::Altitude {
-        panels.push(Panel::new(
-            "pitch (deg)",
-            r.runs
-                .iter()
-                .map(|run| {
-                    Series::new(
-                        run.gains.clone(),
-                        t.clone(),
-                        run.samples.iter().map(|s| s.pitch_deg).collect(),
-                    )
-                })
-                .collect(),
-        ));
+        panels.push(Panel::new("pitch (deg)", per_set(|s| s.pitch_deg)));
     }
     let noise = if r.noise_sigma > 0.0 {
         format!(", noise sigma {}", r.noise_sigma)
