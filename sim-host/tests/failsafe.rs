@@ -541,11 +541,7 @@ fn geofence_breach_returns_home_within_a_turn_radius_of_the_fence() {
         .outcome;
     trace(&o, 2.0);
     assert_eq!(
-        o.summary
-            .uploads
-            .iter()
-            .map(|u| u.2.as_str())
-            .collect::<Vec<_>>(),
+        o.summary.upload_results(),
         ["MAV_MISSION_ACCEPTED", "MAV_MISSION_ACCEPTED"],
         "mission and fence accepted"
     );

@@ -22,14 +22,7 @@ fn fly_default(wind_ned: [f64; 3], turbulence: Turbulence, seed: u64) -> FlightO
 fn landed_as_planned(o: &FlightOutcome) -> MissionSummary {
     let m = o.summary.mission.clone().expect("a mission was flown");
     eprintln!("{m:#?}");
-    assert_eq!(
-        o.summary
-            .uploads
-            .iter()
-            .map(|u| u.2.as_str())
-            .collect::<Vec<_>>(),
-        ["MAV_MISSION_ACCEPTED"]
-    );
+    assert_eq!(o.summary.upload_results(), ["MAV_MISSION_ACCEPTED"]);
     assert!(
         m.all_reached,
         "reached {:?} of {:?}",

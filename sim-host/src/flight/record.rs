@@ -315,6 +315,13 @@ pub struct FlightSummary {
     pub mission: Option<MissionSummary>,
 }
 
+impl FlightSummary {
+    /// The MISSION_ACK result of each upload, in order (`"MAV_MISSION_ACCEPTED"`, ...).
+    pub fn upload_results(&self) -> Vec<&str> {
+        self.uploads.iter().map(|u| u.2.as_str()).collect()
+    }
+}
+
 /// How a mission was flown: tracking errors of the truth against what guidance asked for.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct MissionSummary {
