@@ -35,7 +35,7 @@ use crate::params::{ParamDef, ParamError};
 use serde::{Deserialize, Serialize};
 
 /// Radians per degree.
-pub(crate) const DEG: f32 = core::f32::consts::PI / 180.0;
+pub(crate) use crate::math::{DEG, RAD2DEG};
 
 /// Gains and limits of the lateral-directional autopilot (ailerons and rudder).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -344,9 +344,6 @@ macro_rules! bind {
         }
     };
 }
-
-/// Degrees per radian.
-pub(crate) const RAD2DEG: f32 = 180.0 / core::f32::consts::PI;
 
 /// Every field of [`GainSet`] and its parameter; one entry per parameter of [`all_params`].
 pub const BINDINGS: &[Binding] = &[

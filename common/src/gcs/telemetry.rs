@@ -9,7 +9,7 @@ use super::snapshot::{
     LandedState, MissionRunState, VehicleSnapshot, BATTERY_CRITICAL, BATTERY_LOW,
 };
 
-const RAD2DEG: f32 = 180.0 / core::f32::consts::PI;
+use crate::math::RAD2DEG;
 
 /// Angle in rad to degrees in [0, 360).
 fn heading_deg(rad: f32) -> f32 {

@@ -35,12 +35,10 @@
 //!
 //! Altitudes here are heights above home, m, up: the datum the firmware gives the autopilot.
 
-use crate::math::wrap_pi;
+use crate::math::{wrap_pi, DEG};
 use crate::params::{check_param, default_of, ParamDef, ParamError};
 use core::f32::consts::{FRAC_PI_2, PI};
 use nalgebra::Vector3;
-
-const DEG: f32 = PI / 180.0;
 
 /// Parameters of the path-following vector fields.
 pub const PARAMS: &[ParamDef] = &[

@@ -14,3 +14,8 @@ pub mod frames;
 pub mod geodetic;
 
 pub use frames::*;
+
+/// One degree in radians, in the board's float.
+pub const DEG: f32 = core::f32::consts::PI / 180.0;
+/// Degrees per radian, in the board's float.
+pub const RAD2DEG: f32 = 180.0 / core::f32::consts::PI;

@@ -52,13 +52,11 @@ use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::gcs::mission::{MissionItem, MISSION_CAPACITY};
 use crate::guidance::{Guidance, GuidanceOutput, OrbitDirection, Path};
-use crate::math::wrap_pi;
+use crate::math::{wrap_pi, DEG};
 use crate::params::check_param;
 use crate::params::{ParamDef, ParamError};
-use core::f32::consts::{PI, TAU};
+use core::f32::consts::TAU;
 use nalgebra::Vector3;
-
-const DEG: f32 = PI / 180.0;
 
 /// Parameters of the mission executor and its behaviours.
 pub const PARAMS: &[ParamDef] = &[
