@@ -209,10 +209,12 @@ fn parse_param(s: &str) -> Result<(String, f32), String> {
         .parse()
         .map_err(|e| format!("`{s}`: value `{value}`: {e}"))?;
     let name = name.trim();
-    let def = firmware::app::REGISTRY
-        .iter()
-        .flat_map(|list| list.iter())
-        .find(|d| d.name == name)
+    // The autopilot's own parameter store answers, as it would to the PARAM_SET.
+    let store = common::gcs::param_store::ParamStore::new(firmware::app::REGISTRY)
+        .map_err(|e| format!("the autopilot's parameter registry: {e:?}"))?;
+    let def = store
+        .index_of(name)
+        .and_then(|i| store.def(i))
         .ok_or_else(|| format!("`{s}`: the autopilot has no parameter `{name}`"))?;
     def.check(v).map_err(|e| {
         format!(
