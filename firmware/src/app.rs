@@ -990,31 +990,7 @@ fn in_air(e: &EstimatedState) -> bool {
 /// The navigator's commands carry heights above home; the autopilot flies altitudes above
 /// mean sea level (the estimator's datum).
 fn amsl_commands(mut c: Commands, home_alt_amsl_m: f32) -> Commands {
-    c.lon = match c.lon {
-        LonMode::Altitude { altitude, airspeed } => LonMode::Altitude {
-            altitude: altitude + home_alt_amsl_m,
-            airspeed,
-        },
-        LonMode::Glide {
-            altitude,
-            airspeed,
-            climb_rate,
-        } => LonMode::Glide {
-            altitude: altitude + home_alt_amsl_m,
-            airspeed,
-            climb_rate,
-        },
-        LonMode::TakeOff {
-            altitude,
-            airspeed,
-            clear_altitude,
-        } => LonMode::TakeOff {
-            altitude: altitude + home_alt_amsl_m,
-            airspeed,
-            clear_altitude: clear_altitude + home_alt_amsl_m,
-        },
-        other => other,
-    };
+    c.lon = c.lon.shifted(home_alt_amsl_m);
     c
 }
 

@@ -245,6 +245,26 @@ pub enum LonMode {
     },
 }
 
+impl LonMode {
+    /// The same mode with every altitude in it moved by `dz` m: from one datum to another
+    /// (the navigator's heights above home to the autopilot's altitudes above sea level).
+    pub fn shifted(mut self, dz: f32) -> Self {
+        match &mut self {
+            LonMode::Altitude { altitude, .. } | LonMode::Glide { altitude, .. } => *altitude += dz,
+            LonMode::TakeOff {
+                altitude,
+                clear_altitude,
+                ..
+            } => {
+                *altitude += dz;
+                *clear_altitude += dz;
+            }
+            LonMode::Off | LonMode::Pitch { .. } | LonMode::AirspeedPitch { .. } => {}
+        }
+        self
+    }
+}
+
 /// Flight regime of Figure 3-16.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
