@@ -6,7 +6,7 @@ use super::fly::{fly_report, mission_table, FlyOptions, NOTES_MARKER};
 use crate::aircraft::Aircraft;
 use crate::environment::wind::Turbulence;
 use crate::flight::missions::{default_mission, runway_mission};
-use crate::flight::record::{ground_track_figure, MissionSummary, Sample};
+use crate::flight::record::{ground_track_figure, MissionSummary, Sample, TouchdownSummary};
 use crate::flight::FlightOutcome;
 use crate::plant::ModelParams;
 use crate::report::sig;
@@ -52,15 +52,93 @@ pub fn fly_default(
     Ok(fly_report(aircraft, &cfg, &FlyOptions::default())?.outcome)
 }
 
+/// The targets one flight is held to, each on its own (`calm`: the calm-air cross-track).
+struct TargetsMet {
+    reached: bool,
+    xtrack: bool,
+    altitude: bool,
+    airspeed: bool,
+    touchdown: bool,
+    sink: bool,
+}
+
+impl TargetsMet {
+    fn of(m: &MissionSummary, calm: bool) -> Self {
+        let xt = if calm { 0.5 } else { 2.0 };
+        Self {
+            reached: m.all_reached,
+            xtrack: m.xtrack_rms_m < xt,
+            altitude: m.alt_rms_m < 1.5,
+            airspeed: m.airspeed_rms_mps < 1.0,
+            touchdown: m.touchdown.is_some_and(|t| t.distance_m < 20.0),
+            sink: m.touchdown.is_some_and(|t| t.sink_rate_mps < 1.5),
+        }
+    }
+
+    fn all(&self) -> bool {
+        self.reached && self.xtrack && self.altitude && self.airspeed && self.touchdown && self.sink
+    }
+}
+
 /// Whether a flight meets the targets (`calm`: the calm-air cross-track target).
 pub fn meets_targets(m: &MissionSummary, calm: bool) -> bool {
-    let xt = if calm { 0.5 } else { 2.0 };
-    m.all_reached
-        && m.xtrack_rms_m < xt
-        && m.alt_rms_m < 1.5
-        && m.airspeed_rms_mps < 1.0
-        && m.touchdown
-            .is_some_and(|t| t.distance_m < 20.0 && t.sink_rate_mps < 1.5)
+    TargetsMet::of(m, calm).all()
+}
+
+/// What a set of windy flights shows: how many meet each target, the worst figures and the
+/// touchdowns' spread.
+struct Spread {
+    n: usize,
+    met: usize,
+    reached: usize,
+    xtrack: usize,
+    altitude: usize,
+    airspeed: usize,
+    touchdown: usize,
+    sink: usize,
+    xtrack_max: f64,
+    alt_max: f64,
+    airspeed_max: f64,
+    /// Touchdowns along the runway from the point, m, smallest first.
+    along: Vec<f64>,
+    /// Sink rates at touchdown, m/s, smallest first.
+    sinks: Vec<f64>,
+}
+
+impl Spread {
+    fn of(flights: &[MissionSummary]) -> Self {
+        let met: Vec<TargetsMet> = flights.iter().map(|m| TargetsMet::of(m, false)).collect();
+        let count = |f: fn(&TargetsMet) -> bool| met.iter().filter(|t| f(t)).count();
+        let max = |f: fn(&MissionSummary) -> f64| flights.iter().map(f).fold(f64::NAN, f64::max);
+        let sorted = |f: fn(&TouchdownSummary) -> f64| {
+            let mut v: Vec<f64> = flights
+                .iter()
+                .filter_map(|m| m.touchdown.as_ref().map(f))
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v
+        };
+        Self {
+            n: flights.len(),
+            met: count(TargetsMet::all),
+            reached: count(|t| t.reached),
+            xtrack: count(|t| t.xtrack),
+            altitude: count(|t| t.altitude),
+            airspeed: count(|t| t.airspeed),
+            touchdown: count(|t| t.touchdown),
+            sink: count(|t| t.sink),
+            xtrack_max: max(|m| m.xtrack_rms_m),
+            alt_max: max(|m| m.alt_rms_m),
+            airspeed_max: max(|m| m.airspeed_rms_mps),
+            along: sorted(|t| t.along_m),
+            sinks: sorted(|t| t.sink_rate_mps),
+        }
+    }
+}
+
+/// The middle value of sorted figures (NaN for none).
+fn median(v: &[f64]) -> f64 {
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 fn ground_track(samples: &[Sample], title: &str, path: &Path) -> anyhow::Result<()> {
@@ -265,62 +343,50 @@ fn seed_span(seeds: &[u64]) -> String {
 /// One row of the results table: the worst figure of the flights and how many meet each
 /// target.
 fn windy_row(label: &str, flights: &[MissionSummary]) -> String {
-    let n = flights.len();
-    let max = |f: &dyn Fn(&MissionSummary) -> f64| flights.iter().map(f).fold(f64::NAN, f64::max);
-    let count = |f: &dyn Fn(&MissionSummary) -> bool| flights.iter().filter(|m| f(m)).count();
-    let tds: Vec<_> = flights.iter().filter_map(|m| m.touchdown).collect();
-    let along_lo = tds.iter().map(|t| t.along_m).fold(f64::NAN, f64::min);
-    let along_hi = tds.iter().map(|t| t.along_m).fold(f64::NAN, f64::max);
-    let sink_hi = tds.iter().map(|t| t.sink_rate_mps).fold(f64::NAN, f64::max);
+    let s = Spread::of(flights);
+    let n = s.n;
     format!(
         "| {label} | all on {} of {n} | {} at most; under 2 on {} | {} at most | {} at most | \
          {:+.1} to {:+.1} m along; within 20 m on {} | {:.2} at most; under 1.5 on {} | on {} of {n} |",
-        count(&|m| m.all_reached),
-        sig(max(&|m| m.xtrack_rms_m), 3),
-        count(&|m| m.xtrack_rms_m < 2.0),
-        sig(max(&|m| m.alt_rms_m), 3),
-        sig(max(&|m| m.airspeed_rms_mps), 3),
-        along_lo,
-        along_hi,
-        count(&|m| m.touchdown.is_some_and(|t| t.distance_m < 20.0)),
-        sink_hi,
-        count(&|m| m.touchdown.is_some_and(|t| t.sink_rate_mps < 1.5)),
-        count(&|m| meets_targets(m, false)),
+        s.reached,
+        sig(s.xtrack_max, 3),
+        s.xtrack,
+        sig(s.alt_max, 3),
+        sig(s.airspeed_max, 3),
+        s.along.first().copied().unwrap_or(f64::NAN),
+        s.along.last().copied().unwrap_or(f64::NAN),
+        s.touchdown,
+        s.sinks.last().copied().unwrap_or(f64::NAN),
+        s.sink,
+        s.met,
     )
 }
 
 /// How many of the windy flights meet each target, and the spread of their touchdowns.
 fn spread_summary(flights: &[MissionSummary]) -> String {
-    let n = flights.len();
-    let count = |f: &dyn Fn(&MissionSummary) -> bool| flights.iter().filter(|m| f(m)).count();
-    let tds: Vec<_> = flights.iter().filter_map(|m| m.touchdown).collect();
-    let mut along: Vec<f64> = tds.iter().map(|t| t.along_m).collect();
-    let mut sink: Vec<f64> = tds.iter().map(|t| t.sink_rate_mps).collect();
-    along.sort_by(f64::total_cmp);
-    sink.sort_by(f64::total_cmp);
-    let median = |v: &[f64]| v.get(v.len() / 2).copied().unwrap_or(f64::NAN);
-    let ends = |v: &[f64]| (v.first().copied(), v.last().copied());
-    let (a_lo, a_hi) = ends(&along);
-    let (_, s_hi) = ends(&sink);
-    let f = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:+.1}"));
+    let s = Spread::of(flights);
+    let n = s.n;
+    let f = |x: Option<&f64>| x.map_or("-".to_string(), |x| format!("{x:+.1}"));
     format!(
         "Targets met on **{} of {n}** seeds. Per target: every waypoint {}/{n}, straight-leg \
          cross-track under 2 m {}/{n}, altitude under 1.5 m {}/{n}, airspeed under 1 m/s \
          {}/{n}, touchdown within 20 m {}/{n}, sink under 1.5 m/s {}/{n}. Touchdown along the \
          runway from the point: {} to {} m (median {:+.1}); sink rate median {:.2} m/s, \
          largest {}.\n",
-        count(&|m| meets_targets(m, false)),
-        count(&|m| m.all_reached),
-        count(&|m| m.xtrack_rms_m < 2.0),
-        count(&|m| m.alt_rms_m < 1.5),
-        count(&|m| m.airspeed_rms_mps < 1.0),
-        count(&|m| m.touchdown.is_some_and(|t| t.distance_m < 20.0)),
-        count(&|m| m.touchdown.is_some_and(|t| t.sink_rate_mps < 1.5)),
-        f(a_lo),
-        f(a_hi),
-        median(&along),
-        median(&sink),
-        s_hi.map_or("-".to_string(), |x| format!("{x:.2} m/s")),
+        s.met,
+        s.reached,
+        s.xtrack,
+        s.altitude,
+        s.airspeed,
+        s.touchdown,
+        s.sink,
+        f(s.along.first()),
+        f(s.along.last()),
+        median(&s.along),
+        median(&s.sinks),
+        s.sinks
+            .last()
+            .map_or("-".to_string(), |x| format!("{x:.2} m/s")),
     )
 }
 
