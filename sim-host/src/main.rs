@@ -340,10 +340,7 @@ fn run() -> anyhow::Result<ExitCode> {
                 );
                 // The missions section belongs to `sim-host navigation`: kept as it is.
                 let old = std::fs::read_to_string(path).unwrap_or_default();
-                let md = match sim_host::report::section(&old, commands::navigation::SECTION) {
-                    Some(missions) => format!("{}\n\n{missions}\n", md.trim_end()),
-                    None => md,
-                };
+                let md = sim_host::report::carry_section(&old, &md, commands::navigation::SECTION);
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir)
                         .with_context(|| format!("cannot create `{}`", dir.display()))?;

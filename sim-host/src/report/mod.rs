@@ -53,8 +53,21 @@ pub fn splice_section(doc: &str, name: &str, body: &str) -> String {
     let block = format!("{begin}\n{}\n{end}", body.trim_end());
     match section(doc, name) {
         Some(old) => doc.replacen(old, &block, 1),
-        None => format!("{}\n\n{block}\n", doc.trim_end()),
+        None => append_block(doc, &block),
     }
+}
+
+/// `into` with the section `name` of `from` at its end (unchanged when `from` has none): a
+/// command that rewrites a whole document keeps what another command wrote into it.
+pub fn carry_section(from: &str, into: &str, name: &str) -> String {
+    match section(from, name) {
+        Some(block) => append_block(into, block),
+        None => into.to_string(),
+    }
+}
+
+fn append_block(doc: &str, block: &str) -> String {
+    format!("{}\n\n{block}\n", doc.trim_end())
 }
 
 /// Relative difference `(ours - reference) / |reference|` in percent.
