@@ -13,35 +13,48 @@
 //!
 //! Each failsafe is reported once when it is raised and once when its cause clears.
 
-use crate::params::{default_of, ParamDef};
+use crate::param;
+use crate::params::{independent, Group, ParamDef};
 
 /// Parameters of the failsafes.
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real(
-        "FS_GCS_TOUT_S",
-        5.0,
-        0.0,
-        300.0,
-        "s",
-        "Ground link silent this long while flying: return home (0 disables)",
-    ),
-    ParamDef::real(
-        "FS_GPS_WL_S",
-        10.0,
-        0.0,
-        300.0,
-        "s",
-        "GPS lost: wings level at altitude this long on dead reckoning, then circle",
-    ),
-    ParamDef::int(
-        "GF_ACTION",
-        1,
-        0,
-        1,
-        "",
-        "Geofence breach: 0 report only, 1 return home",
-    ),
-];
+pub const PARAMS: Group<FailsafeConfig> = Group {
+    name: "Failsafes",
+    params: &[
+        param!(
+            ParamDef::real(
+                "FS_GCS_TOUT_S",
+                5.0,
+                0.0,
+                300.0,
+                "s",
+                "Ground link silent this long while flying: return home (0 disables)",
+            ),
+            FailsafeConfig => gcs_timeout_s
+        ),
+        param!(
+            ParamDef::real(
+                "FS_GPS_WL_S",
+                10.0,
+                0.0,
+                300.0,
+                "s",
+                "GPS lost: wings level at altitude this long on dead reckoning, then circle",
+            ),
+            FailsafeConfig => gps_wings_level_s
+        ),
+        param!(
+            ParamDef::choice(
+                "GF_ACTION",
+                1,
+                &["Report only", "Return home"],
+                "What a geofence breach does",
+            ),
+            FailsafeConfig => fence_returns, flag
+        ),
+    ],
+    base: || ZERO,
+    check: independent,
+};
 
 /// Failsafe settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,25 +67,15 @@ pub struct FailsafeConfig {
     pub fence_returns: bool,
 }
 
+const ZERO: FailsafeConfig = FailsafeConfig {
+    gcs_timeout_s: 0.0,
+    gps_wings_level_s: 0.0,
+    fence_returns: false,
+};
+
 impl Default for FailsafeConfig {
     fn default() -> Self {
-        Self {
-            gcs_timeout_s: default_of(PARAMS, "FS_GCS_TOUT_S"),
-            gps_wings_level_s: default_of(PARAMS, "FS_GPS_WL_S"),
-            fence_returns: default_of(PARAMS, "GF_ACTION") >= 0.5,
-        }
-    }
-}
-
-impl FailsafeConfig {
-    /// Reads the settings from a parameter lookup; missing names keep their defaults.
-    pub fn from_params(get: impl Fn(&str) -> Option<f32>) -> Self {
-        let d = Self::default();
-        Self {
-            gcs_timeout_s: get("FS_GCS_TOUT_S").unwrap_or(d.gcs_timeout_s),
-            gps_wings_level_s: get("FS_GPS_WL_S").unwrap_or(d.gps_wings_level_s),
-            fence_returns: get("GF_ACTION").map_or(d.fence_returns, |v| v >= 0.5),
-        }
+        PARAMS.defaults()
     }
 }
 
@@ -308,11 +311,12 @@ mod tests {
     }
 
     #[test]
-    fn parameters_are_well_formed_and_match_the_defaults() {
-        crate::params::validate_defs(PARAMS).unwrap();
-        let cfg =
-            FailsafeConfig::from_params(|n| PARAMS.iter().find(|d| d.name == n).map(|d| d.default));
-        assert_eq!(cfg, FailsafeConfig::default());
+    fn parameters_are_well_formed_and_default_to_px4_like_reactions() {
+        crate::params::validate_defs(PARAMS.defs()).unwrap();
+        // PX4's data-link loss and geofence defaults: return after 5 s, return on a breach.
+        let cfg = FailsafeConfig::default();
+        assert_eq!((cfg.gcs_timeout_s, cfg.fence_returns), (5.0, true));
+        assert_eq!(cfg.gps_wings_level_s, 10.0);
     }
 
     #[test]

@@ -43,3 +43,4 @@ pub mod navigation;
 pub mod params;
 pub mod sensors;
 pub mod storage;
+pub mod vehicle;

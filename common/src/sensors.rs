@@ -55,3 +55,38 @@ pub struct GpsFix {
     /// Horizontal dilution of precision.
     pub hdop: f32,
 }
+
+/// Stick positions, normalised: a ground station's `MANUAL_CONTROL` or the radio's
+/// `RC_CHANNELS`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ManualInput {
+    /// Roll stick, -1..1, positive right.
+    pub roll: f32,
+    /// Pitch stick, -1..1, positive nose up (stick back; MANUAL_CONTROL's x is forward).
+    pub pitch: f32,
+    /// Yaw stick, -1..1, positive nose right.
+    pub yaw: f32,
+    /// Throttle, 0..1.
+    pub throttle: f32,
+    /// When it arrived, us.
+    pub time_us: u64,
+}
+
+/// One sensor frame: the samples taken at one instant, `None` where a sensor has nothing new.
+/// The simulator link decodes `HIL_SENSOR` into it; a board's drivers fill it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SensorFrame {
+    /// When the samples were taken, us: the autopilot's clock (the simulator's in lock-step).
+    pub time_us: u64,
+    /// Accelerometer and gyro.
+    pub imu: Option<ImuSample>,
+    /// Magnetometer.
+    pub mag: Option<MagSample>,
+    /// Barometer.
+    pub baro: Option<BaroSample>,
+    /// Differential pressure.
+    pub pitot: Option<PitotSample>,
+    /// The source reset its state (`HIL_SENSOR` bit 31).
+    pub reset: bool,
+}

@@ -296,7 +296,7 @@ impl FileStorage {
         match load_params(
             &mut self.flash,
             &PARAMS_REGION,
-            app.ground_link_mut().params_mut(),
+            app.vehicle_mut().params_mut(),
             &mut scratch,
         ) {
             Ok(Some(r)) => notes.push(format!("parameters loaded ({r:?})")),
@@ -305,14 +305,14 @@ impl FileStorage {
         }
         match load_missions(&mut self.flash, &MISSIONS_REGION, &mut scratch) {
             Ok(Some(m)) => {
-                app.ground_link_mut().missions_mut().load(m);
+                app.vehicle_mut().plan_mut().load(m);
                 notes.push("missions loaded".into());
             }
             Ok(None) => {}
             Err(e) => notes.push(format!("saved missions unreadable: {e:?}")),
         }
-        self.missions_seen = Some(app.ground_link().missions().change_count());
-        app.ground_link_mut().params_mut().mark_saved();
+        self.missions_seen = Some(app.vehicle().plan().change_count());
+        app.vehicle_mut().params_mut().mark_saved();
         notes
     }
 
@@ -320,26 +320,22 @@ impl FileStorage {
     pub fn save_changes(&mut self, app: &mut App) -> io::Result<()> {
         let mut changed = false;
         let mut scratch = vec![0u8; SECTOR as usize];
-        if app.ground_link().params().is_dirty() {
+        if app.vehicle().params().is_dirty() {
             save_params(
                 &mut self.flash,
                 &PARAMS_REGION,
-                app.ground_link_mut().params_mut(),
+                app.vehicle_mut().params_mut(),
                 &mut scratch,
             )
             .map_err(|e| io::Error::other(format!("parameter save: {e:?}")))?;
             changed = true;
         }
-        let missions = app.ground_link().missions();
-        if Some(missions.change_count()) != self.missions_seen && !missions.busy() {
-            save_missions(
-                &mut self.flash,
-                &MISSIONS_REGION,
-                missions.store(),
-                &mut scratch,
-            )
-            .map_err(|e| io::Error::other(format!("mission save: {e:?}")))?;
-            self.missions_seen = Some(missions.change_count());
+        let plan = app.vehicle().plan();
+        let busy = app.ground_link().missions().busy();
+        if Some(plan.change_count()) != self.missions_seen && !busy {
+            save_missions(&mut self.flash, &MISSIONS_REGION, plan, &mut scratch)
+                .map_err(|e| io::Error::other(format!("mission save: {e:?}")))?;
+            self.missions_seen = Some(plan.change_count());
             changed = true;
         }
         if changed {

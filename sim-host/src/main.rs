@@ -210,8 +210,7 @@ fn parse_param(s: &str) -> Result<(String, f32), String> {
         .map_err(|e| format!("`{s}`: value `{value}`: {e}"))?;
     let name = name.trim();
     // The autopilot's own parameter store answers, as it would to the PARAM_SET.
-    let store = common::gcs::param_store::ParamStore::new(firmware::app::REGISTRY)
-        .map_err(|e| format!("the autopilot's parameter registry: {e:?}"))?;
+    let store = common::params::ParamStore::new(firmware::app::REGISTRY);
     let def = store
         .index_of(name)
         .and_then(|i| store.def(i))

@@ -26,10 +26,10 @@ fn aircraft() -> Aircraft {
 
 /// The firmware's default value of a parameter (what a user flies without changing it).
 fn default_of(name: &str) -> f64 {
-    firmware::app::REGISTRY
-        .iter()
-        .flat_map(|l| l.iter())
-        .find(|d| d.name == name)
+    let store = common::params::ParamStore::new(firmware::app::REGISTRY);
+    store
+        .index_of(name)
+        .and_then(|i| store.def(i))
         .map(|d| f64::from(d.default))
         .unwrap_or_else(|| panic!("no parameter {name}"))
 }

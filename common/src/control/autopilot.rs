@@ -1,127 +1,157 @@
 //! One full control tick: lateral and longitudinal autopilots from measured state and commands
 //! to surface and throttle commands, with a status saying what was refused.
 
-use super::gains::{GainError, GainSet, DESIGNED};
-use super::lateral::{Lateral, RollMode, YawMode};
-use super::longitudinal::{LonMode, Longitudinal, Regime};
+pub use super::inputs::{InputFlags, Measurements};
+use super::lateral::{self, Lateral, LateralGains, RollMode, YawMode};
+use super::longitudinal::{self, LonMode, Longitudinal, LongitudinalGains, Regime};
 use crate::actuators::Surfaces;
-use crate::params::ParamDef;
+use crate::param;
+use crate::params::{Group, ParamDef, ParamError, ParamStore};
+use serde::{Deserialize, Serialize};
+
+/// Time constant with which a bumpless-transfer offset fades by default, s (not in the thesis:
+/// chosen here, a few times the inner loops' rise time).
+pub const TRANSFER_TC_S: f32 = 1.0;
 
 /// Parameters of the autopilot as a whole.
-pub const PARAMS: &[ParamDef] = &[ParamDef::real(
-    "XFER_TC_S",
-    DESIGNED.transfer_tc,
-    0.05,
-    20.0,
-    "s",
-    "Fade time constant of bumpless-transfer offsets (loops without integrator)",
-)];
+pub const PARAMS: Group<GainSet> = Group {
+    name: "Autopilot",
+    params: &[param!(
+        ParamDef::real(
+            "XFER_TC_S",
+            TRANSFER_TC_S,
+            0.05,
+            20.0,
+            "s",
+            "Fade time constant of bumpless-transfer offsets (loops without integrator)",
+        ),
+        GainSet => transfer_tc
+    )],
+    base: || GainSet::THESIS,
+    check: crate::params::independent,
+};
+
+/// Every number the autopilot flies with.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GainSet {
+    /// Ailerons and rudder.
+    pub lateral: LateralGains,
+    /// Elevator and throttle.
+    pub longitudinal: LongitudinalGains,
+    /// Time constant with which a bumpless-transfer offset fades, s.
+    pub transfer_tc: f32,
+}
+
+/// Why a gain set or a parameter value was refused; each names the parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum GainError {
+    /// NaN or infinite.
+    NotFinite(&'static str),
+    /// Outside the parameter's bounds (which also fix each loop gain's stabilising sign).
+    OutOfBounds(&'static str),
+    /// Contradicts another value (a lower limit above an upper one, a trim outside its travel).
+    Inconsistent(&'static str),
+    /// No parameter of that name.
+    Unknown,
+}
+
+impl GainError {
+    /// The parameter the error is about (empty for [`GainError::Unknown`]).
+    pub fn name(&self) -> &'static str {
+        match *self {
+            GainError::NotFinite(n) | GainError::OutOfBounds(n) | GainError::Inconsistent(n) => n,
+            GainError::Unknown => "",
+        }
+    }
+}
+
+impl core::fmt::Display for GainError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            GainError::NotFinite(n) => write!(f, "gain {n} is not finite"),
+            GainError::OutOfBounds(n) => write!(f, "gain {n} outside its bounds"),
+            GainError::Inconsistent(n) => write!(f, "gain {n} contradicts another limit"),
+            GainError::Unknown => f.write_str("no such gain parameter"),
+        }
+    }
+}
+
+impl GainSet {
+    /// The thesis's designed set (chapter 3), every stage's own designed gains.
+    pub const THESIS: GainSet = GainSet {
+        lateral: lateral::THESIS,
+        longitudinal: longitudinal::THESIS,
+        transfer_tc: TRANSFER_TC_S,
+    };
+
+    /// Checks every value: finite, inside its parameter's bounds (the bounds of the loop gains
+    /// admit only the stabilising sign in the UMN convention), and consistent (throttle minimum
+    /// below maximum, trims inside the travel). The error names the first offending parameter.
+    pub fn validate(&self) -> Result<(), GainError> {
+        let named = |(name, e): (&'static str, ParamError)| match e {
+            ParamError::NotFinite => GainError::NotFinite(name),
+            ParamError::Inconsistent => GainError::Inconsistent(name),
+            _ => GainError::OutOfBounds(name),
+        };
+        lateral::PARAMS.validate(&self.lateral).map_err(named)?;
+        longitudinal::PARAMS
+            .validate(&self.longitudinal)
+            .map_err(named)?;
+        PARAMS.validate(self).map_err(named)
+    }
+
+    /// The set as parameter values `(name, value)` in parameter units, stage by stage.
+    pub fn params(&self) -> impl Iterator<Item = (&'static str, f32)> + Clone + '_ {
+        let lat = lateral::PARAMS.params.iter();
+        let lon = longitudinal::PARAMS.params.iter();
+        lat.map(move |p| (p.def.name, (p.get)(&self.lateral)))
+            .chain(lon.map(move |p| (p.def.name, (p.get)(&self.longitudinal))))
+            .chain(
+                PARAMS
+                    .params
+                    .iter()
+                    .map(move |p| (p.def.name, (p.get)(self))),
+            )
+    }
+
+    /// The value of one parameter, in parameter units.
+    pub fn param(&self, name: &str) -> Option<f32> {
+        self.params().find(|(n, _)| *n == name).map(|(_, v)| v)
+    }
+
+    /// Sets one parameter (parameter units) after checking it against its definition. The rest
+    /// of the set is not re-validated: call [`GainSet::validate`] before flying the result.
+    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), GainError> {
+        let r = if lateral::PARAMS.find(name).is_some() {
+            lateral::PARAMS.set(&mut self.lateral, name, value)
+        } else if longitudinal::PARAMS.find(name).is_some() {
+            longitudinal::PARAMS.set(&mut self.longitudinal, name, value)
+        } else {
+            PARAMS.set(self, name, value)
+        };
+        let known = self.params().find(|(n, _)| *n == name).map(|(n, _)| n);
+        r.map_err(|e| match (e, known) {
+            (ParamError::NotFinite, Some(n)) => GainError::NotFinite(n),
+            (_, Some(n)) => GainError::OutOfBounds(n),
+            (_, None) => GainError::Unknown,
+        })
+    }
+
+    /// The set the store holds (consistent by the store's own checks).
+    pub fn from_store(store: &ParamStore) -> GainSet {
+        GainSet {
+            lateral: store.load(&lateral::PARAMS),
+            longitudinal: store.load(&longitudinal::PARAMS),
+            transfer_tc: store.load(&PARAMS).transfer_tc,
+        }
+    }
+}
 
 /// Longest time step accepted, s. A longer gap (a stalled estimator, a paused simulation) would
 /// integrate one stale error over it; such a tick is refused and the outputs held instead.
 pub const MAX_DT: f32 = 0.5;
-
-/// The measured state the autopilot flies on. SI units, radians; body rates in the body frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Measurements {
-    /// Roll angle phi, rad.
-    pub roll: f32,
-    /// Pitch angle theta, rad.
-    pub pitch: f32,
-    /// Course over ground chi, rad (the heading psi in still air, as the thesis assumes).
-    pub course: f32,
-    /// Roll rate p, rad/s.
-    pub roll_rate: f32,
-    /// Pitch rate q, rad/s.
-    pub pitch_rate: f32,
-    /// Yaw rate r, rad/s.
-    pub yaw_rate: f32,
-    /// Altitude h, m (any datum, the same as the altitude commands').
-    pub altitude: f32,
-    /// Airspeed Va, m/s.
-    pub airspeed: f32,
-    /// Sideslip beta, rad.
-    pub sideslip: f32,
-}
-
-impl Measurements {
-    /// Wings-level, straight flight at this airspeed and altitude, heading north.
-    pub fn level(airspeed: f32, altitude: f32) -> Self {
-        Self {
-            airspeed,
-            altitude,
-            ..Self::default()
-        }
-    }
-}
-
-/// A set of inputs, as bits: which measurements (or the command, or the time step) were refused.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct InputFlags(pub u16);
-
-impl InputFlags {
-    /// Roll angle.
-    pub const ROLL: Self = Self(1 << 0);
-    /// Pitch angle.
-    pub const PITCH: Self = Self(1 << 1);
-    /// Course.
-    pub const COURSE: Self = Self(1 << 2);
-    /// Roll rate.
-    pub const ROLL_RATE: Self = Self(1 << 3);
-    /// Pitch rate.
-    pub const PITCH_RATE: Self = Self(1 << 4);
-    /// Yaw rate.
-    pub const YAW_RATE: Self = Self(1 << 5);
-    /// Altitude.
-    pub const ALTITUDE: Self = Self(1 << 6);
-    /// Airspeed.
-    pub const AIRSPEED: Self = Self(1 << 7);
-    /// Sideslip.
-    pub const SIDESLIP: Self = Self(1 << 8);
-    /// A setpoint of the commands.
-    pub const COMMAND: Self = Self(1 << 9);
-    /// The time step.
-    pub const DT: Self = Self(1 << 10);
-
-    /// No flag.
-    pub const fn empty() -> Self {
-        Self(0)
-    }
-
-    /// No flag set.
-    pub const fn is_empty(self) -> bool {
-        self.0 == 0
-    }
-
-    /// All flags of `other` are set.
-    pub const fn contains(self, other: Self) -> bool {
-        self.0 & other.0 == other.0
-    }
-
-    /// Sets (`on`) or clears the flags of `other`.
-    pub fn set(&mut self, other: Self, on: bool) {
-        if on {
-            self.0 |= other.0;
-        } else {
-            self.0 &= !other.0;
-        }
-    }
-}
-
-impl core::ops::BitOr for InputFlags {
-    type Output = Self;
-    fn bitor(self, rhs: Self) -> Self {
-        Self(self.0 | rhs.0)
-    }
-}
-
-impl core::ops::BitOrAssign for InputFlags {
-    fn bitor_assign(&mut self, rhs: Self) {
-        self.0 |= rhs.0;
-    }
-}
 
 /// What each axis is asked to do.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,16 +254,33 @@ fn bump(c: &mut u32, on: bool) {
     }
 }
 
+impl Default for GainSet {
+    fn default() -> Self {
+        GainSet::THESIS
+    }
+}
+
+impl Default for Autopilot {
+    /// A disengaged autopilot flying the thesis's designed set (valid: tested).
+    fn default() -> Self {
+        Self::build(&GainSet::THESIS)
+    }
+}
+
 impl Autopilot {
     /// A disengaged autopilot flying `gains`, which must pass [`GainSet::validate`].
     pub fn new(gains: &GainSet) -> Result<Self, GainError> {
         gains.validate()?;
-        Ok(Self {
+        Ok(Self::build(gains))
+    }
+
+    fn build(gains: &GainSet) -> Self {
+        Self {
             gains: *gains,
             lat: Lateral::new(&gains.lateral, gains.transfer_tc),
             lon: Longitudinal::new(&gains.longitudinal, gains.transfer_tc),
             counters: HoldCounters::default(),
-        })
+        }
     }
 
     /// The gains in use.
@@ -309,6 +356,7 @@ impl Autopilot {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::control::gains::DESIGNED;
     use crate::control::gains::{MINNESOTA, NAMED};
 
     const DT: f32 = 0.02;

@@ -9,8 +9,9 @@
 extern crate std;
 use std::vec::Vec;
 
-use super::autopilot::{Autopilot, Commands, Measurements};
+use super::autopilot::{Autopilot, Commands};
 use super::gains::{GainSet, DESIGNED, DESIGNED_T310, MINNESOTA};
+use super::inputs::Measurements;
 use super::lateral::{Lateral, RollMode, YawMode};
 use super::longitudinal::LonMode;
 

@@ -13,132 +13,245 @@
 //! sideslip: the yaw damper adds `+k r` (right yaw -> rudder that yaws left) and the sideslip PI
 //! has positive gains (see [`super::gains`] for the Table 3.5 sign).
 
-use super::autopilot::{InputFlags, Measurements};
 use super::filters::Washout;
-use super::gains::{LateralGains, DESIGNED, RAD2DEG};
+use super::inputs::{InputFlags, Measurements};
 use super::pid::{Bumpless, Derivative, Pid, PidGains};
 use crate::actuators::SURFACE_LIMIT_RAD;
-use crate::math::wrap_pi;
-use crate::params::ParamDef;
+use crate::math::{wrap_pi, DEG, RAD2DEG};
+use crate::param;
+use crate::params::{Group, ParamDef};
+use serde::{Deserialize, Serialize};
 
-const L: LateralGains = DESIGNED.lateral;
+/// Gains and limits of the lateral-directional autopilot (ailerons and rudder).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LateralGains {
+    /// Roll attitude, proportional: aileron rad per rad of roll error (negative, UMN).
+    pub roll_kp: f32,
+    /// Roll attitude, integral: aileron rad per rad s of roll error (negative, UMN).
+    pub roll_ki: f32,
+    /// Roll-rate damper: aileron rad per rad/s of roll rate, applied as `-kd p` (negative, UMN).
+    pub roll_rate_kd: f32,
+    /// Course hold, proportional: commanded roll rad per rad of course error.
+    pub course_kp: f32,
+    /// Course hold, integral: commanded roll rad per rad s of course error.
+    pub course_ki: f32,
+    /// Sideslip hold, proportional: rudder rad per rad of sideslip error (positive, UMN).
+    pub slip_kp: f32,
+    /// Sideslip hold, integral: rudder rad per rad s of sideslip error (positive, UMN).
+    pub slip_ki: f32,
+    /// Yaw damper: rudder rad per rad/s of washed-out yaw rate, `+k r` (positive: opposes r).
+    pub yaw_damper_k: f32,
+    /// Pole of the yaw-damper washout `s / (s + a)`, rad/s.
+    pub washout_pole: f32,
+    /// Largest commanded roll angle, rad.
+    pub roll_max: f32,
+    /// Aileron travel the loops may use, rad (at most the servo limit).
+    pub aileron_max: f32,
+    /// Rudder travel the loops may use, rad (at most the servo limit).
+    pub rudder_max: f32,
+    /// Aileron trim, the feed-forward of the roll loop, rad.
+    pub trim_aileron: f32,
+    /// Rudder trim, the feed-forward of the rudder loops, rad.
+    pub trim_rudder: f32,
+}
+
+/// The thesis's designed lateral gains, chapter-3 tables: roll Table 3.3, course Table 3.4,
+/// sideslip Table 3.5 (sign corrected, see [`super::gains`]); roll limit 45 deg and surface
+/// travel 25 deg (section 3.3, Appendix F); washout Appendix D; trims Table 2.3 trim I.
+pub const THESIS: LateralGains = LateralGains {
+    roll_kp: -1.1216,
+    roll_ki: -0.1,
+    roll_rate_kd: -0.0618,
+    course_kp: 4.0511,
+    course_ki: 0.01,
+    slip_kp: 3.0,
+    slip_ki: 0.8,
+    yaw_damper_k: 0.065,
+    washout_pole: 2.0,
+    roll_max: 45.0 * DEG,
+    aileron_max: 25.0 * DEG,
+    rudder_max: 25.0 * DEG,
+    trim_aileron: 0.01,
+    trim_rudder: 0.00317,
+};
+
+const L: LateralGains = THESIS;
+
+/// Trims inside the travel the loops may use: otherwise the loop could not return to trim.
+fn consistent(g: &LateralGains) -> Result<(), &'static str> {
+    if libm::fabsf(g.trim_aileron) > g.aileron_max {
+        return Err("TRIM_AIL_DEG");
+    }
+    if libm::fabsf(g.trim_rudder) > g.rudder_max {
+        return Err("TRIM_RUD_DEG");
+    }
+    Ok(())
+}
 
 /// Parameters of the lateral autopilot; defaults are the thesis's designed set. The bounds of
 /// the loop gains admit only the sign that stabilises the loop in the UMN convention.
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real(
-        "RLL_KP",
-        L.roll_kp,
-        -10.0,
-        0.0,
-        "rad/rad",
-        "Roll attitude P gain, aileron per roll error (UMN sign: negative)",
-    ),
-    ParamDef::real(
-        "RLL_KI",
-        L.roll_ki,
-        -10.0,
-        0.0,
-        "1/s",
-        "Roll attitude I gain, aileron per integrated roll error",
-    ),
-    ParamDef::real(
-        "RLL_RATE_KD",
-        L.roll_rate_kd,
-        -2.0,
-        0.0,
-        "s",
-        "Roll-rate damper, aileron per roll rate, applied as -kd*p",
-    ),
-    ParamDef::real(
-        "CRS_KP",
-        L.course_kp,
-        0.0,
-        20.0,
-        "rad/rad",
-        "Course hold P gain, commanded roll per course error",
-    ),
-    ParamDef::real(
-        "CRS_KI",
-        L.course_ki,
-        0.0,
-        20.0,
-        "1/s",
-        "Course hold I gain, commanded roll per integrated course error",
-    ),
-    ParamDef::real(
-        "SLIP_KP",
-        L.slip_kp,
-        0.0,
-        20.0,
-        "rad/rad",
-        "Sideslip hold P gain, rudder per sideslip error (positive)",
-    ),
-    ParamDef::real(
-        "SLIP_KI",
-        L.slip_ki,
-        0.0,
-        20.0,
-        "1/s",
-        "Sideslip hold I gain, rudder per integrated sideslip error",
-    ),
-    ParamDef::real(
-        "YAW_DAMP_K",
-        L.yaw_damper_k,
-        0.0,
-        2.0,
-        "s",
-        "Yaw damper, rudder per washed-out yaw rate (+k*r)",
-    ),
-    ParamDef::real(
-        "YAW_WO_POLE",
-        L.washout_pole,
-        0.1,
-        20.0,
-        "rad/s",
-        "Pole of the yaw-damper washout s/(s+a)",
-    ),
-    ParamDef::real(
-        "LIM_ROLL_DEG",
-        L.roll_max * RAD2DEG,
-        5.0,
-        80.0,
-        "deg",
-        "Largest commanded roll angle",
-    ),
-    ParamDef::real(
-        "LIM_AIL_DEG",
-        25.0,
-        1.0,
-        25.0,
-        "deg",
-        "Aileron travel the autopilot may use",
-    ),
-    ParamDef::real(
-        "LIM_RUD_DEG",
-        25.0,
-        1.0,
-        25.0,
-        "deg",
-        "Rudder travel the autopilot may use",
-    ),
-    ParamDef::real(
-        "TRIM_AIL_DEG",
-        L.trim_aileron * RAD2DEG,
-        -25.0,
-        25.0,
-        "deg",
-        "Aileron trim, feed-forward of the roll loop (trim I)",
-    ),
-    ParamDef::real(
-        "TRIM_RUD_DEG",
-        L.trim_rudder * RAD2DEG,
-        -25.0,
-        25.0,
-        "deg",
-        "Rudder trim, feed-forward of the rudder loops (trim I)",
-    ),
-];
+pub const PARAMS: Group<LateralGains> = Group {
+    name: "Lateral autopilot",
+    params: &[
+        param!(
+            ParamDef::real(
+                "RLL_KP",
+                L.roll_kp,
+                -10.0,
+                0.0,
+                "rad/rad",
+                "Roll attitude P gain, aileron per roll error (UMN sign: negative)",
+            ),
+            LateralGains => roll_kp
+        ),
+        param!(
+            ParamDef::real(
+                "RLL_KI",
+                L.roll_ki,
+                -10.0,
+                0.0,
+                "1/s",
+                "Roll attitude I gain, aileron per integrated roll error",
+            ),
+            LateralGains => roll_ki
+        ),
+        param!(
+            ParamDef::real(
+                "RLL_RATE_KD",
+                L.roll_rate_kd,
+                -2.0,
+                0.0,
+                "s",
+                "Roll-rate damper, aileron per roll rate, applied as -kd*p",
+            ),
+            LateralGains => roll_rate_kd
+        ),
+        param!(
+            ParamDef::real(
+                "CRS_KP",
+                L.course_kp,
+                0.0,
+                20.0,
+                "rad/rad",
+                "Course hold P gain, commanded roll per course error",
+            ),
+            LateralGains => course_kp
+        ),
+        param!(
+            ParamDef::real(
+                "CRS_KI",
+                L.course_ki,
+                0.0,
+                20.0,
+                "1/s",
+                "Course hold I gain, commanded roll per integrated course error",
+            ),
+            LateralGains => course_ki
+        ),
+        param!(
+            ParamDef::real(
+                "SLIP_KP",
+                L.slip_kp,
+                0.0,
+                20.0,
+                "rad/rad",
+                "Sideslip hold P gain, rudder per sideslip error (positive)",
+            ),
+            LateralGains => slip_kp
+        ),
+        param!(
+            ParamDef::real(
+                "SLIP_KI",
+                L.slip_ki,
+                0.0,
+                20.0,
+                "1/s",
+                "Sideslip hold I gain, rudder per integrated sideslip error",
+            ),
+            LateralGains => slip_ki
+        ),
+        param!(
+            ParamDef::real(
+                "YAW_DAMP_K",
+                L.yaw_damper_k,
+                0.0,
+                2.0,
+                "s",
+                "Yaw damper, rudder per washed-out yaw rate (+k*r)",
+            ),
+            LateralGains => yaw_damper_k
+        ),
+        param!(
+            ParamDef::real(
+                "YAW_WO_POLE",
+                L.washout_pole,
+                0.1,
+                20.0,
+                "rad/s",
+                "Pole of the yaw-damper washout s/(s+a)",
+            ),
+            LateralGains => washout_pole
+        ),
+        param!(
+            ParamDef::real(
+                "LIM_ROLL_DEG",
+                L.roll_max * RAD2DEG,
+                5.0,
+                80.0,
+                "deg",
+                "Largest commanded roll angle",
+            ),
+            LateralGains => roll_max, scale RAD2DEG
+        ),
+        param!(
+            ParamDef::real(
+                "LIM_AIL_DEG",
+                25.0,
+                1.0,
+                25.0,
+                "deg",
+                "Aileron travel the autopilot may use",
+            ),
+            LateralGains => aileron_max, scale RAD2DEG
+        ),
+        param!(
+            ParamDef::real(
+                "LIM_RUD_DEG",
+                25.0,
+                1.0,
+                25.0,
+                "deg",
+                "Rudder travel the autopilot may use",
+            ),
+            LateralGains => rudder_max, scale RAD2DEG
+        ),
+        param!(
+            ParamDef::real(
+                "TRIM_AIL_DEG",
+                L.trim_aileron * RAD2DEG,
+                -25.0,
+                25.0,
+                "deg",
+                "Aileron trim, feed-forward of the roll loop (trim I)",
+            ),
+            LateralGains => trim_aileron, scale RAD2DEG
+        ),
+        param!(
+            ParamDef::real(
+                "TRIM_RUD_DEG",
+                L.trim_rudder * RAD2DEG,
+                -25.0,
+                25.0,
+                "deg",
+                "Rudder trim, feed-forward of the rudder loops (trim I)",
+            ),
+            LateralGains => trim_rudder, scale RAD2DEG
+        ),
+    ],
+    base: || THESIS,
+    check: consistent,
+};
 
 /// What the ailerons do.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -476,7 +589,7 @@ mod tests {
     const D: f32 = core::f32::consts::PI / 180.0;
 
     fn zero_trim() -> LateralGains {
-        let mut g = DESIGNED.lateral;
+        let mut g = THESIS;
         g.trim_aileron = 0.0;
         g.trim_rudder = 0.0;
         g
@@ -586,7 +699,7 @@ mod tests {
 
     #[test]
     fn engaging_and_mode_changes_are_bumpless() {
-        let g = DESIGNED.lateral;
+        let g = THESIS;
         let mut lat = Lateral::new(&g, 1.0);
         let m = Measurements {
             roll: 12.0 * D,

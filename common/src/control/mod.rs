@@ -38,9 +38,12 @@
 //! - [`pid`]: the PID building block (saturation, conditional-integration anti-windup,
 //!   derivative on the measurement or a measured rate, bumpless re-initialisation).
 //! - [`filters`]: the feedback low-pass and the yaw-damper washout.
-//! - [`lateral`], [`longitudinal`]: the two autopilots, with their `PARAMS`.
-//! - [`autopilot`]: one tick of both, input validation, status; [`Autopilot`] is the entry point.
-//! - [`gains`]: [`GainSet`], the named sets of the thesis, and the mapping to parameters.
+//! - [`inputs`]: the measured state the stages read, and the flags of what a tick refused.
+//! - [`lateral`], [`longitudinal`]: the two autopilots, each with its gains and their
+//!   parameters (`PARAMS`).
+//! - [`autopilot`]: one tick of both, input validation, status; [`Autopilot`] is the entry
+//!   point; [`GainSet`] holds one gain value of each stage.
+//! - [`gains`]: the named sets of the thesis, composed from the stages' gains.
 //!
 //! Sign convention throughout: the University of Minnesota model's (see
 //! [`crate::actuators::Surfaces`]).
@@ -48,6 +51,7 @@
 pub mod autopilot;
 pub mod filters;
 pub mod gains;
+pub mod inputs;
 pub mod lateral;
 pub mod longitudinal;
 pub mod pid;
@@ -55,7 +59,7 @@ pub mod pid;
 #[cfg(test)]
 mod closed_loop_tests;
 
-pub use autopilot::{Autopilot, Commands, InputFlags, Measurements, Output, Status};
-pub use gains::{GainError, GainSet};
+pub use autopilot::{Autopilot, Commands, GainError, GainSet, Output, Status};
+pub use inputs::{InputFlags, Measurements};
 pub use lateral::{RollMode, YawMode};
 pub use longitudinal::{LonMode, Regime};

@@ -583,7 +583,9 @@ fn gps_outage_degrades_gracefully() {
 fn latency_run(delay_param: f32) -> (f64, f64) {
     let segs = [level(20.0), turn(40.0, 20.0, 0.0)];
     let mut cfg = EstimatorConfig::default();
-    cfg.set("EKF_GPS_DELAY", delay_param).unwrap();
+    config::PARAMS
+        .set(&mut cfg, "EKF_GPS_DELAY", delay_param)
+        .unwrap();
     let mut f = Flight::new(&segs, 21, cfg);
     f.sim.gps_latency = 0.2;
     let (mut pos, mut vel) = (Rms::default(), Rms::default());

@@ -4,8 +4,8 @@
 use mavlink::dialects::common::*;
 use num_traits::FromPrimitive;
 
-use super::modes::FlightMode;
-use super::snapshot::{
+use crate::vehicle::modes::FlightMode;
+use crate::vehicle::snapshot::{
     LandedState, MissionRunState, VehicleSnapshot, BATTERY_CRITICAL, BATTERY_LOW,
 };
 

@@ -9,23 +9,95 @@ use std::vec::Vec;
 use mavlink::dialects::common::*;
 use mavlink::MavHeader;
 
-use super::mission::{MISSION_CAPACITY, UPLOAD_MAX_RETRIES, UPLOAD_RETRY_US};
-use super::modes::{FlightMode, ModeSet};
-use super::snapshot::*;
+use super::mission::{UPLOAD_MAX_RETRIES, UPLOAD_RETRY_US};
 use super::*;
-use crate::params::ParamDef;
+use crate::navigation::plan::MISSION_CAPACITY;
+use crate::navigation::validate::PlanRules;
+use crate::param;
+use crate::params::store::Registry;
+use crate::params::{Group, ParamDef};
+use crate::vehicle::modes::{FlightMode, ModeSet};
+use crate::vehicle::requests::ArmRequest;
+use crate::vehicle::snapshot::*;
 
-const STAGE_A: &[ParamDef] = &[
-    ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", "roll gain"),
-    ParamDef::real("RLL_KI", 0.1, 0.0, 1.0, "", "roll integral gain"),
-    ParamDef::int("NAV_MODE", 2, 0, 5, "", "an enumeration"),
-];
-const STAGE_B: &[ParamDef] = &[
-    ParamDef::real("ASPD_TRIM", 17.0, 10.0, 30.0, "m/s", "trim airspeed"),
-    ParamDef::int("SYS_COUNT", 100000, -5, 1_000_000, "", "a large integer"),
-    ParamDef::real("ALT_KP", 0.05, 0.0, 1.0, "", "altitude gain"),
-];
-const REGISTRY: Registry = &[STAGE_A, STAGE_B];
+#[derive(Clone, Copy, Default)]
+struct A {
+    rll_kp: f32,
+    rll_ki: f32,
+    nav_mode: u8,
+}
+#[derive(Clone, Copy, Default)]
+struct B {
+    aspd: f32,
+    count: i32,
+    alt_kp: f32,
+}
+const STAGE_A: Group<A> = Group {
+    name: "a",
+    params: &[
+        param!(ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", "roll gain"), A => rll_kp),
+        param!(ParamDef::real("RLL_KI", 0.1, 0.0, 1.0, "", "roll integral gain"), A => rll_ki),
+        param!(ParamDef::int("NAV_MODE", 2, 0, 5, "", "an enumeration"), A => nav_mode, count),
+    ],
+    base: A::default,
+    check: crate::params::independent,
+};
+const STAGE_B: Group<B> = Group {
+    name: "b",
+    params: &[
+        param!(ParamDef::real("ASPD_TRIM", 17.0, 10.0, 30.0, "m/s", "trim airspeed"), B => aspd),
+        param!(
+            ParamDef::int("SYS_COUNT", 100000, -5, 1_000_000, "", "a large integer"),
+            B => count,
+            count
+        ),
+        param!(ParamDef::real("ALT_KP", 0.05, 0.0, 1.0, "", "altitude gain"), B => alt_kp),
+    ],
+    base: B::default,
+    check: crate::params::independent,
+};
+const REGISTRY: Registry = &[&STAGE_A, &STAGE_B];
+
+/// The link with the stores a vehicle would lend it.
+struct Bench {
+    link: GroundLink,
+    params: ParamStore,
+    plan: MissionStore,
+    rules: PlanRules,
+}
+
+impl core::ops::Deref for Bench {
+    type Target = GroundLink;
+    fn deref(&self) -> &GroundLink {
+        &self.link
+    }
+}
+
+impl core::ops::DerefMut for Bench {
+    fn deref_mut(&mut self) -> &mut GroundLink {
+        &mut self.link
+    }
+}
+
+impl Bench {
+    fn handle(&mut self, h: &MavHeader, msg: &MavMessage, now: u64, v: &VehicleSnapshot) {
+        let mut stores = Stores {
+            params: &mut self.params,
+            plan: &mut self.plan,
+            rules: self.rules,
+        };
+        self.link.handle(h, msg, now, v, &mut stores);
+    }
+
+    fn poll(&mut self, now: u64, v: &VehicleSnapshot, out: impl FnMut(MavMessage)) {
+        let stores = Stores {
+            params: &mut self.params,
+            plan: &mut self.plan,
+            rules: self.rules,
+        };
+        self.link.poll(now, v, &stores, out);
+    }
+}
 
 const GCS: (u8, u8) = (255, 190);
 
@@ -37,8 +109,13 @@ fn hdr() -> MavHeader {
     }
 }
 
-fn link() -> GroundLink {
-    GroundLink::new(REGISTRY).unwrap()
+fn link() -> Bench {
+    Bench {
+        link: GroundLink::default(),
+        params: ParamStore::new(REGISTRY),
+        plan: MissionStore::default(),
+        rules: PlanRules::default(),
+    }
 }
 
 /// A vehicle on the ground, booted, every sensor healthy, 3D fix, home set.
@@ -73,12 +150,12 @@ fn healthy() -> VehicleSnapshot {
 }
 
 /// Handles `msg` at `now` and returns what the next poll emits.
-fn exchange(l: &mut GroundLink, v: &VehicleSnapshot, now: u64, msg: MavMessage) -> Vec<MavMessage> {
+fn exchange(l: &mut Bench, v: &VehicleSnapshot, now: u64, msg: MavMessage) -> Vec<MavMessage> {
     l.handle(&hdr(), &msg, now, v);
     poll(l, v, now)
 }
 
-fn poll(l: &mut GroundLink, v: &VehicleSnapshot, now: u64) -> Vec<MavMessage> {
+fn poll(l: &mut Bench, v: &VehicleSnapshot, now: u64) -> Vec<MavMessage> {
     let mut out = Vec::new();
     l.poll(now, v, |m| out.push(m));
     out
@@ -205,8 +282,8 @@ fn set_and_read_back() {
     assert_eq!(pv[0].param_value, 1.25);
     assert_eq!(pv[0].param_index, 0);
     assert!(texts(&out).is_empty());
-    assert_eq!(l.params().get("RLL_KP"), Some(1.25));
-    assert!(l.params().is_dirty());
+    assert_eq!(l.params.get("RLL_KP"), Some(1.25));
+    assert!(l.params.is_dirty());
 
     // Integer set bytewise.
     let out = exchange(
@@ -220,7 +297,7 @@ fn set_and_read_back() {
         ),
     );
     assert_eq!(param_values(&out)[0].param_value.to_bits(), -3i32 as u32);
-    assert_eq!(l.params().get("SYS_COUNT"), Some(-3.0));
+    assert_eq!(l.params.get("SYS_COUNT"), Some(-3.0));
 
     // Read by name (index -1) and by index.
     let out = exchange(
@@ -301,8 +378,8 @@ fn bad_values_refused_with_echo_and_reason() {
         ),
     ];
     for (k, (name, value, t, why)) in cases.into_iter().enumerate() {
-        let before = l.params().get(name).unwrap();
-        let changes = l.params().change_count();
+        let before = l.params.get(name).unwrap();
+        let changes = l.params.change_count();
         let out = exchange(&mut l, &v, k as u64, param_set(name, value, t));
         let pv = param_values(&out);
         assert_eq!(pv.len(), 1, "{name}: one echo");
@@ -312,8 +389,8 @@ fn bad_values_refused_with_echo_and_reason() {
             pv[0].param_value
         };
         assert_eq!(echoed, before, "{name}: echo carries the unchanged value");
-        assert_eq!(l.params().get(name), Some(before));
-        assert_eq!(l.params().change_count(), changes);
+        assert_eq!(l.params.get(name), Some(before));
+        assert_eq!(l.params.change_count(), changes);
         let t = texts(&out);
         assert_eq!(t.len(), 1, "{name}: one STATUSTEXT");
         assert!(t[0].contains(name) && t[0].contains(why), "{:?}", t[0]);
@@ -363,8 +440,7 @@ fn heartbeat_one_hertz_identity_and_status() {
         .contains(MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED));
 
     v = healthy();
-    let st =
-        |l: &mut GroundLink, v: &VehicleSnapshot, t: u64| heartbeat_of(&poll(l, v, t)).unwrap();
+    let st = |l: &mut Bench, v: &VehicleSnapshot, t: u64| heartbeat_of(&poll(l, v, t)).unwrap();
     assert_eq!(
         st(&mut l, &v, 6_000_000).system_status,
         MavState::MAV_STATE_STANDBY
@@ -864,7 +940,7 @@ fn available_and_current_modes() {
 
 // ---------------------------------------------------------------- telemetry scheduler
 
-fn count_over(l: &mut GroundLink, v: &VehicleSnapshot, from_us: u64, secs: u64, id: u32) -> usize {
+fn count_over(l: &mut Bench, v: &VehicleSnapshot, from_us: u64, secs: u64, id: u32) -> usize {
     let mut n = 0;
     // Polled at 1 kHz, like a fast SITL loop.
     for k in 0..secs * 1000 {
@@ -1023,7 +1099,7 @@ fn waypoints(n: usize, salt: u32) -> Vec<MISSION_ITEM_INT_DATA> {
 
 /// A ground station uploading `items`, answering each request; returns the final ACK.
 fn upload(
-    l: &mut GroundLink,
+    l: &mut Bench,
     v: &VehicleSnapshot,
     start_us: u64,
     t: MavMissionType,
@@ -1034,7 +1110,7 @@ fn upload(
 
 /// As [`upload`], with the STATUSTEXTs the vehicle sent on the way.
 fn upload_said(
-    l: &mut GroundLink,
+    l: &mut Bench,
     v: &VehicleSnapshot,
     start_us: u64,
     t: MavMissionType,
@@ -1083,7 +1159,7 @@ fn upload_said(
 
 /// A ground station downloading a list.
 fn download(
-    l: &mut GroundLink,
+    l: &mut Bench,
     v: &VehicleSnapshot,
     start_us: u64,
     t: MavMissionType,
@@ -1175,7 +1251,7 @@ fn mission_round_trip_bit_exact_130_items() {
         ),
         MavMissionResult::MAV_MISSION_ACCEPTED
     );
-    assert_eq!(l.missions().store().mission.len(), 130);
+    assert_eq!(l.plan.mission.len(), 130);
     let back = download(
         &mut l,
         &v,
@@ -1213,11 +1289,7 @@ fn mission_round_trip_bit_exact_130_items() {
         ),
         MavMissionResult::MAV_MISSION_NO_SPACE
     );
-    assert_eq!(
-        l.missions().store().mission.len(),
-        MISSION_CAPACITY,
-        "old mission kept"
-    );
+    assert_eq!(l.plan.mission.len(), MISSION_CAPACITY, "old mission kept");
 }
 
 #[test]
@@ -1271,7 +1343,7 @@ fn fence_and_rally_stored_beside_the_mission() {
         upload(&mut l, &v, 6_000_000, f, &waypoints(1, 0)),
         MavMissionResult::MAV_MISSION_UNSUPPORTED
     );
-    assert_eq!(l.missions().store().fence.len(), 4);
+    assert_eq!(l.plan.fence.len(), 4);
     // Clearing the fence leaves the others.
     let out = exchange(
         &mut l,
@@ -1284,9 +1356,9 @@ fn fence_and_rally_stored_beside_the_mission() {
         }),
     );
     assert!(out.iter().any(|m| matches!(m, MavMessage::MISSION_ACK(a) if a.mavtype == MavMissionResult::MAV_MISSION_ACCEPTED && a.mission_type == f)));
-    assert_eq!(l.missions().store().fence.len(), 0);
-    assert_eq!(l.missions().store().mission.len(), 3);
-    assert_eq!(l.missions().store().rally.len(), 1);
+    assert_eq!(l.plan.fence.len(), 0);
+    assert_eq!(l.plan.mission.len(), 3);
+    assert_eq!(l.plan.rally.len(), 1);
     // ALL clears everything.
     exchange(
         &mut l,
@@ -1298,7 +1370,7 @@ fn fence_and_rally_stored_beside_the_mission() {
             mission_type: MavMissionType::MAV_MISSION_TYPE_ALL,
         }),
     );
-    assert!(l.missions().store().mission.is_empty() && l.missions().store().rally.is_empty());
+    assert!(l.plan.mission.is_empty() && l.plan.rally.is_empty());
 }
 
 fn mission_acks(out: &[MavMessage]) -> Vec<MavMissionResult> {
@@ -1365,7 +1437,7 @@ fn erroneous_uploads_get_the_right_ack() {
         mission_acks(&out),
         [MavMissionResult::MAV_MISSION_INVALID_SEQUENCE]
     );
-    assert_eq!(l.missions().store().mission.len(), 2, "old mission kept");
+    assert_eq!(l.plan.mission.len(), 2, "old mission kept");
     assert!(!l.missions().busy());
     // A repeated earlier item is answered by asking again for the expected one.
     exchange(&mut l, &v, 4, count_msg(5));
@@ -1528,7 +1600,7 @@ fn upload_timeouts_retries_and_restart() {
     );
     assert_eq!(final_ack, [MavMissionResult::MAV_MISSION_ERROR]);
     assert!(!l.missions().busy());
-    assert_eq!(l.missions().store().mission.len(), 1, "old mission kept");
+    assert_eq!(l.plan.mission.len(), 1, "old mission kept");
 
     // A retry answered resumes the upload.
     let mut l = link();
@@ -1582,7 +1654,7 @@ fn upload_timeouts_retries_and_restart() {
         ),
         MavMissionResult::MAV_MISSION_ACCEPTED
     );
-    assert_eq!(l.missions().store().mission.len(), 3);
+    assert_eq!(l.plan.mission.len(), 3);
 }
 
 #[allow(deprecated)]
@@ -1741,12 +1813,12 @@ fn ram_footprint_within_budget() {
     use core::mem::size_of;
     let sizes = [
         ("GroundLink", size_of::<GroundLink>()),
-        ("ParamStore", size_of::<param_store::ParamStore>()),
+        ("ParamStore", size_of::<ParamStore>()),
         ("MissionManager", size_of::<mission::MissionManager>()),
-        ("MissionStore", size_of::<mission::MissionStore>()),
+        ("MissionStore", size_of::<MissionStore>()),
         ("VehicleSnapshot", size_of::<VehicleSnapshot>()),
         ("MavMessage", size_of::<MavMessage>()),
-        ("ParamImage", size_of::<param_store::ParamImage>()),
+        ("ParamImage", size_of::<crate::params::store::ParamImage>()),
     ];
     for (n, s) in sizes {
         std::println!("{n}: {s} bytes");
@@ -1834,7 +1906,7 @@ fn preflight_storage_requests_save_and_resets_defaults() {
         ),
     );
     assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
-    assert_eq!(l.params().get("RLL_KP"), Some(2.0));
+    assert_eq!(l.params.get("RLL_KP"), Some(2.0));
     v.armed = false;
     let out = exchange(
         &mut l,
@@ -1846,7 +1918,7 @@ fn preflight_storage_requests_save_and_resets_defaults() {
         ),
     );
     assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
-    assert_eq!(l.params().get("RLL_KP"), Some(0.8));
+    assert_eq!(l.params.get("RLL_KP"), Some(0.8));
 }
 
 /// An upload is checked as the navigator will fly it before it replaces the stored mission:
@@ -1862,7 +1934,7 @@ fn uploads_are_checked_as_the_navigator_will_fly_them() {
         upload(&mut l, &v, 0, mission, &good),
         MavMissionResult::MAV_MISSION_ACCEPTED
     );
-    let stored = l.missions().store().items(PlanKind::Mission).to_vec();
+    let stored = l.plan.items(PlanKind::Mission).to_vec();
     let mut too_high = good.clone();
     too_high[1].z = 5000.0;
     assert_eq!(
@@ -1884,7 +1956,7 @@ fn uploads_are_checked_as_the_navigator_will_fly_them() {
         upload(&mut l, &v, 3_000_000, mission, &jump),
         MavMissionResult::MAV_MISSION_INVALID_SEQUENCE
     );
-    assert_eq!(l.missions().store().items(PlanKind::Mission), &stored[..]);
+    assert_eq!(l.plan.items(PlanKind::Mission), &stored[..]);
     let mut odd = good.clone();
     odd[1].command = MavCmd::MAV_CMD_DO_SET_SERVO;
     odd[1].frame = MavFrame::MAV_FRAME_MISSION;

@@ -36,45 +36,63 @@
 //! Altitudes here are heights above home, m, up: the datum the firmware gives the autopilot.
 
 use crate::math::{wrap_pi, DEG};
-use crate::params::{check_param, default_of, ParamDef, ParamError};
+use crate::param;
+use crate::params::{independent, Group, ParamDef};
 use core::f32::consts::{FRAC_PI_2, PI};
 use nalgebra::Vector3;
 
 /// Parameters of the path-following vector fields.
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real(
-        "NAV_CHI_INF_DEG",
-        60.0,
-        5.0,
-        90.0,
-        "deg",
-        "Approach angle to a straight path far from it (vector field chi_inf)",
-    ),
-    ParamDef::real(
-        "NAV_K_PATH",
-        0.05,
-        0.001,
-        1.0,
-        "1/m",
-        "Straight-path field gain: how sharply the approach bends onto the line",
-    ),
-    ParamDef::real(
-        "NAV_K_ORBIT",
-        2.0,
-        0.1,
-        10.0,
-        "",
-        "Orbit field gain: how sharply the approach bends onto the circle",
-    ),
-    ParamDef::real(
-        "NAV_CRS_TAU_S",
-        0.5,
-        0.0,
-        5.0,
-        "s",
-        "Course-loop time constant the orbit lead makes up for (0: no lead)",
-    ),
-];
+pub const PARAMS: Group<GuidanceParams> = Group {
+    name: "Guidance",
+    params: &[
+        param!(
+            ParamDef::real(
+                "NAV_CHI_INF_DEG",
+                60.0,
+                5.0,
+                90.0,
+                "deg",
+                "Approach angle to a straight path far from it (vector field chi_inf)",
+            ),
+            GuidanceParams => chi_inf, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_K_PATH",
+                0.05,
+                0.001,
+                1.0,
+                "1/m",
+                "Straight-path field gain: how sharply the approach bends onto the line",
+            ),
+            GuidanceParams => k_path
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_K_ORBIT",
+                2.0,
+                0.1,
+                10.0,
+                "",
+                "Orbit field gain: how sharply the approach bends onto the circle",
+            ),
+            GuidanceParams => k_orbit
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_CRS_TAU_S",
+                0.5,
+                0.0,
+                5.0,
+                "s",
+                "Course-loop time constant the orbit lead makes up for (0: no lead)",
+            ),
+            GuidanceParams => course_tau
+        ),
+    ],
+    base: || ZERO,
+    check: independent,
+};
 
 /// The vector fields' gains, in SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,40 +109,16 @@ pub struct GuidanceParams {
     pub course_tau: f32,
 }
 
+const ZERO: GuidanceParams = GuidanceParams {
+    chi_inf: 0.0,
+    k_path: 0.0,
+    k_orbit: 0.0,
+    course_tau: 0.0,
+};
+
 impl Default for GuidanceParams {
     fn default() -> Self {
-        Self {
-            chi_inf: default_of(PARAMS, "NAV_CHI_INF_DEG") * DEG,
-            k_path: default_of(PARAMS, "NAV_K_PATH"),
-            k_orbit: default_of(PARAMS, "NAV_K_ORBIT"),
-            course_tau: default_of(PARAMS, "NAV_CRS_TAU_S"),
-        }
-    }
-}
-
-impl GuidanceParams {
-    /// Sets one parameter by name after checking it; a refused value changes nothing.
-    pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        let v = check_param(PARAMS, name, value)?;
-        match name {
-            "NAV_CHI_INF_DEG" => self.chi_inf = v * DEG,
-            "NAV_K_PATH" => self.k_path = v,
-            "NAV_K_ORBIT" => self.k_orbit = v,
-            "NAV_CRS_TAU_S" => self.course_tau = v,
-            _ => return Err(ParamError::Unknown),
-        }
-        Ok(())
-    }
-
-    /// The current value of one parameter by name, in its parameter unit.
-    pub fn get(&self, name: &str) -> Option<f32> {
-        Some(match name {
-            "NAV_CHI_INF_DEG" => self.chi_inf / DEG,
-            "NAV_K_PATH" => self.k_path,
-            "NAV_K_ORBIT" => self.k_orbit,
-            "NAV_CRS_TAU_S" => self.course_tau,
-            _ => return None,
-        })
+        PARAMS.defaults()
     }
 }
 
@@ -314,7 +308,7 @@ impl Guidance {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::validate_defs;
+    use crate::params::{validate_defs, ParamError};
     use approx::assert_abs_diff_eq;
 
     fn line(chi_q: f32) -> Path {
@@ -327,15 +321,19 @@ mod tests {
 
     #[test]
     fn params_well_formed_and_reachable() {
-        assert_eq!(validate_defs(PARAMS), Ok(()));
+        assert_eq!(validate_defs(PARAMS.defs()), Ok(()));
         let mut p = GuidanceParams::default();
-        for d in PARAMS {
-            assert_abs_diff_eq!(p.get(d.name).unwrap(), d.default, epsilon = 1e-5);
+        for d in PARAMS.defs() {
+            assert_abs_diff_eq!(PARAMS.get(&p, d.name).unwrap(), d.default, epsilon = 1e-5);
         }
-        assert_eq!(p.set("NAV_K_PATH", 5.0), Err(ParamError::OutOfBounds));
-        assert_eq!(p.set("NAV_K_PATH", 0.05), Ok(()));
+        let g = PARAMS;
+        assert_eq!(
+            g.set(&mut p, "NAV_K_PATH", 5.0),
+            Err(ParamError::OutOfBounds)
+        );
+        assert_eq!(g.set(&mut p, "NAV_K_PATH", 0.05), Ok(()));
         assert_eq!(p.k_path, 0.05);
-        assert_eq!(p.set("NAV_CHI_INF_DEG", 45.0), Ok(()));
+        assert_eq!(g.set(&mut p, "NAV_CHI_INF_DEG", 45.0), Ok(()));
         assert_abs_diff_eq!(p.chi_inf, PI / 4.0, epsilon = 1e-6);
     }
 

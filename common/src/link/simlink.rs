@@ -13,9 +13,11 @@
 //! finite or not physically plausible is dropped and counted, never passed on.
 
 use crate::actuators::Surfaces;
-use crate::gcs::ManualInput;
 use crate::math::geodetic::GeoPoint;
-use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, ManualInput, PitotSample};
+
+/// The frame `HIL_SENSOR` decodes into.
+pub use crate::sensors::SensorFrame;
 use mavlink::dialects::common::{
     HilActuatorControlsFlags, HilSensorUpdatedFlags, MavModeFlag, HIL_ACTUATOR_CONTROLS_DATA,
     HIL_GPS_DATA, HIL_SENSOR_DATA, RC_CHANNELS_DATA,
@@ -47,23 +49,6 @@ mod limits {
     /// About 130 m/s of airspeed; small negative readings are sensor offset.
     pub const DIFF_HPA: (f32, f32) = (-5.0, 100.0);
     pub const TEMP_C: (f32, f32) = (-60.0, 90.0);
-}
-
-/// One `HIL_SENSOR` frame as typed samples; `None` where the group was not updated.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SensorFrame {
-    /// Simulation time, us: the autopilot's clock in lock-step.
-    pub time_us: u64,
-    /// Accelerometer and gyro.
-    pub imu: Option<ImuSample>,
-    /// Magnetometer.
-    pub mag: Option<MagSample>,
-    /// Barometer.
-    pub baro: Option<BaroSample>,
-    /// Differential pressure.
-    pub pitot: Option<PitotSample>,
-    /// The simulator reset its state (bit 31).
-    pub reset: bool,
 }
 
 /// Which groups of one frame were dropped as implausible or incomplete.

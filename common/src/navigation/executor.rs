@@ -45,198 +45,266 @@
 //! `DO_CHANGE_SPEED` of ground speed sets the airspeed), terrain, rally points.
 
 use super::items::{self, *};
-use super::path_manager::{PathManager, Waypoint};
+use super::path_manager::{PathManager, PathParams, Waypoint};
+use super::plan::{MissionItem, MISSION_CAPACITY};
 use crate::control::autopilot::Commands;
 use crate::control::lateral::{RollMode, YawMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
-use crate::gcs::mission::{MissionItem, MISSION_CAPACITY};
-use crate::guidance::{Guidance, GuidanceOutput, OrbitDirection, Path};
+use crate::guidance::{Guidance, GuidanceOutput, GuidanceParams, OrbitDirection, Path};
 use crate::math::{wrap_pi, DEG};
-use crate::params::check_param;
-use crate::params::{ParamDef, ParamError};
+use crate::param;
+use crate::params::{Group, ParamDef};
 use core::f32::consts::TAU;
 use nalgebra::Vector3;
 
 /// Parameters of the mission executor and its behaviours.
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real(
-        "NAV_ACC_RAD",
-        15.0,
-        1.0,
-        200.0,
-        "m",
-        "Waypoint acceptance radius when an item gives none",
-    ),
-    ParamDef::real(
-        "NAV_LOIT_RAD",
-        60.0,
-        10.0,
-        1000.0,
-        "m",
-        "Loiter radius when an item gives none",
-    ),
-    ParamDef::real(
-        "NAV_ALT_ACC",
-        5.0,
-        0.5,
-        50.0,
-        "m",
-        "Altitude counted as reached (take-off, loiter to altitude, return)",
-    ),
-    ParamDef::real(
-        "NAV_ASPD",
-        17.0,
-        8.0,
-        40.0,
-        "m/s",
-        "Cruise airspeed (the thesis's trim I)",
-    ),
-    ParamDef::real(
-        "NAV_ASPD_MIN",
-        13.0,
-        8.0,
-        40.0,
-        "m/s",
-        "Lowest airspeed DO_CHANGE_SPEED may set",
-    ),
-    ParamDef::real(
-        "NAV_ASPD_MAX",
-        25.0,
-        8.0,
-        40.0,
-        "m/s",
-        "Highest airspeed DO_CHANGE_SPEED may set",
-    ),
-    ParamDef::real(
-        "NAV_RTL_ALT",
-        60.0,
-        10.0,
-        1000.0,
-        "m",
-        "Return altitude above home",
-    ),
-    ParamDef::int(
-        "NAV_RTL_LAND",
-        0,
-        0,
-        1,
-        "",
-        "Return mode lands at home after the return (1) or circles (0)",
-    ),
-    ParamDef::real(
-        "NAV_TKO_VR",
-        13.0,
-        5.0,
-        30.0,
-        "m/s",
-        "Take-off rotation airspeed",
-    ),
-    ParamDef::real(
-        "NAV_TKO_CLR_M",
-        10.0,
-        1.0,
-        100.0,
-        "m",
-        "Take-off regime (fixed pitch, full throttle) ends at this height",
-    ),
-    ParamDef::real(
-        "NAV_LND_SLP_DEG",
-        5.0,
-        1.0,
-        20.0,
-        "deg",
-        "Landing glide slope",
-    ),
-    ParamDef::real(
-        "NAV_LND_ASPD",
-        15.0,
-        8.0,
-        30.0,
-        "m/s",
-        "Landing approach airspeed",
-    ),
-    ParamDef::real(
-        "NAV_FLR_ALT",
-        1.5,
-        0.5,
-        20.0,
-        "m",
-        "Flare below this height above the land point",
-    ),
-    ParamDef::real(
-        "NAV_FLR_PTCH_DEG",
-        3.0,
-        -5.0,
-        15.0,
-        "deg",
-        "Flare pitch at the touchdown sink rate",
-    ),
-    ParamDef::real(
-        "NAV_FLR_SINK",
-        0.4,
-        0.05,
-        3.0,
-        "m/s",
-        "Sink rate aimed for at touchdown",
-    ),
-    ParamDef::real(
-        "NAV_FLR_K",
-        0.15,
-        0.0,
-        1.0,
-        "rad s/m",
-        "Flare pitch per m/s of sink rate above the aim",
-    ),
-    ParamDef::real(
-        "NAV_FLR_PAST_K",
-        0.05,
-        0.0,
-        1.0,
-        "1/s",
-        "Flare past the land point: sink rate aimed for rises this much per metre past it (0: no steering)",
-    ),
-    ParamDef::real(
-        "NAV_LND_TD_M",
-        0.5,
-        0.05,
-        5.0,
-        "m",
-        "Touchdown: height above the land point under this for 1 s (or rolling slower than 5 m/s)",
-    ),
-    ParamDef::real(
-        "NAV_FLR_THR",
-        0.0,
-        0.0,
-        1.0,
-        "",
-        "Throttle at the start of the flare, faded to zero at touchdown height (keeps the energy a gusty flare needs)",
-    ),
-    ParamDef::real(
-        "NAV_APP_DIVE_M",
-        1.0,
-        0.1,
-        50.0,
-        "m",
-        "Approach: the altitude command lies at most this far below the present height (above the slope the aircraft closes it gently instead of diving)",
-    ),
-    ParamDef::real(
-        "NAV_APP_I",
-        0.1,
-        0.0,
-        1.0,
-        "1/s",
-        "Approach: integral gain on the height error below or above the glide slope (removes the proportional altitude loop's steady offset there)",
-    ),
-    ParamDef::real(
-        "NAV_STEER_K",
-        1.5,
-        0.0,
-        10.0,
-        "rad/rad",
-        "Ground steering: rudder (tail wheel) per radian of course error on the runway",
-    ),
-];
+pub const PARAMS: Group<NavParams> = Group {
+    name: "Navigator",
+    params: &[
+        param!(
+            ParamDef::real(
+                "NAV_ACC_RAD",
+                15.0,
+                1.0,
+                200.0,
+                "m",
+                "Waypoint acceptance radius when an item gives none",
+            ),
+            NavParams => accept_radius
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LOIT_RAD",
+                60.0,
+                10.0,
+                1000.0,
+                "m",
+                "Loiter radius when an item gives none",
+            ),
+            NavParams => loiter_radius
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ALT_ACC",
+                5.0,
+                0.5,
+                50.0,
+                "m",
+                "Altitude counted as reached (take-off, loiter to altitude, return)",
+            ),
+            NavParams => alt_accept
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ASPD",
+                17.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Cruise airspeed (the thesis's trim I)",
+            ),
+            NavParams => airspeed
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ASPD_MIN",
+                13.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Lowest airspeed DO_CHANGE_SPEED may set",
+            ),
+            NavParams => airspeed_min
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ASPD_MAX",
+                25.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Highest airspeed DO_CHANGE_SPEED may set",
+            ),
+            NavParams => airspeed_max
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_RTL_ALT",
+                60.0,
+                10.0,
+                1000.0,
+                "m",
+                "Return altitude above home",
+            ),
+            NavParams => rtl_alt
+        ),
+        param!(
+            ParamDef::boolean(
+                "NAV_RTL_LAND",
+                false,
+                "Return mode lands at home after the return (on) or circles there (off)",
+            ),
+            NavParams => rtl_land, flag
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TKO_VR",
+                13.0,
+                5.0,
+                30.0,
+                "m/s",
+                "Take-off rotation airspeed",
+            ),
+            NavParams => takeoff_vr
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TKO_CLR_M",
+                10.0,
+                1.0,
+                100.0,
+                "m",
+                "Take-off regime (fixed pitch, full throttle) ends at this height",
+            ),
+            NavParams => takeoff_clear
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_SLP_DEG",
+                5.0,
+                1.0,
+                20.0,
+                "deg",
+                "Landing glide slope",
+            ),
+            NavParams => glide_slope, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_ASPD",
+                15.0,
+                8.0,
+                30.0,
+                "m/s",
+                "Landing approach airspeed",
+            ),
+            NavParams => land_airspeed
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_ALT",
+                1.5,
+                0.5,
+                20.0,
+                "m",
+                "Flare below this height above the land point",
+            ),
+            NavParams => flare_alt
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_PTCH_DEG",
+                3.0,
+                -5.0,
+                15.0,
+                "deg",
+                "Flare pitch at the touchdown sink rate",
+            ),
+            NavParams => flare_pitch, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_SINK",
+                0.4,
+                0.05,
+                3.0,
+                "m/s",
+                "Sink rate aimed for at touchdown",
+            ),
+            NavParams => flare_sink
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_K",
+                0.15,
+                0.0,
+                1.0,
+                "rad s/m",
+                "Flare pitch per m/s of sink rate above the aim",
+            ),
+            NavParams => flare_k
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_PAST_K",
+                0.05,
+                0.0,
+                1.0,
+                "1/s",
+                "Flare past the land point: sink rate aimed for rises this much per metre past it (0: no steering)",
+            ),
+            NavParams => flare_past_k
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_TD_M",
+                0.5,
+                0.05,
+                5.0,
+                "m",
+                "Touchdown: height above the land point under this for 1 s (or rolling slower than 5 m/s)",
+            ),
+            NavParams => touchdown_alt
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_THR",
+                0.0,
+                0.0,
+                1.0,
+                "",
+                "Throttle at the start of the flare, faded to zero at touchdown height (keeps the energy a gusty flare needs)",
+            ),
+            NavParams => flare_throttle
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_APP_DIVE_M",
+                1.0,
+                0.1,
+                50.0,
+                "m",
+                "Approach: the altitude command lies at most this far below the present height (above the slope the aircraft closes it gently instead of diving)",
+            ),
+            NavParams => approach_dive
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_APP_I",
+                0.1,
+                0.0,
+                1.0,
+                "1/s",
+                "Approach: integral gain on the height error below or above the glide slope (removes the proportional altitude loop's steady offset there)",
+            ),
+            NavParams => approach_i
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_STEER_K",
+                1.5,
+                0.0,
+                10.0,
+                "rad/rad",
+                "Ground steering: rudder (tail wheel) per radian of course error on the runway",
+            ),
+            NavParams => steer_k
+        ),
+    ],
+    base: || ZERO,
+    check: consistent,
+};
 
 /// Largest height the approach's integral may add to or take off the glide slope, m, and the
 /// largest height error it integrates: it is there for the metre the proportional loop
@@ -317,90 +385,49 @@ pub struct NavParams {
     pub flare_throttle: f32,
 }
 
+const ZERO: NavParams = NavParams {
+    accept_radius: 0.0,
+    loiter_radius: 0.0,
+    alt_accept: 0.0,
+    airspeed: 0.0,
+    airspeed_min: 0.0,
+    airspeed_max: 0.0,
+    rtl_alt: 0.0,
+    rtl_land: false,
+    takeoff_vr: 0.0,
+    takeoff_clear: 0.0,
+    glide_slope: 0.0,
+    land_airspeed: 0.0,
+    flare_alt: 0.0,
+    flare_pitch: 0.0,
+    flare_sink: 0.0,
+    flare_k: 0.0,
+    touchdown_alt: 0.0,
+    steer_k: 0.0,
+    approach_i: 0.0,
+    approach_dive: 0.0,
+    flare_past_k: 0.0,
+    flare_throttle: 0.0,
+};
+
 impl Default for NavParams {
     fn default() -> Self {
-        let mut p = Self {
-            accept_radius: 0.0,
-            loiter_radius: 0.0,
-            alt_accept: 0.0,
-            airspeed: 0.0,
-            airspeed_min: 0.0,
-            airspeed_max: 0.0,
-            rtl_alt: 0.0,
-            rtl_land: false,
-            takeoff_vr: 0.0,
-            takeoff_clear: 0.0,
-            glide_slope: 0.0,
-            land_airspeed: 0.0,
-            flare_alt: 0.0,
-            flare_pitch: 0.0,
-            flare_sink: 0.0,
-            flare_k: 0.0,
-            touchdown_alt: 0.0,
-            steer_k: 0.0,
-            approach_i: 0.0,
-            approach_dive: 0.0,
-            flare_past_k: 0.0,
-            flare_throttle: 0.0,
-        };
-        for d in PARAMS {
-            // Defaults lie inside their bounds (checked by the tests).
-            let _ = p.set(d.name, d.default);
-        }
-        p
+        PARAMS.defaults()
     }
 }
 
-impl NavParams {
-    /// Sets one parameter by name after checking it; a refused value changes nothing.
-    pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        let v = check_param(PARAMS, name, value)?;
-        match name {
-            "NAV_RTL_LAND" => self.rtl_land = v != 0.0,
-            "NAV_LND_SLP_DEG" => self.glide_slope = v * DEG,
-            "NAV_FLR_PTCH_DEG" => self.flare_pitch = v * DEG,
-            _ => *self.slot(name).ok_or(ParamError::Unknown)? = v,
-        }
-        Ok(())
+/// Airspeeds in order: cruise and approach inside the settable range.
+fn consistent(p: &NavParams) -> Result<(), &'static str> {
+    if p.airspeed_min >= p.airspeed_max {
+        return Err("NAV_ASPD_MIN");
     }
-
-    /// The value of one parameter by name, in its parameter unit.
-    pub fn get(&self, name: &str) -> Option<f32> {
-        match name {
-            "NAV_RTL_LAND" => Some(f32::from(u8::from(self.rtl_land))),
-            "NAV_LND_SLP_DEG" => Some(self.glide_slope / DEG),
-            "NAV_FLR_PTCH_DEG" => Some(self.flare_pitch / DEG),
-            _ => {
-                let mut c = *self;
-                c.slot(name).map(|s| *s)
-            }
-        }
+    if !(p.airspeed_min..=p.airspeed_max).contains(&p.airspeed) {
+        return Err("NAV_ASPD");
     }
-
-    fn slot(&mut self, name: &str) -> Option<&mut f32> {
-        Some(match name {
-            "NAV_ACC_RAD" => &mut self.accept_radius,
-            "NAV_LOIT_RAD" => &mut self.loiter_radius,
-            "NAV_ALT_ACC" => &mut self.alt_accept,
-            "NAV_ASPD" => &mut self.airspeed,
-            "NAV_ASPD_MIN" => &mut self.airspeed_min,
-            "NAV_ASPD_MAX" => &mut self.airspeed_max,
-            "NAV_RTL_ALT" => &mut self.rtl_alt,
-            "NAV_TKO_VR" => &mut self.takeoff_vr,
-            "NAV_TKO_CLR_M" => &mut self.takeoff_clear,
-            "NAV_LND_ASPD" => &mut self.land_airspeed,
-            "NAV_FLR_ALT" => &mut self.flare_alt,
-            "NAV_FLR_SINK" => &mut self.flare_sink,
-            "NAV_FLR_K" => &mut self.flare_k,
-            "NAV_LND_TD_M" => &mut self.touchdown_alt,
-            "NAV_STEER_K" => &mut self.steer_k,
-            "NAV_APP_I" => &mut self.approach_i,
-            "NAV_APP_DIVE_M" => &mut self.approach_dive,
-            "NAV_FLR_PAST_K" => &mut self.flare_past_k,
-            "NAV_FLR_THR" => &mut self.flare_throttle,
-            _ => return None,
-        })
+    if !(p.airspeed_min..=p.airspeed_max).contains(&p.land_airspeed) {
+        return Err("NAV_LND_ASPD");
     }
+    Ok(())
 }
 
 /// What the navigator needs of the estimate.
@@ -764,17 +791,16 @@ impl Navigator {
         &self.params
     }
 
-    /// Sets a parameter of the executor, the path manager or the guidance by name.
-    pub fn set_param(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        match self.params.set(name, value) {
-            Err(ParamError::Unknown) => {}
-            r => return r,
-        }
-        match self.paths.set(name, value) {
-            Err(ParamError::Unknown) => {}
-            r => return r,
-        }
-        self.guidance.params.set(name, value)
+    /// Takes new settings for the executor, the path manager and the guidance.
+    pub fn configure(&mut self, nav: &NavParams, paths: &PathParams, guidance: &GuidanceParams) {
+        self.set_params(nav);
+        self.paths.configure(paths);
+        self.guidance.params = *guidance;
+    }
+
+    /// Takes new settings for the executor.
+    pub fn set_params(&mut self, nav: &NavParams) {
+        self.params = *nav;
     }
 
     /// Flies the mission from item `seq` on the next step, with fresh jump counts and the

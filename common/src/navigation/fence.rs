@@ -9,11 +9,11 @@
 //! [`breached`] and refused by [`validate_fence`] at upload.
 
 use super::items::{FENCE_POLYGON_EXCLUSION, FENCE_POLYGON_INCLUSION};
+use super::plan::MissionItem;
 use crate::estimator::Home;
-use crate::gcs::mission::MissionItem;
 use crate::math::geodetic::{ned_offset, GeoPoint};
-use crate::params::{check_param, default_of};
-use crate::params::{ParamDef, ParamError};
+use crate::param;
+use crate::params::{independent, Group, ParamDef};
 use mavlink::dialects::common::{MavCmd, MavMissionResult};
 use nalgebra::Vector3;
 
@@ -21,14 +21,22 @@ const CIRCLE_INCLUSION: u16 = MavCmd::MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION as u16;
 const CIRCLE_EXCLUSION: u16 = MavCmd::MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION as u16;
 
 /// Parameters of the geofence.
-pub const PARAMS: &[ParamDef] = &[ParamDef::real(
-    "GF_MAX_ALT_M",
-    0.0,
-    0.0,
-    10000.0,
-    "m",
-    "Highest height above home inside the fence (0, the default as in PX4: no altitude limit)",
-)];
+pub const PARAMS: Group<FenceParams> = Group {
+    name: "Geofence",
+    params: &[param!(
+        ParamDef::real(
+            "GF_MAX_ALT_M",
+            0.0,
+            0.0,
+            10000.0,
+            "m",
+            "Highest height above home inside the fence (0, the default as in PX4: no altitude limit)",
+        ),
+        FenceParams => max_alt
+    )],
+    base: || FenceParams { max_alt: 0.0 },
+    check: independent,
+};
 
 /// The geofence's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,17 +48,7 @@ pub struct FenceParams {
 
 impl Default for FenceParams {
     fn default() -> Self {
-        Self {
-            max_alt: default_of(PARAMS, "GF_MAX_ALT_M"),
-        }
-    }
-}
-
-impl FenceParams {
-    /// Sets one parameter by name after checking it; a refused value changes nothing.
-    pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        self.max_alt = check_param(PARAMS, name, value)?;
-        Ok(())
+        PARAMS.defaults()
     }
 }
 
@@ -238,7 +236,7 @@ mod tests {
 
     #[test]
     fn concave_polygon_and_altitude() {
-        assert_eq!(validate_defs(PARAMS), Ok(()));
+        assert_eq!(validate_defs(PARAMS.defs()), Ok(()));
         let f = l_shape();
         assert_eq!(FenceParams::default().max_alt, 0.0);
         let p = FenceParams { max_alt: 120.0 };

@@ -1,7 +1,7 @@
 //! Mission items as the navigator reads them: command numbers, frames, positions and altitudes.
 
+use super::plan::MissionItem;
 use crate::estimator::Home;
-use crate::gcs::mission::MissionItem;
 use crate::math::geodetic::{ned_offset, GeoPoint};
 use mavlink::dialects::common::{MavCmd, MavFrame};
 use nalgebra::Vector3;

@@ -3,6 +3,7 @@
 //! - [`executor`]: the [`Navigator`]: mission items to commands for the autopilot, plus the
 //!   return and loiter-here behaviours.
 //! - [`path_manager`]: waypoint switching with fillets (Beard & McLain 11.2).
+//! - [`plan`]: the stored mission, geofence and rally lists, and their capacities.
 //! - [`items`]: mission items as the navigator reads them (commands, frames, altitudes).
 //! - [`validate`]: mission checks at upload, with the `MAV_MISSION_RESULT` of the first fault.
 //! - [`fence`]: the geofence (inclusion/exclusion polygons and circles, maximum height).
@@ -11,6 +12,7 @@ pub mod executor;
 pub mod fence;
 pub mod items;
 pub mod path_manager;
+pub mod plan;
 pub mod validate;
 
 #[cfg(test)]
@@ -18,18 +20,8 @@ pub(crate) mod sim;
 #[cfg(test)]
 mod tests;
 
-use crate::params::ParamDef;
-
-/// Every parameter list of guidance and navigation, for the parameter registry.
-pub const PARAM_LISTS: &[&[ParamDef]] = &[
-    crate::guidance::PARAMS,
-    path_manager::PARAMS,
-    executor::PARAMS,
-    validate::PARAMS,
-    fence::PARAMS,
-];
-
 pub use executor::{HomeRequest, NavOutput, NavParams, NavState, NavWarning, Navigator, Phase};
 pub use fence::{breached, validate_fence, Breach, FenceParams};
-pub use path_manager::{PathManager, Waypoint};
+pub use path_manager::{PathManager, PathParams, Waypoint};
+pub use plan::{MissionItem, MissionStore, PlanKind};
 pub use validate::{validate_mission, MissionLimits, Rejection, Validation, ValidationWarning};

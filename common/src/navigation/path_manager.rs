@@ -27,8 +27,8 @@
 //! The caller shifts the window by one after each `reached` event.
 
 use crate::guidance::{OrbitDirection, Path};
-use crate::params::{check_param, default_of};
-use crate::params::{ParamDef, ParamError};
+use crate::param;
+use crate::params::{independent, Group, ParamDef};
 use nalgebra::{Vector2, Vector3};
 
 /// Parameters of the path manager. The default fillet radius is the Ultra Stick's turn over
@@ -36,14 +36,36 @@ use nalgebra::{Vector2, Vector3};
 /// 35 degrees of bank (the 45-degree limit less room for gusts and the course loop)
 /// `22^2 / (g tan 35)` is 70 m. A 50 m fillet held the bank on its limit downwind and let one
 /// gust carry the aircraft 20 m outside the corner.
-pub const PARAMS: &[ParamDef] = &[ParamDef::real(
-    "NAV_TURN_RAD",
-    70.0,
-    5.0,
-    500.0,
-    "m",
-    "Fillet radius at waypoint corners: the smallest turn radius over ground, wind included",
-)];
+pub const PARAMS: Group<PathParams> = Group {
+    name: "Path manager",
+    params: &[param!(
+        ParamDef::real(
+        "NAV_TURN_RAD",
+        70.0,
+        5.0,
+        500.0,
+        "m",
+        "Fillet radius at waypoint corners: the smallest turn radius over ground, wind included",
+    ),
+        PathParams => turn_radius
+    )],
+    base: || PathParams { turn_radius: 0.0 },
+    check: independent,
+};
+
+/// The path manager's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PathParams {
+    /// Fillet radius, m.
+    pub turn_radius: f32,
+}
+
+impl Default for PathParams {
+    fn default() -> Self {
+        PARAMS.defaults()
+    }
+}
 
 /// Waypoints the manager looks at: the leg's start, its end and the one after.
 pub const WINDOW: usize = 3;
@@ -96,7 +118,7 @@ pub struct PathManager {
 
 impl Default for PathManager {
     fn default() -> Self {
-        Self::new(default_of(PARAMS, "NAV_TURN_RAD"))
+        Self::new(PathParams::default().turn_radius)
     }
 }
 
@@ -124,11 +146,9 @@ impl PathManager {
         }
     }
 
-    /// Sets a parameter by name (`NAV_TURN_RAD`).
-    pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        let v = check_param(PARAMS, name, value)?;
-        self.turn_radius = v;
-        Ok(())
+    /// Takes new settings (the fillet radius, clamped to at least 1 m).
+    pub fn configure(&mut self, p: &PathParams) {
+        self.turn_radius = sane_radius(p.turn_radius);
     }
 
     /// The fillet radius, m.
@@ -266,7 +286,7 @@ fn sane_radius(r: f32) -> f32 {
     if r.is_finite() {
         r.max(1.0)
     } else {
-        default_of(PARAMS, "NAV_TURN_RAD")
+        PathParams::default().turn_radius
     }
 }
 
@@ -282,7 +302,7 @@ mod tests {
     use super::*;
     use crate::guidance::Guidance;
     use crate::navigation::sim::Kinematic;
-    use crate::params::validate_defs;
+    use crate::params::{validate_defs, ParamError};
     use approx::assert_abs_diff_eq;
 
     fn wp(id: u16, n: f32, e: f32, h: f32) -> Waypoint {
@@ -296,7 +316,7 @@ mod tests {
 
     #[test]
     fn params_well_formed() {
-        assert_eq!(validate_defs(PARAMS), Ok(()));
+        assert_eq!(validate_defs(PARAMS.defs()), Ok(()));
         let mut m = PathManager::default();
         // The default is the turn over ground of 22 m/s (17 m/s of airspeed, 5 m/s of wind
         // behind) at 35 degrees of bank.
@@ -306,8 +326,13 @@ mod tests {
             "{} vs {r}",
             m.turn_radius()
         );
-        assert_eq!(m.set("NAV_TURN_RAD", 1.0), Err(ParamError::OutOfBounds));
-        assert_eq!(m.set("NAV_TURN_RAD", 60.0), Ok(()));
+        let mut p = PathParams::default();
+        assert_eq!(
+            PARAMS.set(&mut p, "NAV_TURN_RAD", 1.0),
+            Err(ParamError::OutOfBounds)
+        );
+        assert_eq!(PARAMS.set(&mut p, "NAV_TURN_RAD", 60.0), Ok(()));
+        m.configure(&p);
         assert_eq!(m.turn_radius(), 60.0);
     }
 

@@ -5,18 +5,17 @@ extern crate std;
 use super::executor::PARAMS as EXEC_PARAMS;
 use super::items::*;
 use super::path_manager::PARAMS as PATH_PARAMS;
+use super::plan::MissionItem;
 use super::sim::Kinematic;
 use super::*;
 use crate::control::autopilot::Commands;
 use crate::control::lateral::RollMode;
 use crate::control::longitudinal::LonMode;
 use crate::estimator::Home;
-use crate::gcs::mission::MissionItem;
 use crate::guidance::Guidance;
 use crate::guidance::PARAMS as GUIDANCE_PARAMS;
 use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
 use crate::math::wrap_pi;
-use crate::params::{validate_defs, ParamDef};
 use nalgebra::Vector3;
 use std::vec::Vec;
 
@@ -190,30 +189,30 @@ fn fly(
 }
 
 #[test]
-fn parameter_lists_are_well_formed_and_unique_across_the_autopilot() {
-    let mut all: Vec<ParamDef> = Vec::new();
-    for list in PARAM_LISTS {
-        assert_eq!(validate_defs(list), Ok(()));
-        all.extend_from_slice(list);
-    }
-    all.extend(crate::control::gains::all_params().copied());
-    all.extend_from_slice(crate::estimator::PARAMS);
-    assert_eq!(validate_defs(&all), Ok(()));
-    let p = NavParams::default();
-    for d in EXEC_PARAMS {
-        let v = p.get(d.name).unwrap();
+fn navigation_parameters_are_well_formed_and_default_to_their_declarations() {
+    use crate::params::{ParamStore, Registry};
+    const NAV: Registry = &[
+        &GUIDANCE_PARAMS,
+        &PATH_PARAMS,
+        &EXEC_PARAMS,
+        &super::validate::PARAMS,
+        &super::fence::PARAMS,
+    ];
+    assert_eq!(ParamStore::validate(NAV), Ok(()));
+    let store = ParamStore::new(NAV);
+    let p = store.load(&EXEC_PARAMS);
+    assert_eq!(p, NavParams::default());
+    for d in EXEC_PARAMS.defs() {
+        let v = EXEC_PARAMS.get(&p, d.name).unwrap();
         assert!((v - d.default).abs() < 1e-5, "{}", d.name);
     }
-    let mut nav = navigator();
-    for d in GUIDANCE_PARAMS.iter().chain(PATH_PARAMS).chain(EXEC_PARAMS) {
-        assert_eq!(nav.set_param(d.name, d.default), Ok(()), "{}", d.name);
-    }
+    let mut q = p;
     assert_eq!(
-        nav.set_param("NAV_ACC_RAD", 1e6),
+        EXEC_PARAMS.set(&mut q, "NAV_ACC_RAD", 1e6),
         Err(crate::params::ParamError::OutOfBounds)
     );
     assert_eq!(
-        nav.set_param("NO_SUCH", 1.0),
+        EXEC_PARAMS.set(&mut q, "NO_SUCH", 1.0),
         Err(crate::params::ParamError::Unknown)
     );
 }
@@ -374,8 +373,10 @@ fn change_speed_and_set_home() {
     assert_eq!(o.guidance.unwrap().airspeed, 25.0);
     // Crossed limits (a minimum above the maximum) are no reason to panic: the maximum wins.
     let mut nav = navigator();
-    nav.set_param("NAV_ASPD_MIN", 30.0).unwrap();
-    nav.set_param("NAV_ASPD_MAX", 20.0).unwrap();
+    let mut p = *nav.params();
+    p.airspeed_min = 30.0;
+    p.airspeed_max = 20.0;
+    nav.set_params(&p);
     nav.start_mission(0);
     let o = nav.step(&items, &home(), &plane.state(), DT);
     assert_eq!(o.guidance.unwrap().airspeed, 20.0);
@@ -791,10 +792,14 @@ fn navigator() -> Navigator {
     // The glide geometry is checked without the approach's integral (the test's altitude
     // lag is part of the expectation).
     let mut p = NavParams::default();
-    p.set("NAV_APP_I", 0.0).expect("in range");
+    EXEC_PARAMS.set(&mut p, "NAV_APP_I", 0.0).expect("in range");
     // The glide geometry these tests were written for: 6 deg, flare from 4 m.
-    p.set("NAV_LND_SLP_DEG", 6.0).expect("in range");
-    p.set("NAV_FLR_ALT", 4.0).expect("in range");
+    EXEC_PARAMS
+        .set(&mut p, "NAV_LND_SLP_DEG", 6.0)
+        .expect("in range");
+    EXEC_PARAMS
+        .set(&mut p, "NAV_FLR_ALT", 4.0)
+        .expect("in range");
     Navigator::new(
         p,
         Guidance::for_course_lag(1.0, 0.03),
@@ -876,7 +881,11 @@ fn a_flare_past_the_point_pitches_down_for_the_runway() {
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
     let pitch_past = |k: f32| {
         let mut nav = navigator();
-        nav.set_param("NAV_FLR_PAST_K", k).expect("in range");
+        let mut p = *nav.params();
+        EXEC_PARAMS
+            .set(&mut p, "NAV_FLR_PAST_K", k)
+            .expect("in range");
+        nav.set_params(&p);
         let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
         nav.start_mission(0);
         fly(&mut nav, &mut plane, &items, 120.0, |o| {

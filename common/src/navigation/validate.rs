@@ -3,32 +3,52 @@
 
 use super::executor::NavParams;
 use super::items::{self, *};
+use super::plan::MissionItem;
 use crate::estimator::Home;
-use crate::gcs::mission::MissionItem;
 use crate::math::geodetic::ned_offset;
-use crate::params::{check_param, default_of};
-use crate::params::{ParamDef, ParamError};
+use crate::param;
+use crate::params::{Group, ParamDef};
 use mavlink::dialects::common::MavMissionResult;
 
 /// Parameters of the mission checks.
-pub const PARAMS: &[ParamDef] = &[
-    ParamDef::real(
-        "MIS_ALT_MIN",
-        -20.0,
-        -1000.0,
-        0.0,
-        "m",
-        "Lowest item altitude accepted, height above home",
-    ),
-    ParamDef::real(
-        "MIS_ALT_MAX",
-        400.0,
-        10.0,
-        10000.0,
-        "m",
-        "Highest item altitude accepted, height above home",
-    ),
-];
+pub const PARAMS: Group<MissionLimits> = Group {
+    name: "Mission checks",
+    params: &[
+        param!(
+            ParamDef::real(
+                "MIS_ALT_MIN",
+                -20.0,
+                -1000.0,
+                0.0,
+                "m",
+                "Lowest item altitude accepted, height above home",
+            ),
+            MissionLimits => alt_min
+        ),
+        param!(
+            ParamDef::real(
+                "MIS_ALT_MAX",
+                400.0,
+                10.0,
+                10000.0,
+                "m",
+                "Highest item altitude accepted, height above home",
+            ),
+            MissionLimits => alt_max
+        ),
+    ],
+    base: || MissionLimits {
+        alt_min: 0.0,
+        alt_max: 0.0,
+    },
+    check: |l| {
+        if l.alt_min < l.alt_max {
+            Ok(())
+        } else {
+            Err("MIS_ALT_MIN")
+        }
+    },
+};
 
 /// Altitude range accepted for items, heights above home, m.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,23 +62,20 @@ pub struct MissionLimits {
 
 impl Default for MissionLimits {
     fn default() -> Self {
-        Self {
-            alt_min: default_of(PARAMS, "MIS_ALT_MIN"),
-            alt_max: default_of(PARAMS, "MIS_ALT_MAX"),
-        }
+        PARAMS.defaults()
     }
 }
 
-impl MissionLimits {
-    /// Sets one parameter by name after checking it; a refused value changes nothing.
-    pub fn set(&mut self, name: &str, value: f32) -> Result<(), ParamError> {
-        let v = check_param(PARAMS, name, value)?;
-        match name {
-            "MIS_ALT_MIN" => self.alt_min = v,
-            _ => self.alt_max = v,
-        }
-        Ok(())
-    }
+/// What a finished upload is checked against before it replaces the stored list: the
+/// navigator's limits and the present home (the vehicle hands them to the link).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanRules {
+    /// Home, once known (absolute altitudes are checked against it).
+    pub home: Option<Home>,
+    /// Altitude range of mission items.
+    pub limits: MissionLimits,
+    /// The navigator's parameters (approach checks).
+    pub nav: NavParams,
 }
 
 /// Why an item is refused.
@@ -249,7 +266,7 @@ mod tests {
             assert!(write!(s, "{w}").is_ok(), "{w:?} does not fit: {s}");
         }
     }
-    use crate::params::validate_defs;
+    use crate::params::{validate_defs, ParamError};
 
     use crate::navigation::tests::{home, item};
 
@@ -272,10 +289,14 @@ mod tests {
 
     #[test]
     fn params_well_formed() {
-        assert_eq!(validate_defs(PARAMS), Ok(()));
+        assert_eq!(validate_defs(PARAMS.defs()), Ok(()));
         let mut l = MissionLimits::default();
-        assert_eq!(l.set("MIS_ALT_MAX", 5.0), Err(ParamError::OutOfBounds));
-        assert_eq!(l.set("MIS_ALT_MAX", 150.0), Ok(()));
+        let g = PARAMS;
+        assert_eq!(
+            g.set(&mut l, "MIS_ALT_MAX", 5.0),
+            Err(ParamError::OutOfBounds)
+        );
+        assert_eq!(g.set(&mut l, "MIS_ALT_MAX", 150.0), Ok(()));
         assert_eq!(l.alt_max, 150.0);
     }
 

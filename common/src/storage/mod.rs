@@ -21,8 +21,8 @@
 
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::gcs::mission::MissionStore;
-use crate::gcs::param_store::{ImportReport, ParamExport, ParamImage, ParamStore};
+use crate::navigation::plan::MissionStore;
+use crate::params::store::{ImportReport, ParamExport, ParamImage, ParamStore};
 
 /// A flash device (or a model of one). Erased bytes read 0xFF; a write can only clear bits.
 pub trait Flash {

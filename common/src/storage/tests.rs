@@ -5,9 +5,10 @@ extern crate std;
 use serde::{Deserialize, Serialize};
 
 use super::*;
-use crate::gcs::mission::{MissionItem, MissionStore};
-use crate::gcs::param_store::ParamExport;
-use crate::params::ParamDef;
+use crate::navigation::plan::{MissionItem, MissionStore};
+use crate::param;
+use crate::params::store::ParamExport;
+use crate::params::{Group, ParamDef};
 
 const SECTOR: u32 = 1024;
 type Dev = RamFlash<4096>;
@@ -156,25 +157,43 @@ fn corrupted_newest_falls_back_and_other_magic_ignored() {
     );
 }
 
-const OLD_TABLE: &[ParamDef] = &[
-    ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", ""),
-    ParamDef::int("NAV_MODE", 2, 0, 5, "", ""),
-    ParamDef::real("GONE", 1.0, 0.0, 5.0, "", ""),
-    ParamDef::real("NARROWED", 1.0, 0.0, 5.0, "", ""),
-];
+#[derive(Clone, Copy, Default)]
+struct Settings {
+    rll_kp: f32,
+    nav_mode: u8,
+    gone: f32,
+    narrowed: f32,
+    added: f32,
+}
+const OLD_TABLE: Group<Settings> = Group {
+    name: "old",
+    params: &[
+        param!(ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", ""), Settings => rll_kp),
+        param!(ParamDef::int("NAV_MODE", 2, 0, 5, "", ""), Settings => nav_mode, count),
+        param!(ParamDef::real("GONE", 1.0, 0.0, 5.0, "", ""), Settings => gone),
+        param!(ParamDef::real("NARROWED", 1.0, 0.0, 5.0, "", ""), Settings => narrowed),
+    ],
+    base: Settings::default,
+    check: crate::params::independent,
+};
 // The next firmware: reordered, one removed, one added, one with tighter bounds.
-const NEW_TABLE: &[ParamDef] = &[
-    ParamDef::real("ADDED", 3.0, 0.0, 5.0, "", ""),
-    ParamDef::real("NARROWED", 1.0, 0.0, 2.0, "", ""),
-    ParamDef::int("NAV_MODE", 2, 0, 5, "", ""),
-    ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", ""),
-];
+const NEW_TABLE: Group<Settings> = Group {
+    name: "new",
+    params: &[
+        param!(ParamDef::real("ADDED", 3.0, 0.0, 5.0, "", ""), Settings => added),
+        param!(ParamDef::real("NARROWED", 1.0, 0.0, 2.0, "", ""), Settings => narrowed),
+        param!(ParamDef::int("NAV_MODE", 2, 0, 5, "", ""), Settings => nav_mode, count),
+        param!(ParamDef::real("RLL_KP", 0.8, 0.0, 5.0, "", ""), Settings => rll_kp),
+    ],
+    base: Settings::default,
+    check: crate::params::independent,
+};
 
 #[test]
 fn params_load_by_name_into_a_reordered_table() {
     let mut f = Dev::new(SECTOR);
     let mut scratch = [0u8; 1024];
-    let mut old = ParamStore::new(&[OLD_TABLE]).unwrap();
+    let mut old = ParamStore::new(&[&OLD_TABLE]);
     old.set("RLL_KP", 1.5).unwrap();
     old.set("NAV_MODE", 4.0).unwrap();
     old.set("GONE", 2.0).unwrap();
@@ -191,7 +210,7 @@ fn params_load_by_name_into_a_reordered_table() {
     let streamed = postcard::to_slice(&ParamExport(&old), &mut streamed).unwrap();
     assert_eq!(image, streamed);
 
-    let mut new = ParamStore::new(&[NEW_TABLE]).unwrap();
+    let mut new = ParamStore::new(&[&NEW_TABLE]);
     let report = load_params(&mut f, &REGION, &mut new, &mut scratch)
         .unwrap()
         .unwrap();
@@ -250,8 +269,8 @@ fn missions_persist_bit_exact() {
 #[test]
 fn full_records_fit_their_sectors() {
     // The largest parameter image and mission store encode within one 16 KiB sector.
-    use crate::gcs::mission::{FENCE_CAPACITY, MISSION_CAPACITY, RALLY_CAPACITY};
-    use crate::gcs::param_store::{ParamRecord, MAX_PARAMS};
+    use crate::navigation::plan::{FENCE_CAPACITY, MISSION_CAPACITY, RALLY_CAPACITY};
+    use crate::params::store::{ParamRecord, MAX_PARAMS};
     let worst = MissionItem {
         params: [u32::MAX; 4],
         x: i32::MIN,

@@ -1,0 +1,397 @@
+//! The command service: `COMMAND_LONG` / `COMMAND_INT` checked against the vehicle's
+//! snapshot, answered with `COMMAND_ACK`, accepted ones queued as requests.
+
+use super::outbox::{After, Command, Pending};
+use super::streams::Stream;
+use super::{telemetry, GroundLink, Stores, FORCE_ARM_MAGIC, HEARTBEAT_INTERVAL_US};
+use crate::navigation::plan::MissionStore;
+use crate::vehicle::modes::FlightMode;
+use crate::vehicle::requests::{AltitudeSetpoint, ArmRequest, CourseSetpoint};
+use crate::vehicle::snapshot::{LandedState, VehicleSnapshot};
+use mavlink::dialects::common::*;
+use num_traits::FromPrimitive;
+
+/// Airspeeds a setpoint may ask for, m/s (the Ultra Stick's envelope with margin).
+pub const AIRSPEED_SETPOINT_RANGE: (f32, f32) = (10.0, 30.0);
+
+impl GroundLink {
+    // GET_MESSAGE_INTERVAL and REQUEST_AUTOPILOT_CAPABILITIES are superseded by
+    // REQUEST_MESSAGE but QGC and MAVSDK versions in use still send them.
+    #[allow(deprecated)]
+    pub(super) fn on_command(
+        &mut self,
+        c: Command,
+        from: (u8, u8),
+        now_us: u64,
+        v: &VehicleSnapshot,
+        stores: &mut Stores,
+    ) {
+        let mut after = After::new();
+        let result = match c.cmd {
+            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => self.arm_disarm(&c, v),
+            MavCmd::MAV_CMD_DO_SET_MODE => {
+                let base = c.p[0] as u32;
+                if base & MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as u32 == 0 {
+                    self.textf(
+                        MavSeverity::MAV_SEVERITY_WARNING,
+                        format_args!("Mode refused: only custom modes"),
+                    );
+                    MavResult::MAV_RESULT_DENIED
+                } else {
+                    let (main, sub) = (c.p[1] as u8, c.p[2] as u8);
+                    match FlightMode::from_px4(main, sub) {
+                        Some(m) => self.request_mode(m, v, stores.plan),
+                        None => self.unknown_mode((u32::from(main) << 16) | (u32::from(sub) << 24)),
+                    }
+                }
+            }
+            MavCmd::MAV_CMD_DO_SET_STANDARD_MODE => {
+                match MavStandardMode::from_u32(c.p[0] as u32).and_then(FlightMode::from_standard) {
+                    Some(m) => self.request_mode(m, v, stores.plan),
+                    None => {
+                        self.textf(
+                            MavSeverity::MAV_SEVERITY_WARNING,
+                            format_args!("Standard mode {} not supported", c.p[0] as u32),
+                        );
+                        MavResult::MAV_RESULT_FAILED
+                    }
+                }
+            }
+            MavCmd::MAV_CMD_MISSION_START => {
+                let r = self.request_mode(FlightMode::Mission, v, stores.plan);
+                let first = c.p[0];
+                if r == MavResult::MAV_RESULT_ACCEPTED
+                    && first >= 1.0
+                    && (first as usize) < stores.plan.mission.len()
+                {
+                    self.requests.mission_seq = Some(first as u16);
+                }
+                r
+            }
+            MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => {
+                self.request_mode(FlightMode::Return, v, stores.plan)
+            }
+            MavCmd::MAV_CMD_NAV_TAKEOFF => self.request_mode(FlightMode::Takeoff, v, stores.plan),
+            MavCmd::MAV_CMD_NAV_LAND => self.request_mode(FlightMode::Land, v, stores.plan),
+            MavCmd::MAV_CMD_DO_SET_MISSION_CURRENT => {
+                let seq = c.p[0];
+                if (0.0..65536.0).contains(&seq)
+                    && self.set_mission_current(seq as u16, stores.plan)
+                {
+                    MavResult::MAV_RESULT_ACCEPTED
+                } else {
+                    MavResult::MAV_RESULT_DENIED
+                }
+            }
+            MavCmd::MAV_CMD_DO_CHANGE_ALTITUDE => {
+                // param1 altitude, param2 frame (MAV_FRAME_GLOBAL = 0 or GLOBAL_RELATIVE_ALT = 3).
+                let frame = c.p[1] as i32;
+                if !c.p[0].is_finite() || !(-500.0..=10_000.0).contains(&c.p[0]) {
+                    MavResult::MAV_RESULT_DENIED
+                } else if frame != 0 && frame != 3 {
+                    MavResult::MAV_RESULT_UNSUPPORTED
+                } else {
+                    self.requests.altitude = Some(AltitudeSetpoint {
+                        alt_m: c.p[0],
+                        relative_to_home: frame == 3,
+                    });
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+            }
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED => {
+                // param1 speed type (0 or 1: airspeed), param2 speed, -1 / -2: no change.
+                let (lo, hi) = AIRSPEED_SETPOINT_RANGE;
+                if c.p[1] == -1.0 || c.p[1] == -2.0 {
+                    MavResult::MAV_RESULT_ACCEPTED
+                } else if c.p[0] as i32 > 1 {
+                    MavResult::MAV_RESULT_UNSUPPORTED
+                } else if !(lo..=hi).contains(&c.p[1]) {
+                    self.textf(
+                        MavSeverity::MAV_SEVERITY_WARNING,
+                        format_args!("Airspeed {} refused: outside [{}, {}] m/s", c.p[1], lo, hi),
+                    );
+                    MavResult::MAV_RESULT_DENIED
+                } else {
+                    self.requests.airspeed = Some(c.p[1]);
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+            }
+            MavCmd::MAV_CMD_CONDITION_YAW => {
+                // param1 angle deg, param3 direction (-1 ccw, 1 cw) when relative, param4 1 = relative.
+                let relative = c.p[3] as i32 == 1;
+                if !c.p[0].is_finite() || !(0.0..=360.0).contains(&c.p[0]) {
+                    MavResult::MAV_RESULT_DENIED
+                } else {
+                    let sign = if relative && c.p[2] < 0.0 { -1.0 } else { 1.0 };
+                    self.requests.course = Some(CourseSetpoint {
+                        angle: sign * c.p[0].to_radians(),
+                        relative,
+                    });
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+            }
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
+                match message_id(c.p[0]) {
+                    Some(0) => MavResult::MAV_RESULT_DENIED, // the heartbeat stays at 1 Hz
+                    Some(id) => match Stream::from_message_id(id) {
+                        Some(s) => {
+                            self.streams.set_interval(s, c.p[1], now_us);
+                            MavResult::MAV_RESULT_ACCEPTED
+                        }
+                        None => MavResult::MAV_RESULT_UNSUPPORTED,
+                    },
+                    None => MavResult::MAV_RESULT_DENIED,
+                }
+            }
+            MavCmd::MAV_CMD_GET_MESSAGE_INTERVAL => match message_id(c.p[0]) {
+                Some(id) => {
+                    let interval_us = if id == 0 {
+                        HEARTBEAT_INTERVAL_US as i32
+                    } else {
+                        match Stream::from_message_id(id) {
+                            Some(s) => self
+                                .streams
+                                .interval_us(s)
+                                .map_or(-1, |i| i.min(i32::MAX as u32) as i32),
+                            None => 0,
+                        }
+                    };
+                    let _ = after.push(Pending::MessageInterval {
+                        id: id as u16,
+                        interval_us,
+                    });
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+                None => MavResult::MAV_RESULT_DENIED,
+            },
+            MavCmd::MAV_CMD_REQUEST_MESSAGE => {
+                let (r, p) = self.request_message(&c, v);
+                after = p;
+                r
+            }
+            MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
+                let _ = after.push(Pending::AutopilotVersion);
+                MavResult::MAV_RESULT_ACCEPTED
+            }
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE => match c.p[0] as i32 {
+                1 => {
+                    self.requests.save_params = true;
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+                2 if v.armed => MavResult::MAV_RESULT_DENIED,
+                2 => {
+                    stores.params.reset_to_defaults();
+                    self.requests.save_params = true;
+                    MavResult::MAV_RESULT_ACCEPTED
+                }
+                _ => MavResult::MAV_RESULT_UNSUPPORTED,
+            },
+            _ => MavResult::MAV_RESULT_UNSUPPORTED,
+        };
+        self.ack(c.cmd, result, from);
+        for p in after {
+            self.push(p);
+        }
+    }
+
+    /// `MAV_CMD_REQUEST_MESSAGE`: the result and, when accepted, what to send after the ACK.
+    fn request_message(&mut self, c: &Command, v: &VehicleSnapshot) -> (MavResult, After) {
+        let mut after = After::new();
+        let Some(id) = message_id(c.p[0]) else {
+            return (MavResult::MAV_RESULT_DENIED, after);
+        };
+        let one = match id {
+            0 => Some(Pending::Heartbeat),
+            148 => Some(Pending::AutopilotVersion),
+            436 => Some(Pending::CurrentMode),
+            435 => {
+                let n = FlightMode::ALL.len();
+                let index = c.p[1];
+                if index == 0.0 {
+                    // 0 asks for every mode.
+                    for i in 0..n {
+                        let _ = after.push(Pending::AvailableMode(i as u8));
+                    }
+                    return (MavResult::MAV_RESULT_ACCEPTED, after);
+                } else if index >= 1.0 && index <= n as f32 && libm::truncf(index) == index {
+                    Some(Pending::AvailableMode(index as u8 - 1))
+                } else {
+                    return (MavResult::MAV_RESULT_DENIED, after);
+                }
+            }
+            _ => match Stream::from_message_id(id) {
+                Some(Stream::HomePosition) if !v.home.valid => {
+                    return (MavResult::MAV_RESULT_TEMPORARILY_REJECTED, after)
+                }
+                Some(s) => Some(Pending::Stream(s)),
+                None => return (MavResult::MAV_RESULT_UNSUPPORTED, after),
+            },
+        };
+        if let Some(p) = one {
+            let _ = after.push(p);
+        }
+        (MavResult::MAV_RESULT_ACCEPTED, after)
+    }
+
+    fn arm_disarm(&mut self, c: &Command, v: &VehicleSnapshot) -> MavResult {
+        let arm = c.p[0] > 0.5;
+        let forced = (c.p[1] - FORCE_ARM_MAGIC).abs() < 0.5;
+        if arm {
+            if v.armed {
+                return MavResult::MAV_RESULT_ACCEPTED;
+            }
+            if !forced {
+                if !v.boot_complete {
+                    self.textf(
+                        MavSeverity::MAV_SEVERITY_CRITICAL,
+                        format_args!("Arming denied: system still starting"),
+                    );
+                    return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
+                }
+                if let Some(why) = telemetry::prearm_failure(v) {
+                    self.textf(
+                        MavSeverity::MAV_SEVERITY_CRITICAL,
+                        format_args!("Arming denied: {}", why),
+                    );
+                    return MavResult::MAV_RESULT_DENIED;
+                }
+            }
+        } else {
+            if !v.armed {
+                return MavResult::MAV_RESULT_ACCEPTED;
+            }
+            let flying = matches!(
+                v.landed,
+                LandedState::InAir | LandedState::Takeoff | LandedState::Landing
+            );
+            if flying && !forced {
+                self.textf(
+                    MavSeverity::MAV_SEVERITY_CRITICAL,
+                    format_args!("Disarming denied: not landed"),
+                );
+                return MavResult::MAV_RESULT_DENIED;
+            }
+        }
+        self.requests.arm = Some(ArmRequest { arm, forced });
+        MavResult::MAV_RESULT_ACCEPTED
+    }
+
+    pub(super) fn unknown_mode(&mut self, custom_mode: u32) -> MavResult {
+        self.textf(
+            MavSeverity::MAV_SEVERITY_WARNING,
+            format_args!(
+                "Mode {}.{} not supported",
+                (custom_mode >> 16) & 0xff,
+                custom_mode >> 24
+            ),
+        );
+        MavResult::MAV_RESULT_FAILED
+    }
+
+    /// Checks a mode change and, when possible, queues it for the vehicle.
+    pub(super) fn request_mode(
+        &mut self,
+        mode: FlightMode,
+        v: &VehicleSnapshot,
+        plan: &MissionStore,
+    ) -> MavResult {
+        if mode == FlightMode::Mission && plan.mission.is_empty() {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Mode Mission refused: no mission"),
+            );
+            return MavResult::MAV_RESULT_DENIED;
+        }
+        if mode == FlightMode::Return && !v.home.valid {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Mode Return refused: no home position"),
+            );
+            return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
+        }
+        if !v.modes_available.contains(mode) {
+            let why = if mode.needs_position() && !v.health.position_valid {
+                "no position estimate"
+            } else {
+                "not available now"
+            };
+            self.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Mode {} refused: {}", mode.name(), why),
+            );
+            return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
+        }
+        self.requests.mode = Some(mode);
+        MavResult::MAV_RESULT_ACCEPTED
+    }
+
+    /// Asks the vehicle to make `seq` current and confirms with MISSION_CURRENT; false (and a
+    /// STATUSTEXT) when there is no such item.
+    pub(super) fn set_mission_current(&mut self, seq: u16, plan: &MissionStore) -> bool {
+        let n = plan.mission.len();
+        if usize::from(seq) >= n {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Mission item {} does not exist ({} items)", seq, n),
+            );
+            return false;
+        }
+        self.requests.mission_seq = Some(seq);
+        self.push(Pending::MissionCurrent(Some(seq)));
+        true
+    }
+
+    #[allow(deprecated)] // PARAM_FLOAT is deprecated in favour of the encoding flags, yet
+                         // the design names it and older ground stations look for it.
+    pub(super) fn autopilot_version(&self) -> MavMessage {
+        type C = MavProtocolCapability;
+        let capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+            | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
+            | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
+            | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+            | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
+            | C::MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
+            | C::MAV_PROTOCOL_CAPABILITY_MISSION_RALLY;
+        MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
+            capabilities,
+            uid: self.cfg.uid,
+            flight_sw_version: FLIGHT_SW_VERSION,
+            middleware_sw_version: 0,
+            os_sw_version: 0,
+            board_version: 0,
+            vendor_id: 0,
+            product_id: 0,
+            flight_custom_version: [0; 8],
+            middleware_custom_version: [0; 8],
+            os_custom_version: [0; 8],
+            uid2: [0; 18],
+        })
+    }
+}
+
+/// A message id carried in a float command parameter.
+fn message_id(p: f32) -> Option<u32> {
+    if (0.0..16_777_216.0).contains(&p) && libm::truncf(p) == p {
+        Some(p as u32)
+    } else {
+        None
+    }
+}
+
+const fn parse_u8(s: &str) -> u32 {
+    let b = s.as_bytes();
+    let mut v = 0u32;
+    let mut i = 0;
+    while i < b.len() {
+        v = v * 10 + (b[i] - b'0') as u32;
+        i += 1;
+    }
+    v & 0xff
+}
+
+/// `AUTOPILOT_VERSION.flight_sw_version`: major, minor, patch of this crate and 255
+/// (`FIRMWARE_VERSION_TYPE_OFFICIAL`), one byte each, as PX4 packs it.
+pub const FLIGHT_SW_VERSION: u32 = (parse_u8(env!("CARGO_PKG_VERSION_MAJOR")) << 24)
+    | (parse_u8(env!("CARGO_PKG_VERSION_MINOR")) << 16)
+    | (parse_u8(env!("CARGO_PKG_VERSION_PATCH")) << 8)
+    | 255;

@@ -1,0 +1,106 @@
+//! The parameter service: the list streamed at the link's pace, single reads, and writes
+//! checked by the parameter store (refused values are answered with the value kept).
+
+use super::outbox::Pending;
+use super::GroundLink;
+use crate::params::store::{encode_wire, param_id_str, ParamStore};
+use crate::params::ParamKind;
+use mavlink::dialects::common::*;
+
+impl GroundLink {
+    /// `PARAM_REQUEST_READ`: by index, or by name when the index is -1.
+    pub(super) fn on_param_read(&mut self, d: &PARAM_REQUEST_READ_DATA, params: &ParamStore) {
+        let index = if d.param_index < 0 {
+            param_id_str(&d.param_id[..]).and_then(|n| params.index_of(n))
+        } else {
+            Some(d.param_index as usize).filter(|&i| i < params.len())
+        };
+        if let Some(i) = index {
+            self.push(Pending::ParamValue(i as u16));
+        }
+    }
+
+    /// The next `params_per_poll` values of a list download, if one runs.
+    pub(super) fn stream_params<F: FnMut(MavMessage)>(&mut self, params: &ParamStore, out: &mut F) {
+        let Some(next) = self.param_next else {
+            return;
+        };
+        let n = params.len();
+        let mut i = usize::from(next);
+        for _ in 0..self.cfg.params_per_poll.max(1) {
+            if i >= n {
+                break;
+            }
+            if let Some(m) = param_value(params, i) {
+                out(m);
+            }
+            i += 1;
+        }
+        self.param_next = if i >= n { None } else { Some(i as u16) };
+    }
+
+    /// `PARAM_SET`: the store checks the value; the echo carries the value it now holds.
+    pub(super) fn on_param_set(&mut self, d: &PARAM_SET_DATA, params: &mut ParamStore) {
+        let Some(name) = param_id_str(&d.param_id[..]) else {
+            return;
+        };
+        let Some(index) = params.index_of(name) else {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Param {}: unknown", name),
+            );
+            return;
+        };
+        let Some(def) = params.def(index) else {
+            return;
+        };
+        let int_types = matches!(
+            d.param_type,
+            MavParamType::MAV_PARAM_TYPE_INT32
+                | MavParamType::MAV_PARAM_TYPE_UINT8
+                | MavParamType::MAV_PARAM_TYPE_INT8
+                | MavParamType::MAV_PARAM_TYPE_UINT16
+                | MavParamType::MAV_PARAM_TYPE_INT16
+        );
+        let real = d.param_type == MavParamType::MAV_PARAM_TYPE_REAL32;
+        let candidate = match (def.kind, real) {
+            (ParamKind::Real, true) => Ok(d.param_value),
+            // Bytewise encoding: the integer's bytes travel in the float field.
+            (k, false) if k.is_integer() && int_types => Ok(d.param_value.to_bits() as i32 as f32),
+            // Tools that send every value as REAL32 (pymavlink's default) may set an
+            // integer parameter with a whole number.
+            (k, true) if k.is_integer() => Ok(d.param_value),
+            _ => Err("wrong type"),
+        };
+        let result = candidate.and_then(|v| {
+            params
+                .set_index(index, v)
+                .map_err(crate::params::ParamError::text)
+        });
+        if let Err(why) = result {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Param {} refused: {} [{}, {}]", name, why, def.min, def.max),
+            );
+        }
+        // The echo carries the value now stored, changed or not.
+        self.push(Pending::ParamValue(index as u16));
+    }
+}
+
+/// `PARAM_VALUE` of the parameter at `index`.
+pub(super) fn param_value(params: &ParamStore, index: usize) -> Option<MavMessage> {
+    let def = params.def(index)?;
+    let value = params.value(index)?;
+    Some(MavMessage::PARAM_VALUE(PARAM_VALUE_DATA {
+        param_value: encode_wire(def.kind, value),
+        param_count: params.len() as u16,
+        param_index: index as u16,
+        param_id: def.name.into(),
+        param_type: if def.kind.is_integer() {
+            MavParamType::MAV_PARAM_TYPE_INT32
+        } else {
+            MavParamType::MAV_PARAM_TYPE_REAL32
+        },
+    }))
+}

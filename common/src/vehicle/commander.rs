@@ -1,0 +1,521 @@
+//! The commander: what the vehicle is doing and what it asks of the control stages.
+//!
+//! It keeps the armed state and the chosen mode, takes the requests a ground link accepted
+//! (arming, mode entry, set points, the current mission item), reacts to the failsafes (the
+//! mode actually flown), hands the navigation modes to the navigator and turns the flown mode
+//! into [`Commands`] for the autopilot, or into surfaces directly in Manual. Everything it
+//! has to say goes out as [`Notice`]s.
+
+use heapless::Deque;
+
+use super::modes::FlightMode;
+use super::requests::VehicleRequests;
+use super::snapshot::MissionRunState;
+use crate::actuators::Surfaces;
+use crate::control::autopilot::{Commands, GainSet};
+use crate::control::lateral::{RollMode, RUDDER};
+use crate::control::longitudinal::LonMode;
+use crate::estimator::{EstimatedState, Home};
+use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
+use crate::navigation::executor::{HomeRequest, NavOutput, NavState, Navigator, Phase};
+use crate::navigation::fence::{breached, FenceParams};
+use crate::navigation::plan::{MissionItem, MissionStore, PlanKind};
+use crate::sensors::ManualInput;
+
+/// Sticks older than this are ignored (the ground station or the radio stopped sending), us.
+pub const STICK_TIMEOUT_US: u64 = 500_000;
+
+/// How urgent a [`Notice`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Severity {
+    /// Something happened as asked.
+    Info,
+    /// Something was refused or is not as expected.
+    Warning,
+    /// A failsafe or a refusal that grounds the aircraft.
+    Critical,
+}
+
+/// What the vehicle has to tell its ground station.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Notice {
+    /// A status text.
+    Text(Severity, &'static str),
+    /// Mission progress: a new current item, an item finished.
+    Mission {
+        /// The new current item.
+        current: Option<u16>,
+        /// The item just finished.
+        reached: Option<u16>,
+    },
+}
+
+/// Notices kept until the vehicle's owner collects them (more are dropped).
+pub const NOTICE_CAPACITY: usize = 16;
+
+/// What the autopilot is asked to hold in the guided modes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Setpoints {
+    /// Course over ground, rad.
+    pub course: f32,
+    /// Altitude above mean sea level, m.
+    pub alt_amsl_m: f32,
+    /// Airspeed, m/s.
+    pub airspeed: f32,
+}
+
+/// What the flown mode asks of the actuators this tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Demand {
+    /// Surfaces set directly (Manual: the sticks, or the trim without them).
+    Surfaces(Surfaces),
+    /// Commands for the autopilot's loops.
+    Commands(Commands),
+}
+
+/// The failsafes' settings and the fence they watch.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Watch {
+    /// Failsafe timeouts and actions.
+    pub failsafe: FailsafeConfig,
+    /// Geofence settings.
+    pub fence: FenceParams,
+}
+
+/// The commander's state.
+#[derive(Clone, Debug)]
+pub struct Commander {
+    armed: bool,
+    mode: FlightMode,
+    setpoints: Setpoints,
+    sticks: Option<ManualInput>,
+    reaction: Reaction,
+    /// Altitude (AMSL, m) held while a GPS failsafe flies wings level.
+    wings_level: Option<f32>,
+    navigator: Navigator,
+    nav: NavOutput,
+    /// The mode the navigator was last started for.
+    nav_for: Option<FlightMode>,
+    mission_seq: u16,
+    mission_state: MissionRunState,
+    failsafes: Failsafes,
+    notices: Deque<Notice, NOTICE_CAPACITY>,
+    dropped_notices: u32,
+}
+
+impl Default for Commander {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Armed flight is told from the ground by airspeed and height (there is no weight-on-wheels
+/// switch): above 8 m/s and 5 m above home.
+pub fn in_air(e: &EstimatedState) -> bool {
+    let height = e.home.map_or(0.0, |h| e.alt_amsl_m - h.alt_amsl_m);
+    e.airspeed > 8.0 && height > 5.0
+}
+
+/// The trims of a gain set as surface positions.
+pub fn trim_surfaces(g: &GainSet) -> Surfaces {
+    Surfaces {
+        elevator: g.longitudinal.trim_elevator,
+        aileron: g.lateral.trim_aileron,
+        rudder: g.lateral.trim_rudder,
+        throttle: g.longitudinal.trim_throttle,
+    }
+}
+
+/// The navigator's commands carry heights above home; the autopilot flies altitudes above
+/// mean sea level (the estimator's datum).
+fn amsl_commands(mut c: Commands, home_alt_amsl_m: f32) -> Commands {
+    c.lon = c.lon.shifted(home_alt_amsl_m);
+    c
+}
+
+/// The Takeoff mode's one item: climb out along the present heading to the return altitude.
+fn takeoff_item(height_m: f32) -> MissionItem {
+    use mavlink::dialects::common::{MavCmd, MavFrame};
+    MissionItem {
+        params: [0, 0, 0, f32::NAN.to_bits()],
+        x: 0,
+        y: 0,
+        z: height_m.to_bits(),
+        command: MavCmd::MAV_CMD_NAV_TAKEOFF as u16,
+        frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT as u8,
+        autocontinue: true,
+    }
+}
+
+impl Commander {
+    /// Disarmed, in Manual, holding 100 m AMSL at 17 m/s when a guided mode engages.
+    pub fn new() -> Self {
+        Self {
+            armed: false,
+            mode: FlightMode::Manual,
+            setpoints: Setpoints {
+                course: 0.0,
+                alt_amsl_m: 100.0,
+                airspeed: 17.0,
+            },
+            sticks: None,
+            reaction: Reaction::None,
+            wings_level: None,
+            navigator: Navigator::default(),
+            nav: NavOutput::default(),
+            nav_for: None,
+            mission_seq: 0,
+            mission_state: MissionRunState::NotStarted,
+            failsafes: Failsafes::new(),
+            notices: Deque::new(),
+            dropped_notices: 0,
+        }
+    }
+
+    /// Armed (throttle live).
+    pub fn armed(&self) -> bool {
+        self.armed
+    }
+
+    /// The mode the pilot (or ground station) chose.
+    pub fn chosen_mode(&self) -> FlightMode {
+        self.mode
+    }
+
+    /// Mode being flown: the pilot's choice, or what a failsafe put in its place.
+    pub fn flown_mode(&self) -> FlightMode {
+        match self.reaction {
+            Reaction::None => self.mode,
+            Reaction::WingsLevel => FlightMode::Altitude,
+            Reaction::Loiter => FlightMode::Loiter,
+            Reaction::Return => FlightMode::Return,
+        }
+    }
+
+    /// What a failsafe has the aircraft do instead of the chosen mode.
+    pub fn reaction(&self) -> Reaction {
+        self.reaction
+    }
+
+    /// Whether any failsafe is raised.
+    pub fn failsafe_active(&self) -> bool {
+        self.failsafes.active()
+    }
+
+    /// The guided modes' set points.
+    pub fn setpoints(&self) -> Setpoints {
+        self.setpoints
+    }
+
+    /// The navigator's last output (phase, mission item, guidance errors).
+    pub fn navigation(&self) -> &NavOutput {
+        &self.nav
+    }
+
+    /// The navigator (its parameters).
+    pub fn navigator(&self) -> &Navigator {
+        &self.navigator
+    }
+
+    /// The navigator, to configure.
+    pub fn navigator_mut(&mut self) -> &mut Navigator {
+        &mut self.navigator
+    }
+
+    /// The current mission item and how far the mission has come.
+    pub fn mission(&self) -> (u16, MissionRunState) {
+        (self.mission_seq, self.mission_state)
+    }
+
+    /// The airspeed the altitude-holding modes hold, m/s.
+    pub fn set_cruise_airspeed(&mut self, v: f32) {
+        self.setpoints.airspeed = v;
+    }
+
+    /// The latest stick positions (a ground station's or the radio's).
+    pub fn on_sticks(&mut self, s: ManualInput) {
+        self.sticks = Some(s);
+    }
+
+    /// Queues a notice for the owner (dropped and counted when the queue is full).
+    pub fn notify(&mut self, n: Notice) {
+        if self.notices.push_back(n).is_err() {
+            self.dropped_notices = self.dropped_notices.saturating_add(1);
+        }
+    }
+
+    /// The next notice, oldest first.
+    pub fn next_notice(&mut self) -> Option<Notice> {
+        self.notices.pop_front()
+    }
+
+    /// Notices dropped because nobody collected them.
+    pub fn dropped_notices(&self) -> u32 {
+        self.dropped_notices
+    }
+
+    fn text(&mut self, s: Severity, t: &'static str) {
+        self.notify(Notice::Text(s, t));
+    }
+
+    /// Acts on what the ground station asked for. Returns a new home when arming on the
+    /// ground moves it.
+    pub fn apply(&mut self, r: &VehicleRequests, e: &EstimatedState) -> Option<Home> {
+        let mut rehome = None;
+        if let Some(a) = r.arm {
+            if a.arm && !self.armed && !in_air(e) {
+                // Home is where the aircraft is armed, as in PX4: the first fix set it from one
+                // GPS altitude (5 m of vertical noise); the estimate at arming has averaged
+                // GPS and barometer for as long as the estimator took to converge, and the
+                // landing aims at this height.
+                if let Some(h) = e.home {
+                    let here = Home {
+                        point: e.position,
+                        alt_amsl_m: e.alt_amsl_m,
+                    };
+                    if here != h {
+                        rehome = Some(here);
+                    }
+                }
+            }
+            if a.arm != self.armed {
+                self.armed = a.arm;
+                if !a.arm {
+                    self.navigator.stop();
+                    self.nav_for = None;
+                    self.failsafes.acknowledge();
+                }
+                self.text(Severity::Info, if a.arm { "Armed" } else { "Disarmed" });
+            }
+        }
+        if let Some(mode) = r.mode {
+            if mode != self.mode {
+                // Entering a guided mode holds where the aircraft is.
+                if matches!(mode, FlightMode::Hold | FlightMode::Altitude)
+                    && !matches!(self.mode, FlightMode::Hold | FlightMode::Altitude)
+                {
+                    self.setpoints.course = e.course;
+                    self.setpoints.alt_amsl_m = e.alt_amsl_m;
+                }
+                if self.mode == FlightMode::Mission {
+                    self.mission_state = MissionRunState::Paused;
+                }
+                self.mode = mode;
+                self.nav_for = None;
+            }
+            // Choosing a mode, even the same one, takes over from a failsafe's return.
+            self.failsafes.acknowledge();
+        }
+        if let Some(seq) = r.mission_seq {
+            self.mission_seq = seq;
+            if self.nav_for == Some(FlightMode::Mission) {
+                self.navigator.set_current(seq);
+            }
+        }
+        if let Some(alt) = r.altitude {
+            let base = if alt.relative_to_home {
+                e.home.map(|h| h.alt_amsl_m)
+            } else {
+                Some(0.0)
+            };
+            match base {
+                Some(b) => self.setpoints.alt_amsl_m = b + alt.alt_m,
+                None => self.text(
+                    Severity::Warning,
+                    "Altitude above home refused: no home yet",
+                ),
+            }
+        }
+        if let Some(v) = r.airspeed {
+            self.setpoints.airspeed = v;
+        }
+        if r.manual.is_some() {
+            self.sticks = r.manual;
+        }
+        if let Some(c) = r.course {
+            let base = if c.relative {
+                self.setpoints.course
+            } else {
+                0.0
+            };
+            self.setpoints.course = crate::math::wrap_two_pi(base + c.angle);
+        }
+        rehome
+    }
+
+    /// Watches the failsafes at the control rate and acts on their reaction.
+    pub fn check_failsafes(
+        &mut self,
+        now_us: u64,
+        e: &EstimatedState,
+        watch: &Watch,
+        plan: &MissionStore,
+        gcs_heard_us: Option<u64>,
+    ) {
+        let flying = self.armed && in_air(e);
+        let fence_breached = match e.home {
+            Some(h) => {
+                breached(plan.items(PlanKind::Fence), &h, &e.pos_ned, &watch.fence).is_some()
+            }
+            None => false,
+        };
+        let inputs = FailsafeInputs {
+            t_s: now_us as f64 * 1e-6,
+            flying,
+            gcs_heard_s: gcs_heard_us.map(|t| t as f64 * 1e-6),
+            gps_ok: e.health.gps.healthy,
+            airspeed_ok: e.health.pitot.healthy,
+            fence_breached,
+        };
+        let (reaction, events) = self.failsafes.update(&watch.failsafe, &inputs);
+        for ev in events {
+            let sev = if ev.raises() {
+                Severity::Critical
+            } else {
+                Severity::Info
+            };
+            self.text(sev, ev.text());
+        }
+        if reaction == Reaction::WingsLevel && self.wings_level.is_none() {
+            self.wings_level = Some(e.alt_amsl_m);
+        }
+        if reaction != Reaction::WingsLevel {
+            self.wings_level = None;
+        }
+        self.reaction = reaction;
+    }
+
+    /// What the flown mode asks of the actuators this tick, at `now_us`, `dt` after the last
+    /// one. The second value is a home a mission item moved (DO_SET_HOME).
+    pub fn demand(
+        &mut self,
+        now_us: u64,
+        dt: f32,
+        e: &EstimatedState,
+        plan: &MissionStore,
+        gains: &GainSet,
+    ) -> (Demand, Option<Home>) {
+        let sp = self.setpoints;
+        let level = gains.longitudinal;
+        let sticks = self
+            .sticks
+            .filter(|s| now_us.saturating_sub(s.time_us) <= STICK_TIMEOUT_US);
+        if self.mode == FlightMode::Manual {
+            // Pass-through: sticks straight to the surfaces (PX4's normalised sense), trim
+            // when no stick is live.
+            let s = match sticks {
+                Some(s) => Surfaces::from_px4_controls([s.roll, s.pitch, s.yaw, s.throttle]),
+                None => trim_surfaces(gains),
+            };
+            return (Demand::Surfaces(s), None);
+        }
+        let flown = self.flown_mode();
+        let hold = |altitude| Commands {
+            roll: RollMode::Roll(0.0),
+            yaw: RUDDER,
+            lon: LonMode::Altitude {
+                altitude,
+                airspeed: sp.airspeed,
+            },
+        };
+        if let (Reaction::WingsLevel, Some(alt)) = (self.reaction, self.wings_level) {
+            return (Demand::Commands(hold(alt)), None);
+        }
+        if flown.needs_navigator() {
+            let (commands, home) = self.navigate(flown, dt, e, plan);
+            // No home yet (refused before, so only after a reset): hold what we have.
+            let c = commands.unwrap_or(hold(sp.alt_amsl_m));
+            return (Demand::Commands(c), home);
+        }
+        let commands = match flown {
+            FlightMode::Stabilized => Commands {
+                // Sticks command attitude within the loops' limits; centred: wings level.
+                roll: RollMode::Roll(sticks.map_or(0.0, |s| s.roll * gains.lateral.roll_max)),
+                yaw: RUDDER,
+                lon: LonMode::Pitch {
+                    pitch: sticks.map_or(0.0, |s| s.pitch * level.pitch_max),
+                    throttle: sticks.map_or(level.trim_throttle, |s| s.throttle),
+                },
+            },
+            FlightMode::Altitude => hold(sp.alt_amsl_m),
+            FlightMode::Hold => Commands {
+                roll: RollMode::Course(sp.course),
+                ..hold(sp.alt_amsl_m)
+            },
+            _ => Commands::OFF,
+        };
+        (Demand::Commands(commands), None)
+    }
+
+    /// Runs the navigator for a navigation mode: starts it when the mode has changed, steps
+    /// it, reports mission progress. No commands until home is set.
+    fn navigate(
+        &mut self,
+        flown: FlightMode,
+        dt: f32,
+        e: &EstimatedState,
+        plan: &MissionStore,
+    ) -> (Option<Commands>, Option<Home>) {
+        let Some(home) = e.home else {
+            return (None, None);
+        };
+        if self.nav_for != Some(flown) {
+            self.nav_for = Some(flown);
+            match flown {
+                FlightMode::Mission => {
+                    self.navigator.set_current(self.mission_seq);
+                    self.mission_state = MissionRunState::Active;
+                }
+                FlightMode::Loiter => self.navigator.start_loiter(None),
+                FlightMode::Return => self
+                    .navigator
+                    .start_return(self.navigator.params().rtl_land),
+                FlightMode::Land => self.navigator.start_return(true),
+                _ => self.navigator.start_mission(0),
+            }
+        }
+        let takeoff = [takeoff_item(self.navigator.params().rtl_alt)];
+        let items: &[MissionItem] = match flown {
+            FlightMode::Mission => plan.items(PlanKind::Mission),
+            FlightMode::Takeoff => &takeoff,
+            _ => &[],
+        };
+        let out = self
+            .navigator
+            .step(items, &home, &NavState::from_estimate(e), dt);
+        if flown == FlightMode::Mission {
+            let current = out.current_seq.filter(|&c| c != self.mission_seq);
+            if let Some(c) = out.current_seq {
+                self.mission_seq = c;
+            }
+            if current.is_some() || out.reached.is_some() {
+                self.notify(Notice::Mission {
+                    current,
+                    reached: out.reached,
+                });
+            }
+            if out.phase == Phase::Complete || out.phase == Phase::Landed {
+                self.mission_state = MissionRunState::Complete;
+            }
+        }
+        for w in &out.warnings {
+            self.text(Severity::Warning, w.text());
+        }
+        let rehome = out.set_home.map(|req| match req {
+            HomeRequest::Here => Home {
+                point: e.position,
+                alt_amsl_m: e.alt_amsl_m,
+            },
+            HomeRequest::At(h) => h,
+        });
+        if out.landed && self.armed {
+            self.armed = false;
+            self.text(Severity::Info, "Landed, disarmed");
+        }
+        let commands = out.commands.map(|c| amsl_commands(c, home.alt_amsl_m));
+        self.nav = out;
+        (commands, rehome)
+    }
+}

@@ -1,0 +1,368 @@
+//! The vehicle: every stage of one autopilot tick, wired together, with its parameters and
+//! its plan.
+//!
+//! ```text
+//! SensorFrame, GpsFix ─► estimator ─► commander (mode, failsafes) ─► navigator ─► guidance
+//!                                          │                                         │
+//!                            requests ─────┘           autopilot ◄── Commands ◄──────┘
+//!                                                          │
+//!                                                      Surfaces
+//! ```
+//!
+//! [`Vehicle`] is what a board runs: one way in for sensors ([`Vehicle::on_sensors`], fed by
+//! HIL decoding in SITL and by drivers on a board), the ground station's requests handed in
+//! with them, surfaces out, a [`snapshot::VehicleSnapshot`] for telemetry and [`Notice`]s to
+//! report. It reads no clock: its time is the sensor frames' timestamps.
+//!
+//! - [`modes`]: the flight modes and what each asks of the vehicle.
+//! - [`requests`]: requests a ground link accepted, for the vehicle to act on.
+//! - [`commander`]: arming, mode entry, failsafe reactions, the navigator hand-off, mode to
+//!   commands.
+//! - [`params`]: the one registry of every parameter.
+//! - [`report`], [`snapshot`]: the state the vehicle reports each tick.
+
+pub mod commander;
+pub mod modes;
+pub mod params;
+pub mod report;
+pub mod requests;
+pub mod snapshot;
+
+use crate::actuators::Surfaces;
+use crate::control::autopilot::{Autopilot, GainSet};
+use crate::control::gains::NAMED;
+use crate::control::inputs::Measurements;
+use crate::estimator::{config as estimator_config, EstimatedState, Estimator};
+use crate::navigation::plan::MissionStore;
+use crate::navigation::validate::{MissionLimits, PlanRules};
+use crate::navigation::{executor, fence, path_manager, validate};
+use crate::params::ParamStore;
+use crate::sensors::{GpsFix, ManualInput, SensorFrame};
+use crate::{failsafe, guidance};
+use commander::{trim_surfaces, Commander, Demand, Setpoints, Severity, Watch};
+use modes::FlightMode;
+use requests::VehicleRequests;
+
+pub use commander::Notice;
+
+/// Control period, us: the thesis's 50 Hz.
+pub const CONTROL_PERIOD_US: u64 = 20_000;
+
+/// What the ground link hands the vehicle with each sensor frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FromGround {
+    /// Requests accepted since the last frame.
+    pub requests: VehicleRequests,
+    /// When a ground station was last heard, us (for the link-loss failsafe).
+    pub heard_us: Option<u64>,
+}
+
+/// The vehicle.
+#[derive(Clone, Debug)]
+pub struct Vehicle {
+    params: ParamStore,
+    plan: MissionStore,
+    estimator: Estimator,
+    autopilot: Autopilot,
+    commander: Commander,
+    watch: Watch,
+    limits: MissionLimits,
+    use_truth: bool,
+    params_seen: Option<u32>,
+    gain_set_seen: u8,
+    last_time_us: Option<u64>,
+    last_imu_us: Option<u64>,
+    last_control_us: Option<u64>,
+    stale_frames: u32,
+    last_gps: Option<GpsFix>,
+    truth: Option<Measurements>,
+    surfaces: Surfaces,
+}
+
+impl Default for Vehicle {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Vehicle {
+    /// A freshly booted vehicle with default parameters: disarmed, in Manual.
+    pub fn new() -> Self {
+        let mut v = Self {
+            params: ParamStore::new(params::REGISTRY),
+            plan: MissionStore::default(),
+            estimator: Estimator::default(),
+            autopilot: Autopilot::default(),
+            commander: Commander::new(),
+            watch: Watch::default(),
+            limits: MissionLimits::default(),
+            use_truth: false,
+            params_seen: None,
+            gain_set_seen: 0,
+            last_time_us: None,
+            last_imu_us: None,
+            last_control_us: None,
+            stale_frames: 0,
+            last_gps: None,
+            truth: None,
+            surfaces: trim_surfaces(&GainSet::default()),
+        };
+        v.apply_params();
+        v
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &ParamStore {
+        &self.params
+    }
+
+    /// The parameters, writable (loading from flash, marking saved).
+    pub fn params_mut(&mut self) -> &mut ParamStore {
+        &mut self.params
+    }
+
+    /// The stored mission, geofence and rally lists.
+    pub fn plan(&self) -> &MissionStore {
+        &self.plan
+    }
+
+    /// The stored lists, writable (loading from flash).
+    pub fn plan_mut(&mut self) -> &mut MissionStore {
+        &mut self.plan
+    }
+
+    /// What a ground link reads and writes: the parameters, the plan, and what an upload is
+    /// checked against.
+    pub fn stores(&mut self) -> (&mut ParamStore, &mut MissionStore, PlanRules) {
+        let rules = PlanRules {
+            home: self.estimator.state().home,
+            limits: self.limits,
+            nav: *self.commander.navigator().params(),
+        };
+        (&mut self.params, &mut self.plan, rules)
+    }
+
+    /// The estimator's current state.
+    pub fn estimate(&self) -> EstimatedState {
+        self.estimator.state()
+    }
+
+    /// The commander (mode, arming, failsafes, navigator).
+    pub fn commander(&self) -> &Commander {
+        &self.commander
+    }
+
+    /// The vehicle's clock: the time of the latest sensor frame, us.
+    pub fn time_us(&self) -> Option<u64> {
+        self.last_time_us
+    }
+
+    /// Sensor frames whose time did not advance.
+    pub fn stale_frames(&self) -> u32 {
+        self.stale_frames
+    }
+
+    /// The last accepted GPS fix.
+    pub fn last_gps(&self) -> Option<GpsFix> {
+        self.last_gps
+    }
+
+    /// The last surface commands.
+    pub fn surfaces(&self) -> Surfaces {
+        self.surfaces
+    }
+
+    /// Armed (throttle live).
+    pub fn armed(&self) -> bool {
+        self.commander.armed()
+    }
+
+    /// What the autopilot is holding: the guided modes' set points, or in a navigation mode
+    /// what guidance commands (its altitude as AMSL).
+    pub fn setpoints(&self) -> Setpoints {
+        let sp = self.commander.setpoints();
+        if !self.commander.flown_mode().needs_navigator() {
+            return sp;
+        }
+        let home_alt = self.estimator.state().home.map_or(0.0, |h| h.alt_amsl_m);
+        match self.commander.navigation().guidance {
+            Some(g) => Setpoints {
+                course: g.course,
+                alt_amsl_m: g.altitude + home_alt,
+                airspeed: g.airspeed,
+            },
+            None => sp,
+        }
+    }
+
+    /// What the ground link reports and checks.
+    pub fn snapshot(&self) -> snapshot::VehicleSnapshot {
+        let extras = report::Extras {
+            time_us: self.last_time_us,
+            gps: self.last_gps,
+            throttle: self.surfaces.throttle,
+        };
+        report::snapshot(&self.estimator.state(), &self.commander, &extras)
+    }
+
+    /// The next thing the vehicle has to report, oldest first.
+    pub fn next_notice(&mut self) -> Option<Notice> {
+        self.commander.next_notice()
+    }
+
+    /// One sensor frame: the samples to the estimator, then, with what the ground link
+    /// handed over, requests, parameters and (every [`CONTROL_PERIOD_US`]) the control tick.
+    pub fn on_sensors(&mut self, f: &SensorFrame, ground: &FromGround) {
+        let t = f.time_us;
+        if self.last_time_us.is_some_and(|last| t <= last) {
+            self.stale_frames = self.stale_frames.saturating_add(1);
+        }
+        self.last_time_us = Some(t.max(self.last_time_us.unwrap_or(0)));
+        // The gyro integrates over the time since the last *accepted* IMU sample, so a
+        // rejected sample does not lose its share of the rotation.
+        if let Some(imu) = f.imu {
+            if let Some(last) = self.last_imu_us.filter(|&l| t > l) {
+                self.estimator.update_imu(&imu, (t - last) as f32 * 1e-6);
+            }
+            self.last_imu_us = Some(t);
+        }
+        if let Some(m) = f.mag {
+            self.estimator.update_mag(&m);
+        }
+        if let Some(b) = f.baro {
+            self.estimator.update_baro(&b);
+        }
+        if let Some(p) = f.pitot {
+            self.estimator.update_pitot(&p);
+        }
+        self.tick(t, ground);
+    }
+
+    /// A GPS fix.
+    pub fn on_gps(&mut self, fix: &GpsFix) {
+        self.last_gps = Some(*fix);
+        self.estimator.update_gps(fix);
+    }
+
+    /// The simulator's truth, flown instead of the estimate when `SIM_USE_TRUTH` is set.
+    pub fn on_truth(&mut self, m: Measurements) {
+        self.truth = Some(m);
+    }
+
+    /// The radio's sticks.
+    pub fn on_sticks(&mut self, s: ManualInput) {
+        self.commander.on_sticks(s);
+    }
+
+    /// Acts on requests a ground link accepted.
+    pub fn apply(&mut self, r: &VehicleRequests) {
+        let e = self.estimator.state();
+        if let Some(home) = self.commander.apply(r, &e) {
+            self.estimator.set_home(home);
+        }
+    }
+
+    /// Everything after the sensors: requests, parameters, control at 50 Hz.
+    fn tick(&mut self, now_us: u64, ground: &FromGround) {
+        self.apply(&ground.requests);
+        self.apply_params();
+        let due = self
+            .last_control_us
+            .is_none_or(|t| now_us >= t + CONTROL_PERIOD_US);
+        if !due {
+            return;
+        }
+        let dt = self
+            .last_control_us
+            .map_or(CONTROL_PERIOD_US as f32 * 1e-6, |t| {
+                (now_us - t) as f32 * 1e-6
+            });
+        self.last_control_us = Some(now_us);
+        // One estimate for the whole control step.
+        let e = self.estimator.state();
+        self.commander
+            .check_failsafes(now_us, &e, &self.watch, &self.plan, ground.heard_us);
+        let m = self.measurements(&e);
+        let gains = *self.autopilot.gains();
+        let clock = self.last_time_us.unwrap_or(0);
+        let (demand, home) = self.commander.demand(clock, dt, &e, &self.plan, &gains);
+        if let Some(h) = home {
+            self.estimator.set_home(h);
+        }
+        match demand {
+            Demand::Surfaces(s) => {
+                self.surfaces = s;
+                // The loops start from these positions when a stabilised mode engages.
+                self.autopilot.handover(s);
+            }
+            Demand::Commands(c) => self.surfaces = self.autopilot.step(&m, &c, dt).surfaces,
+        }
+    }
+
+    fn measurements(&self, e: &EstimatedState) -> Measurements {
+        if self.use_truth {
+            if let Some(t) = self.truth {
+                return t;
+            }
+        }
+        Measurements {
+            roll: e.euler.phi,
+            pitch: e.euler.theta,
+            // Course needs ground speed; on the ground or in a hover-like crawl use heading.
+            course: if e.ground_speed > 3.0 {
+                e.course
+            } else {
+                e.euler.psi
+            },
+            roll_rate: e.body_rates.x,
+            pitch_rate: e.body_rates.y,
+            yaw_rate: e.body_rates.z,
+            altitude: e.alt_amsl_m,
+            airspeed: e.airspeed,
+            sideslip: e.sideslip,
+        }
+    }
+
+    /// Hands changed parameters to the stages.
+    fn apply_params(&mut self) {
+        let count = self.params.change_count();
+        if self.params_seen == Some(count) {
+            return;
+        }
+        self.params_seen = Some(count);
+        let sys = self.params.load(&params::PARAMS);
+        // A new gain set overwrites the control parameters with its values.
+        if sys.gain_set != self.gain_set_seen {
+            self.gain_set_seen = sys.gain_set;
+            if let Some((_, g, _)) = NAMED.get(usize::from(sys.gain_set)) {
+                if self.params.set_all(g.params()).is_err() {
+                    self.commander
+                        .notify(Notice::Text(Severity::Warning, "Gain set refused"));
+                }
+            }
+        }
+        let gains = GainSet::from_store(&self.params);
+        if self.autopilot.set_gains(&gains).is_err() {
+            self.commander.notify(Notice::Text(
+                Severity::Warning,
+                "Gains refused: inconsistent set, previous kept",
+            ));
+        }
+        let p = &self.params;
+        self.estimator.set_config(p.load(&estimator_config::PARAMS));
+        self.commander.navigator_mut().configure(
+            &p.load(&executor::PARAMS),
+            &p.load(&path_manager::PARAMS),
+            &p.load(&guidance::PARAMS),
+        );
+        self.limits = p.load(&validate::PARAMS);
+        self.watch = Watch {
+            failsafe: p.load(&failsafe::PARAMS),
+            fence: p.load(&fence::PARAMS),
+        };
+        self.use_truth = sys.use_truth;
+        if count == 0 || self.commander.chosen_mode() == FlightMode::Manual {
+            self.commander.set_cruise_airspeed(sys.airspeed_trim);
+        }
+    }
+}

@@ -1,0 +1,92 @@
+//! Every parameter the vehicle has, in one registry: each stage's group, in the order a ground
+//! station lists them, and the vehicle's own settings.
+
+use crate::control::{autopilot, gains, lateral, longitudinal};
+use crate::navigation::{executor, fence, path_manager, validate};
+use crate::param;
+use crate::params::{independent, Group, ParamDef, Registry};
+use crate::{estimator, failsafe, guidance};
+
+/// The vehicle's own settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SystemParams {
+    /// Index in [`gains::NAMED`] of the gain set loaded into the control parameters.
+    pub gain_set: u8,
+    /// Fly on the simulator's truth instead of the estimate.
+    pub use_truth: bool,
+    /// Airspeed held in the altitude-holding modes until a ground station changes it, m/s.
+    pub airspeed_trim: f32,
+}
+
+/// Parameters of the vehicle itself.
+pub const PARAMS: Group<SystemParams> = Group {
+    name: "System",
+    params: &[
+        param!(
+            ParamDef::choice(
+                "SYS_GAIN_SET",
+                0,
+                gains::NAMES,
+                "Gain set loaded into the control parameters when this changes",
+            ),
+            SystemParams => gain_set,
+            count
+        ),
+        param!(
+            ParamDef::boolean(
+                "SIM_USE_TRUTH",
+                false,
+                "Fly on the simulator's truth (HIL_STATE_QUATERNION) instead of the estimator, to measure what estimation costs",
+            ),
+            SystemParams => use_truth,
+            flag
+        ),
+        param!(
+            ParamDef::real(
+                "FW_AIRSPD_TRIM",
+                17.0,
+                10.0,
+                30.0,
+                "m/s",
+                "Airspeed held in the altitude-holding modes until a ground station changes it",
+            ),
+            SystemParams => airspeed_trim
+        ),
+    ],
+    base: || SystemParams {
+        gain_set: 0,
+        use_truth: false,
+        airspeed_trim: 0.0,
+    },
+    check: independent,
+};
+
+/// Every parameter of the vehicle: the control stages, the estimator, guidance and navigation,
+/// the failsafes and the vehicle's own settings.
+pub const REGISTRY: Registry = &[
+    &lateral::PARAMS,
+    &longitudinal::PARAMS,
+    &autopilot::PARAMS,
+    &estimator::config::PARAMS,
+    &guidance::PARAMS,
+    &path_manager::PARAMS,
+    &executor::PARAMS,
+    &validate::PARAMS,
+    &fence::PARAMS,
+    &failsafe::PARAMS,
+    &PARAMS,
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::ParamStore;
+
+    #[test]
+    fn the_registry_is_valid_and_every_name_unique() {
+        assert_eq!(ParamStore::validate(REGISTRY), Ok(()));
+        let store = ParamStore::new(REGISTRY);
+        assert!(store.len() > 100, "{}", store.len());
+        assert_eq!(store.load(&PARAMS).airspeed_trim, 17.0);
+    }
+}

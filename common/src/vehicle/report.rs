@@ -1,0 +1,138 @@
+//! What the vehicle reports: its [`VehicleSnapshot`], built from the estimate and the
+//! commander's state, which the ground link turns into telemetry and checks commands against.
+
+use super::commander::{in_air, Commander};
+use super::modes::{FlightMode, ModeSet};
+use super::snapshot::{
+    Battery, GpsRaw, Home, LandedState, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot,
+};
+use crate::estimator::EstimatedState;
+use crate::math::{course_and_speed, wrap_two_pi};
+use crate::sensors::GpsFix;
+
+/// Everything besides the estimate and the commander that the snapshot reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Extras {
+    /// The vehicle's clock (the time of the last sensor frame), us; `None` before the first.
+    pub time_us: Option<u64>,
+    /// The last accepted GPS fix.
+    pub gps: Option<GpsFix>,
+    /// Throttle commanded, 0..1.
+    pub throttle: f32,
+}
+
+/// The modes the vehicle can fly with this estimate: attitude for the altitude hold, a
+/// position for Hold, a position and a home for the navigator's modes.
+pub fn available_modes(e: &EstimatedState) -> ModeSet {
+    let mut modes = ModeSet::EMPTY
+        .with(FlightMode::Manual)
+        .with(FlightMode::Stabilized);
+    if e.converged || e.attitude_valid {
+        modes = modes.with(FlightMode::Altitude);
+    }
+    if e.position_valid {
+        modes = modes.with(FlightMode::Hold);
+        if e.home.is_some() {
+            for m in FlightMode::ALL.iter().filter(|m| m.needs_navigator()) {
+                modes = modes.with(*m);
+            }
+        }
+    }
+    modes
+}
+
+/// The snapshot of a vehicle.
+pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapshot {
+    let h = &e.health;
+    let health = SensorHealth {
+        gyro_ok: h.imu.healthy,
+        accel_ok: h.imu.healthy,
+        mag_ok: h.mag.healthy,
+        baro_ok: h.baro.healthy,
+        airspeed_ok: h.pitot.healthy,
+        gps_ok: h.gps.healthy,
+        attitude_converged: e.converged,
+        position_valid: e.position_valid,
+    };
+    let home = e.home.map_or(Home::default(), |h| Home {
+        valid: true,
+        lat_e7: h.point.lat_e7,
+        lon_e7: h.point.lon_e7,
+        alt_amsl_m: h.alt_amsl_m,
+    });
+    let gps = x.gps.map_or(GpsRaw::default(), |g| {
+        let (course, speed) = course_and_speed(&g.vel_ned);
+        GpsRaw {
+            time_usec: x.time_us.unwrap_or(0),
+            fix_type: g.fix_type,
+            lat_e7: g.position.lat_e7,
+            lon_e7: g.position.lon_e7,
+            alt_amsl_m: g.alt_amsl_m,
+            hdop: g.hdop,
+            vdop: g.hdop * 1.5,
+            ground_speed_m_s: speed,
+            course: wrap_two_pi(course),
+            satellites: g.satellites,
+        }
+    });
+    let (mission_seq, mission_state) = c.mission();
+    VehicleSnapshot {
+        boot_complete: x.time_us.is_some(),
+        hil: true,
+        armed: c.armed(),
+        failsafe: c.failsafe_active(),
+        mode: c.flown_mode(),
+        modes_available: available_modes(e),
+        landed: if in_air(e) {
+            LandedState::InAir
+        } else {
+            LandedState::OnGround
+        },
+        health,
+        roll: e.euler.phi,
+        pitch: e.euler.theta,
+        yaw: e.euler.psi,
+        roll_rate: e.body_rates.x,
+        pitch_rate: e.body_rates.y,
+        yaw_rate: e.body_rates.z,
+        lat_e7: e.position.lat_e7,
+        lon_e7: e.position.lon_e7,
+        alt_amsl_m: e.alt_amsl_m,
+        alt_rel_home_m: e.alt_amsl_m - home.alt_amsl_m,
+        vel_n: e.vel_ned.x,
+        vel_e: e.vel_ned.y,
+        vel_d: e.vel_ned.z,
+        airspeed: e.airspeed,
+        throttle: if c.armed() { x.throttle } else { 0.0 },
+        home,
+        gps,
+        battery: Battery {
+            present: false,
+            ..Battery::default()
+        },
+        nav: nav_telemetry(e, c),
+        mission_seq,
+        mission_state,
+        cpu_load: 0.0,
+    }
+}
+
+/// NAV_CONTROLLER_OUTPUT from the navigator's last step (zeros outside navigation modes).
+fn nav_telemetry(e: &EstimatedState, c: &Commander) -> NavTelemetry {
+    if !c.flown_mode().needs_navigator() {
+        return NavTelemetry::default();
+    }
+    let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
+    let nav = c.navigation();
+    let g = nav.guidance;
+    NavTelemetry {
+        roll_cmd: 0.0,
+        pitch_cmd: 0.0,
+        course_cmd: g.map_or(0.0, |g| wrap_two_pi(g.course)),
+        target_bearing: finite(wrap_two_pi(nav.target_bearing)),
+        wp_dist_m: finite(nav.wp_dist_m),
+        alt_error_m: g.map_or(0.0, |g| finite(g.altitude + e.pos_ned.z)),
+        airspeed_error_m_s: g.map_or(0.0, |g| finite(g.airspeed - e.airspeed)),
+        xtrack_error_m: g.map_or(0.0, |g| finite(g.cross_track)),
+    }
+}

@@ -1,0 +1,58 @@
+//! What a ground station may ask of the vehicle. The ground link checks each request against
+//! the vehicle's snapshot and queues it; the vehicle takes the queue and acts on it.
+
+use super::modes::FlightMode;
+use crate::sensors::ManualInput;
+
+/// An arming or disarming request the link accepted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ArmRequest {
+    /// `true` to arm, `false` to disarm.
+    pub arm: bool,
+    /// Forced (param2 = 21196): checks skipped, disarm even in the air.
+    pub forced: bool,
+}
+
+/// What the ground station asked the vehicle to do, after the link's checks. The vehicle takes
+/// these with [`GroundLink::take_requests`] and acts on them.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct VehicleRequests {
+    /// Arm or disarm.
+    pub arm: Option<ArmRequest>,
+    /// Switch to this mode.
+    pub mode: Option<FlightMode>,
+    /// Make this mission item the current one.
+    pub mission_seq: Option<u16>,
+    /// Persist the parameters now (`MAV_CMD_PREFLIGHT_STORAGE` write).
+    pub save_params: bool,
+    /// New altitude setpoint (`MAV_CMD_DO_CHANGE_ALTITUDE`).
+    pub altitude: Option<AltitudeSetpoint>,
+    /// New airspeed setpoint, m/s (`MAV_CMD_DO_CHANGE_SPEED`, airspeed type).
+    pub airspeed: Option<f32>,
+    /// New course setpoint, rad in [0, 2 pi) (`MAV_CMD_CONDITION_YAW`, absolute or relative).
+    pub course: Option<CourseSetpoint>,
+    /// The latest stick positions (`MANUAL_CONTROL`: QGC's virtual joystick or a gamepad).
+    pub manual: Option<ManualInput>,
+}
+
+/// An altitude the ground station asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AltitudeSetpoint {
+    /// Altitude, m.
+    pub alt_m: f32,
+    /// `true`: above home (`MAV_FRAME_GLOBAL_RELATIVE_ALT`); `false`: above mean sea level.
+    pub relative_to_home: bool,
+}
+
+/// A course the ground station asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CourseSetpoint {
+    /// Angle, rad.
+    pub angle: f32,
+    /// `true`: added to the current course (direction already applied); `false`: absolute.
+    pub relative: bool,
+}

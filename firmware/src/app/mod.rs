@@ -1,0 +1,259 @@
+//! The autopilot's application, independent of any board: the [`Vehicle`] of `common` and its
+//! two MAVLink ports.
+//!
+//! ```text
+//! sim link bytes -> SimPort (HIL_SENSOR / HIL_GPS decoding) -> Vehicle::on_sensors
+//!                <- HIL_ACTUATOR_CONTROLS (one per sensor frame, lock-step)
+//! GCS link bytes -> GroundPort -> GroundLink (params, missions, commands) -> requests
+//!                <- telemetry, acknowledgements, STATUSTEXT
+//! ```
+//!
+//! - [`simlink`]: the simulator port.
+//! - [`ground`]: the ground-station port.
+//!
+//! The clock is the simulator's (`time_usec` of the sensor frames) in SITL and the board's
+//! sensor timestamps on the MCU; nothing here reads a clock of its own.
+
+pub mod ground;
+pub mod simlink;
+
+use common::actuators::Surfaces;
+use common::estimator::EstimatedState;
+use common::failsafe::Reaction;
+use common::gcs::GroundLink;
+use common::link::framing::LinkStats;
+use common::navigation::NavOutput;
+use common::sensors::GpsFix;
+use common::vehicle::modes::FlightMode;
+use common::vehicle::snapshot::VehicleSnapshot;
+use common::vehicle::Vehicle;
+use ground::GroundPort;
+use simlink::SimPort;
+
+pub use simlink::SimLinkHealth;
+
+pub use common::vehicle::commander::Setpoints;
+pub use common::vehicle::params::REGISTRY;
+pub use common::vehicle::CONTROL_PERIOD_US;
+
+/// MAVLink identity of the autopilot (DESIGN.md: system 1, component 1).
+pub use common::gcs::{COMPONENT_ID, SYSTEM_ID};
+
+/// The autopilot application.
+pub struct App {
+    vehicle: Vehicle,
+    sim: SimPort,
+    ground: GroundPort,
+}
+
+impl Default for App {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl App {
+    /// A freshly booted autopilot with default parameters: disarmed, in Manual.
+    pub fn new() -> Self {
+        Self {
+            vehicle: Vehicle::new(),
+            sim: SimPort::new(),
+            ground: GroundPort::new(),
+        }
+    }
+
+    /// The vehicle.
+    pub fn vehicle(&self) -> &Vehicle {
+        &self.vehicle
+    }
+
+    /// The vehicle, writable (loading persisted parameters and missions at start-up).
+    pub fn vehicle_mut(&mut self) -> &mut Vehicle {
+        &mut self.vehicle
+    }
+
+    /// Counters of the simulator link.
+    pub fn sim_health(&self) -> SimLinkHealth {
+        SimLinkHealth {
+            stale_frames: self.vehicle.stale_frames(),
+            gcs_bytes_dropped: self.ground.bytes_dropped(),
+            ..self.sim.health()
+        }
+    }
+
+    /// Framing counters of the simulator link.
+    pub fn sim_link_stats(&self) -> LinkStats {
+        self.sim.stats()
+    }
+
+    /// Framing counters of the ground link.
+    pub fn gcs_link_stats(&self) -> LinkStats {
+        self.ground.stats()
+    }
+
+    /// The last accepted GPS fix.
+    pub fn last_gps(&self) -> Option<GpsFix> {
+        self.vehicle.last_gps()
+    }
+
+    /// The estimator's current state.
+    pub fn estimate(&self) -> EstimatedState {
+        self.vehicle.estimate()
+    }
+
+    /// Armed (throttle live).
+    pub fn armed(&self) -> bool {
+        self.vehicle.armed()
+    }
+
+    /// Mode being flown: the pilot's choice, or what a failsafe put in its place.
+    pub fn mode(&self) -> FlightMode {
+        self.vehicle.commander().flown_mode()
+    }
+
+    /// The mode the pilot (or ground station) chose.
+    pub fn chosen_mode(&self) -> FlightMode {
+        self.vehicle.commander().chosen_mode()
+    }
+
+    /// What a failsafe has the aircraft do instead of the chosen mode.
+    pub fn failsafe_reaction(&self) -> Reaction {
+        self.vehicle.commander().reaction()
+    }
+
+    /// The navigator's last output (phase, mission item, guidance errors).
+    pub fn navigation(&self) -> &NavOutput {
+        self.vehicle.commander().navigation()
+    }
+
+    /// What the autopilot is holding (see [`Vehicle::setpoints`]).
+    pub fn setpoints(&self) -> Setpoints {
+        self.vehicle.setpoints()
+    }
+
+    /// The last surface commands.
+    pub fn surfaces(&self) -> Surfaces {
+        self.vehicle.surfaces()
+    }
+
+    /// The ground link's protocol state.
+    pub fn ground_link(&self) -> &GroundLink {
+        self.ground.link()
+    }
+
+    /// What the ground link reports and checks.
+    pub fn snapshot(&self) -> VehicleSnapshot {
+        self.vehicle.snapshot()
+    }
+
+    /// Feeds bytes from the simulator link; `out` receives the bytes to send back.
+    pub fn on_sim_bytes(&mut self, bytes: &[u8], out: &mut impl FnMut(&[u8])) {
+        self.sim
+            .on_bytes(bytes, &mut self.vehicle, &mut self.ground, out);
+    }
+
+    /// Feeds bytes from the ground station; the answers wait in [`App::drain_gcs`].
+    pub fn on_gcs_bytes(&mut self, bytes: &[u8]) {
+        self.ground.on_bytes(bytes, &mut self.vehicle);
+    }
+
+    /// Hands out the bytes waiting for the ground station.
+    pub fn drain_gcs(&mut self, out: &mut impl FnMut(&[u8])) {
+        self.ground.drain(out);
+    }
+}
+
+/// A heartbeat frame of the autopilot on its simulator link (the ground link's heartbeat, so
+/// both links describe the vehicle the same way).
+pub fn heartbeat_frame(app: &mut App) -> heapless::Vec<u8, 280> {
+    let msg = common::gcs::telemetry::heartbeat(&app.vehicle.snapshot());
+    app.sim.encode(&msg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_registry_builds_and_every_name_is_unique() {
+        assert_eq!(common::params::ParamStore::validate(REGISTRY), Ok(()));
+    }
+
+    extern crate std;
+    use common::link::framing::{FrameParser, Sender};
+    use common::link::simlink::encode_hil_sensor;
+    use common::sensors::{ImuSample, SensorFrame};
+    use mavlink::dialects::common::MavMessage;
+    use mavlink::dialects::common::MANUAL_CONTROL_DATA;
+    use std::vec::Vec;
+
+    fn sensor_frame(k: u64) -> Vec<u8> {
+        let f = SensorFrame {
+            time_us: k * 10_000,
+            imu: Some(ImuSample {
+                accel: nalgebra::Vector3::new(0.0, 0.0, -9.8),
+                gyro: nalgebra::Vector3::zeros(),
+            }),
+            ..Default::default()
+        };
+        let mut sim = Sender::new(1, 51);
+        sim.encode(&MavMessage::HIL_SENSOR(encode_hil_sensor(&f, 0.0)))
+            .raw_bytes()
+            .to_vec()
+    }
+
+    fn actuators(app: &mut App, k: u64) -> [f32; 16] {
+        let mut out = Vec::new();
+        app.on_sim_bytes(&sensor_frame(k), &mut |b| out.extend_from_slice(b));
+        let mut p = FrameParser::new();
+        let mut controls = [f32::NAN; 16];
+        p.push(&out, |f| {
+            if let MavMessage::HIL_ACTUATOR_CONTROLS(d) = f.message {
+                controls = d.controls;
+            }
+        });
+        controls
+    }
+
+    #[test]
+    fn manual_mode_passes_the_sticks_through() {
+        let mut app = App::new();
+        assert_eq!(app.mode(), FlightMode::Manual);
+        // No stick yet: the trim (UMN elevator -0.0963 rad is nose-up: positive PX4 pitch).
+        let c = actuators(&mut app, 0);
+        assert!(c[1] > 0.0 && c[1] < 0.3, "{c:?}");
+        // Full right roll, half nose-up (stick back is negative x), some right yaw.
+        let mut gcs = Sender::new(255, 190);
+        let stick = MavMessage::MANUAL_CONTROL(MANUAL_CONTROL_DATA {
+            x: -500,
+            y: 1000,
+            z: 600,
+            r: 250,
+            target: 1,
+            ..Default::default()
+        });
+        app.on_gcs_bytes(gcs.encode(&stick).raw_bytes());
+        // The next control tick (50 Hz: the frame at 20 ms) applies them.
+        let c = actuators(&mut app, 2);
+        assert!(
+            (c[0] - 1.0).abs() < 1e-5 && (c[1] - 0.5).abs() < 1e-5,
+            "{c:?}"
+        );
+        assert!((c[2] - 0.25).abs() < 1e-5, "{c:?}");
+        // Disarmed: no throttle reaches the motor whatever the stick says.
+        assert_eq!(c[3], 0.0);
+        // Sticks that stop arriving fall back to the trim.
+        let c = actuators(&mut app, 80);
+        assert!(c[0].abs() < 0.1, "{c:?}");
+    }
+
+    #[test]
+    fn the_application_fits_the_stm32f405_ram_with_room_for_the_stack() {
+        // 128 KiB of SRAM: the whole application state must leave most of it to the stack.
+        assert!(
+            core::mem::size_of::<App>() < 40 * 1024,
+            "{}",
+            core::mem::size_of::<App>()
+        );
+    }
+}
