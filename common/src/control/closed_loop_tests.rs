@@ -18,7 +18,7 @@ use super::longitudinal::LonMode;
 const DT: f32 = 0.02;
 const SUB: usize = 20;
 const VA: f64 = 17.0;
-const G0: f64 = 9.80665;
+const G0: f64 = crate::math::STANDARD_GRAVITY;
 const D: f64 = core::f64::consts::PI / 180.0;
 
 /// A linear plant x' = f(x, u), stepped with RK4 over one control sample with u held.

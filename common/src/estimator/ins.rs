@@ -32,7 +32,7 @@ use crate::math::frames::Euler;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 /// Standard gravity, m/s^2.
-pub const GRAVITY: f32 = 9.80665;
+pub use crate::math::GRAVITY;
 /// States kept for the delayed GPS update (0.64 s at 100 Hz).
 pub const HISTORY: usize = 64;
 /// Size of the error state.

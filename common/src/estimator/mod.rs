@@ -28,30 +28,13 @@ pub use config::{EstimatorConfig, PARAMS};
 use crate::math::atmosphere::pressure_altitude;
 use crate::math::frames::{course_and_speed, AirData, Euler};
 use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
-use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use crate::sensors::{limits, BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
 use ins::{Fusion, GpsNoise, Ins, Motion, ProcessNoise};
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// Largest accepted IMU time step, s (a longer gap is a stalled loop, not a time step).
 pub const MAX_IMU_DT_S: f32 = 0.2;
-/// Largest accepted specific force per axis, m/s^2 (16 g, the usual accelerometer range).
-pub const MAX_ACCEL_MPS2: f32 = 16.0 * 9.80665;
-/// Largest accepted angular rate per axis, rad/s (2000 deg/s, the usual gyro range).
-pub const MAX_GYRO_RADPS: f32 = 34.9;
-/// Accepted magnetic field strength, gauss (the earth's field is 0.25-0.65 G).
-pub const MAG_RANGE_GAUSS: (f32, f32) = (0.05, 2.0);
-/// Accepted static pressure, Pa (-600 m to 12 km in the standard atmosphere).
-pub const BARO_RANGE_PA: (f32, f32) = (19_000.0, 110_000.0);
-/// Accepted air temperature, deg C.
-pub const TEMP_RANGE_C: (f32, f32) = (-80.0, 85.0);
-/// Accepted differential pressure, Pa (noise at rest reads slightly negative; 20 kPa is
-/// about 180 m/s).
-pub const PITOT_RANGE_PA: (f32, f32) = (-500.0, 20_000.0);
-/// Accepted GPS altitude, m.
-pub const GPS_ALT_RANGE_M: (f32, f32) = (-1_000.0, 20_000.0);
-/// Largest accepted GPS speed, m/s.
-pub const MAX_GPS_SPEED_MPS: f32 = 150.0;
 /// Samples of the other sensors after which a silent IMU is declared unhealthy (the IMU is
 /// the clock, so its silence can only be seen through the others).
 pub const IMU_STALE_SAMPLES: u32 = 50;
@@ -238,14 +221,6 @@ impl Default for Estimator {
     }
 }
 
-fn finite3(v: &Vector3<f32>) -> bool {
-    v.iter().all(|c| c.is_finite())
-}
-
-fn within(v: &Vector3<f32>, limit: f32) -> bool {
-    v.iter().all(|c| c.is_finite() && c.abs() <= limit)
-}
-
 impl Estimator {
     /// A fresh estimator with the given settings.
     pub fn new(cfg: EstimatorConfig) -> Self {
@@ -392,7 +367,7 @@ impl Estimator {
             self.refresh_health();
             return;
         }
-        if !within(&sample.accel, MAX_ACCEL_MPS2) || !within(&sample.gyro, MAX_GYRO_RADPS) {
+        if !sample.plausible() {
             // The time still passed: the next good sample is held over it, so the state
             // stays that of the last good sample and no interval is lost.
             self.pending_dt = (self.pending_dt + dt).min(MAX_IMU_DT_S);
@@ -451,8 +426,7 @@ impl Estimator {
     /// One magnetometer sample.
     pub fn update_mag(&mut self, sample: &MagSample) {
         self.note_other_sensor();
-        let n = sample.field.norm();
-        if !finite3(&sample.field) || !(MAG_RANGE_GAUSS.0..=MAG_RANGE_GAUSS.1).contains(&n) {
+        if !sample.plausible() {
             self.health.mag.reject();
             self.refresh_health();
             return;
@@ -483,10 +457,7 @@ impl Estimator {
         self.note_other_sensor();
         let p = sample.pressure_pa;
         let tc = sample.temperature_c;
-        let ok = p.is_finite()
-            && (BARO_RANGE_PA.0..=BARO_RANGE_PA.1).contains(&p)
-            && tc.is_finite()
-            && (TEMP_RANGE_C.0..=TEMP_RANGE_C.1).contains(&tc);
+        let ok = sample.plausible();
         let (Some(alt), Some(rho), true) = (pressure_altitude(p), air_density(p, tc), ok) else {
             self.health.baro.reject();
             self.refresh_health();
@@ -519,7 +490,7 @@ impl Estimator {
     pub fn update_pitot(&mut self, sample: &PitotSample) {
         self.note_other_sensor();
         let dp = sample.diff_pressure_pa;
-        if !dp.is_finite() || !(PITOT_RANGE_PA.0..=PITOT_RANGE_PA.1).contains(&dp) {
+        if !sample.plausible() {
             self.health.pitot.reject();
             self.refresh_health();
             return;
@@ -574,12 +545,7 @@ impl Estimator {
     /// non-finite or impossible numbers are rejected and counted.
     pub fn update_gps(&mut self, fix: &GpsFix) {
         self.note_other_sensor();
-        let ok = fix.position.is_valid()
-            && fix.alt_amsl_m.is_finite()
-            && (GPS_ALT_RANGE_M.0..=GPS_ALT_RANGE_M.1).contains(&fix.alt_amsl_m)
-            && finite3(&fix.vel_ned)
-            && fix.vel_ned.norm() <= MAX_GPS_SPEED_MPS
-            && !fix.hdop.is_nan();
+        let ok = fix.plausible();
         if !ok {
             self.health.gps.reject();
             self.refresh_health();
@@ -689,9 +655,7 @@ impl Estimator {
         let Some(old) = self.home else {
             return false;
         };
-        if !home.point.is_valid()
-            || !(GPS_ALT_RANGE_M.0..=GPS_ALT_RANGE_M.1).contains(&home.alt_amsl_m)
-        {
+        if !home.point.is_valid() || !limits::in_range(home.alt_amsl_m, limits::GPS_ALT_M) {
             return false;
         }
         let (n, e): (f32, f32) = ned_offset(home.point, old.point);

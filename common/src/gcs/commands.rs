@@ -9,10 +9,8 @@ use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::{AltitudeSetpoint, ArmRequest, CourseSetpoint};
 use crate::vehicle::snapshot::{LandedState, VehicleSnapshot};
 use mavlink::dialects::common::*;
+use mavlink::MessageData;
 use num_traits::FromPrimitive;
-
-/// Airspeeds a setpoint may ask for, m/s (the Ultra Stick's envelope with margin).
-pub const AIRSPEED_SETPOINT_RANGE: (f32, f32) = (10.0, 30.0);
 
 impl GroundLink {
     // GET_MESSAGE_INTERVAL and REQUEST_AUTOPILOT_CAPABILITIES are superseded by
@@ -100,7 +98,7 @@ impl GroundLink {
             }
             MavCmd::MAV_CMD_DO_CHANGE_SPEED => {
                 // param1 speed type (0 or 1: airspeed), param2 speed, -1 / -2: no change.
-                let (lo, hi) = AIRSPEED_SETPOINT_RANGE;
+                let (lo, hi) = v.airspeed_range_m_s;
                 if c.p[1] == -1.0 || c.p[1] == -2.0 {
                     MavResult::MAV_RESULT_ACCEPTED
                 } else if c.p[0] as i32 > 1 {
@@ -132,7 +130,8 @@ impl GroundLink {
             }
             MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL => {
                 match message_id(c.p[0]) {
-                    Some(0) => MavResult::MAV_RESULT_DENIED, // the heartbeat stays at 1 Hz
+                    // The heartbeat stays at 1 Hz.
+                    Some(HEARTBEAT_DATA::ID) => MavResult::MAV_RESULT_DENIED,
                     Some(id) => match Stream::from_message_id(id) {
                         Some(s) => {
                             self.streams.set_interval(s, c.p[1], now_us);
@@ -145,7 +144,7 @@ impl GroundLink {
             }
             MavCmd::MAV_CMD_GET_MESSAGE_INTERVAL => match message_id(c.p[0]) {
                 Some(id) => {
-                    let interval_us = if id == 0 {
+                    let interval_us = if id == HEARTBEAT_DATA::ID {
                         HEARTBEAT_INTERVAL_US as i32
                     } else {
                         match Stream::from_message_id(id) {
@@ -201,10 +200,10 @@ impl GroundLink {
             return (MavResult::MAV_RESULT_DENIED, after);
         };
         let one = match id {
-            0 => Some(Pending::Heartbeat),
-            148 => Some(Pending::AutopilotVersion),
-            436 => Some(Pending::CurrentMode),
-            435 => {
+            HEARTBEAT_DATA::ID => Some(Pending::Heartbeat),
+            AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
+            CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
+            AVAILABLE_MODES_DATA::ID => {
                 let n = FlightMode::ALL.len();
                 let index = c.p[1];
                 if index == 0.0 {

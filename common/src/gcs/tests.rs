@@ -122,6 +122,7 @@ fn link() -> Bench {
 fn healthy() -> VehicleSnapshot {
     VehicleSnapshot {
         boot_complete: true,
+        airspeed_range_m_s: (13.0, 25.0),
         modes_available: ModeSet::ALL,
         landed: LandedState::OnGround,
         health: SensorHealth {
@@ -1966,4 +1967,50 @@ fn uploads_are_checked_as_the_navigator_will_fly_them() {
     let said = said.join(" | ");
     assert!(said.contains("Item 1: command 183 unsupported"), "{said}");
     assert!(said.contains("no landing"), "{said}");
+}
+
+#[test]
+fn change_speed_is_held_to_the_vehicles_airspeed_range() {
+    let mut l = link();
+    let v = healthy();
+    let speed = |s: f32| {
+        cmd_long(
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED,
+            [0.0, s, -1.0, 0.0, 0.0, 0.0, 0.0],
+        )
+    };
+    let out = exchange(&mut l, &v, 0, speed(20.0));
+    assert_eq!(
+        acks(&out),
+        [(
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED,
+            MavResult::MAV_RESULT_ACCEPTED
+        )]
+    );
+    assert_eq!(l.take_requests().airspeed, Some(20.0));
+    // Above NAV_ASPD_MAX (25 m/s here): denied, with the range in the text.
+    let out = exchange(&mut l, &v, 0, speed(28.0));
+    assert_eq!(
+        acks(&out),
+        [(
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED,
+            MavResult::MAV_RESULT_DENIED
+        )]
+    );
+    assert!(
+        texts(&out).iter().any(|t| t.contains("[13, 25]")),
+        "{:?}",
+        texts(&out)
+    );
+    assert_eq!(l.take_requests().airspeed, None);
+    // -1: "no change" in the command's own convention.
+    let out = exchange(&mut l, &v, 0, speed(-1.0));
+    assert_eq!(
+        acks(&out),
+        [(
+            MavCmd::MAV_CMD_DO_CHANGE_SPEED,
+            MavResult::MAV_RESULT_ACCEPTED
+        )]
+    );
+    assert_eq!(l.take_requests().airspeed, None);
 }

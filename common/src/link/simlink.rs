@@ -14,7 +14,7 @@
 
 use crate::actuators::Surfaces;
 use crate::math::geodetic::GeoPoint;
-use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, ManualInput, PitotSample};
+use crate::sensors::{limits, BaroSample, GpsFix, ImuSample, MagSample, ManualInput, PitotSample};
 
 /// The frame `HIL_SENSOR` decodes into.
 pub use crate::sensors::SensorFrame;
@@ -36,21 +36,6 @@ pub const BITS_BARO: u32 = (1 << 9) | (1 << 11) | (1 << 12);
 /// `fields_updated` bit of a differential-pressure update.
 pub const BITS_DIFF_PRESSURE: u32 = 1 << 10;
 
-/// Plausibility limits: beyond these a value is a fault, not a measurement.
-mod limits {
-    /// 16 g, the range of common MEMS accelerometers.
-    pub const ACCEL_MPS2: f32 = 16.0 * 9.81;
-    /// 2000 deg/s.
-    pub const GYRO_RADPS: f32 = 34.9;
-    /// The earth's field is below 0.7 gauss; allow local disturbance.
-    pub const MAG_GAUSS: f32 = 4.0;
-    /// 10 km above sea level to below the Dead Sea.
-    pub const BARO_HPA: (f32, f32) = (260.0, 1100.0);
-    /// About 130 m/s of airspeed; small negative readings are sensor offset.
-    pub const DIFF_HPA: (f32, f32) = (-5.0, 100.0);
-    pub const TEMP_C: (f32, f32) = (-60.0, 90.0);
-}
-
 /// Which groups of one frame were dropped as implausible or incomplete.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -70,14 +55,6 @@ impl Rejected {
     pub fn none(&self) -> bool {
         !(self.imu || self.mag || self.baro || self.pitot)
     }
-}
-
-fn finite_within(v: &[f32], limit: f32) -> bool {
-    v.iter().all(|x| x.is_finite() && x.abs() <= limit)
-}
-
-fn in_range(x: f32, (lo, hi): (f32, f32)) -> bool {
-    x.is_finite() && x >= lo && x <= hi
 }
 
 /// Encodes a sensor frame (simulator side).
@@ -128,11 +105,12 @@ pub fn decode_hil_sensor(d: &HIL_SENSOR_DATA) -> (SensorFrame, Rejected) {
         BITS_IMU => {
             let a = [d.xacc, d.yacc, d.zacc];
             let g = [d.xgyro, d.ygyro, d.zgyro];
-            if finite_within(&a, limits::ACCEL_MPS2) && finite_within(&g, limits::GYRO_RADPS) {
-                f.imu = Some(ImuSample {
-                    accel: Vector3::from(a),
-                    gyro: Vector3::from(g),
-                });
+            let imu = ImuSample {
+                accel: Vector3::from(a),
+                gyro: Vector3::from(g),
+            };
+            if imu.plausible() {
+                f.imu = Some(imu);
             } else {
                 r.imu = true;
             }
@@ -143,10 +121,11 @@ pub fn decode_hil_sensor(d: &HIL_SENSOR_DATA) -> (SensorFrame, Rejected) {
         0 => {}
         BITS_MAG => {
             let m = [d.xmag, d.ymag, d.zmag];
-            if finite_within(&m, limits::MAG_GAUSS) {
-                f.mag = Some(MagSample {
-                    field: Vector3::from(m),
-                });
+            let mag = MagSample {
+                field: Vector3::from(m),
+            };
+            if mag.plausible() {
+                f.mag = Some(mag);
             } else {
                 r.mag = true;
             }
@@ -155,25 +134,26 @@ pub fn decode_hil_sensor(d: &HIL_SENSOR_DATA) -> (SensorFrame, Rejected) {
     }
     // Pressure is what matters; a frame may carry it without altitude or temperature.
     if group(1 << 9) != 0 {
-        let temp_ok = group(1 << 12) == 0 || in_range(d.temperature, limits::TEMP_C);
-        if in_range(d.abs_pressure, limits::BARO_HPA) && temp_ok {
-            f.baro = Some(BaroSample {
-                pressure_pa: d.abs_pressure * PA_PER_HPA,
-                temperature_c: if group(1 << 12) != 0 {
-                    d.temperature
-                } else {
-                    15.0
-                },
-            });
+        let baro = BaroSample {
+            pressure_pa: d.abs_pressure * PA_PER_HPA,
+            temperature_c: if group(1 << 12) != 0 {
+                d.temperature
+            } else {
+                15.0
+            },
+        };
+        if baro.plausible() {
+            f.baro = Some(baro);
         } else {
             r.baro = true;
         }
     }
     if group(BITS_DIFF_PRESSURE) != 0 {
-        if in_range(d.diff_pressure, limits::DIFF_HPA) {
-            f.pitot = Some(PitotSample {
-                diff_pressure_pa: d.diff_pressure * PA_PER_HPA,
-            });
+        let pitot = PitotSample {
+            diff_pressure_pa: d.diff_pressure * PA_PER_HPA,
+        };
+        if pitot.plausible() {
+            f.pitot = Some(pitot);
         } else {
             r.pitot = true;
         }
@@ -274,7 +254,8 @@ pub fn decode_hil_gps(d: &HIL_GPS_DATA) -> Option<GpsFix> {
         lon_e7: d.lon,
     };
     let alt_amsl_m = d.alt as f32 / 1000.0;
-    if d.fix_type >= 2 && (!position.is_valid() || !(-1000.0..=20_000.0).contains(&alt_amsl_m)) {
+    if d.fix_type >= 2 && (!position.is_valid() || !limits::in_range(alt_amsl_m, limits::GPS_ALT_M))
+    {
         return None;
     }
     Some(GpsFix {

@@ -17,5 +17,10 @@ pub use frames::*;
 
 /// One degree in radians, in the board's float.
 pub const DEG: f32 = core::f32::consts::PI / 180.0;
+
+/// Standard gravity, m/s^2 (the plant's `f64` view).
+pub const STANDARD_GRAVITY: f64 = 9.80665;
+/// Standard gravity, m/s^2, in the `f32` of the firmware.
+pub const GRAVITY: f32 = STANDARD_GRAVITY as f32;
 /// Degrees per radian, in the board's float.
 pub const RAD2DEG: f32 = 180.0 / core::f32::consts::PI;

@@ -361,8 +361,10 @@ impl Vehicle {
             fence: p.load(&fence::PARAMS),
         };
         self.use_truth = sys.use_truth;
+        // The cruise airspeed is the altitude-holding modes' until a ground station changes it.
         if count == 0 || self.commander.chosen_mode() == FlightMode::Manual {
-            self.commander.set_cruise_airspeed(sys.airspeed_trim);
+            let cruise = self.commander.navigator().params().airspeed;
+            self.commander.set_cruise_airspeed(cruise);
         }
     }
 }

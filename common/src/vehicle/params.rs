@@ -14,8 +14,6 @@ pub struct SystemParams {
     pub gain_set: u8,
     /// Fly on the simulator's truth instead of the estimate.
     pub use_truth: bool,
-    /// Airspeed held in the altitude-holding modes until a ground station changes it, m/s.
-    pub airspeed_trim: f32,
 }
 
 /// Parameters of the vehicle itself.
@@ -41,22 +39,10 @@ pub const PARAMS: Group<SystemParams> = Group {
             SystemParams => use_truth,
             flag
         ),
-        param!(
-            ParamDef::real(
-                "FW_AIRSPD_TRIM",
-                17.0,
-                10.0,
-                30.0,
-                "m/s",
-                "Airspeed held in the altitude-holding modes until a ground station changes it",
-            ),
-            SystemParams => airspeed_trim
-        ),
     ],
     base: || SystemParams {
         gain_set: 0,
         use_truth: false,
-        airspeed_trim: 0.0,
     },
     check: independent,
 };
@@ -87,6 +73,6 @@ mod tests {
         assert_eq!(ParamStore::validate(REGISTRY), Ok(()));
         let store = ParamStore::new(REGISTRY);
         assert!(store.len() > 100, "{}", store.len());
-        assert_eq!(store.load(&PARAMS).airspeed_trim, 17.0);
+        assert_eq!(store.load(&PARAMS).gain_set, 0);
     }
 }

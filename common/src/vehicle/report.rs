@@ -103,6 +103,10 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         vel_e: e.vel_ned.y,
         vel_d: e.vel_ned.z,
         airspeed: e.airspeed,
+        airspeed_range_m_s: {
+            let p = c.navigator().params();
+            (p.airspeed_min, p.airspeed_max)
+        },
         throttle: if c.armed() { x.throttle } else { 0.0 },
         home,
         gps,

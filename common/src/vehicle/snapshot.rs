@@ -191,6 +191,8 @@ pub struct VehicleSnapshot {
     pub vel_d: f32,
     /// Indicated airspeed, m/s.
     pub airspeed: f32,
+    /// Airspeeds the vehicle may be asked to hold, m/s (`NAV_ASPD_MIN`, `NAV_ASPD_MAX`).
+    pub airspeed_range_m_s: (f32, f32),
     /// Throttle command, 0..1.
     pub throttle: f32,
     /// Home position.

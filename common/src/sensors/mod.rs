@@ -4,6 +4,8 @@
 //! frames. Units are SI: specific force in m/s^2 (level flight reads z = -g), rates in rad/s,
 //! magnetic field in gauss, pressures in Pa, temperatures in deg C.
 
+pub mod limits;
+
 use crate::math::geodetic::GeoPoint;
 use nalgebra::Vector3;
 
