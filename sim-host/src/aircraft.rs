@@ -302,6 +302,10 @@ pub struct Ground {
     pub tail_steer_per_rudder: f64,
 }
 
+/// Most belly points a `[ground]` table may list: the contact model keeps its points in
+/// fixed-size arrays, after the three wheels.
+pub const MAX_BELLY_POINTS: usize = 9;
+
 /// The whole aircraft file.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -531,7 +535,7 @@ impl Aircraft {
             t[0] < 0.0 && t[2] > 0.0,
             "the tail wheel is behind (x < 0) and below (z > 0) the CG",
         )?;
-        let max_belly = crate::plant::ground::MAX_CONTACTS - 3;
+        let max_belly = MAX_BELLY_POINTS;
         if gr.belly_points_m.len() > max_belly {
             return Err(bad(
                 "belly_points_m",
