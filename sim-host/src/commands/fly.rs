@@ -2,7 +2,8 @@
 //! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
 
 use crate::aircraft::Aircraft;
-use crate::flight::record::{write_log_and_plots, MissionSummary};
+use crate::flight::plots::write_log_and_plots;
+use crate::flight::summary::MissionSummary;
 use crate::flight::{fly, spawn_firmware, FlightConfig, FlightOutcome, InprocOnboard, Onboard};
 use crate::link::lockstep::Lockstep;
 use crate::link::tlog::TlogWriter;
