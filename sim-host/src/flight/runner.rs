@@ -13,6 +13,7 @@ use crate::link::transport::Transport;
 use crate::plant::propulsion::motor_power_w;
 use crate::plant::{Controls, Environment, ModelParams, Plant, ServoBank};
 use crate::sensors::models::{SensorSuite, Truth};
+use common::estimator::ins::GRAVITY;
 use common::link::simlink::{encode_hil_gps, encode_hil_sensor, encode_rc_channels};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
@@ -314,7 +315,11 @@ fn truth_frame(time_us: u64, t: &Truth, plant: &Plant, alt_amsl: f64) -> HIL_STA
     let q = t.attitude.quaternion();
     let p = plant.geodetic();
     let cm = |v: f64| (v * 100.0).round().clamp(-32768.0, 32767.0) as i16;
-    let mg = |v: f64| (v / 9.80665 * 1000.0).round().clamp(-32768.0, 32767.0) as i16;
+    let mg = |v: f64| {
+        (v / f64::from(GRAVITY) * 1000.0)
+            .round()
+            .clamp(-32768.0, 32767.0) as i16
+    };
     let rho0 = standard_atmosphere(0.0).density;
     let rho = standard_atmosphere(alt_amsl).density;
     let eas = t.airspeed_mps * (rho / rho0).sqrt();
