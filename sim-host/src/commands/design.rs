@@ -3,7 +3,8 @@
 
 use super::Format;
 use crate::aircraft::Aircraft;
-use crate::analysis::design::{describe_poles, design, Design, DesignInputs};
+use crate::analysis::design::inputs::DesignInputs;
+use crate::analysis::design::{describe_poles, design, Design};
 use crate::report::{sig, Table};
 use common::control::gains::GainSet;
 use serde::Serialize;
