@@ -325,7 +325,7 @@ pub struct Aircraft {
     /// Servos.
     pub actuators: Actuators,
     /// Sensor rates, noise, biases and the GPS receiver.
-    pub sensors: crate::sensors::SensorConfig,
+    pub sensors: crate::sensors::config::SensorConfig,
     /// Environment.
     pub environment: Environment,
     /// Landing gear and belly contact.

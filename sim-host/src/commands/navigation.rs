@@ -8,9 +8,9 @@ use crate::environment::wind::Turbulence;
 use crate::flight::missions::{default_mission, runway_mission};
 use crate::flight::plots::ground_track_figure;
 use crate::flight::record::Sample;
+use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::{MissionSummary, TouchdownSummary};
-use crate::flight::FlightOutcome;
-use crate::plant::ModelParams;
+use crate::plant::params::ModelParams;
 use crate::report::sig;
 use anyhow::Context;
 use std::fmt::Write as _;
@@ -45,7 +45,7 @@ pub fn fly_default(
     turbulence: Turbulence,
     seed: u64,
 ) -> anyhow::Result<FlightOutcome> {
-    let cfg = crate::flight::FlightConfig {
+    let cfg = crate::flight::config::FlightConfig {
         wind_ned,
         turbulence,
         seed,

@@ -2,7 +2,7 @@
 
 use super::record::{csv_headers, csv_row, Sample, DEG};
 use crate::report::csv_out::write_csv;
-use crate::report::{Figure, Panel, Series};
+use crate::report::plot::{Figure, Panel, Series};
 use common::math::wrap_pi;
 use std::path::{Path, PathBuf};
 

@@ -48,7 +48,7 @@ use super::lti::{damping_and_frequency, margins};
 use super::transfer::TransferFunction;
 use super::trim::{trim_with, TrimResult, TrimTarget};
 use crate::aircraft::Aircraft;
-use crate::plant::ModelParams;
+use crate::plant::params::ModelParams;
 use common::control::gains::{GainSet, DESIGNED};
 use common::math::atmosphere::standard_atmosphere;
 use loops::{closed, gain, limit_gain, predict, reduce, tf, through_inner, with_actuation};

@@ -2,7 +2,7 @@
 
 use crate::aircraft::Aircraft;
 use crate::analysis::trim::{trim, TrimResult, TrimTarget};
-use crate::report::Table;
+use crate::report::table::Table;
 use crate::scenario::metrics::{run_metrics, RunMetrics};
 use crate::scenario::sim::{simulate, Run, SimConfig};
 use crate::scenario::Scenario;

@@ -2,7 +2,9 @@
 
 use super::run::ScenarioResult;
 use crate::report::csv_out::write_csv;
-use crate::report::{sig, to_json, Figure, Panel, Series, Table};
+use crate::report::plot::{Figure, Panel, Series};
+use crate::report::table::Table;
+use crate::report::{sig, to_json};
 use crate::scenario::Axis;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
