@@ -10,7 +10,7 @@
 /// The paragraphs of block `name` of `template` (none when it has no such block), each on one
 /// line, with every `{key}` of `values` replaced by its value; a `{...}` that names no value is
 /// kept as written.
-pub fn paragraphs(template: &str, name: &str, values: &[(&str, String)]) -> Vec<String> {
+pub fn paragraphs(template: &str, name: &str, values: &[(&str, &str)]) -> Vec<String> {
     let marker = format!("<!-- {name} -->");
     let mut lines = template.lines().skip_while(|l| l.trim_end() != marker);
     if lines.next().is_none() {
@@ -24,7 +24,7 @@ pub fn paragraphs(template: &str, name: &str, values: &[(&str, String)]) -> Vec<
 }
 
 /// Block `name` of `template` filled in, its paragraphs separated by blank lines.
-pub fn block(template: &str, name: &str, values: &[(&str, String)]) -> String {
+pub fn block(template: &str, name: &str, values: &[(&str, &str)]) -> String {
     paragraphs(template, name, values).join("\n\n")
 }
 
@@ -42,7 +42,7 @@ fn is_marker(line: &str) -> bool {
 
 /// `text` with every `{key}` of `values` replaced, in one pass (a value is never searched for
 /// keys itself).
-fn fill(text: &str, values: &[(&str, String)]) -> String {
+fn fill(text: &str, values: &[(&str, &str)]) -> String {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(i) = rest.find('{') {
@@ -71,11 +71,13 @@ fn fill(text: &str, values: &[(&str, String)]) -> String {
 mod tests {
     use super::*;
 
-    const T: &str = "<!-- A note on the file,\nover two lines. -->\n\n<!-- one -->\nFirst {x} of\nthe block.\n\nSecond {y}, {unknown} kept.\n<!-- two -->\n\n- **Item** {x}\n";
+    const T: &str = "<!-- A note on the file,\nover two lines. -->\n\n\
+                     <!-- one -->\nFirst {x} of\nthe block.\n\nSecond {y}, {unknown} kept.\n\
+                     <!-- two -->\n\n- **Item** {x}\n";
 
     #[test]
     fn blocks_are_unwrapped_and_filled() {
-        let v = [("x", "1 {y}".to_string()), ("y", "2".to_string())];
+        let v = [("x", "1 {y}"), ("y", "2")];
         assert_eq!(
             paragraphs(T, "one", &v),
             ["First 1 {y} of the block.", "Second 2, {unknown} kept."]

@@ -106,7 +106,7 @@ fn requirement_rows(report: &ScenarioReport, set: &str) -> Vec<(String, String, 
 pub fn results_markdown(report: &ScenarioReport, command: &str, aircraft: &Aircraft) -> String {
     let mut s = String::new();
     s.push_str("# Closed-loop results: the tests of thesis chapter 4 on the nonlinear plant\n\n");
-    s.push_str(&block(PROSE, "intro", &[("command", command.to_string())]));
+    s.push_str(&block(PROSE, "intro", &[("command", command)]));
     s.push_str("\n\n");
     s.push_str(include_str!("setup.md"));
     s.push_str("\n## Scenarios\n\n| scenario | loop | command | length (s) |\n|---|---|---|---|\n");
@@ -171,7 +171,7 @@ pub fn results_markdown(report: &ScenarioReport, command: &str, aircraft: &Aircr
         all_met.join(", ")
     };
     s.push('\n');
-    s.push_str(&block(PROSE, "all_met", &[("sets", all_met)]));
+    s.push_str(&block(PROSE, "all_met", &[("sets", &all_met)]));
     s.push('\n');
     s.push_str(&prediction_vs_flight(report, aircraft));
     s.push_str("\n## The thesis's claims\n\n");
@@ -204,8 +204,8 @@ fn prediction_vs_flight(report: &ScenarioReport, aircraft: &Aircraft) -> String 
         String::from("\n## The computed set: linear prediction against the nonlinear plant\n\n");
     s.push_str(&block(PROSE, "prediction", &[]));
     s.push_str(
-        "\n\n| loop | test | rise predicted (s) | rise flown (s) | difference | overshoot predicted \
-         (%) | overshoot flown (%) |\n|---|---|---|---|---|---|---|\n",
+        "\n\n| loop | test | rise predicted (s) | rise flown (s) | difference | \
+         overshoot predicted (%) | overshoot flown (%) |\n|---|---|---|---|---|---|---|\n",
     );
     for (name, sc) in pairs {
         let Some(l) = d.loops.iter().find(|l| l.name.starts_with(name)) else {
