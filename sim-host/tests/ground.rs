@@ -3,7 +3,8 @@
 use nalgebra::Vector3;
 use sim_host::aircraft::Aircraft;
 use sim_host::analysis::trim::{trim, TrimTarget};
-use sim_host::plant::ground::{self, MAIN_LEFT, MAIN_RIGHT, TAIL};
+use sim_host::plant::gear::{MAIN_LEFT, MAIN_RIGHT, TAIL};
+use sim_host::plant::ground;
 use sim_host::plant::{Controls, Environment, ModelParams, Plant, State};
 
 fn aircraft() -> Aircraft {

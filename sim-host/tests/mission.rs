@@ -6,7 +6,7 @@
 use sim_host::aircraft::Aircraft;
 use sim_host::commands::navigation;
 use sim_host::environment::wind::Turbulence;
-use sim_host::flight::record::MissionSummary;
+use sim_host::flight::summary::MissionSummary;
 use sim_host::flight::FlightOutcome;
 
 /// The default mission from the runway, with the firmware's parameters and the ground

@@ -8,7 +8,10 @@
 use super::linearize::{ix, u5_of, Linearization, X13};
 use super::trim::TrimResult;
 use crate::aircraft::Aircraft;
-use crate::plant::{Controls, Environment, ModelParams, Plant, ServoBank};
+use crate::plant::inputs::{Controls, Environment};
+use crate::plant::params::ModelParams;
+use crate::plant::servo::ServoBank;
+use crate::plant::Plant;
 use serde::Serialize;
 
 /// The surface a doublet is applied to.

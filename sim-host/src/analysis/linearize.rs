@@ -10,7 +10,9 @@
 
 use super::trim::TrimResult;
 use crate::plant::dynamics::derivatives;
-use crate::plant::{Controls, Environment, ModelParams, State};
+use crate::plant::inputs::{Controls, Environment};
+use crate::plant::params::ModelParams;
+use crate::plant::state::State;
 use common::math::{AirData, Euler};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector, Vector3};
 use serde::Serialize;

@@ -9,7 +9,9 @@
 
 use crate::aircraft::Aircraft;
 use crate::plant::dynamics::derivatives;
-use crate::plant::{Controls, Environment, ModelParams, State};
+use crate::plant::inputs::{Controls, Environment};
+use crate::plant::params::ModelParams;
+use crate::plant::state::State;
 use common::math::{AirData, Euler};
 use nalgebra::{SMatrix, SVector, Vector3};
 use serde::Serialize;

@@ -3,8 +3,10 @@
 
 use super::Format;
 use crate::aircraft::Aircraft;
-use crate::analysis::design::{describe_poles, design, Design, DesignInputs};
-use crate::report::{sig, Table};
+use crate::analysis::design::inputs::DesignInputs;
+use crate::analysis::design::{describe_poles, design, Design};
+use crate::report::sig;
+use crate::report::table::Table;
 use common::control::gains::GainSet;
 use serde::Serialize;
 

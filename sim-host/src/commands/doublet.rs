@@ -5,9 +5,11 @@ use crate::analysis::doublet::{run, DoubletConfig, DoubletRun, Surface, OUTPUT_I
 use crate::analysis::linearize::linearize;
 use crate::analysis::references::{THESIS_DOUBLET_LAT, THESIS_DOUBLET_LON};
 use crate::analysis::trim::{trim_with, TrimTarget};
-use crate::plant::ModelParams;
+use crate::plant::params::ModelParams;
 use crate::report::csv_out::write_csv;
-use crate::report::{sig, Figure, Panel, Series, Table};
+use crate::report::plot::{Figure, Panel, Series};
+use crate::report::sig;
+use crate::report::table::Table;
 use anyhow::{bail, Context};
 use serde::Serialize;
 use std::path::{Path, PathBuf};

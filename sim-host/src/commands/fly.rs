@@ -2,12 +2,16 @@
 //! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
 
 use crate::aircraft::Aircraft;
-use crate::flight::record::{write_log_and_plots, MissionSummary};
-use crate::flight::{fly, spawn_firmware, FlightConfig, FlightOutcome, InprocOnboard, Onboard};
+use crate::flight::config::FlightConfig;
+use crate::flight::onboard::{spawn_firmware, InprocOnboard, Onboard};
+use crate::flight::plots::write_log_and_plots;
+use crate::flight::runner::{fly, FlightOutcome};
+use crate::flight::summary::MissionSummary;
 use crate::link::lockstep::Lockstep;
 use crate::link::tlog::TlogWriter;
 use crate::link::transport::{Inproc, PtyServer, TcpServer, Transport, UdpServer};
-use crate::report::{sig, to_json, Table};
+use crate::report::table::Table;
+use crate::report::{sig, to_json};
 use anyhow::Context;
 use firmware::app::App;
 use firmware::sitl::SimEndpoint;

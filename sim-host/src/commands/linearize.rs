@@ -8,8 +8,9 @@ use crate::analysis::transfer::{
     thesis_transfer_functions, ThesisTransferFunctions, TransferFunction,
 };
 use crate::analysis::trim::{trim_with, TrimResult, TrimTarget};
-use crate::plant::ModelParams;
-use crate::report::{pct, sig, Table};
+use crate::plant::params::ModelParams;
+use crate::report::table::Table;
+use crate::report::{pct, sig};
 use anyhow::{anyhow, bail};
 use serde::Serialize;
 

@@ -10,7 +10,7 @@ pub mod scenario;
 pub mod trim;
 pub mod validation;
 
-use crate::report::Table;
+use crate::report::table::Table;
 
 /// How a command prints its tables.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,9 +6,11 @@ use super::fly::{fly_report, mission_table, FlyOptions, NOTES_MARKER};
 use crate::aircraft::Aircraft;
 use crate::environment::wind::Turbulence;
 use crate::flight::missions::{default_mission, runway_mission};
-use crate::flight::record::{ground_track_figure, MissionSummary, Sample, TouchdownSummary};
-use crate::flight::FlightOutcome;
-use crate::plant::ModelParams;
+use crate::flight::plots::ground_track_figure;
+use crate::flight::record::Sample;
+use crate::flight::runner::FlightOutcome;
+use crate::flight::summary::{MissionSummary, TouchdownSummary};
+use crate::plant::params::ModelParams;
 use crate::report::sig;
 use anyhow::Context;
 use std::fmt::Write as _;
@@ -43,7 +45,7 @@ pub fn fly_default(
     turbulence: Turbulence,
     seed: u64,
 ) -> anyhow::Result<FlightOutcome> {
-    let cfg = crate::flight::FlightConfig {
+    let cfg = crate::flight::config::FlightConfig {
         wind_ned,
         turbulence,
         seed,

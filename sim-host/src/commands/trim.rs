@@ -3,8 +3,9 @@
 use crate::aircraft::Aircraft;
 use crate::analysis::references::{umn_trim, ThesisTrim, THESIS_TRIM};
 use crate::analysis::trim::{trim_with, TrimResult, TrimTarget};
-use crate::plant::ModelParams;
-use crate::report::{pct, sig, Table};
+use crate::plant::params::ModelParams;
+use crate::report::table::Table;
+use crate::report::{pct, sig};
 use serde::Serialize;
 
 /// One trimmed target with its references.

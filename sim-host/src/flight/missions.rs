@@ -1,6 +1,8 @@
 //! Missions written as a planner would write them: MAVLink `MISSION_ITEM_INT`s with global
 //! positions, built from offsets in metres from the simulator's home (the runway).
 
+use super::config::FlightConfig;
+use super::script::{Action, Script, ScriptStep};
 use common::math::geodetic::{offset_point, GeoPoint};
 use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
 
@@ -185,23 +187,23 @@ pub const MISSION_TUNING: [(&str, f32); 2] = [("ASPD_THR_KP", 0.3), ("ASPD_THR_K
 /// with QGroundControl flies it: [`MISSION_TUNING`] set, the mission uploaded, the autopilot
 /// armed once its estimator has converged, the mission started a second later; the flight
 /// ends when the autopilot has landed and disarmed (or after 900 s).
-pub fn runway_mission(mission: Vec<MISSION_ITEM_INT_DATA>) -> super::FlightConfig {
-    super::FlightConfig {
+pub fn runway_mission(mission: Vec<MISSION_ITEM_INT_DATA>) -> FlightConfig {
+    FlightConfig {
         duration_s: 900.0,
         stop_when_landed: true,
         runway_heading: Some(0.0),
-        script: super::Script {
-            steps: vec![super::ScriptStep {
+        script: Script {
+            steps: vec![ScriptStep {
                 after_arm_s: 1.0,
-                action: super::Action::MissionStart,
+                action: Action::MissionStart,
             }],
             mission,
             params: MISSION_TUNING
                 .iter()
                 .map(|(n, v)| (n.to_string(), *v))
                 .collect(),
-            ..super::Script::thesis()
+            ..Script::thesis()
         },
-        ..super::FlightConfig::default()
+        ..FlightConfig::default()
     }
 }

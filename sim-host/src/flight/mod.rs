@@ -22,38 +22,18 @@
 //! identity) to the autopilot's ground link. It waits for each COMMAND_ACK before the next
 //! sensor frame, so a command takes effect at the same frame on every transport.
 
+pub mod config;
 pub mod missions;
 pub mod onboard;
+pub mod plots;
 pub mod record;
 pub mod runner;
 pub mod script;
+pub mod summary;
 
+pub use config::{parse_turbulence, turbulence_name, Fault, FaultWindow, FlightConfig, RcSticks};
 pub use onboard::{spawn_firmware, InprocOnboard, Onboard, ThreadOnboard};
-pub use record::{FlightSummary, Sample};
-pub use runner::{fly, Fault, FaultWindow, FlightConfig, FlightError, FlightOutcome, RcSticks};
+pub use record::Sample;
+pub use runner::{fly, FlightError, FlightOutcome};
 pub use script::{Action, Script, ScriptStep};
-
-use crate::environment::wind::Turbulence;
-
-/// Parses a turbulence severity as the command line spells it.
-pub fn parse_turbulence(s: &str) -> Result<Turbulence, String> {
-    match s {
-        "none" => Ok(Turbulence::None),
-        "light" => Ok(Turbulence::Light),
-        "moderate" => Ok(Turbulence::Moderate),
-        "severe" => Ok(Turbulence::Severe),
-        _ => Err(format!(
-            "turbulence `{s}`: expected none, light, moderate or severe"
-        )),
-    }
-}
-
-/// The name of a turbulence severity.
-pub fn turbulence_name(t: Turbulence) -> &'static str {
-    match t {
-        Turbulence::None => "none",
-        Turbulence::Light => "light",
-        Turbulence::Moderate => "moderate",
-        Turbulence::Severe => "severe",
-    }
-}
+pub use summary::FlightSummary;

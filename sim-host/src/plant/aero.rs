@@ -5,7 +5,8 @@
 //! body-axis moments (as the Simulink model wires them), plus the moment of the aerodynamic
 //! force about the CG through the 4.5 mm arm.
 
-use super::{Controls, ModelParams};
+use super::inputs::Controls;
+use super::params::ModelParams;
 use common::math::{wind_to_body, AirData};
 use nalgebra::Vector3;
 

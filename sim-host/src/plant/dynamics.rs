@@ -1,6 +1,9 @@
 //! Flat-earth rigid-body equations of motion with the engine-speed state.
 
-use super::{aero, ground, propulsion, quat_of, Controls, Environment, ModelParams, StateVector};
+use super::inputs::{Controls, Environment};
+use super::params::ModelParams;
+use super::state::{quat_of, StateVector};
+use super::{aero, ground, propulsion};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::{body_to_ned, ned_to_body, AirData};
 use nalgebra::{Quaternion, Vector3};

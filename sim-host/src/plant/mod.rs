@@ -8,7 +8,8 @@
 //!                                                           ▼
 //!                          dynamics (flat-earth 6-DOF rigid body) ──► integrator (RK4)
 //! ```
-//! [`ground`] adds the landing gear's contact with the runway (zero in the air).
+//! [`ground`] adds the contact of the landing gear and belly points ([`gear`]) with the runway
+//! (zero in the air). [`state`], [`inputs`] and [`params`] hold what every block reads.
 //! [`servo`] models the surface servos; simulations put it in front of the plant, trim and
 //! linearisation do not.
 //!
@@ -17,222 +18,26 @@
 
 pub mod aero;
 pub mod dynamics;
+pub mod gear;
 pub mod ground;
+pub mod inputs;
 pub mod integrator;
+pub mod params;
 pub mod propulsion;
 pub mod servo;
+pub mod state;
 
-use crate::aircraft::{Aero, Aircraft, Propulsion};
-use common::actuators::Surfaces;
+use crate::aircraft::Aircraft;
 use common::math::geodetic::{offset_point, GeoPoint};
 use common::math::{body_to_ned, AirData, Euler};
-use nalgebra::{Matrix3, SVector, UnitQuaternion, Vector3};
-use std::f64::consts::PI;
+use nalgebra::{UnitQuaternion, Vector3};
+use state::quat_of;
 
 pub use dynamics::Derivatives;
+pub use inputs::{Controls, Environment};
+pub use params::ModelParams;
 pub use servo::{Servo, ServoBank};
-
-/// Number of numbers in the integrated state vector.
-pub const STATE_LEN: usize = 14;
-/// The integrated state vector:
-/// `[pn, pe, pd, u, v, w, q0, q1, q2, q3, p, q, r, Omega]` (quaternion scalar first).
-pub type StateVector = SVector<f64, STATE_LEN>;
-
-/// Surface and throttle positions the plant sees (after the servos), UMN signs, rad.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Controls {
-    /// Elevator, positive trailing edge down (nose down).
-    pub elevator: f64,
-    /// Left aileron, positive trailing edge down.
-    pub aileron_left: f64,
-    /// Right aileron, positive trailing edge down.
-    pub aileron_right: f64,
-    /// Rudder, positive trailing edge left (nose left).
-    pub rudder: f64,
-    /// Throttle, 0..1.
-    pub throttle: f64,
-    /// Left flap, positive trailing edge down.
-    pub flap_left: f64,
-    /// Right flap, positive trailing edge down.
-    pub flap_right: f64,
-}
-
-impl Controls {
-    /// Controls from the combined aileron (`left = -aileron`, `right = +aileron`), no flaps.
-    pub fn new(elevator: f64, aileron: f64, rudder: f64, throttle: f64) -> Self {
-        Self {
-            elevator,
-            aileron_left: -aileron,
-            aileron_right: aileron,
-            rudder,
-            throttle,
-            flap_left: 0.0,
-            flap_right: 0.0,
-        }
-    }
-
-    /// The combined aileron `(right - left) / 2`, rad (positive rolls left).
-    pub fn aileron(&self) -> f64 {
-        0.5 * (self.aileron_right - self.aileron_left)
-    }
-
-    /// The same controls with both flaps at `flap` rad.
-    pub fn with_flaps(self, flap: f64) -> Self {
-        Self {
-            flap_left: flap,
-            flap_right: flap,
-            ..self
-        }
-    }
-}
-
-impl From<Surfaces> for Controls {
-    fn from(s: Surfaces) -> Self {
-        Self::new(
-            f64::from(s.elevator),
-            f64::from(s.aileron),
-            f64::from(s.rudder),
-            f64::from(s.throttle),
-        )
-    }
-}
-
-/// What the air mass does around the aircraft.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Environment {
-    /// Wind (velocity of the air mass) in NED, m/s: steady wind plus any turbulence.
-    pub wind_ned: Vector3<f64>,
-}
-
-/// The plant state in readable form.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct State {
-    /// Position from the home point, NED, m.
-    pub pos_ned: Vector3<f64>,
-    /// Inertial velocity in body axes, m/s.
-    pub vel_body: Vector3<f64>,
-    /// Attitude, body to NED.
-    pub attitude: UnitQuaternion<f64>,
-    /// Body rates `(p, q, r)`, rad/s.
-    pub omega_body: Vector3<f64>,
-    /// Engine (motor and propeller) speed, rad/s.
-    pub engine_speed: f64,
-}
-
-impl State {
-    /// Packs the state into the integrated vector.
-    pub fn to_vector(&self) -> StateVector {
-        let q = self.attitude.quaternion();
-        let mut x = StateVector::zeros();
-        x.fixed_rows_mut::<3>(0).copy_from(&self.pos_ned);
-        x.fixed_rows_mut::<3>(3).copy_from(&self.vel_body);
-        x[6] = q.w;
-        x[7] = q.i;
-        x[8] = q.j;
-        x[9] = q.k;
-        x.fixed_rows_mut::<3>(10).copy_from(&self.omega_body);
-        x[13] = self.engine_speed;
-        x
-    }
-
-    /// Unpacks an integrated vector (normalising its quaternion).
-    pub fn from_vector(x: &StateVector) -> Self {
-        Self {
-            pos_ned: x.fixed_rows::<3>(0).into_owned(),
-            vel_body: x.fixed_rows::<3>(3).into_owned(),
-            attitude: quat_of(x),
-            omega_body: x.fixed_rows::<3>(10).into_owned(),
-            engine_speed: x[13],
-        }
-    }
-}
-
-/// The unit quaternion of an integrated vector.
-#[inline]
-pub(crate) fn quat_of(x: &StateVector) -> UnitQuaternion<f64> {
-    UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(x[6], x[7], x[8], x[9]))
-}
-
-/// The model parameters in the form the hot path wants (derived quantities precomputed).
-#[derive(Clone, Debug)]
-pub struct ModelParams {
-    /// Mass, kg.
-    pub mass: f64,
-    /// Inertia matrix, kg m^2.
-    pub inertia: Matrix3<f64>,
-    /// Its inverse.
-    pub inertia_inv: Matrix3<f64>,
-    /// Wing span, m.
-    pub b: f64,
-    /// Mean chord, m.
-    pub c: f64,
-    /// Wing area, m^2.
-    pub s: f64,
-    /// `1 / (pi AR e)`.
-    pub induced_drag_factor: f64,
-    /// Aerodynamic force point from the CG, m.
-    pub aero_arm: Vector3<f64>,
-    /// Thrust point from the CG, m.
-    pub prop_arm: Vector3<f64>,
-    /// Aerodynamic derivatives.
-    pub aero: Aero,
-    /// Propulsion data.
-    pub prop: Propulsion,
-    /// `(4 / pi^2) R^4`: thrust = `CT rho` times this times `Omega^2`.
-    pub thrust_factor: f64,
-    /// `(4 / pi^3) R^5`: propeller torque = `CP rho` times this times `Omega^2`.
-    pub torque_factor: f64,
-    /// Gravity, m/s^2.
-    pub g: f64,
-    /// Altitude above mean sea level of the NED origin, m.
-    pub home_alt_msl_m: f64,
-    /// Home point.
-    pub home: GeoPoint,
-    /// Landing gear and belly contact.
-    pub ground: ground::GroundParams,
-}
-
-impl ModelParams {
-    /// Derives the hot-path parameters from a validated aircraft file.
-    pub fn new(a: &Aircraft) -> Self {
-        let m = &a.mass;
-        let inertia = Matrix3::new(
-            m.Jx_kgm2,
-            0.0,
-            -m.Jxz_kgm2,
-            0.0,
-            m.Jy_kgm2,
-            0.0,
-            -m.Jxz_kgm2,
-            0.0,
-            m.Jz_kgm2,
-        );
-        // Validation guarantees Jx Jz - Jxz^2 > 0 and positive diagonal: invertible.
-        let inertia_inv = inertia.try_inverse().unwrap_or_else(Matrix3::identity);
-        let g = &a.geometry;
-        let ar = g.b_m * g.b_m / g.S_m2;
-        let r = a.propulsion.prop_radius_m;
-        Self {
-            mass: m.mass_kg,
-            inertia,
-            inertia_inv,
-            b: g.b_m,
-            c: g.c_m,
-            s: g.S_m2,
-            induced_drag_factor: 1.0 / (PI * ar * a.aero.drag.oswald_e),
-            aero_arm: Vector3::from(g.aero_arm_from_cg_m),
-            prop_arm: Vector3::from(g.prop_arm_from_cg_m),
-            aero: a.aero.clone(),
-            prop: a.propulsion.clone(),
-            thrust_factor: 4.0 / (PI * PI) * r.powi(4),
-            torque_factor: 4.0 / (PI * PI * PI) * r.powi(5),
-            g: a.environment.g_mps2,
-            home_alt_msl_m: a.environment.home_alt_msl_m,
-            home: GeoPoint::from_deg(a.environment.home_lat_deg, a.environment.home_lon_deg),
-            ground: ground::GroundParams::new(&a.ground),
-        }
-    }
-}
+pub use state::{State, StateVector, STATE_LEN};
 
 /// The first contact of a landing: what a landing report reads.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -243,7 +48,7 @@ pub struct Touchdown {
     pub pos_ned: Vector3<f64>,
     /// Inertial velocity at that instant, NED, m/s (`z` is the sink rate, positive down).
     pub vel_ned: Vector3<f64>,
-    /// Index of the first point that touched ([`ground::GroundParams::points`]).
+    /// Index of the first point that touched ([`gear::GroundParams::points`]).
     pub point: usize,
     /// Contacts after airborne phases shorter than [`MIN_FLIGHT_S`] since then (bounces).
     pub bounces: u32,

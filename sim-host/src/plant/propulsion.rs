@@ -1,6 +1,6 @@
 //! The electric motor and propeller, with the engine speed as a state.
 
-use super::ModelParams;
+use super::params::ModelParams;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 

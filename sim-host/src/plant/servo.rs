@@ -1,7 +1,7 @@
 //! Surface servos: first order at 8 Hz, rate limited to 150 deg/s, position limited to +-25 deg.
 //! The throttle has no dynamics and is only saturated to 0..1.
 
-use super::Controls;
+use super::inputs::Controls;
 use crate::aircraft::Actuators;
 
 /// One servo.

@@ -1,9 +1,10 @@
 //! Reporting pieces every command shares: aligned text and Markdown tables, JSON, CSV time
-//! series and time-series plots.
+//! series, time-series plots and prose templates.
 
 pub mod csv_out;
 pub mod plot;
 pub mod table;
+pub mod template;
 
 pub use plot::{Figure, Panel, Series};
 pub use table::Table;

@@ -8,7 +8,9 @@
 use super::{Axis, Scenario};
 use crate::aircraft::Aircraft;
 use crate::analysis::trim::TrimResult;
-use crate::plant::{Controls, Environment, Plant, ServoBank};
+use crate::plant::inputs::{Controls, Environment};
+use crate::plant::servo::ServoBank;
+use crate::plant::Plant;
 use common::actuators::Surfaces;
 use common::control::autopilot::{Autopilot, Measurements};
 use common::control::gains::GainSet;

@@ -8,8 +8,8 @@
 //! them), and the GPS a latency. Each sensor draws from its own seeded stream, so turning one
 //! sensor off or changing its rate does not change the noise of another.
 
-mod config;
-mod models;
+pub mod config;
+pub mod models;
 
 pub use config::{GpsConfig, SensorConfig};
 pub use models::{SensorFaults, SensorSuite, Truth};

@@ -1,6 +1,6 @@
 //! The sensor suite, sampled at the lock-step frame rate.
 
-use super::SensorConfig;
+use super::config::SensorConfig;
 use common::link::simlink::SensorFrame;
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::{offset_point, GeoPoint};

@@ -5,14 +5,18 @@
 //! steps, each failing with the file, the dotted key and the value it rejects:
 //! TOML syntax, non-finite numbers (TOML accepts `nan` and `inf`), shape (unknown, missing or
 //! mistyped keys, through `deny_unknown_fields`), then physical sense (positive mass, a positive
-//! definite inertia, ordered limits, ...).
+//! definite inertia, ordered limits, ...). [`load`] takes the first three steps, [`validate`]
+//! the last.
 #![allow(non_snake_case)]
 
+pub mod load;
+pub mod validate;
+
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The aircraft file shipped with the simulator, compiled in so the binary runs from any directory.
-pub const DEFAULT_AIRCRAFT_TOML: &str = include_str!("../aircraft/ultrastick25e.toml");
+pub const DEFAULT_AIRCRAFT_TOML: &str = include_str!("../../aircraft/ultrastick25e.toml");
 /// The name under which errors in the built-in file are reported.
 pub const DEFAULT_AIRCRAFT_NAME: &str = "<built-in>/sim-host/aircraft/ultrastick25e.toml";
 
@@ -302,6 +306,10 @@ pub struct Ground {
     pub tail_steer_per_rudder: f64,
 }
 
+/// Most belly points a `[ground]` table may list: the contact model keeps its points in
+/// fixed-size arrays, after the three wheels.
+pub const MAX_BELLY_POINTS: usize = 9;
+
 /// The whole aircraft file.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -317,281 +325,11 @@ pub struct Aircraft {
     /// Servos.
     pub actuators: Actuators,
     /// Sensor rates, noise, biases and the GPS receiver.
-    pub sensors: crate::sensors::SensorConfig,
+    pub sensors: crate::sensors::config::SensorConfig,
     /// Environment.
     pub environment: Environment,
     /// Landing gear and belly contact.
     pub ground: Ground,
-}
-
-impl Aircraft {
-    /// The built-in Ultra Stick 25e.
-    pub fn ultrastick25e() -> Result<Self, AircraftError> {
-        Self::from_toml_str(DEFAULT_AIRCRAFT_TOML, Path::new(DEFAULT_AIRCRAFT_NAME))
-    }
-
-    /// Reads and validates an aircraft file.
-    pub fn from_file(path: &Path) -> Result<Self, AircraftError> {
-        let text = std::fs::read_to_string(path).map_err(|source| AircraftError::Read {
-            file: path.to_path_buf(),
-            source,
-        })?;
-        Self::from_toml_str(&text, path)
-    }
-
-    /// The file given, or the built-in one when `None`.
-    pub fn load(path: Option<&Path>) -> Result<Self, AircraftError> {
-        match path {
-            Some(p) => Self::from_file(p),
-            None => Self::ultrastick25e(),
-        }
-    }
-
-    /// Parses and validates TOML text; `file` names it in errors.
-    pub fn from_toml_str(text: &str, file: &Path) -> Result<Self, AircraftError> {
-        let file_buf = file.to_path_buf();
-        let table: toml::Table = toml::from_str(text).map_err(|e| AircraftError::Syntax {
-            file: file_buf.clone(),
-            message: e.message().to_string() + &location(text, e.span()),
-        })?;
-        check_finite(&toml::Value::Table(table), "", file)?;
-        let de = toml::Deserializer::parse(text).map_err(|e| AircraftError::Syntax {
-            file: file_buf.clone(),
-            message: e.message().to_string(),
-        })?;
-        let aircraft: Aircraft = serde_path_to_error::deserialize(de).map_err(|e| {
-            let key = e.path().to_string();
-            let inner = e.into_inner();
-            AircraftError::Shape {
-                file: file_buf.clone(),
-                key,
-                message: inner.message().to_string() + &location(text, inner.span()),
-            }
-        })?;
-        aircraft.validate(file)?;
-        Ok(aircraft)
-    }
-
-    /// Checks the physical sense of every value.
-    pub fn validate(&self, file: &Path) -> Result<(), AircraftError> {
-        let bad = |key: &str, value: String, reason: &str| AircraftError::Value {
-            file: file.to_path_buf(),
-            key: key.to_string(),
-            value,
-            reason: reason.to_string(),
-        };
-        let positive = |key: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(bad(key, v.to_string(), "must be positive"))
-            }
-        };
-        let non_negative = |key: &str, v: f64| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(bad(key, v.to_string(), "must not be negative"))
-            }
-        };
-        let ordered = |key: &str, v: [f64; 2]| {
-            if v[0] < v[1] {
-                Ok(())
-            } else {
-                Err(bad(
-                    key,
-                    format!("{v:?}"),
-                    "must be [min, max] with min < max",
-                ))
-            }
-        };
-        let m = &self.mass;
-        positive("mass.mass_kg", m.mass_kg)?;
-        positive("mass.Jx_kgm2", m.Jx_kgm2)?;
-        positive("mass.Jy_kgm2", m.Jy_kgm2)?;
-        positive("mass.Jz_kgm2", m.Jz_kgm2)?;
-        if m.Jx_kgm2 * m.Jz_kgm2 - m.Jxz_kgm2 * m.Jxz_kgm2 <= 0.0 {
-            return Err(bad(
-                "mass.Jxz_kgm2",
-                m.Jxz_kgm2.to_string(),
-                &format!(
-                    "inertia not positive definite: Jx*Jz - Jxz^2 = {:.6} <= 0",
-                    m.Jx_kgm2 * m.Jz_kgm2 - m.Jxz_kgm2 * m.Jxz_kgm2
-                ),
-            ));
-        }
-        let g = &self.geometry;
-        positive("geometry.b_m", g.b_m)?;
-        positive("geometry.S_m2", g.S_m2)?;
-        positive("geometry.c_m", g.c_m)?;
-        positive("aero.drag.oswald_e", self.aero.drag.oswald_e)?;
-        non_negative("aero.drag.CD_min", self.aero.drag.CD_min)?;
-        let p = &self.propulsion;
-        positive("propulsion.prop_radius_m", p.prop_radius_m)?;
-        positive("propulsion.Jmp_kgm2", p.Jmp_kgm2)?;
-        ordered("propulsion.J_clamp", p.J_clamp)?;
-        non_negative("propulsion.J_clamp", p.J_clamp[0])?;
-        ordered("propulsion.motor_power_clamp_W", p.motor_power_clamp_W)?;
-        ordered("propulsion.omega_limits_radps", p.omega_limits_radps)?;
-        // Qm = P / Omega: the lower engine-speed limit keeps the division finite.
-        positive("propulsion.omega_limits_radps", p.omega_limits_radps[0])?;
-        let a = &self.actuators;
-        positive("actuators.bandwidth_Hz", a.bandwidth_Hz)?;
-        positive("actuators.rate_limit_radps", a.rate_limit_radps)?;
-        ordered("actuators.position_limit_rad", a.position_limit_rad)?;
-        if let Err((key, value, reason)) = self.sensors.validate() {
-            return Err(bad(&key, value, reason));
-        }
-        let e = &self.environment;
-        positive("environment.g_mps2", e.g_mps2)?;
-        if !(-90.0..=90.0).contains(&e.home_lat_deg) {
-            return Err(bad(
-                "environment.home_lat_deg",
-                e.home_lat_deg.to_string(),
-                "must be within -90..90 deg",
-            ));
-        }
-        if !(-180.0..=180.0).contains(&e.home_lon_deg) {
-            return Err(bad(
-                "environment.home_lon_deg",
-                e.home_lon_deg.to_string(),
-                "must be within -180..180 deg",
-            ));
-        }
-        self.validate_ground(file)
-    }
-
-    /// Checks the `[ground]` table: a taildragger whose gear stands below the CG.
-    fn validate_ground(&self, file: &Path) -> Result<(), AircraftError> {
-        let bad = |key: &str, value: String, reason: &str| AircraftError::Value {
-            file: file.to_path_buf(),
-            key: format!("ground.{key}"),
-            value,
-            reason: reason.to_string(),
-        };
-        let gr = &self.ground;
-        for (key, v) in [
-            ("main_stiffness_Npm", gr.main_stiffness_Npm),
-            ("tail_stiffness_Npm", gr.tail_stiffness_Npm),
-            ("belly_stiffness_Npm", gr.belly_stiffness_Npm),
-            ("slip_speed_mps", gr.slip_speed_mps),
-        ] {
-            if v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                return Err(bad(key, v.to_string(), "must be positive"));
-            }
-        }
-        for (key, v) in [
-            ("main_damping_Nspm", gr.main_damping_Nspm),
-            ("tail_damping_Nspm", gr.tail_damping_Nspm),
-            ("belly_damping_Nspm", gr.belly_damping_Nspm),
-        ] {
-            if v.partial_cmp(&0.0) == Some(std::cmp::Ordering::Less) || !v.is_finite() {
-                return Err(bad(key, v.to_string(), "must not be negative"));
-            }
-        }
-        for (key, v) in [
-            ("mu_roll", gr.mu_roll),
-            ("mu_side", gr.mu_side),
-            ("mu_belly", gr.mu_belly),
-        ] {
-            if !(0.0..=2.0).contains(&v) {
-                return Err(bad(key, v.to_string(), "must be within 0..2"));
-            }
-        }
-        if !(-2.0..=2.0).contains(&gr.tail_steer_per_rudder) {
-            return Err(bad(
-                "tail_steer_per_rudder",
-                gr.tail_steer_per_rudder.to_string(),
-                "must be within -2..2",
-            ));
-        }
-        let point = |key: &str, v: [f64; 3], ok: bool, reason: &str| {
-            if ok {
-                Ok(())
-            } else {
-                Err(bad(key, format!("{v:?}"), reason))
-            }
-        };
-        let (l, r, t) = (gr.main_wheel_left_m, gr.main_wheel_right_m, gr.tail_wheel_m);
-        point(
-            "main_wheel_left_m",
-            l,
-            l[0] > 0.0 && l[1] < 0.0 && l[2] > 0.0,
-            "a taildragger's left main wheel is ahead of (x > 0), left of (y < 0) and below (z > 0) the CG",
-        )?;
-        point(
-            "main_wheel_right_m",
-            r,
-            r[0] > 0.0 && r[1] > 0.0 && r[2] > 0.0,
-            "a taildragger's right main wheel is ahead of (x > 0), right of (y > 0) and below (z > 0) the CG",
-        )?;
-        point(
-            "tail_wheel_m",
-            t,
-            t[0] < 0.0 && t[2] > 0.0,
-            "the tail wheel is behind (x < 0) and below (z > 0) the CG",
-        )?;
-        let max_belly = crate::plant::ground::MAX_CONTACTS - 3;
-        if gr.belly_points_m.len() > max_belly {
-            return Err(bad(
-                "belly_points_m",
-                format!("{} points", gr.belly_points_m.len()),
-                &format!("at most {max_belly} belly points"),
-            ));
-        }
-        for (i, p) in gr.belly_points_m.iter().enumerate() {
-            if p.iter().any(|c| c.abs() > 10.0) {
-                return Err(bad(
-                    &format!("belly_points_m[{i}]"),
-                    format!("{p:?}"),
-                    "must be within 10 m of the CG",
-                ));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// " (line L, column C)" of a byte span, or nothing.
-fn location(text: &str, span: Option<std::ops::Range<usize>>) -> String {
-    match span {
-        Some(r) if r.start <= text.len() => {
-            let before = &text[..r.start];
-            let line = before.matches('\n').count() + 1;
-            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-            format!(" (line {line}, column {col})")
-        }
-        _ => String::new(),
-    }
-}
-
-fn check_finite(v: &toml::Value, path: &str, file: &Path) -> Result<(), AircraftError> {
-    match v {
-        toml::Value::Float(x) if !x.is_finite() => Err(AircraftError::Value {
-            file: file.to_path_buf(),
-            key: path.to_string(),
-            value: x.to_string(),
-            reason: "must be a finite number".into(),
-        }),
-        toml::Value::Table(t) => {
-            for (k, v) in t {
-                let p = if path.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{path}.{k}")
-                };
-                check_finite(v, &p, file)?;
-            }
-            Ok(())
-        }
-        toml::Value::Array(a) => {
-            for (i, v) in a.iter().enumerate() {
-                check_finite(v, &format!("{path}[{i}]"), file)?;
-            }
-            Ok(())
-        }
-        _ => Ok(()),
-    }
 }
 
 #[cfg(test)]

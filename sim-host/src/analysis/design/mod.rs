@@ -40,78 +40,24 @@
 //!   `kp`, `ki` from the same pole placement on `h/theta = Va/s`, `Va/theta = -g/(s + a_V1)`
 //!   and the throttle-to-airspeed model with the engine-speed lag.
 
+pub mod inputs;
+pub mod loops;
+
 use super::linearize::{linearize, Linearization};
-use super::lti::{damping_and_frequency, margins, Margins};
-use super::metrics::step_metrics;
+use super::lti::{damping_and_frequency, margins};
 use super::transfer::TransferFunction;
 use super::trim::{trim_with, TrimResult, TrimTarget};
 use crate::aircraft::Aircraft;
-use crate::plant::ModelParams;
+use crate::plant::params::ModelParams;
 use common::control::gains::{GainSet, DESIGNED};
 use common::math::atmosphere::standard_atmosphere;
+use loops::{closed, gain, limit_gain, predict, reduce, tf, through_inner, with_actuation};
 use nalgebra::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// The choices a designer makes; defaults are the thesis's.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct DesignInputs {
-    /// Damping ratio of every loop.
-    pub zeta: f64,
-    /// Aileron deflection the roll design may use, deg (Appendix C: 45).
-    pub roll_aileron_max_deg: f64,
-    /// Roll error at which the aileron saturates, deg (Appendix C: 15).
-    pub roll_error_max_deg: f64,
-    /// Bandwidth separation of course from roll (Appendix C: 10).
-    pub course_separation: f64,
-    /// Bandwidth separation of sideslip from roll (Appendix C: 20).
-    pub sideslip_separation: f64,
-    /// Elevator deflection the pitch design may use, deg (the servo limit).
-    pub pitch_elevator_max_deg: f64,
-    /// Pitch error at which the elevator saturates, deg (the pitch-command limit).
-    pub pitch_error_max_deg: f64,
-    /// Bandwidth separation of altitude from pitch.
-    pub altitude_separation: f64,
-    /// Separation of the airspeed loops from the feedback low-pass pole.
-    pub filter_separation: f64,
-    /// Separation of the altitude loop from the feedback low-pass pole (the pitch loop adds
-    /// its own lag there).
-    pub altitude_filter_separation: f64,
-    /// Integrator zero of the inner PID loops, as a fraction of their natural frequency.
-    pub integrator_zero_fraction: f64,
-    /// Integrator zero of the outer PI loops, as a fraction of their proportional bandwidth
-    /// `2 zeta wn` (the pole-placement `ki = wn^2 ...` puts the zero at `wn / (2 zeta)`,
-    /// which costs some 20 % overshoot against the thesis's 5 % requirement).
-    pub outer_integrator_fraction: f64,
-    /// Control sample time, s.
-    pub sample_time_s: f64,
-    /// Samples of delay in the flight software.
-    pub delay_samples: f64,
-    /// Phase margin the inner loops must keep with servo and delay, deg.
-    pub inner_phase_margin_deg: f64,
-}
-
-impl Default for DesignInputs {
-    fn default() -> Self {
-        Self {
-            zeta: 0.707,
-            roll_aileron_max_deg: 45.0,
-            roll_error_max_deg: 15.0,
-            course_separation: 15.0,
-            sideslip_separation: 20.0,
-            pitch_elevator_max_deg: 25.0,
-            pitch_error_max_deg: 20.0,
-            altitude_separation: 10.0,
-            filter_separation: 4.0,
-            altitude_filter_separation: 16.0,
-            integrator_zero_fraction: 0.02,
-            outer_integrator_fraction: 0.05,
-            sample_time_s: 0.02,
-            delay_samples: 2.0,
-            inner_phase_margin_deg: 45.0,
-        }
-    }
-}
+pub use inputs::DesignInputs;
+pub use loops::LoopDesign;
 
 /// Model coefficients the design rules use.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -160,27 +106,6 @@ pub struct AppendixC {
     pub phase_margin_deg: Option<f64>,
 }
 
-/// One designed loop and what the linear model predicts of it.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct LoopDesign {
-    /// Loop name.
-    pub name: String,
-    /// Gains as (parameter, ours, thesis "designed").
-    pub gains: Vec<(String, f64, f64)>,
-    /// Natural frequency the design aims at, rad/s.
-    pub wn_radps: f64,
-    /// Closed-loop poles of the reduced model with the inner loops as designed.
-    pub poles: Vec<[f64; 2]>,
-    /// Predicted 10-90 % rise time, s.
-    pub rise_time_s: Option<f64>,
-    /// Predicted overshoot, %.
-    pub overshoot_pct: f64,
-    /// Predicted 2 % settling time, s.
-    pub settling_time_s: Option<f64>,
-    /// Margins with servo, delay (and feedback filter where the loop has one).
-    pub margins: Margins,
-}
-
 /// The whole design.
 #[derive(Clone, Debug, Serialize)]
 pub struct Design {
@@ -195,70 +120,6 @@ pub struct Design {
     /// The gain set ("computed").
     #[serde(skip)]
     pub gains: GainSet,
-}
-
-type Freq = Box<dyn Fn(f64) -> Complex<f64>>;
-
-fn tf(num: &[f64], den: &[f64]) -> TransferFunction {
-    TransferFunction::new(num, den)
-}
-
-/// A gain row of a loop: parameter, computed value, the thesis's designed value.
-fn gain(name: &str, computed: f64, thesis: f32) -> (String, f64, f64) {
-    (name.into(), computed, f64::from(thesis))
-}
-
-/// The loop transfer `L(jw)` of an inner loop with the servo and delay that act on it.
-fn with_actuation(l: &TransferFunction, actuation: impl Fn(f64) -> Complex<f64> + 'static) -> Freq {
-    let l = l.clone();
-    Box::new(move |w| l.eval(w) * actuation(w))
-}
-
-/// The loop transfer of an outer loop: its controller, the inner closed loop (as flown, with
-/// servo and delay), the kinematics from the inner loop's output, and the feedback path.
-fn through_inner(
-    controller: &TransferFunction,
-    inner: impl Fn(f64) -> Complex<f64> + 'static,
-    kinematics: &TransferFunction,
-    feedback: &TransferFunction,
-) -> Freq {
-    let (c, k, f) = (controller.clone(), kinematics.clone(), feedback.clone());
-    Box::new(move |w| c.eval(w) * inner(w) * k.eval(w) * f.eval(w))
-}
-
-/// `forward / (1 + forward * feedback)`.
-fn closed(forward: &TransferFunction, feedback: &TransferFunction) -> TransferFunction {
-    use super::transfer::{poly_add, poly_mul};
-    TransferFunction::new(
-        &poly_mul(&forward.num, &feedback.den),
-        &poly_add(
-            &poly_mul(&forward.den, &feedback.den),
-            &poly_mul(&forward.num, &feedback.num),
-        ),
-    )
-}
-
-fn predict(
-    name: &str,
-    gains: Vec<(String, f64, f64)>,
-    wn: f64,
-    closed_loop: &TransferFunction,
-    loop_gain: Freq,
-    t_end: f64,
-) -> LoopDesign {
-    let dt = (t_end / 20_000.0).min(1e-3);
-    let (t, y) = closed_loop.step_response(t_end, dt);
-    let m = step_metrics(&t, &y, 0.0, 1.0, 0.0, t_end + dt);
-    LoopDesign {
-        name: name.into(),
-        gains,
-        wn_radps: wn,
-        poles: closed_loop.poles().iter().map(|p| [p.re, p.im]).collect(),
-        rise_time_s: m.rise_time_s,
-        overshoot_pct: m.overshoot_pct,
-        settling_time_s: m.settling_time_s,
-        margins: margins(loop_gain, 1e-3, 1e3),
-    }
 }
 
 /// Designs every loop at the level trim of `aircraft`.
@@ -596,57 +457,6 @@ pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Desi
         loops,
         gains,
     })
-}
-
-/// The largest gain, at most `k` in size, whose loop keeps `pm_deg` of phase margin (1 % steps
-/// down; the delay costs phase in proportion to the crossover frequency).
-fn limit_gain(k: f64, pm_deg: f64, pm: impl Fn(f64) -> Option<f64>) -> f64 {
-    let mut g = k;
-    for _ in 0..400 {
-        if pm(g).is_some_and(|m| m >= pm_deg) {
-            return g;
-        }
-        g *= 0.99;
-    }
-    g
-}
-
-/// Cancels pole-zero pairs that coincide (the pitch loop's closed form repeats factors).
-fn reduce(t: &TransferFunction) -> TransferFunction {
-    use super::transfer::{poly_mul, poly_roots};
-    let mut zeros = poly_roots(&t.num);
-    let mut poles = poly_roots(&t.den);
-    let gain = t.num.first().copied().unwrap_or(0.0);
-    let mut i = 0;
-    while i < zeros.len() {
-        let scale = zeros[i].norm().max(1.0);
-        if let Some(j) = poles
-            .iter()
-            .position(|p| (p - zeros[i]).norm() < 1e-6 * scale)
-        {
-            poles.remove(j);
-            zeros.remove(i);
-        } else {
-            i += 1;
-        }
-    }
-    let expand = |roots: &[Complex<f64>]| {
-        roots
-            .iter()
-            .fold(vec![Complex::new(1.0, 0.0)], |acc, r| {
-                let mut out = vec![Complex::new(0.0, 0.0); acc.len() + 1];
-                for (k, a) in acc.iter().enumerate() {
-                    out[k] += a;
-                    out[k + 1] -= a * r;
-                }
-                out
-            })
-            .iter()
-            .map(|c| c.re)
-            .collect::<Vec<f64>>()
-    };
-    let num = poly_mul(&[gain], &expand(&zeros));
-    TransferFunction::new(&num, &expand(&poles))
 }
 
 /// The "computed" gain set: [`design`] with the thesis's design inputs.

@@ -1,0 +1,236 @@
+//! The command line: the subcommands, their options and the parsers of option values.
+
+use clap::{Parser, Subcommand};
+use sim_host::commands::{self, Format};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "sim-host",
+    version,
+    about = "Ultra Stick 25e 6-DOF simulator and analysis"
+)]
+pub(crate) struct Cli {
+    /// Aircraft file (TOML); the built-in Ultra Stick 25e when absent.
+    #[arg(long, global = true, value_name = "FILE")]
+    pub(crate) aircraft: Option<PathBuf>,
+    #[command(subcommand)]
+    pub(crate) command: Option<Command>,
+}
+
+#[derive(Clone, Copy, clap::Args)]
+pub(crate) struct Output {
+    /// Print JSON instead of tables.
+    #[arg(long, conflicts_with = "markdown")]
+    pub(crate) json: bool,
+    /// Print Markdown tables.
+    #[arg(long)]
+    pub(crate) markdown: bool,
+}
+
+impl Output {
+    /// How the tables print: Markdown when asked for, aligned text otherwise (JSON is not a
+    /// table format: the caller prints it instead).
+    pub(crate) fn format(self) -> Format {
+        if self.markdown {
+            Format::Markdown
+        } else {
+            Format::Text
+        }
+    }
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Command {
+    /// Trim the thesis's Table 2.3 targets and the 5 deg sideslip (Va 17 m/s, h 100 m).
+    Trim {
+        #[command(flatten)]
+        out: Output,
+    },
+    /// Linearise about a trim: A/B matrices, poles, transfer functions.
+    Linearize {
+        /// Trim to linearise about: level, climb, turn, climbing-turn, sideslip.
+        #[arg(long, default_value = "level")]
+        trim: String,
+        #[command(flatten)]
+        out: Output,
+    },
+    /// Linear-versus-nonlinear elevator, aileron and rudder doublets from level trim.
+    Doublet {
+        /// Directory for the CSV and PNG files.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Doublet amplitude, deg.
+        #[arg(long, default_value_t = 3.0)]
+        amplitude_deg: f64,
+        /// Duration of each half of the doublet, s.
+        #[arg(long, default_value_t = 0.5)]
+        half_period_s: f64,
+        /// Length of each run, s.
+        #[arg(long, default_value_t = 10.0)]
+        duration_s: f64,
+        /// Integration step, s.
+        #[arg(long, default_value_t = 0.005)]
+        dt_s: f64,
+        #[command(flatten)]
+        fmt: Output,
+    },
+    /// Closed-loop tests of thesis chapter 4 on the nonlinear plant (servos, 50 Hz autopilot,
+    /// 2-sample input delay, optional sensor noise), for several gain sets.
+    Scenario {
+        /// Scenario name, or `all` (every scenario, without noise and with noise 1e-3).
+        name: String,
+        /// Gain sets, comma separated (default: every named set).
+        #[arg(long, value_delimiter = ',', value_name = "SET[,SET...]")]
+        gains: Option<Vec<String>>,
+        /// White noise sigma on every measurement, SI units (rad, rad/s, m, m/s); with `all`
+        /// the sigma of the noisy half (default 1e-3).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        noise: f64,
+        /// Noise seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Directory for the CSV, PNG and JSON files.
+        #[arg(long, default_value = "out/scenarios")]
+        out: PathBuf,
+        /// Also write the results document (Markdown, with the verdicts on the thesis's
+        /// claims) to this file.
+        #[arg(long, value_name = "FILE")]
+        results: Option<PathBuf>,
+        #[command(flatten)]
+        fmt: Output,
+    },
+    /// Design the "computed" gain set by successive loop closure and predict every loop.
+    Design {
+        #[command(flatten)]
+        out: Output,
+        /// Also write the computed gain set to this TOML file (a gain file for
+        /// `scenario --gains FILE.toml`).
+        #[arg(long, value_name = "FILE")]
+        write_gains: Option<PathBuf>,
+    },
+    /// Fly the firmware against the plant over the simulator link, commanded by a scripted
+    /// ground station: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet.
+    Fly(FlyArgs),
+    /// Fly the default mission (calm air, and a 5 m/s wind with light turbulence over five
+    /// seeds) and write the navigation results with ground-track plots.
+    Navigation {
+        /// Markdown file to write (notes below its `---` line are kept).
+        #[arg(long, default_value = "docs/NAVIGATION.md")]
+        out: PathBuf,
+        /// Directory for the ground-track PNGs.
+        #[arg(long, default_value = "docs/img")]
+        img: PathBuf,
+        /// Results document whose missions section is rewritten with the summary (the rest
+        /// of it, `sim-host scenario all --results`'s, is kept).
+        #[arg(long, default_value = "docs/RESULTS.md")]
+        results: PathBuf,
+    },
+    /// Write the validation document (trim, poles, transfer functions, doublets).
+    Validation {
+        /// Markdown file to write.
+        #[arg(long, default_value = "docs/VALIDATION.md")]
+        out: PathBuf,
+        /// Directory for the doublet CSV and PNG files.
+        #[arg(long, default_value = "out")]
+        out_dir: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+pub(crate) struct FlyArgs {
+    /// Simulator link: inproc, tcp, udp or pty.
+    #[arg(long, default_value = "inproc")]
+    pub(crate) link: commands::fly::LinkKind,
+    /// Address the simulator listens on for tcp and udp.
+    #[arg(long, default_value = "127.0.0.1:4560")]
+    pub(crate) bind: String,
+    /// Pace the simulation to the wall clock.
+    #[arg(long)]
+    pub(crate) realtime: bool,
+    /// Steady wind N,E,D in m/s (the direction it blows towards).
+    #[arg(long, value_parser = parse_wind, default_value = "0,0,0", allow_hyphen_values = true)]
+    pub(crate) wind: [f64; 3],
+    /// Turbulence: none, light, moderate or severe (MIL-F-8785C Dryden).
+    #[arg(long, default_value = "none", value_parser = sim_host::flight::parse_turbulence)]
+    pub(crate) turbulence: sim_host::environment::wind::Turbulence,
+    /// Seed of the sensor noise and turbulence.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Simulated time, s (default: long enough for the whole script).
+    #[arg(long)]
+    pub(crate) duration: Option<f64>,
+    /// Plant integration step, s.
+    #[arg(long, default_value_t = 0.001)]
+    pub(crate) dt: f64,
+    /// Directory for flight.csv, flight.tlog, the PNG plots and summary.json.
+    #[arg(long, default_value = "out/fly")]
+    pub(crate) out: PathBuf,
+    /// Gain set loaded before arming (SYS_GAIN_SET): 0 designed, 1 designed_t310,
+    /// 2 designed_appe, 3 minnesota, 4 minnesota_appe. Without it the "computed" set
+    /// (`sim-host design`) is uploaded parameter by parameter, as a ground station would;
+    /// with `--mission` the firmware's defaults (the designed set) fly.
+    #[arg(long)]
+    pub(crate) gains: Option<u32>,
+    /// Fly on the simulator's truth instead of the estimator (SIM_USE_TRUTH = 1).
+    #[arg(long)]
+    pub(crate) truth: bool,
+    /// Also fly the same flight on truth and write this Markdown report (estimator accuracy,
+    /// step figures on estimates vs on truth).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) report: Option<PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Fly a mission from the runway instead of the thesis's script: a QGroundControl `.plan`
+    /// or `QGC WPL 110` file (mission and geofence are uploaded), or `default` for the
+    /// built-in take-off, rectangle, orbit, return and landing.
+    #[arg(long, value_name = "FILE|default")]
+    pub(crate) mission: Option<PathBuf>,
+    /// Wall-clock pace with --realtime: simulated seconds per wall second.
+    #[arg(long, default_value_t = 1.0)]
+    pub(crate) speed: f64,
+    /// Set an autopilot parameter before arming (PARAM_SET from the ground station), after
+    /// the mission's own tuning; repeatable: `--param NAV_LND_SLP_DEG=6`.
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    pub(crate) params: Vec<(String, f32)>,
+}
+
+/// `NAME=VALUE` for `--param`, checked against the autopilot's parameters (name, bounds).
+fn parse_param(s: &str) -> Result<(String, f32), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected NAME=VALUE"))?;
+    let v: f32 = value
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: value `{value}`: {e}"))?;
+    let name = name.trim();
+    // The autopilot's own parameter store answers, as it would to the PARAM_SET.
+    let store = common::params::ParamStore::new(firmware::app::REGISTRY);
+    let def = store
+        .index_of(name)
+        .and_then(|i| store.def(i))
+        .ok_or_else(|| format!("`{s}`: the autopilot has no parameter `{name}`"))?;
+    def.check(v).map_err(|e| {
+        format!(
+            "`{s}`: {name} refuses {v} ({e:?}; bounds {} to {} {})",
+            def.min, def.max, def.unit
+        )
+    })?;
+    Ok((name.to_string(), v))
+}
+
+fn parse_wind(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("wind `{s}`: {e} (expected N,E,D in m/s)"))?;
+    match v.as_slice() {
+        [n, e, d] if v.iter().all(|x| x.is_finite()) => Ok([*n, *e, *d]),
+        _ => Err(format!(
+            "wind `{s}`: expected three finite numbers N,E,D in m/s"
+        )),
+    }
+}

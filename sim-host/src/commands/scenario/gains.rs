@@ -1,0 +1,72 @@
+//! The gain sets a scenario flies: the named sets of `common`, the set designed for the
+//! aircraft flown, or a gain file.
+
+use crate::aircraft::Aircraft;
+use crate::analysis::design::computed_gain_set;
+use anyhow::Context;
+use common::control::gains::{GainSet, NAMES};
+
+/// Name of the gain set designed from the linear model of the aircraft flown
+/// ([`computed_gain_set`]).
+pub const COMPUTED: &str = "computed";
+
+/// Every gain set the command can fly: the named sets of `common`, then [`COMPUTED`].
+pub fn gain_set_names() -> Vec<&'static str> {
+    let mut v = NAMES.to_vec();
+    v.push(COMPUTED);
+    v
+}
+
+/// An unknown gain-set name, with the valid ones.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown gain set `{name}`; valid names: {}", valid.join(", "))]
+pub struct UnknownGainSet {
+    /// The name asked for.
+    pub name: String,
+    /// The valid names.
+    pub valid: Vec<&'static str>,
+}
+
+/// Reads a gain set from a TOML file (the `GainSet` fields: `[lateral]`, `[longitudinal]`,
+/// `transfer_tc`; as `sim-host design --write-gains` writes it). Every gain must be there and
+/// finite: the error names the file and the gain.
+pub fn gain_file(path: &std::path::Path) -> anyhow::Result<GainSet> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("gain file `{}`: cannot read", path.display()))?;
+    let de = toml::Deserializer::parse(&text)
+        .map_err(|e| anyhow::anyhow!("gain file `{}`: {e}", path.display()))?;
+    let g: GainSet = serde_path_to_error::deserialize(de).map_err(|e| {
+        anyhow::anyhow!(
+            "gain file `{}`: key `{}`: {}",
+            path.display(),
+            e.path(),
+            e.inner()
+        )
+    })?;
+    g.validate().map_err(|e| {
+        anyhow::anyhow!(
+            "gain file `{}`: gain `{}` refused ({e:?})",
+            path.display(),
+            e.name()
+        )
+    })?;
+    Ok(g)
+}
+
+/// The gain set of this name for `aircraft` (only [`COMPUTED`] depends on the aircraft); a
+/// name ending in `.toml` is a gain file.
+pub fn gain_set(aircraft: &Aircraft, name: &str) -> anyhow::Result<GainSet> {
+    if name.ends_with(".toml") {
+        return gain_file(std::path::Path::new(name));
+    }
+    if name == COMPUTED {
+        return computed_gain_set(aircraft).context("designing the computed gain set");
+    }
+    GainSet::named(name).map_err(|_| {
+        UnknownGainSet {
+            name: name.to_string(),
+            valid: gain_set_names(),
+        }
+        .into()
+    })
+}

@@ -1,0 +1,490 @@
+//! Figures of a flight: estimator errors against the truth, the chapter-4 step figures of
+//! each scripted command, how a mission was flown, the link counters and the speed of the loop.
+
+use super::config::{turbulence_name, FlightConfig};
+use super::record::{Sample, DEG};
+use super::script::{Action, CommandRecord, GroundStation};
+use crate::analysis::metrics::{step_metrics, StepMetrics};
+use crate::plant::Touchdown;
+use common::link::framing::LinkStats;
+use common::math::wrap_pi;
+use common::navigation::Phase;
+use firmware::app::SimLinkHealth;
+use serde::Serialize;
+
+/// Time after the estimator first reports `converged` from which the "settled" errors count,
+/// s: the autopilot has taken over (arming follows convergence within a second) and pulled
+/// the aircraft onto its course and altitude.
+pub const SETTLE_S: f64 = 30.0;
+
+/// Root-mean-square and largest estimation errors, from convergence to the end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct EstimatorErrors {
+    /// Time the estimator first reported itself converged, s.
+    pub from_s: f64,
+    /// Samples counted.
+    pub samples: usize,
+    /// Roll RMS error, deg.
+    pub roll_rms_deg: f64,
+    /// Pitch RMS error, deg.
+    pub pitch_rms_deg: f64,
+    /// Heading RMS error, deg.
+    pub heading_rms_deg: f64,
+    /// Altitude RMS error, m.
+    pub alt_rms_m: f64,
+    /// Airspeed RMS error, m/s.
+    pub airspeed_rms_mps: f64,
+    /// Horizontal wind RMS error against the steady wind, m/s.
+    pub wind_rms_mps: f64,
+    /// Horizontal wind RMS error against the total wind (turbulence included), m/s.
+    pub wind_total_rms_mps: f64,
+    /// Largest roll error, deg.
+    pub roll_max_deg: f64,
+    /// Largest pitch error, deg.
+    pub pitch_max_deg: f64,
+    /// Largest heading error, deg.
+    pub heading_max_deg: f64,
+    /// Largest altitude error, m.
+    pub alt_max_m: f64,
+}
+
+/// Figures of one scripted command.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Segment {
+    /// What was commanded.
+    pub what: String,
+    /// `altitude` (m) or `course` (deg).
+    pub signal: &'static str,
+    /// Time of the command, s.
+    pub t_s: f64,
+    /// End of the segment (next command or end of flight), s.
+    pub t_end_s: f64,
+    /// Commanded value (m AMSL or deg, course unwrapped from the start value).
+    pub command: f64,
+    /// Chapter-4 step figures of the true response (unit as `signal`).
+    pub metrics: StepMetrics,
+    /// Largest |command - truth| over the last 5 s of the segment.
+    pub final_error_max: f64,
+    /// Largest |altitude setpoint - true altitude| over the segment after 15 s (m): how well
+    /// altitude is held through the turns.
+    pub alt_hold_error_max_m: f64,
+}
+
+/// Figures of a flight.
+#[derive(Clone, Debug, Serialize)]
+pub struct FlightSummary {
+    /// Sensor frames exchanged.
+    pub frames: u64,
+    /// Frames the autopilot flew (armed).
+    pub armed_frames: u64,
+    /// Simulated time, s.
+    pub sim_s: f64,
+    /// Wall-clock time of the loop, s.
+    pub wall_s: f64,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Turbulence.
+    pub turbulence: &'static str,
+    /// Steady wind, NED, m/s.
+    pub wind_ned: [f64; 3],
+    /// Arming accepted at, s.
+    pub armed_at_s: Option<f64>,
+    /// Estimator errors from the first `converged` to the end.
+    pub estimator: Option<EstimatorErrors>,
+    /// Estimator errors from 30 s after the first `converged` ([`SETTLE_S`]) to the end: the
+    /// launch transient flown out.
+    pub estimator_settled: Option<EstimatorErrors>,
+    /// One entry per altitude or course command.
+    pub segments: Vec<Segment>,
+    /// Every ground-station command and its answer.
+    pub commands: Vec<CommandRecord>,
+    /// The autopilot's STATUSTEXT messages.
+    pub texts: Vec<(f64, String)>,
+    /// Framing counters of the autopilot's answers (simulator side).
+    pub sim_rx: LinkStatsJson,
+    /// The autopilot's counters of what it received.
+    pub autopilot_rx: AutopilotRx,
+    /// Mission and geofence uploads: what, when, the MISSION_ACK result.
+    pub uploads: Vec<(String, f64, String)>,
+    /// How the mission went, when one was uploaded.
+    pub mission: Option<MissionSummary>,
+}
+
+impl FlightSummary {
+    /// The MISSION_ACK result of each upload, in order (`"MAV_MISSION_ACCEPTED"`, ...).
+    pub fn upload_results(&self) -> Vec<&str> {
+        self.uploads.iter().map(|u| u.2.as_str()).collect()
+    }
+}
+
+/// How a mission was flown: tracking errors of the truth against what guidance asked for.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MissionSummary {
+    /// Items uploaded.
+    pub items: usize,
+    /// The navigation items (waypoints, loiters, take-off, landing): each must be reached.
+    pub nav_items: Vec<u16>,
+    /// MISSION_ITEM_REACHED as the ground station received them, in order.
+    pub reached: Vec<u16>,
+    /// Every navigation item reached.
+    pub all_reached: bool,
+    /// Cross-track error on straight legs (waypoint items, fillets excluded), RMS, m.
+    pub xtrack_rms_m: f64,
+    /// Largest cross-track error on straight legs, m.
+    pub xtrack_max_m: f64,
+    /// Cross-track error while circling a loiter item, RMS, m.
+    pub orbit_xtrack_rms_m: f64,
+    /// Altitude error (guidance's altitude minus the true altitude) over the waypoint and loiter
+    /// items, RMS, m.
+    pub alt_rms_m: f64,
+    /// Airspeed error (commanded minus true) over the same items, RMS, m/s.
+    pub airspeed_rms_mps: f64,
+    /// Armed time, s.
+    pub flight_time_s: f64,
+    /// Energy the motor drew (the UMN motor-power curve at the commanded throttle), Wh.
+    pub energy_wh: f64,
+    /// The landing, when there was one.
+    pub touchdown: Option<TouchdownSummary>,
+}
+
+/// The first contact of a landing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct TouchdownSummary {
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// Where, north of home, m.
+    pub north_m: f64,
+    /// Where, east of home, m.
+    pub east_m: f64,
+    /// Horizontal distance from the mission's landing point, m (NaN without a NAV_LAND).
+    pub distance_m: f64,
+    /// Along the landing direction (positive: past the point), m.
+    pub along_m: f64,
+    /// Sink rate, m/s.
+    pub sink_rate_mps: f64,
+    /// Ground speed, m/s.
+    pub ground_speed_mps: f64,
+    /// Bounces after the first contact.
+    pub bounces: u32,
+}
+
+/// Cross-track error within which a loiter counts as arrived on its circle, m (the
+/// navigator's default acceptance radius, `NAV_ACC_RAD`).
+const ORBIT_ARRIVAL_M: f64 = 15.0;
+
+/// Figures of a mission flight. `land_point` is the NAV_LAND item north and east of home.
+pub fn mission_summary(
+    mission: &[mavlink::dialects::common::MISSION_ITEM_INT_DATA],
+    land_point: Option<(f64, f64)>,
+    samples: &[Sample],
+    reached: &[u16],
+    touchdown: Option<&Touchdown>,
+    energy_j: f64,
+    frame_s: f64,
+) -> MissionSummary {
+    use mavlink::dialects::common::MavCmd as C;
+    let nav_items: Vec<u16> = mission
+        .iter()
+        .filter(|i| {
+            matches!(
+                i.command,
+                C::MAV_CMD_NAV_WAYPOINT
+                    | C::MAV_CMD_NAV_LOITER_TURNS
+                    | C::MAV_CMD_NAV_LOITER_TIME
+                    | C::MAV_CMD_NAV_LOITER_TO_ALT
+                    | C::MAV_CMD_NAV_TAKEOFF
+                    | C::MAV_CMD_NAV_LAND
+            )
+        })
+        .map(|i| i.seq)
+        .collect();
+    let rms = |v: &[f64]| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+        }
+    };
+    let leg: Vec<f64> = samples
+        .iter()
+        .filter(|s| s.armed && s.straight && s.nav_phase == Phase::Waypoint as u8)
+        .map(|s| s.xtrack)
+        .filter(|x| x.is_finite())
+        .collect();
+    // On the circle: from the first sample of each loiter within the acceptance radius (the
+    // executor's own test for arrival) to the end of that loiter.
+    let mut orbit = Vec::new();
+    let mut on_circle = false;
+    for s in samples {
+        if !(s.armed && s.nav_phase == Phase::Loiter as u8 && s.xtrack.is_finite()) {
+            on_circle = false;
+            continue;
+        }
+        on_circle |= s.xtrack.abs() <= ORBIT_ARRIVAL_M;
+        if on_circle {
+            orbit.push(s.xtrack);
+        }
+    }
+    let cruising = samples.iter().filter(|s| {
+        s.armed && (s.nav_phase == Phase::Waypoint as u8 || s.nav_phase == Phase::Loiter as u8)
+    });
+    let (alt, va): (Vec<f64>, Vec<f64>) = cruising
+        .map(|s| (s.sp_alt - s.alt, s.sp_airspeed - s.airspeed))
+        .unzip();
+    let touchdown = touchdown.map(|t| {
+        let (n, e) = (t.pos_ned.x, t.pos_ned.y);
+        let (distance_m, along_m) = match land_point {
+            Some((ln, le)) => {
+                let v = t.vel_ned;
+                let h = v.x.hypot(v.y).max(1e-9);
+                (
+                    (n - ln).hypot(e - le),
+                    ((n - ln) * v.x + (e - le) * v.y) / h,
+                )
+            }
+            None => (f64::NAN, f64::NAN),
+        };
+        TouchdownSummary {
+            time_s: t.time_s,
+            north_m: n,
+            east_m: e,
+            distance_m,
+            along_m,
+            sink_rate_mps: t.sink_rate_mps(),
+            ground_speed_mps: t.vel_ned.x.hypot(t.vel_ned.y),
+            bounces: t.bounces,
+        }
+    });
+    MissionSummary {
+        items: mission.len(),
+        all_reached: nav_items.iter().all(|i| reached.contains(i)),
+        nav_items,
+        reached: reached.to_vec(),
+        xtrack_rms_m: rms(&leg),
+        xtrack_max_m: leg.iter().fold(0.0, |m, x| m.max(x.abs())),
+        orbit_xtrack_rms_m: rms(&orbit),
+        alt_rms_m: rms(&alt),
+        airspeed_rms_mps: rms(&va),
+        flight_time_s: samples.iter().filter(|s| s.armed).count() as f64 * frame_s,
+        energy_wh: energy_j / 3600.0,
+        touchdown,
+    }
+}
+
+/// [`LinkStats`] for JSON.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LinkStatsJson {
+    /// Frames decoded.
+    pub frames_ok: u32,
+    /// CRC errors.
+    pub crc_errors: u32,
+    /// Unknown message ids.
+    pub unknown_ids: u32,
+    /// Undecodable payloads.
+    pub parse_errors: u32,
+    /// Bytes skipped.
+    pub bytes_skipped: u32,
+    /// Sequence gaps.
+    pub seq_gaps: u32,
+}
+
+impl From<LinkStats> for LinkStatsJson {
+    fn from(s: LinkStats) -> Self {
+        Self {
+            frames_ok: s.frames_ok,
+            crc_errors: s.crc_errors,
+            unknown_ids: s.unknown_ids,
+            parse_errors: s.parse_errors,
+            bytes_skipped: s.bytes_skipped,
+            seq_gaps: s.seq_gaps,
+        }
+    }
+}
+
+/// What the autopilot counted on its simulator link.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct AutopilotRx {
+    /// Framing counters.
+    pub framing: LinkStatsJson,
+    /// Sensor frames accepted.
+    pub sensor_frames: u32,
+    /// GPS frames accepted.
+    pub gps_frames: u32,
+    /// Frames from other systems.
+    pub foreign_frames: u32,
+    /// Frames of messages the sim link does not carry.
+    pub ignored_frames: u32,
+    /// Sensor groups rejected (IMU, mag, baro, pitot) and GPS frames rejected.
+    pub rejected: [u32; 5],
+    /// Stale sensor frames.
+    pub stale_frames: u32,
+}
+
+fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Estimator errors over the samples from `delay_s` after the first `converged` on.
+pub fn estimator_errors(samples: &[Sample], delay_s: f64) -> Option<EstimatorErrors> {
+    let t0 = samples.iter().find(|s| s.converged)?.t + delay_s;
+    let first = samples.iter().position(|s| s.t >= t0)?;
+    let s = &samples[first..];
+    let col = |f: &dyn Fn(&Sample) -> f64| s.iter().map(f).collect::<Vec<f64>>();
+    let roll = col(&|x| wrap_pi(x.est_roll - x.roll) * DEG);
+    let pitch = col(&|x| wrap_pi(x.est_pitch - x.pitch) * DEG);
+    let yaw = col(&|x| wrap_pi(x.est_yaw - x.yaw) * DEG);
+    let alt = col(&|x| x.est_alt - x.alt);
+    let va = col(&|x| x.est_airspeed - x.airspeed);
+    let wind = col(&|x| (x.est_wind[0] - x.wind_steady[0]).hypot(x.est_wind[1] - x.wind_steady[1]));
+    let wind_t = col(&|x| (x.est_wind[0] - x.wind[0]).hypot(x.est_wind[1] - x.wind[1]));
+    Some(EstimatorErrors {
+        from_s: s[0].t,
+        samples: s.len(),
+        roll_rms_deg: rms(&roll),
+        pitch_rms_deg: rms(&pitch),
+        heading_rms_deg: rms(&yaw),
+        alt_rms_m: rms(&alt),
+        airspeed_rms_mps: rms(&va),
+        wind_rms_mps: rms(&wind),
+        wind_total_rms_mps: rms(&wind_t),
+        roll_max_deg: max_abs(&roll),
+        pitch_max_deg: max_abs(&pitch),
+        heading_max_deg: max_abs(&yaw),
+        alt_max_m: max_abs(&alt),
+    })
+}
+
+/// Step figures of each scripted altitude and course command.
+fn segments(samples: &[Sample], gcs: &GroundStation, home_alt: f64) -> Vec<Segment> {
+    let Some(t0) = gcs.armed_at_s() else {
+        return Vec::new();
+    };
+    let end = samples.last().map_or(0.0, |s| s.t);
+    let steps = &gcs.script().steps;
+    let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    let mut out = Vec::new();
+    for (i, step) in steps.iter().enumerate() {
+        // The command goes out at the first frame at or after its time.
+        let Some(k0) = samples.iter().position(|s| s.t >= t0 + step.after_arm_s) else {
+            break;
+        };
+        let ts = samples[k0].t;
+        let te = steps
+            .get(i + 1)
+            .map_or(end + 1e-9, |n| t0 + n.after_arm_s)
+            .min(end + 1e-9);
+        let idx: Vec<usize> = (k0..samples.len()).filter(|&k| samples[k].t < te).collect();
+        let last5: Vec<usize> = idx
+            .iter()
+            .copied()
+            .filter(|&k| samples[k].t >= te - 5.0)
+            .collect();
+        let alt_hold_error_max_m = idx
+            .iter()
+            .filter(|&&k| samples[k].t >= ts + 15.0)
+            .map(|&k| (samples[k].sp_alt - samples[k].alt).abs())
+            .fold(0.0, f64::max);
+        let (signal, command, y, y0) = match step.action {
+            Action::AltitudeAboveHome(h) => {
+                let y: Vec<f64> = samples.iter().map(|s| s.alt).collect();
+                ("altitude", home_alt + f64::from(h), y, samples[k0].alt)
+            }
+            Action::Turn(_) => {
+                // Unwrap the course about its value at the command, and read the new
+                // setpoint the autopilot adopted one frame later.
+                let c0 = samples[k0].course;
+                let y: Vec<f64> = samples
+                    .iter()
+                    .map(|s| (c0 + wrap_pi(s.course - c0)) * DEG)
+                    .collect();
+                let sp = samples
+                    .get(k0 + 1)
+                    .map_or(samples[k0].sp_course, |s| s.sp_course);
+                let target = (c0 + wrap_pi(sp - c0)) * DEG;
+                // A 90 deg turn passes +-180 from the start value only past the target.
+                ("course", target, y, c0 * DEG)
+            }
+            _ => continue,
+        };
+        let metrics = step_metrics(&t, &y, y0, command, ts, te);
+        let final_error_max = last5
+            .iter()
+            .map(|&k| (command - y[k]).abs())
+            .fold(0.0, f64::max);
+        out.push(Segment {
+            what: gcs
+                .commands
+                .iter()
+                .find(|c| (c.t_s - ts).abs() < 1e-9)
+                .map_or_else(|| format!("{:?}", step.action), |c| c.what.clone()),
+            signal,
+            t_s: ts,
+            t_end_s: te,
+            command,
+            metrics,
+            final_error_max,
+            alt_hold_error_max_m,
+        });
+    }
+    out
+}
+
+/// Builds the summary of a flight.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn summarise(
+    cfg: &FlightConfig,
+    samples: &[Sample],
+    gcs: &GroundStation,
+    frames: u64,
+    frame_s: f64,
+    armed_frames: u64,
+    wall_s: f64,
+    sim_rx: LinkStats,
+    (health, ap_stats): (SimLinkHealth, LinkStats),
+    home_alt: f64,
+) -> FlightSummary {
+    let sim_s = frames as f64 * frame_s;
+    FlightSummary {
+        uploads: gcs.uploads.clone(),
+        mission: None,
+        frames,
+        armed_frames,
+        sim_s,
+        wall_s,
+        real_time_factor: if wall_s > 0.0 { sim_s / wall_s } else { 0.0 },
+        seed: cfg.seed,
+        turbulence: turbulence_name(cfg.turbulence),
+        wind_ned: cfg.wind_ned,
+        armed_at_s: gcs.armed_at_s(),
+        estimator: estimator_errors(samples, 0.0),
+        estimator_settled: estimator_errors(samples, SETTLE_S),
+        segments: segments(samples, gcs, home_alt),
+        commands: gcs.commands.clone(),
+        texts: gcs.texts.clone(),
+        sim_rx: sim_rx.into(),
+        autopilot_rx: AutopilotRx {
+            framing: ap_stats.into(),
+            sensor_frames: health.sensor_frames,
+            gps_frames: health.gps_frames,
+            foreign_frames: health.foreign_frames,
+            ignored_frames: health.ignored_frames,
+            rejected: [
+                health.rejected_imu,
+                health.rejected_mag,
+                health.rejected_baro,
+                health.rejected_pitot,
+                health.rejected_gps,
+            ],
+            stale_frames: health.stale_frames,
+        },
+    }
+}
