@@ -126,6 +126,12 @@ pub(crate) enum Command {
         #[arg(long, default_value = "docs/RESULTS.md")]
         results: PathBuf,
     },
+    /// The autopilot's parameters: tables, the Markdown of docs/PARAMETERS.md (--markdown),
+    /// or the parameter metadata file QGroundControl reads (--json).
+    Params {
+        #[command(flatten)]
+        out: Output,
+    },
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.

@@ -179,6 +179,20 @@ fn run() -> anyhow::Result<ExitCode> {
             emit(&format!("wrote {}\n", results.display()))?;
             Ok(ExitCode::SUCCESS)
         }
+        Some(Command::Params { out }) => {
+            let registry = firmware::app::REGISTRY;
+            if out.json {
+                emit(&format!(
+                    "{}\n",
+                    serde_json::to_string_pretty(&commands::params::metadata_json(registry))?
+                ))?;
+            } else if out.markdown {
+                emit(&commands::params::markdown(registry))?;
+            } else {
+                emit(&render(&commands::params::tables(registry), Format::Text))?;
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Validation { out, out_dir }) => {
             let md = commands::validation::validation_markdown(&aircraft, Some(&out_dir))?;
             if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {

@@ -28,6 +28,9 @@ pub mod report;
 pub mod requests;
 pub mod snapshot;
 
+#[cfg(test)]
+mod tests;
+
 use crate::actuators::Surfaces;
 use crate::control::autopilot::{Autopilot, GainSet};
 use crate::control::gains::NAMED;

@@ -6,6 +6,7 @@ pub mod doublet;
 pub mod fly;
 pub mod linearize;
 pub mod navigation;
+pub mod params;
 pub mod scenario;
 pub mod trim;
 pub mod validation;

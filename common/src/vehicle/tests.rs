@@ -1,0 +1,256 @@
+//! The commander and the vehicle without any link: requests in, modes, commands and notices
+//! out. Expectations come from the modes' definitions (DESIGN.md, PX4's behaviour) and the
+//! thesis's trims, not from this code.
+
+extern crate std;
+
+use super::commander::*;
+use super::modes::FlightMode;
+use super::requests::{AltitudeSetpoint, ArmRequest, VehicleRequests};
+use super::*;
+use crate::control::gains::DESIGNED;
+use crate::control::lateral::RollMode;
+use crate::control::longitudinal::LonMode;
+use crate::estimator::Home;
+use crate::failsafe::Reaction;
+use crate::math::geodetic::GeoPoint;
+use nalgebra::Vector3;
+
+/// Flying level at 17 m/s, 60 m above a home at 300 m, course 90 deg, every sensor healthy.
+fn flying() -> EstimatedState {
+    let mut e = Estimator::default().state();
+    e.home = Some(Home {
+        point: GeoPoint {
+            lat_e7: 449_000_000,
+            lon_e7: -932_000_000,
+        },
+        alt_amsl_m: 300.0,
+    });
+    e.alt_amsl_m = 360.0;
+    e.pos_ned = Vector3::new(0.0, 0.0, -60.0);
+    e.airspeed = 17.0;
+    e.course = core::f32::consts::FRAC_PI_2;
+    e.ground_speed = 17.0;
+    e.position_valid = true;
+    e.converged = true;
+    e.health.gps.healthy = true;
+    e.health.pitot.healthy = true;
+    e
+}
+
+fn on_ground() -> EstimatedState {
+    let mut e = flying();
+    e.alt_amsl_m = 300.0;
+    e.pos_ned = Vector3::zeros();
+    e.airspeed = 0.0;
+    e
+}
+
+fn arm() -> VehicleRequests {
+    VehicleRequests {
+        arm: Some(ArmRequest {
+            arm: true,
+            forced: false,
+        }),
+        ..Default::default()
+    }
+}
+
+fn mode(m: FlightMode) -> VehicleRequests {
+    VehicleRequests {
+        mode: Some(m),
+        ..Default::default()
+    }
+}
+
+fn texts(c: &mut Commander) -> std::vec::Vec<&'static str> {
+    let mut v = std::vec::Vec::new();
+    while let Some(n) = c.next_notice() {
+        if let Notice::Text(_, t) = n {
+            v.push(t);
+        }
+    }
+    v
+}
+
+#[test]
+fn arming_on_the_ground_sets_home_where_the_aircraft_stands_and_says_so() {
+    let mut c = Commander::new();
+    let mut e = on_ground();
+    // The estimate moved 2 m north and 0.4 m up since the first fix set home.
+    e.position = GeoPoint {
+        lat_e7: 449_000_180,
+        lon_e7: -932_000_000,
+    };
+    e.alt_amsl_m = 300.4;
+    let home = c.apply(&arm(), &e);
+    assert_eq!(
+        home,
+        Some(Home {
+            point: e.position,
+            alt_amsl_m: 300.4
+        })
+    );
+    assert!(c.armed());
+    assert_eq!(texts(&mut c), ["Armed"]);
+    // Arming again changes nothing and says nothing.
+    assert_eq!(c.apply(&arm(), &e), None);
+    assert!(texts(&mut c).is_empty());
+}
+
+#[test]
+fn arming_in_the_air_keeps_home() {
+    let mut c = Commander::new();
+    assert_eq!(c.apply(&arm(), &flying()), None);
+    assert!(c.armed());
+}
+
+#[test]
+fn entering_hold_holds_the_present_course_and_altitude() {
+    let mut c = Commander::new();
+    let e = flying();
+    c.apply(&mode(FlightMode::Hold), &e);
+    let sp = c.setpoints();
+    assert_eq!((sp.course, sp.alt_amsl_m), (e.course, 360.0));
+    // Hold flies the outer loops on those set points.
+    let (d, _) = c.demand(0, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    match d {
+        Demand::Commands(cmd) => {
+            assert_eq!(cmd.roll, RollMode::Course(e.course));
+            assert_eq!(
+                cmd.lon,
+                LonMode::Altitude {
+                    altitude: 360.0,
+                    airspeed: sp.airspeed
+                }
+            );
+        }
+        Demand::Surfaces(_) => panic!("Hold flies the loops"),
+    }
+}
+
+#[test]
+fn an_altitude_above_home_needs_a_home() {
+    let mut c = Commander::new();
+    let mut e = flying();
+    let up = VehicleRequests {
+        altitude: Some(AltitudeSetpoint {
+            alt_m: 80.0,
+            relative_to_home: true,
+        }),
+        ..Default::default()
+    };
+    c.apply(&up, &e);
+    assert_eq!(c.setpoints().alt_amsl_m, 380.0);
+    e.home = None;
+    c.apply(&up, &e);
+    assert_eq!(texts(&mut c), ["Altitude above home refused: no home yet"]);
+}
+
+#[test]
+fn manual_passes_the_sticks_and_falls_back_to_the_thesis_trim_without_them() {
+    let mut c = Commander::new();
+    let e = flying();
+    let (d, _) = c.demand(1_000_000, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let trim = Surfaces {
+        elevator: -0.0963,
+        aileron: 0.01,
+        rudder: 0.00317,
+        throttle: 0.569,
+    };
+    assert_eq!(d, Demand::Surfaces(trim));
+    // Full right roll in PX4's sense is aileron -25 deg in the UMN sense.
+    c.on_sticks(ManualInput {
+        roll: 1.0,
+        pitch: 0.0,
+        yaw: 0.0,
+        throttle: 0.5,
+        time_us: 1_000_000,
+    });
+    let (d, _) = c.demand(1_100_000, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let Demand::Surfaces(s) = d else {
+        panic!("Manual sets the surfaces")
+    };
+    assert!((s.aileron + 25f32.to_radians()).abs() < 1e-6, "{s:?}");
+    assert_eq!(s.throttle, 0.5);
+    // Sticks older than the timeout no longer count.
+    let later = 1_000_000 + STICK_TIMEOUT_US + 1;
+    let (d, _) = c.demand(later, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    assert_eq!(d, Demand::Surfaces(trim));
+}
+
+#[test]
+fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() {
+    let mut c = Commander::new();
+    let e = flying();
+    c.apply(&arm(), &e);
+    c.apply(&mode(FlightMode::Hold), &e);
+    texts(&mut c);
+    let watch = Watch::default();
+    let plan = MissionStore::default();
+    // Heard at 0 s; FS_GCS_TOUT_S is 5 s by default.
+    c.check_failsafes(4_900_000, &e, &watch, &plan, Some(0));
+    assert_eq!(c.flown_mode(), FlightMode::Hold);
+    c.check_failsafes(5_100_000, &e, &watch, &plan, Some(0));
+    assert_eq!(c.reaction(), Reaction::Return);
+    assert_eq!(c.flown_mode(), FlightMode::Return);
+    assert_eq!(c.chosen_mode(), FlightMode::Hold);
+    assert!(!texts(&mut c).is_empty(), "the failsafe is reported");
+    // Choosing a mode, even the same one, takes over from the return.
+    c.apply(&mode(FlightMode::Hold), &e);
+    c.check_failsafes(5_200_000, &e, &watch, &plan, Some(5_150_000));
+    assert_eq!(c.flown_mode(), FlightMode::Hold);
+}
+
+#[test]
+fn a_navigation_mode_without_home_holds_altitude_wings_level() {
+    let mut c = Commander::new();
+    let mut e = flying();
+    e.home = None;
+    c.apply(&mode(FlightMode::Loiter), &e);
+    let (d, _) = c.demand(0, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let Demand::Commands(cmd) = d else {
+        panic!("Loiter flies the loops")
+    };
+    assert_eq!(cmd.roll, RollMode::Roll(0.0));
+}
+
+#[test]
+fn the_vehicle_runs_its_control_tick_every_20_ms_of_sensor_time() {
+    let mut v = Vehicle::new();
+    let imu = crate::sensors::ImuSample {
+        accel: Vector3::new(0.0, 0.0, -crate::math::GRAVITY),
+        gyro: Vector3::zeros(),
+    };
+    let g = FromGround::default();
+    // 100 Hz frames: the Manual trim is applied at the first frame and held.
+    for k in 0..10u64 {
+        let f = SensorFrame {
+            time_us: k * 10_000,
+            imu: Some(imu),
+            ..Default::default()
+        };
+        v.on_sensors(&f, &g);
+    }
+    assert_eq!(v.surfaces(), trim_surfaces(&DESIGNED));
+    assert_eq!(v.time_us(), Some(90_000));
+    // A frame from the past is counted, and the clock does not go back.
+    let old = SensorFrame {
+        time_us: 50_000,
+        imu: Some(imu),
+        ..Default::default()
+    };
+    v.on_sensors(&old, &g);
+    assert_eq!(v.stale_frames(), 1);
+    assert_eq!(v.time_us(), Some(90_000));
+}
+
+#[test]
+fn a_gain_set_chosen_by_parameter_is_flown_and_read_back() {
+    let mut v = Vehicle::new();
+    v.params_mut().set("SYS_GAIN_SET", 3.0).unwrap();
+    let f = SensorFrame::default();
+    v.on_sensors(&f, &FromGround::default());
+    // The Minnesota set's roll gain (Table 3.10) is now in the store.
+    assert_eq!(v.params().get("RLL_KP"), Some(-0.52));
+}
