@@ -188,8 +188,12 @@ mod tests {
     use std::vec::Vec;
 
     fn sensor_frame(k: u64) -> Vec<u8> {
+        frame_at(k * 10_000)
+    }
+
+    fn frame_at(time_us: u64) -> Vec<u8> {
         let f = SensorFrame {
-            time_us: k * 10_000,
+            time_us,
             imu: Some(ImuSample {
                 accel: nalgebra::Vector3::new(0.0, 0.0, -9.8),
                 gyro: nalgebra::Vector3::zeros(),
@@ -203,8 +207,12 @@ mod tests {
     }
 
     fn actuators(app: &mut App, k: u64) -> [f32; 16] {
+        answer(app, &sensor_frame(k))
+    }
+
+    fn answer(app: &mut App, frame: &[u8]) -> [f32; 16] {
         let mut out = Vec::new();
-        app.on_sim_bytes(&sensor_frame(k), &mut |b| out.extend_from_slice(b));
+        app.on_sim_bytes(frame, &mut |b| out.extend_from_slice(b));
         let mut p = FrameParser::new();
         let mut controls = [f32::NAN; 16];
         p.push(&out, |f| {
@@ -243,6 +251,9 @@ mod tests {
         // Disarmed: no throttle reaches the motor whatever the stick says.
         assert_eq!(c[3], 0.0);
         // Sticks that stop arriving fall back to the trim.
+        for k in 3..80 {
+            actuators(&mut app, k);
+        }
         let c = actuators(&mut app, 80);
         assert!(c[0].abs() < 0.1, "{c:?}");
     }
@@ -255,5 +266,71 @@ mod tests {
             "{}",
             core::mem::size_of::<App>()
         );
+    }
+
+    fn roll_stick(app: &mut App, y: i16) {
+        let mut gcs = Sender::new(255, 190);
+        let stick = MavMessage::MANUAL_CONTROL(MANUAL_CONTROL_DATA {
+            y,
+            target: 1,
+            ..Default::default()
+        });
+        app.on_gcs_bytes(gcs.encode(&stick).raw_bytes());
+    }
+
+    fn heartbeats(app: &mut App) -> usize {
+        let mut n = 0;
+        let mut p = FrameParser::new();
+        app.drain_gcs(&mut |b| {
+            p.push(b, |f| {
+                n += usize::from(matches!(f.message, MavMessage::HEARTBEAT(_)))
+            })
+        });
+        n
+    }
+
+    /// Flies `frames` regular frames of 10 ms from `from_us`, moving the roll stick full right
+    /// half-way: the aileron follows within two control periods and the heartbeat keeps its
+    /// 1 Hz.
+    fn still_alive(app: &mut App, from_us: u64, frames: u64) {
+        heartbeats(app);
+        roll_stick(app, 0);
+        let mut rolled = false;
+        for k in 0..frames {
+            if k == frames / 2 {
+                roll_stick(app, 1000);
+            }
+            let c = answer(app, &frame_at(from_us + k * 10_000));
+            rolled |= k > frames / 2 + 4 && (c[0] - 1.0).abs() < 1e-5;
+        }
+        assert!(rolled, "the surfaces follow the sticks");
+        let beats = heartbeats(app);
+        assert!(beats as u64 >= frames / 100 - 1, "{beats} heartbeats");
+        roll_stick(app, 0);
+    }
+
+    #[test]
+    fn one_sensor_time_from_the_far_future_freezes_nothing() {
+        for hostile in [1u64 << 62, u64::MAX, u64::MAX - 1] {
+            let mut app = App::new();
+            still_alive(&mut app, 0, 200);
+            // One frame from the far future, then the simulator carries on.
+            answer(&mut app, &frame_at(hostile));
+            still_alive(&mut app, 2_000_000, 300);
+            assert_eq!(app.vehicle().clock_stats().refused, 1);
+        }
+    }
+
+    #[test]
+    fn a_simulator_three_seconds_back_costs_a_few_frames_not_three_seconds() {
+        let mut app = App::new();
+        still_alive(&mut app, 0, 500);
+        let before = app.vehicle().time_us().unwrap();
+        // The time base restarts 3 s earlier and continues regularly.
+        still_alive(&mut app, 2_000_000, 300);
+        assert_eq!(app.vehicle().clock_stats().resyncs, 1);
+        // The vehicle's clock never went back, and lost only the frames before the resync.
+        let after = app.vehicle().time_us().unwrap();
+        assert!(after > before + 2_900_000, "{before} -> {after}");
     }
 }
