@@ -2,8 +2,8 @@
 
 extern crate std;
 
-use super::executor::PARAMS as EXEC_PARAMS;
 use super::items::*;
+use super::navigator::params::PARAMS as EXEC_PARAMS;
 use super::path_manager::PARAMS as PATH_PARAMS;
 use super::plan::MissionItem;
 use super::sim::Kinematic;

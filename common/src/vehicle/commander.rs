@@ -17,8 +17,9 @@ use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
-use crate::navigation::executor::{HomeRequest, NavOutput, NavState, Navigator, Phase};
 use crate::navigation::fence::{breached, FenceParams};
+use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
+use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::{MissionItem, MissionStore, PlanKind};
 use crate::sensors::ManualInput;
 
