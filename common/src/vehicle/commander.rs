@@ -129,13 +129,6 @@ pub fn trim_surfaces(g: &GainSet) -> Surfaces {
     }
 }
 
-/// The navigator's commands carry heights above home; the autopilot flies altitudes above
-/// mean sea level (the estimator's datum).
-fn amsl_commands(mut c: Commands, home_alt_amsl_m: f32) -> Commands {
-    c.lon = c.lon.shifted(home_alt_amsl_m);
-    c
-}
-
 /// The Takeoff mode's one item: climb out along the present heading to the return altitude.
 fn takeoff_item(height_m: f32) -> MissionItem {
     use mavlink::dialects::common::{MavCmd, MavFrame};
@@ -515,7 +508,7 @@ impl Commander {
             self.armed = false;
             self.text(Severity::Info, "Landed, disarmed");
         }
-        let commands = out.commands.map(|c| amsl_commands(c, home.alt_amsl_m));
+        let commands = out.commands;
         self.nav = out;
         (commands, rehome)
     }

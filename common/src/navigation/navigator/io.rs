@@ -127,9 +127,11 @@ pub enum Phase {
 /// Result of one step.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct NavOutput {
-    /// Commands for the autopilot (`None` while idle: the caller keeps its own).
+    /// Commands for the autopilot, their altitudes above mean sea level (`None` while idle:
+    /// the caller keeps its own).
     pub commands: Option<Commands>,
-    /// The guidance output behind the commands (cross-track error and so on).
+    /// The guidance output behind the commands (cross-track error and so on), its altitude a
+    /// height above home.
     pub guidance: Option<GuidanceOutput>,
     /// The point flown to (or circled), NED from home.
     pub target: Option<Vector3<f32>>,

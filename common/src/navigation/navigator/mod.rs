@@ -3,9 +3,14 @@
 //!
 //! [`Navigator::step`] walks the mission items, keeps the one being flown as the *current* item
 //! (for `MISSION_CURRENT`), reports each navigation item when it is done (for
-//! `MISSION_ITEM_REACHED`), and turns the item into
-//! [`Commands`](crate::control::autopilot::Commands) for the autopilot through the path manager
-//! and the guidance.
+//! `MISSION_ITEM_REACHED`), and turns the item into [`Commands`] for the autopilot through the
+//! path manager and the guidance.
+//!
+//! Altitudes: inside, the navigator works in its NED frame from home, so its targets, circles
+//! and glide slopes, and the guidance output it reports, are heights above home. The
+//! [`Commands`] it hands the autopilot carry altitudes above mean sea level, the datum of the
+//! measured altitude the autopilot holds them against: the home's altitude is added on the way
+//! out, so the caller passes them through.
 //!
 //! - [`mission`]: the walk through the items (`DO_*` items, jumps, speed changes, home moves)
 //!   and the legs between waypoints.
@@ -38,6 +43,7 @@ use self::mission::{Leg, MissionWalk};
 use self::params::NavParams;
 use self::rtl::Return;
 use self::takeoff::Takeoff;
+use crate::control::autopilot::Commands;
 use crate::estimator::Home;
 use crate::guidance::{Guidance, GuidanceParams};
 use crate::navigation::items::{
@@ -163,7 +169,8 @@ impl Navigator {
     }
 
     /// One step: `items` is the stored mission, `home` the NED origin, `state` the estimate,
-    /// `dt` the time since the last step (s).
+    /// `dt` the time since the last step (s). The commands' altitudes are above mean sea
+    /// level.
     pub fn step(
         &mut self,
         items: &[MissionItem],
@@ -213,6 +220,11 @@ impl Navigator {
             out.wp_dist_m = horizontal_dist(&t, &pos);
             out.target_bearing = libm::atan2f(t.y - pos.y, t.x - pos.x);
         }
+        // Heights above home to the autopilot's altitudes above mean sea level.
+        out.commands = out.commands.map(|c| Commands {
+            lon: c.lon.shifted(home.alt_amsl_m),
+            ..c
+        });
         out
     }
 
