@@ -39,7 +39,7 @@ use crate::control::inputs::Measurements;
 use crate::estimator::{config as estimator_config, EstimatedState, Estimator};
 use crate::navigation::plan::MissionStore;
 use crate::navigation::validate::{MissionLimits, PlanRules};
-use crate::navigation::{executor, fence, path_manager, validate};
+use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::params::ParamStore;
 use crate::sensors::{GpsFix, ManualInput, SensorFrame};
 use crate::{failsafe, guidance};
@@ -380,7 +380,7 @@ impl Vehicle {
         let p = &self.params;
         self.estimator.set_config(p.load(&estimator_config::PARAMS));
         self.commander.navigator_mut().configure(
-            &p.load(&executor::PARAMS),
+            &p.load(&navigator::params::PARAMS),
             &p.load(&path_manager::PARAMS),
             &p.load(&guidance::PARAMS),
         );
