@@ -89,7 +89,7 @@ impl Plane {
 
     fn apply(&mut self, c: &Commands, dt: f32) {
         let h = self.height();
-        let max_rate = 9.80665 / self.k.airspeed.max(5.0);
+        let max_rate = crate::math::GRAVITY / self.k.airspeed.max(5.0);
         match c.roll {
             RollMode::Course(chi) if h > 0.5 => {
                 let rate =
