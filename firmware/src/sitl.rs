@@ -2,6 +2,7 @@
 //! same [`App`] the MCU runs.
 
 use crate::app::App;
+use common::gcs::Dest;
 use common::storage::{
     load_missions, load_params, save_missions, save_params, AbRegion, RamFlash, MISSION_MAGIC,
     PARAMS_MAGIC,
@@ -351,15 +352,21 @@ impl FileStorage {
 }
 
 /// The ground-station link over UDP: telemetry to a fixed remote (QGroundControl listens on
-/// 14550) and to every peer that has sent us a frame (MAVSDK, pymavlink, test clients).
+/// 14550) and to every station that has sent us a frame lately (MAVSDK, pymavlink, test
+/// clients). Each station has its own channel: the fixed remote 0, the others 1 to
+/// [`MAX_GCS_PEERS`]; answers go back only to the station that asked, telemetry to all.
 pub struct GcsUdp {
     socket: UdpSocket,
     remote: Option<SocketAddr>,
-    peers: Vec<SocketAddr>,
+    /// Stations that spoke first, with when each was last heard.
+    peers: [Option<(SocketAddr, Instant)>; MAX_GCS_PEERS],
 }
 
-/// Most ground stations a SITL link answers at once.
+/// Most stations besides the fixed remote a SITL link serves at once; a new one takes the
+/// place of the one heard longest ago.
 pub const MAX_GCS_PEERS: usize = 8;
+/// A station silent this long is forgotten (QGroundControl sends a heartbeat every second).
+pub const PEER_TIMEOUT: Duration = Duration::from_secs(10);
 
 impl GcsUdp {
     /// Binds `bind` and sends to `remote` as well as to whoever speaks.
@@ -373,7 +380,7 @@ impl GcsUdp {
         Ok(Self {
             socket,
             remote,
-            peers: Vec::new(),
+            peers: [None; MAX_GCS_PEERS],
         })
     }
 
@@ -382,19 +389,37 @@ impl GcsUdp {
         self.socket.local_addr()
     }
 
+    /// The channel of a station that sent a datagram at `now`: the fixed remote's, its own,
+    /// a free one, or the one of the station heard longest ago.
+    fn channel_of(&mut self, from: SocketAddr, now: Instant) -> u8 {
+        if Some(from) == self.remote {
+            return 0;
+        }
+        let slot = self
+            .peers
+            .iter()
+            .position(|p| p.is_some_and(|(a, _)| a == from))
+            .or_else(|| {
+                self.peers.iter().position(|p| {
+                    p.is_none_or(|(_, heard)| now.duration_since(heard) > PEER_TIMEOUT)
+                })
+            })
+            .unwrap_or_else(|| {
+                let heard = |i: &usize| self.peers[*i].map(|(_, h)| h);
+                (0..MAX_GCS_PEERS).min_by_key(heard).unwrap_or(0)
+            });
+        self.peers[slot] = Some((from, now));
+        slot as u8 + 1
+    }
+
     /// Takes every waiting datagram into the autopilot, then sends its answers.
     pub fn service(&mut self, app: &mut App) -> io::Result<()> {
         let mut buf = [0u8; 2048];
         loop {
             match self.socket.recv_from(&mut buf) {
                 Ok((n, from)) => {
-                    if Some(from) != self.remote
-                        && !self.peers.contains(&from)
-                        && self.peers.len() < MAX_GCS_PEERS
-                    {
-                        self.peers.push(from);
-                    }
-                    app.on_gcs_bytes(&buf[..n]);
+                    let channel = self.channel_of(from, Instant::now());
+                    app.on_gcs_datagram(channel, &buf[..n]);
                 }
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
                 // A peer that went away makes the next recv report it (ICMP); keep going.
@@ -406,14 +431,37 @@ impl GcsUdp {
         Ok(())
     }
 
-    /// Sends what the autopilot has for the ground stations.
+    /// Sends what the autopilot has for the ground stations, one frame per datagram: to
+    /// everyone, or back to the station it answers.
     pub fn flush(&mut self, app: &mut App) {
+        let now = Instant::now();
         let (socket, remote, peers) = (&self.socket, self.remote, &self.peers);
-        app.drain_gcs(&mut |bytes| {
-            // Frames are cut at frame boundaries by the app; one datagram per drain is fine
-            // below 8 KiB, the loopback datagram limit is far above that.
-            for to in remote.iter().chain(peers.iter()) {
-                let _ = socket.send_to(bytes, to);
+        let live = move |c: usize| {
+            peers
+                .get(c)
+                .copied()
+                .flatten()
+                .filter(|(_, heard)| now.duration_since(*heard) <= PEER_TIMEOUT)
+                .map(|(a, _)| a)
+        };
+        app.drain_gcs_to(&mut |dest, frame| match dest {
+            Dest::All => {
+                for to in remote
+                    .into_iter()
+                    .chain((0..MAX_GCS_PEERS).filter_map(live))
+                {
+                    let _ = socket.send_to(frame, to);
+                }
+            }
+            Dest::Channel(0) => {
+                if let Some(to) = remote {
+                    let _ = socket.send_to(frame, to);
+                }
+            }
+            Dest::Channel(c) => {
+                if let Some(to) = live(usize::from(c) - 1) {
+                    let _ = socket.send_to(frame, to);
+                }
             }
         });
     }

@@ -518,3 +518,43 @@ fn arming_waits_for_the_pre_arm_checks_and_streams_follow_their_interval() {
         );
     }
 }
+
+#[test]
+fn a_dozen_stations_in_turn_each_get_their_answers() {
+    // More stations than the SITL link keeps at once (eight besides the fixed one): the one
+    // heard longest ago makes room, so the newest always gets its answer.
+    let gps = Arc::new(AtomicBool::new(true));
+    let sitl = Sitl::start(None, gps);
+    let mut stations: Vec<Gcs> = (0..12).map(|_| Gcs::new(sitl.gcs_addr)).collect();
+    for (i, g) in stations.iter_mut().enumerate() {
+        assert_eq!(g.param_read("NAV_ASPD"), Some(17.0), "station {i} answered");
+    }
+}
+
+#[test]
+fn a_request_behind_a_corrupt_length_in_its_datagram_is_answered_at_once() {
+    let gps = Arc::new(AtomicBool::new(true));
+    let sitl = Sitl::start(None, gps);
+    let mut gcs = Gcs::new(sitl.gcs_addr);
+    gcs.wait(5.0, heartbeat_of).expect("heartbeat");
+    // One datagram: a heartbeat whose length byte was hit (claiming 200 bytes), then a read.
+    let mut bad = gcs.sender.encode(&gcs_heartbeat()).raw_bytes().to_vec();
+    bad[1] = 200;
+    let read = gcs
+        .sender
+        .encode(&MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: -1,
+            target_system: 1,
+            target_component: 1,
+            param_id: "NAV_ASPD".into(),
+        }));
+    bad.extend_from_slice(read.raw_bytes());
+    gcs.send_raw(&bad);
+    let value = gcs.wait(1.0, |m| match m {
+        MavMessage::PARAM_VALUE(v) if v.param_id.to_str().ok() == Some("NAV_ASPD") => {
+            Some(v.param_value)
+        }
+        _ => None,
+    });
+    assert_eq!(value, Some(17.0), "answered within a second, not held");
+}

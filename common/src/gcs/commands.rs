@@ -2,6 +2,7 @@
 //! snapshot, answered with `COMMAND_ACK`, accepted ones queued as requests.
 
 use super::outbox::{After, Command, Pending};
+use super::peer::Peer;
 use super::streams::Stream;
 use super::{telemetry, GroundLink, Stores, FORCE_ARM_MAGIC, HEARTBEAT_INTERVAL_US};
 use crate::navigation::plan::MissionStore;
@@ -19,7 +20,7 @@ impl GroundLink {
     pub(super) fn on_command(
         &mut self,
         c: Command,
-        from: (u8, u8),
+        from: Peer,
         now_us: u64,
         v: &VehicleSnapshot,
         stores: &mut Stores,
@@ -133,10 +134,11 @@ impl GroundLink {
                     // The heartbeat stays at 1 Hz.
                     Some(HEARTBEAT_DATA::ID) => MavResult::MAV_RESULT_DENIED,
                     Some(id) => match Stream::from_message_id(id) {
-                        Some(s) => {
-                            self.streams.set_interval(s, c.p[1], now_us);
+                        // A NaN interval asks for nothing: refused, the rate kept.
+                        Some(s) if self.streams.set_interval(s, c.p[1], now_us) => {
                             MavResult::MAV_RESULT_ACCEPTED
                         }
+                        Some(_) => MavResult::MAV_RESULT_DENIED,
                         None => MavResult::MAV_RESULT_UNSUPPORTED,
                     },
                     None => MavResult::MAV_RESULT_DENIED,
@@ -189,7 +191,7 @@ impl GroundLink {
         };
         self.ack(c.cmd, result, from);
         for p in after {
-            self.push(p);
+            self.push_to(p, from.dest());
         }
     }
 

@@ -23,6 +23,7 @@ pub mod mission;
 pub mod modes;
 pub mod outbox;
 pub mod params;
+pub mod peer;
 pub mod streams;
 pub mod telemetry;
 
@@ -45,6 +46,9 @@ use crate::vehicle::requests::VehicleRequests;
 use crate::vehicle::snapshot::VehicleSnapshot;
 use mission::{mission_message, MissionManager, MissionReply};
 use outbox::{Command, Pending, Text};
+
+pub use outbox::{CommandAck, Outgoing};
+pub use peer::{Dest, Peer};
 
 pub use outbox::STATUSTEXT_LEN;
 use streams::{Scheduler, Stream};
@@ -103,10 +107,11 @@ pub struct GroundLink {
     cfg: LinkConfig,
     missions: MissionManager,
     streams: Scheduler,
-    pending: Deque<Pending, PENDING_CAPACITY>,
+    pending: Deque<(Pending, Dest), PENDING_CAPACITY>,
     texts: Deque<Text, TEXT_CAPACITY>,
     requests: VehicleRequests,
-    param_next: Option<u16>,
+    /// The next index of a parameter list download, and the channel that asked for it.
+    param_next: Option<(u16, u8)>,
     next_heartbeat_us: u64,
     gcs_last_seen_us: Option<u64>,
     last_mode: Option<FlightMode>,
@@ -200,14 +205,19 @@ impl GroundLink {
         self.queue_text(severity, s);
     }
 
+    /// Queues a message for every station.
     fn push(&mut self, p: Pending) {
-        if self.pending.push_back(p).is_err() {
+        self.push_to(p, Dest::All);
+    }
+
+    fn push_to(&mut self, p: Pending, dest: Dest) {
+        if self.pending.push_back((p, dest)).is_err() {
             self.dropped = self.dropped.wrapping_add(1);
         }
     }
 
-    /// Consumes one message from the ground station. Messages addressed to another system or
-    /// component, and our own echoes, are ignored.
+    /// Consumes one message from a ground station, received on the board's `channel`.
+    /// Messages addressed to another system or component, and our own echoes, are ignored.
     // SET_MODE, MISSION_REQUEST, MISSION_SET_CURRENT and MISSION_ITEM are deprecated but still
     // sent by pymavlink and older ground stations; answering them is part of compatibility.
     #[allow(deprecated)]
@@ -218,6 +228,7 @@ impl GroundLink {
         now_us: u64,
         vehicle: &VehicleSnapshot,
         stores: &mut Stores,
+        channel: u8,
     ) {
         let Ok(sys) = u8::try_from(header.system_id) else {
             return;
@@ -235,17 +246,22 @@ impl GroundLink {
                 return;
             }
         }
-        let from = (sys, header.component_id);
+        let from = Peer {
+            system: sys,
+            component: header.component_id,
+            channel,
+        };
         match msg {
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
                 self.gcs_last_seen_us = Some(now_us);
             }
             MavMessage::PARAM_REQUEST_LIST(_) => {
-                // A new request restarts the stream: every index once, in order.
-                self.param_next = Some(0);
+                // A new request restarts the stream: every index once, in order, to the
+                // channel that asked.
+                self.param_next = Some((0, channel));
             }
             MavMessage::PARAM_REQUEST_READ(d) => {
-                self.on_param_read(d, stores.params);
+                self.on_param_read(d, stores.params, from);
             }
             MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params),
             MavMessage::MANUAL_CONTROL(d) => {
@@ -306,12 +322,12 @@ impl GroundLink {
                 let r = self
                     .missions
                     .on_count(stores.plan, d.mission_type, d.count, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_ITEM_INT(d) => {
                 let plan = &mut *stores.plan;
                 if let Some(r) = self.missions.on_item(plan, &stores.rules, d, from, now_us) {
-                    self.push(Pending::Mission(r, from));
+                    self.push_to(Pending::Mission(r, from), from.dest());
                 }
                 for w in self.missions.take_warnings() {
                     self.mission_warning(w);
@@ -320,52 +336,78 @@ impl GroundLink {
             // Float items lose precision; this autopilot asks for MISSION_ITEM_INT only.
             MavMessage::MISSION_ITEM(d) if self.missions.busy() => {
                 self.missions.on_ack(d.mission_type, from);
-                self.push(Pending::Mission(
-                    MissionReply::Ack(d.mission_type, MavMissionResult::MAV_MISSION_UNSUPPORTED),
-                    from,
-                ));
+                let nack =
+                    MissionReply::Ack(d.mission_type, MavMissionResult::MAV_MISSION_UNSUPPORTED);
+                self.push_to(Pending::Mission(nack, from), from.dest());
             }
             MavMessage::MISSION_REQUEST_LIST(d) => {
                 let r = self
                     .missions
                     .on_request_list(stores.plan, d.mission_type, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_REQUEST_INT(d) => {
                 let r = self
                     .missions
                     .on_request(stores.plan, d.mission_type, d.seq, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_REQUEST(d) => {
                 // Legacy request: answered with MISSION_ITEM_INT all the same.
                 let r = self
                     .missions
                     .on_request(stores.plan, d.mission_type, d.seq, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_ACK(d) => self.missions.on_ack(d.mission_type, from),
             MavMessage::MISSION_CLEAR_ALL(d) => {
                 let r = self.missions.on_clear(stores.plan, d.mission_type);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_SET_CURRENT(d) => {
                 // The message has no ACK: a bad index gets a STATUSTEXT and the current item.
                 let ok = self.set_mission_current(d.seq, stores.plan);
                 if !ok {
-                    self.push(Pending::MissionCurrent(None));
+                    self.push_to(Pending::MissionCurrent(None), from.dest());
                 }
             }
             _ => {}
         }
     }
 
-    fn ack(&mut self, command: MavCmd, result: MavResult, to: (u8, u8)) {
-        self.push(Pending::Ack {
-            command,
-            result,
-            to,
-        });
+    /// A frame whose checksum matched but whose payload the dialect could not decode: a
+    /// command with an id this autopilot does not know gets `MAV_RESULT_UNSUPPORTED`, as the
+    /// command protocol asks, when it is addressed to us.
+    pub fn handle_undecoded(&mut self, header: &MavHeader, id: u32, payload: &[u8], channel: u8) {
+        let Some((command, ts, tc)) = outbox::undecoded_command(id, payload) else {
+            return;
+        };
+        let Ok(sys) = u8::try_from(header.system_id) else {
+            return;
+        };
+        let ours =
+            (ts == 0 || ts == self.cfg.system_id) && (tc == 0 || tc == self.cfg.component_id);
+        let echo = sys == self.cfg.system_id && header.component_id == self.cfg.component_id;
+        if !ours || echo {
+            return;
+        }
+        let to = Peer {
+            system: sys,
+            component: header.component_id,
+            channel,
+        };
+        self.push_to(Pending::Unsupported { command, to }, to.dest());
+    }
+
+    fn ack(&mut self, command: MavCmd, result: MavResult, to: Peer) {
+        self.push_to(
+            Pending::Ack {
+                command,
+                result,
+                to,
+            },
+            to.dest(),
+        );
     }
 
     /// The vehicle's mission progress: a new current item (MISSION_CURRENT at once, besides
@@ -379,49 +421,73 @@ impl GroundLink {
         }
     }
 
-    /// Emits everything due at `now_us`: answers to handled messages, the heartbeat, status
-    /// texts, mission retries, the parameter stream, then telemetry streams.
-    pub fn poll<F: FnMut(MavMessage)>(
+    /// Emits everything due at `now_us`, each with where it goes: answers to handled messages
+    /// (back on the asker's channel), the heartbeat, status texts, mission retries, the
+    /// parameter stream, then telemetry streams.
+    pub fn poll<F: FnMut(Dest, Outgoing)>(
         &mut self,
         now_us: u64,
         v: &VehicleSnapshot,
         stores: &Stores,
-        mut out: F,
+        mut out_raw: F,
     ) {
-        while let Some(p) = self.pending.pop_front() {
-            self.emit(p, now_us, v, stores, &mut out);
+        while let Some((p, dest)) = self.pending.pop_front() {
+            if let Pending::Unsupported { command, to } = p {
+                let ack = CommandAck {
+                    command,
+                    result: MavResult::MAV_RESULT_UNSUPPORTED,
+                    target: to.address(),
+                };
+                out_raw(dest, Outgoing::Ack(ack));
+                continue;
+            }
+            self.emit(p, dest, now_us, v, stores, &mut |d, m| {
+                out_raw(d, Outgoing::Message(m))
+            });
         }
+        let mut out_msg = |d, m| out_raw(d, Outgoing::Message(m));
+        let out = &mut out_msg;
         if now_us >= self.next_heartbeat_us {
-            out(telemetry::heartbeat(v));
+            out(Dest::All, telemetry::heartbeat(v));
             self.next_heartbeat_us = self.next_heartbeat_us.saturating_add(HEARTBEAT_INTERVAL_US);
             if self.next_heartbeat_us <= now_us {
                 self.next_heartbeat_us = now_us.saturating_add(HEARTBEAT_INTERVAL_US);
             }
         }
         while let Some(t) = self.texts.pop_front() {
-            out(MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+            let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
                 severity: t.severity,
                 text: t.text.as_str().into(),
                 id: 0,
                 chunk_seq: 0,
-            }));
+            });
+            out(Dest::All, text);
         }
         if let Some((reply, to)) = self.missions.poll(now_us) {
-            self.emit(Pending::Mission(reply, to), now_us, v, stores, &mut out);
+            self.emit(
+                Pending::Mission(reply, to),
+                to.dest(),
+                now_us,
+                v,
+                stores,
+                out,
+            );
         }
         if self.last_mode != Some(v.mode) {
             if self.last_mode.is_some() {
-                out(telemetry::current_mode(v, self.intended_mode(v)));
+                out(Dest::All, telemetry::current_mode(v, self.intended_mode(v)));
             }
             self.last_mode = Some(v.mode);
         }
-        self.stream_params(stores.params, &mut out);
+        self.stream_params(stores.params, out);
         let mut due: heapless::Vec<Stream, { streams::STREAM_COUNT }> = heapless::Vec::new();
         self.streams.run(now_us, |s| {
             let _ = due.push(s);
         });
         for s in due {
-            self.emit_stream(s, now_us, v, stores.plan, &mut out);
+            if let Some(m) = self.stream_message(s, now_us, v, stores.plan) {
+                out(Dest::All, m);
+            }
         }
     }
 
@@ -437,15 +503,14 @@ impl GroundLink {
         )
     }
 
-    fn emit_stream<F: FnMut(MavMessage)>(
+    fn stream_message(
         &self,
         s: Stream,
         now_us: u64,
         v: &VehicleSnapshot,
         plan: &MissionStore,
-        out: &mut F,
-    ) {
-        let m = match s {
+    ) -> Option<MavMessage> {
+        Some(match s {
             Stream::SysStatus => telemetry::sys_status(v, self.rx_errors),
             Stream::GpsRawInt => telemetry::gps_raw_int(v),
             Stream::Attitude => telemetry::attitude(v, now_us),
@@ -459,25 +524,25 @@ impl GroundLink {
             Stream::NavControllerOutput => telemetry::nav_controller_output(v),
             Stream::VfrHud => telemetry::vfr_hud(v),
             Stream::BatteryStatus => telemetry::battery_status(v),
-            Stream::HomePosition => match telemetry::home_position(v, now_us) {
-                Some(m) => m,
-                None => return,
-            },
+            Stream::HomePosition => telemetry::home_position(v, now_us)?,
             Stream::ExtendedSysState => telemetry::extended_sys_state(v),
             Stream::CurrentMode => telemetry::current_mode(v, self.intended_mode(v)),
-        };
-        out(m);
+        })
     }
 
-    fn emit<F: FnMut(MavMessage)>(
+    fn emit<F: FnMut(Dest, MavMessage)>(
         &self,
         p: Pending,
+        dest: Dest,
         now_us: u64,
         v: &VehicleSnapshot,
         stores: &Stores,
         out: &mut F,
     ) {
+        let mut out = |m| out(dest, m);
         match p {
+            // Sent as raw data by `poll`.
+            Pending::Unsupported { .. } => {}
             Pending::Ack {
                 command,
                 result,
@@ -487,8 +552,8 @@ impl GroundLink {
                 result,
                 progress: 0,
                 result_param2: 0,
-                target_system: to.0,
-                target_component: to.1,
+                target_system: to.system,
+                target_component: to.component,
             })),
             Pending::ParamValue(i) => {
                 if let Some(m) = params::param_value(stores.params, usize::from(i)) {
@@ -496,7 +561,7 @@ impl GroundLink {
                 }
             }
             Pending::Mission(reply, to) => {
-                if let Some(m) = mission_message(reply, to, stores.plan, v.mission_seq) {
+                if let Some(m) = mission_message(reply, to.address(), stores.plan, v.mission_seq) {
                     out(m);
                 }
             }
@@ -517,7 +582,12 @@ impl GroundLink {
             }
             Pending::CurrentMode => out(telemetry::current_mode(v, self.intended_mode(v))),
             Pending::Heartbeat => out(telemetry::heartbeat(v)),
-            Pending::Stream(s) => self.emit_stream(s, now_us, v, stores.plan, out),
+            Pending::Stream(s) => {
+                let m = self.stream_message(s, now_us, v, stores.plan);
+                if let Some(m) = m {
+                    out(m);
+                }
+            }
             Pending::MessageInterval { id, interval_us } => {
                 out(MavMessage::MESSAGE_INTERVAL(MESSAGE_INTERVAL_DATA {
                     interval_us,

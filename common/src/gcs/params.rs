@@ -2,6 +2,7 @@
 //! checked by the parameter store (refused values are answered with the value kept).
 
 use super::outbox::Pending;
+use super::peer::{Dest, Peer};
 use super::GroundLink;
 use crate::params::store::{encode_wire, param_id_str, ParamStore};
 use crate::params::ParamKind;
@@ -9,20 +10,30 @@ use mavlink::dialects::common::*;
 
 impl GroundLink {
     /// `PARAM_REQUEST_READ`: by index, or by name when the index is -1.
-    pub(super) fn on_param_read(&mut self, d: &PARAM_REQUEST_READ_DATA, params: &ParamStore) {
+    pub(super) fn on_param_read(
+        &mut self,
+        d: &PARAM_REQUEST_READ_DATA,
+        params: &ParamStore,
+        from: Peer,
+    ) {
         let index = if d.param_index < 0 {
             param_id_str(&d.param_id[..]).and_then(|n| params.index_of(n))
         } else {
             Some(d.param_index as usize).filter(|&i| i < params.len())
         };
         if let Some(i) = index {
-            self.push(Pending::ParamValue(i as u16));
+            self.push_to(Pending::ParamValue(i as u16), from.dest());
         }
     }
 
-    /// The next `params_per_poll` values of a list download, if one runs.
-    pub(super) fn stream_params<F: FnMut(MavMessage)>(&mut self, params: &ParamStore, out: &mut F) {
-        let Some(next) = self.param_next else {
+    /// The next `params_per_poll` values of a list download, if one runs, to the channel that
+    /// asked for it.
+    pub(super) fn stream_params<F: FnMut(Dest, MavMessage)>(
+        &mut self,
+        params: &ParamStore,
+        out: &mut F,
+    ) {
+        let Some((next, channel)) = self.param_next else {
             return;
         };
         let n = params.len();
@@ -32,11 +43,15 @@ impl GroundLink {
                 break;
             }
             if let Some(m) = param_value(params, i) {
-                out(m);
+                out(Dest::Channel(channel), m);
             }
             i += 1;
         }
-        self.param_next = if i >= n { None } else { Some(i as u16) };
+        self.param_next = if i >= n {
+            None
+        } else {
+            Some((i as u16, channel))
+        };
     }
 
     /// `PARAM_SET`: the store checks the value; the echo carries the value it now holds.

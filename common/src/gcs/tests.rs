@@ -81,15 +81,39 @@ impl core::ops::DerefMut for Bench {
 
 impl Bench {
     fn handle(&mut self, h: &MavHeader, msg: &MavMessage, now: u64, v: &VehicleSnapshot) {
+        self.handle_on(0, h, msg, now, v);
+    }
+
+    fn handle_on(
+        &mut self,
+        channel: u8,
+        h: &MavHeader,
+        msg: &MavMessage,
+        now: u64,
+        v: &VehicleSnapshot,
+    ) {
         let mut stores = Stores {
             params: &mut self.params,
             plan: &mut self.plan,
             rules: self.rules,
         };
-        self.link.handle(h, msg, now, v, &mut stores);
+        self.link.handle(h, msg, now, v, &mut stores, channel);
     }
 
-    fn poll(&mut self, now: u64, v: &VehicleSnapshot, out: impl FnMut(MavMessage)) {
+    fn poll(&mut self, now: u64, v: &VehicleSnapshot, mut out: impl FnMut(MavMessage)) {
+        self.poll_to(now, v, |_, m| out(m));
+    }
+
+    /// The dialect's messages, with where they go; raw acknowledgements are dropped here.
+    fn poll_to(&mut self, now: u64, v: &VehicleSnapshot, mut out: impl FnMut(Dest, MavMessage)) {
+        self.poll_raw(now, v, |d, o| {
+            if let Outgoing::Message(m) = o {
+                out(d, m)
+            }
+        });
+    }
+
+    fn poll_raw(&mut self, now: u64, v: &VehicleSnapshot, out: impl FnMut(Dest, Outgoing)) {
         let stores = Stores {
             params: &mut self.params,
             plan: &mut self.plan,
@@ -2013,4 +2037,97 @@ fn change_speed_is_held_to_the_vehicles_airspeed_range() {
         )]
     );
     assert_eq!(l.take_requests().airspeed, None);
+}
+
+/// What the next poll sends back on `channel` (answers to its stations and broadcasts).
+fn poll_channel(l: &mut Bench, v: &VehicleSnapshot, now: u64, channel: u8) -> Vec<MavMessage> {
+    let mut out = Vec::new();
+    l.poll_to(now, v, |d, m| {
+        if d.reaches(channel) {
+            out.push(m);
+        }
+    });
+    out
+}
+
+#[test]
+fn two_stations_with_one_identity_on_two_channels_cannot_interleave_an_upload() {
+    let mut l = link();
+    let v = healthy();
+    let a = waypoints(3, 0);
+    let b = waypoints(5, 100);
+    // Both say "255/190"; only the board's channel tells them apart.
+    l.handle_on(0, &hdr(), &count_msg(3), 0, &v);
+    l.handle_on(1, &hdr(), &count_msg(5), 0, &v);
+    let mut to_a = Vec::new();
+    let mut to_b = Vec::new();
+    l.poll_to(0, &v, |d, m| match d {
+        Dest::Channel(0) => to_a.push(m),
+        Dest::Channel(1) => to_b.push(m),
+        _ => {}
+    });
+    assert_eq!(requests(&to_a), [0], "the first station's upload starts");
+    assert_eq!(
+        mission_acks(&to_b),
+        [MavMissionResult::MAV_MISSION_DENIED],
+        "the second is told the vehicle is busy, on its own channel only"
+    );
+    assert!(mission_acks(&to_a).is_empty());
+    // The second station sends its items anyway, interleaved with the first's.
+    let mut acks_a = Vec::new();
+    for (i, item_b) in b.iter().enumerate() {
+        if let Some(item) = a.get(i) {
+            let m = MavMessage::MISSION_ITEM_INT(item.clone());
+            l.handle_on(0, &hdr(), &m, 1, &v);
+            acks_a.extend(mission_acks(&poll_channel(&mut l, &v, 1, 0)));
+        }
+        let m = MavMessage::MISSION_ITEM_INT(item_b.clone());
+        l.handle_on(1, &hdr(), &m, 1, &v);
+    }
+    assert_eq!(acks_a, [MavMissionResult::MAV_MISSION_ACCEPTED]);
+    // The stored mission is the first station's, complete.
+    assert_eq!(l.plan.mission.len(), 3);
+    for (stored, sent) in l.plan.mission.iter().zip(&a) {
+        assert_eq!(stored.x, sent.x);
+    }
+}
+
+#[test]
+fn a_parameter_list_goes_to_the_channel_that_asked() {
+    let mut l = link();
+    let v = healthy();
+    let list = MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+        target_system: 1,
+        target_component: 1,
+    });
+    l.handle_on(2, &hdr(), &list, 0, &v);
+    let mut dests = Vec::new();
+    for k in 0..10 {
+        l.poll_to(k * 20_000, &v, |d, m| {
+            if matches!(m, MavMessage::PARAM_VALUE(_)) {
+                dests.push(d);
+            }
+        });
+    }
+    assert_eq!(dests.len(), 6);
+    assert!(dests.iter().all(|d| *d == Dest::Channel(2)), "{dests:?}");
+}
+
+#[test]
+fn a_nan_message_interval_is_denied_and_the_rate_kept() {
+    let mut l = link();
+    let v = healthy();
+    let set = |iv: f32| {
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [30.0, iv, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+    };
+    assert_eq!(
+        acks(&exchange(&mut l, &v, 0, set(f32::NAN)))[0].1,
+        MavResult::MAV_RESULT_DENIED
+    );
+    // ATTITUDE stays at its default 15 Hz, not the 1 kHz a NaN cast to an integer gave.
+    let n = count_over(&mut l, &v, 1_000, 10, 30);
+    assert!(n.abs_diff(150) <= 1, "default gave {n}");
 }

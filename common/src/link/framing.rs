@@ -37,6 +37,38 @@ pub struct LinkStats {
     pub bytes_skipped: u32,
     /// Lost frames, from gaps in each sender's sequence numbers.
     pub seq_gaps: u32,
+    /// Frames cut short: still waiting for bytes when their datagram ended.
+    pub cut_short: u32,
+}
+
+impl core::ops::Add for LinkStats {
+    type Output = Self;
+    /// The counts of two parsers together (wrapping, as each counter does).
+    fn add(self, o: Self) -> Self {
+        Self {
+            frames_ok: self.frames_ok.wrapping_add(o.frames_ok),
+            crc_errors: self.crc_errors.wrapping_add(o.crc_errors),
+            unknown_ids: self.unknown_ids.wrapping_add(o.unknown_ids),
+            parse_errors: self.parse_errors.wrapping_add(o.parse_errors),
+            unsupported: self.unsupported.wrapping_add(o.unsupported),
+            bytes_skipped: self.bytes_skipped.wrapping_add(o.bytes_skipped),
+            seq_gaps: self.seq_gaps.wrapping_add(o.seq_gaps),
+            cut_short: self.cut_short.wrapping_add(o.cut_short),
+        }
+    }
+}
+
+/// A frame whose checksum matched but whose payload this dialect could not decode (an enum
+/// value it does not know): what a protocol may still answer (an unknown command gets
+/// `MAV_RESULT_UNSUPPORTED`).
+#[derive(Clone, Copy, Debug)]
+pub struct Undecoded<'a> {
+    /// Sender, sequence and component.
+    pub header: MavHeader,
+    /// Message id.
+    pub id: u32,
+    /// The payload as received (MAVLink 2 may have cut its trailing zeros).
+    pub payload: &'a [u8],
 }
 
 /// A decoded frame.
@@ -69,8 +101,9 @@ impl Default for FrameParser {
 enum Check {
     NeedMore,
     Bad,
-    /// Skip a whole frame of this length (its CRC matched but its payload did not decode).
-    Skip(usize),
+    /// Skip a whole frame (its CRC matched but its payload did not decode): its header, id,
+    /// where its payload lies and its whole length.
+    Skip(MavHeader, u32, core::ops::Range<usize>, usize),
     Done(Frame, usize),
 }
 
@@ -88,6 +121,7 @@ impl FrameParser {
                 unsupported: 0,
                 bytes_skipped: 0,
                 seq_gaps: 0,
+                cut_short: 0,
             },
             last_seq: None,
         }
@@ -99,7 +133,18 @@ impl FrameParser {
     }
 
     /// Feeds bytes; calls `on_frame` for every complete, valid frame in order.
-    pub fn push(&mut self, bytes: &[u8], mut on_frame: impl FnMut(Frame)) {
+    pub fn push(&mut self, bytes: &[u8], on_frame: impl FnMut(Frame)) {
+        self.push_with(bytes, on_frame, |_| {});
+    }
+
+    /// As [`FrameParser::push`], and calls `on_undecoded` for every frame whose checksum
+    /// matched but whose payload did not decode.
+    pub fn push_with(
+        &mut self,
+        bytes: &[u8],
+        mut on_frame: impl FnMut(Frame),
+        mut on_undecoded: impl FnMut(Undecoded<'_>),
+    ) {
         for &b in bytes {
             if self.len == 0 && b != STX_V1 && b != STX_V2 {
                 self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(1);
@@ -109,12 +154,37 @@ impl FrameParser {
                 self.buf[self.len] = b;
                 self.len += 1;
             }
-            self.drain(&mut on_frame);
+            self.drain(&mut on_frame, &mut on_undecoded);
+        }
+    }
+
+    /// The transport says a datagram ended. On a datagram link (MAVLink over UDP) a frame never
+    /// spans two datagrams, so a candidate still waiting for bytes is not a frame (a corrupt
+    /// length byte, a truncated send): it is dropped and the frames behind it in the same
+    /// datagram are delivered now, not when later datagrams have filled the length it claimed.
+    pub fn end_of_datagram(&mut self, mut on_frame: impl FnMut(Frame)) {
+        self.end_of_datagram_with(&mut on_frame, &mut |_| {});
+    }
+
+    /// As [`FrameParser::end_of_datagram`], with [`FrameParser::push_with`]'s callbacks.
+    pub fn end_of_datagram_with(
+        &mut self,
+        on_frame: &mut impl FnMut(Frame),
+        on_undecoded: &mut impl FnMut(Undecoded<'_>),
+    ) {
+        while self.len > 0 {
+            self.stats.cut_short = self.stats.cut_short.wrapping_add(1);
+            self.resync();
+            self.drain(on_frame, on_undecoded);
         }
     }
 
     /// Checks the buffer until it needs more bytes.
-    fn drain(&mut self, on_frame: &mut impl FnMut(Frame)) {
+    fn drain(
+        &mut self,
+        on_frame: &mut impl FnMut(Frame),
+        on_undecoded: &mut impl FnMut(Undecoded<'_>),
+    ) {
         loop {
             match self.check() {
                 Check::NeedMore => return,
@@ -124,7 +194,15 @@ impl FrameParser {
                     on_frame(frame);
                     self.consume(n);
                 }
-                Check::Skip(n) => self.consume(n),
+                Check::Skip(header, id, payload, n) => {
+                    let payload = self.buf.get(payload).unwrap_or(&[]);
+                    on_undecoded(Undecoded {
+                        header,
+                        id,
+                        payload,
+                    });
+                    self.consume(n)
+                }
                 // A corrupt candidate: the real frame may start inside it, so resynchronise
                 // on the next marker after its first byte.
                 Check::Bad => self.resync(),
@@ -178,6 +256,7 @@ impl FrameParser {
         if self.len < 3 {
             return Check::NeedMore;
         }
+
         let payload_len = usize::from(self.buf[1]);
         if stx == STX_V2 {
             let iflags = self.buf[2];
@@ -205,7 +284,8 @@ impl FrameParser {
                 component_id: raw.component_id(),
                 sequence: raw.sequence(),
             };
-            self.finish(header, MavlinkVersion::V2, id, raw.payload(), total)
+            let start = 1 + V2_HEADER;
+            self.finish(header, MavlinkVersion::V2, id, raw.payload(), start, total)
         } else {
             let total = 1 + V1_HEADER + payload_len + CHECKSUM;
             if self.len < total {
@@ -222,7 +302,8 @@ impl FrameParser {
                 component_id: raw.component_id(),
                 sequence: raw.sequence(),
             };
-            self.finish(header, MavlinkVersion::V1, id, raw.payload(), total)
+            let start = 1 + V1_HEADER;
+            self.finish(header, MavlinkVersion::V1, id, raw.payload(), start, total)
         }
     }
 
@@ -245,6 +326,7 @@ impl FrameParser {
         version: MavlinkVersion,
         id: u32,
         payload: &[u8],
+        payload_start: usize,
         total: usize,
     ) -> Check {
         match MavMessage::parse(version, id, payload) {
@@ -258,7 +340,8 @@ impl FrameParser {
             ),
             Err(_) => {
                 self.stats.parse_errors = self.stats.parse_errors.wrapping_add(1);
-                Check::Skip(total)
+                let range = payload_start..payload_start + payload.len();
+                Check::Skip(header, id, range, total)
             }
         }
     }
@@ -303,6 +386,14 @@ impl Sender {
     /// Encodes `message` as the next MAVLink 2 frame of this sender.
     pub fn encode(&mut self, message: &MavMessage) -> MAVLinkV2MessageRaw {
         encode_v2(self.next_header(), message)
+    }
+
+    /// Encodes one message's data (a type of the dialect's, or one written for a case the
+    /// dialect's types cannot express) as the next MAVLink 2 frame of this sender.
+    pub fn encode_data<D: mavlink::MessageData>(&mut self, data: &D) -> MAVLinkV2MessageRaw {
+        let mut raw = MAVLinkV2MessageRaw::new();
+        raw.serialize_message_data(self.next_header(), data);
+        raw
     }
 }
 
@@ -396,6 +487,64 @@ mod tests {
         assert_eq!(f.len(), 2);
         assert_eq!(f[0].version, MavlinkVersion::V1);
         assert_eq!(st.seq_gaps, 2);
+    }
+
+    #[test]
+    fn a_corrupt_length_does_not_hold_the_frames_behind_it_in_its_datagram() {
+        // A heartbeat whose length byte was hit (9 became 200), then two good ones, in one
+        // datagram: they arrive when the datagram ends, not after 200 more bytes.
+        let mut bad = heartbeat(0);
+        bad[1] = 200;
+        let mut s = bad;
+        s.extend(heartbeat(1));
+        s.extend(heartbeat(2));
+        let mut p = FrameParser::new();
+        let mut got = Vec::new();
+        p.push(&s, |f| got.push(f.header.sequence));
+        assert!(
+            got.is_empty(),
+            "held behind the corrupt length until the datagram ends"
+        );
+        p.end_of_datagram(|f| got.push(f.header.sequence));
+        assert_eq!(got, [1, 2]);
+        assert_eq!(p.stats().cut_short, 1);
+        // The next datagram starts clean.
+        p.push(&heartbeat(3), |f| got.push(f.header.sequence));
+        assert_eq!(got, [1, 2, 3]);
+    }
+
+    #[test]
+    fn a_frame_whose_payload_holds_a_whole_mavlink1_frame_still_arrives_byte_by_byte() {
+        use mavlink::dialects::common::{MavSeverity, STATUSTEXT_DATA};
+        // A MAVLink 1 heartbeat (17 bytes) inside a status text: while the text arrives, a
+        // complete, valid frame lies in the buffer behind its start.
+        let h = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 0,
+        };
+        let mut v1 = mavlink::MAVLinkV1MessageRaw::new();
+        v1.serialize_message(h, &MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()));
+        let mut text = [b'x'; 50];
+        text[10..10 + v1.raw_bytes().len()].copy_from_slice(v1.raw_bytes());
+        let msg = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+            severity: MavSeverity::MAV_SEVERITY_INFO,
+            text: text.into(),
+            id: 0,
+            chunk_seq: 0,
+        });
+        let s = encode_v2(h, &msg).raw_bytes().to_vec();
+        let (f, _) = frames(&s, 1);
+        assert!(
+            matches!(
+                f.as_slice(),
+                [Frame {
+                    message: MavMessage::STATUSTEXT(_),
+                    ..
+                }]
+            ),
+            "{f:?}"
+        );
     }
 
     #[test]
