@@ -242,7 +242,9 @@ pub fn run_with(
         }
         last_rx = Instant::now();
         let mut out = Vec::new();
-        app.on_sim_bytes(&buf[..n], &mut |b| out.extend_from_slice(b));
+        app.on_sim_bytes(buf.get(..n).unwrap_or(&[]), &mut |b| {
+            out.extend_from_slice(b)
+        });
         if !out.is_empty() {
             link.write_all_bytes(&out)?;
         }
@@ -405,10 +407,12 @@ impl GcsUdp {
                 })
             })
             .unwrap_or_else(|| {
-                let heard = |i: &usize| self.peers[*i].map(|(_, h)| h);
+                let heard = |i: &usize| self.peers.get(*i).copied().flatten().map(|(_, h)| h);
                 (0..MAX_GCS_PEERS).min_by_key(heard).unwrap_or(0)
             });
-        self.peers[slot] = Some((from, now));
+        if let Some(p) = self.peers.get_mut(slot) {
+            *p = Some((from, now));
+        }
         slot as u8 + 1
     }
 
@@ -419,7 +423,7 @@ impl GcsUdp {
             match self.socket.recv_from(&mut buf) {
                 Ok((n, from)) => {
                     let channel = self.channel_of(from, Instant::now());
-                    app.on_gcs_datagram(channel, &buf[..n]);
+                    app.on_gcs_datagram(channel, buf.get(..n).unwrap_or(&[]));
                 }
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
                 // A peer that went away makes the next recv report it (ICMP); keep going.

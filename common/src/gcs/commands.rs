@@ -215,7 +215,7 @@ impl GroundLink {
                     }
                     return (MavResult::MAV_RESULT_ACCEPTED, after);
                 } else if index >= 1.0 && index <= n as f32 && libm::truncf(index) == index {
-                    Some(Pending::AvailableMode(index as u8 - 1))
+                    Some(Pending::AvailableMode((index as u8).saturating_sub(1)))
                 } else {
                     return (MavResult::MAV_RESULT_DENIED, after);
                 }
@@ -379,6 +379,8 @@ fn message_id(p: f32) -> Option<u32> {
     }
 }
 
+// Runs at compile time only, on the crate's own version numbers.
+#[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
 const fn parse_u8(s: &str) -> u32 {
     let b = s.as_bytes();
     let mut v = 0u32;

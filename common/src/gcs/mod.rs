@@ -17,6 +17,9 @@
 //! PX4's `custom_mode` encoding (see [`modes`]). `docs/GROUND-STATION.md` describes the
 //! behaviour a ground station sees.
 
+// Counts, lengths and offsets here come from outside: every operation on them is checked.
+#![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
+
 pub mod client;
 pub mod commands;
 pub mod mission;

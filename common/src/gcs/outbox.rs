@@ -110,10 +110,12 @@ impl MessageData for CommandAck {
 
     fn deser(version: MavlinkVersion, payload: &[u8]) -> Result<Self, mavlink::error::ParserError> {
         let mut full = [0u8; COMMAND_ACK_DATA::ENCODED_LEN];
-        let n = payload.len().min(full.len());
-        full[..n].copy_from_slice(&payload[..n]);
+        for (d, s) in full.iter_mut().zip(payload) {
+            *d = *s;
+        }
         let command = u16::from_le_bytes([full[0], full[1]]);
-        full[..2].copy_from_slice(&(MavCmd::MAV_CMD_NAV_WAYPOINT as u16).to_le_bytes());
+        let placeholder = (MavCmd::MAV_CMD_NAV_WAYPOINT as u16).to_le_bytes();
+        (full[0], full[1]) = (placeholder[0], placeholder[1]);
         let d = COMMAND_ACK_DATA::deser(version, &full)?;
         Ok(Self {
             command,

@@ -45,7 +45,7 @@ impl GroundLink {
             if let Some(m) = param_value(params, i) {
                 out(Dest::Channel(channel), m);
             }
-            i += 1;
+            i = i.saturating_add(1);
         }
         self.param_next = if i >= n {
             None
