@@ -27,6 +27,7 @@ pub mod modes;
 pub mod outbox;
 pub mod params;
 pub mod peer;
+pub mod signing;
 pub mod streams;
 pub mod telemetry;
 
@@ -51,9 +52,10 @@ use mission::{mission_message, MissionManager, MissionReply};
 use outbox::{Command, Pending, Text};
 
 pub use outbox::{CommandAck, Outgoing};
-pub use peer::{Dest, Peer};
+pub use peer::{Dest, Origin, Peer};
 
 pub use outbox::STATUSTEXT_LEN;
+use signing::Signing;
 use streams::{Scheduler, Stream};
 
 /// Our MAVLink system id.
@@ -120,6 +122,7 @@ pub struct GroundLink {
     last_mode: Option<FlightMode>,
     dropped: u32,
     rx_errors: u16,
+    signing: Signing,
 }
 
 impl Default for GroundLink {
@@ -144,7 +147,18 @@ impl GroundLink {
             last_mode: None,
             dropped: 0,
             rx_errors: 0,
+            signing: Signing::default(),
         }
+    }
+
+    /// MAVLink 2 signing: the key and its policy.
+    pub fn signing(&self) -> &Signing {
+        &self.signing
+    }
+
+    /// MAVLink 2 signing, writable (loading a persisted key at start-up).
+    pub fn signing_mut(&mut self) -> &mut Signing {
+        &mut self.signing
     }
 
     /// The mission protocol's state (a transfer in progress).
@@ -219,8 +233,10 @@ impl GroundLink {
         }
     }
 
-    /// Consumes one message from a ground station, received on the board's `channel`.
-    /// Messages addressed to another system or component, and our own echoes, are ignored.
+    /// Consumes one message from a ground station, received on the board's `channel` (with
+    /// its signature block, when it was signed and a key is installed). Messages addressed to
+    /// another system or component, our own echoes, and whatever the signing policy refuses
+    /// are ignored.
     // SET_MODE, MISSION_REQUEST, MISSION_SET_CURRENT and MISSION_ITEM are deprecated but still
     // sent by pymavlink and older ground stations; answering them is part of compatibility.
     #[allow(deprecated)]
@@ -231,8 +247,9 @@ impl GroundLink {
         now_us: u64,
         vehicle: &VehicleSnapshot,
         stores: &mut Stores,
-        channel: u8,
+        origin: Origin,
     ) {
+        let Origin { channel, signed } = origin;
         let Ok(sys) = u8::try_from(header.system_id) else {
             return;
         };
@@ -249,12 +266,30 @@ impl GroundLink {
                 return;
             }
         }
+        if self
+            .signing
+            .admit(sys, header.component_id, msg, signed)
+            .is_err()
+        {
+            return;
+        }
         let from = Peer {
             system: sys,
             component: header.component_id,
             channel,
         };
         match msg {
+            MavMessage::SETUP_SIGNING(d) => {
+                let with_key = signed.is_some_and(|s| s.valid);
+                let text = if !self.signing.setup(d, with_key) {
+                    "Signing setup refused: not signed with the key"
+                } else if self.signing.key().is_some() {
+                    "Signing on: unsigned writes are refused"
+                } else {
+                    "Signing off"
+                };
+                self.send_statustext(MavSeverity::MAV_SEVERITY_INFO, text);
+            }
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
                 self.gcs_last_seen_us = Some(now_us);
             }
@@ -382,6 +417,10 @@ impl GroundLink {
     /// command with an id this autopilot does not know gets `MAV_RESULT_UNSUPPORTED`, as the
     /// command protocol asks, when it is addressed to us.
     pub fn handle_undecoded(&mut self, header: &MavHeader, id: u32, payload: &[u8], channel: u8) {
+        // Whether it was signed cannot be told here: with signing on, no answer.
+        if self.signing.key().is_some() {
+            return;
+        }
         let Some((command, ts, tc)) = outbox::undecoded_command(id, payload) else {
             return;
         };
@@ -434,6 +473,7 @@ impl GroundLink {
         stores: &Stores,
         mut out_raw: F,
     ) {
+        self.signing.tick(now_us);
         while let Some((p, dest)) = self.pending.pop_front() {
             if let Pending::Unsupported { command, to } = p {
                 let ack = CommandAck {

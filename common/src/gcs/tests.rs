@@ -97,7 +97,11 @@ impl Bench {
             plan: &mut self.plan,
             rules: self.rules,
         };
-        self.link.handle(h, msg, now, v, &mut stores, channel);
+        let origin = Origin {
+            channel,
+            signed: None,
+        };
+        self.link.handle(h, msg, now, v, &mut stores, origin);
     }
 
     fn poll(&mut self, now: u64, v: &VehicleSnapshot, mut out: impl FnMut(MavMessage)) {

@@ -7,6 +7,7 @@
 //! payload. It takes bytes in whatever chunks a UART, a socket or a pipe delivers them, never
 //! allocates and never panics.
 
+use super::signing::{self, Key, Signed};
 use mavlink::dialects::common::MavMessage;
 use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message};
 
@@ -80,6 +81,9 @@ pub struct Frame {
     pub version: MavlinkVersion,
     /// The message.
     pub message: MavMessage,
+    /// For a signed MAVLink 2 frame read with a key installed: its signature block and
+    /// whether it matches the key (`None`: unsigned, or no key to check against).
+    pub signed: Option<Signed>,
 }
 
 /// Incremental MAVLink 1 and 2 frame parser.
@@ -88,6 +92,7 @@ pub struct FrameParser {
     len: usize,
     stats: LinkStats,
     last_seq: Option<(u32, u8)>,
+    key: Option<Key>,
 }
 
 impl Default for FrameParser {
@@ -124,7 +129,13 @@ impl FrameParser {
                 cut_short: 0,
             },
             last_seq: None,
+            key: None,
         }
+    }
+
+    /// The key signed frames are checked against (MAVLink 2 signing); `None`: not checked.
+    pub fn set_key(&mut self, key: Option<Key>) {
+        self.key = key;
     }
 
     /// The bytes held, waiting to form a frame.
@@ -294,8 +305,19 @@ impl FrameParser {
                 component_id: raw.component_id(),
                 sequence: raw.sequence(),
             };
+            let signed = match (&self.key, self.held().get(..total)) {
+                (Some(k), Some(frame)) => signing::check(frame, k),
+                _ => None,
+            };
             let start = 1 + V2_HEADER;
-            self.finish(header, MavlinkVersion::V2, id, raw.payload(), start, total)
+            let check = self.finish(header, MavlinkVersion::V2, id, raw.payload(), start, total);
+            match check {
+                Check::Done(mut f, n) => {
+                    f.signed = signed;
+                    Check::Done(f, n)
+                }
+                other => other,
+            }
         } else {
             #[allow(clippy::arithmetic_side_effects)]
             let total = 1 + V1_HEADER + payload_len + CHECKSUM;
@@ -348,6 +370,7 @@ impl FrameParser {
                     header,
                     version,
                     message,
+                    signed: None,
                 },
                 total,
             ),

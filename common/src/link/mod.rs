@@ -5,4 +5,5 @@
 #![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
 
 pub mod framing;
+pub mod signing;
 pub mod simlink;

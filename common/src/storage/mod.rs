@@ -59,6 +59,18 @@ pub struct AbRegion {
 pub const PARAMS_MAGIC: u32 = 0x5052_4d31; // "PRM1"
 /// Magic of the mission record, format 1.
 pub const MISSION_MAGIC: u32 = 0x4d53_4e31; // "MSN1"
+/// Magic of the signing record (MAVLink 2 signing key and timestamp), format 1.
+pub const SIGNING_MAGIC: u32 = 0x5347_4e31; // "SGN1"
+
+/// The MAVLink 2 signing key and the signing clock when it was saved: a new boot carries on
+/// from that timestamp, so its frames are never older than the ones it signed before.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct SigningRecord {
+    /// The secret key; `None`: signing off.
+    pub key: Option<[u8; 32]>,
+    /// Signing clock, 10 us units since 2015-01-01.
+    pub timestamp: u64,
+}
 
 const HEADER_LEN: u32 = 16;
 

@@ -3,8 +3,9 @@
 //! snapshot and stores; the link's answers, telemetry and the vehicle's notices encoded into
 //! one outgoing buffer, each frame tagged with where it goes.
 
-use common::gcs::{Dest, GroundLink, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID};
+use common::gcs::{Dest, GroundLink, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID};
 use common::link::framing::{FrameParser, LinkStats, Sender};
+use common::link::signing;
 use common::vehicle::commander::Severity;
 use common::vehicle::{FromGround, Notice, Vehicle};
 use mavlink::dialects::common::MavSeverity;
@@ -65,6 +66,11 @@ impl GroundPort {
         &self.link
     }
 
+    /// MAVLink 2 signing of the link.
+    pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
+        self.link.signing_mut()
+    }
+
     /// Framing counters, every channel together.
     pub fn stats(&self) -> LinkStats {
         self.parsers
@@ -102,18 +108,17 @@ impl GroundPort {
             plan,
             rules,
         };
+        // Signed frames are checked against the key in force when they arrive.
+        parser.set_key(self.link.signing().key().copied());
         // Both callbacks answer through the link, one frame at a time, in order.
         let link = core::cell::RefCell::new(&mut self.link);
-        let mut on_frame = |frame: common::link::framing::Frame| {
+        let mut on_frame = |f: common::link::framing::Frame| {
             let mut link = link.borrow_mut();
-            link.handle(
-                &frame.header,
-                &frame.message,
-                now,
-                &snapshot,
-                &mut stores,
+            let origin = Origin {
                 channel,
-            )
+                signed: f.signed,
+            };
+            link.handle(&f.header, &f.message, now, &snapshot, &mut stores, origin)
         };
         let mut on_undecoded = |raw: common::link::framing::Undecoded<'_>| {
             let mut link = link.borrow_mut();
@@ -151,12 +156,30 @@ impl GroundPort {
             rules,
         };
         let (tx, buf, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
+        let mut outgoing = heapless::Vec::<(Dest, Outgoing), 64>::new();
         self.link.poll(now_us, &snapshot, &stores, |dest, msg| {
+            if outgoing.push((dest, msg)).is_err() {
+                *dropped = dropped.saturating_add(1);
+            }
+        });
+        for (dest, msg) in outgoing {
             let raw = match msg {
                 Outgoing::Message(m) => tx.encode(&m),
                 Outgoing::Ack(a) => tx.encode_data(&a),
             };
-            let frame = raw.raw_bytes();
+            // With signing on, every frame is signed; the link id says which channel.
+            let link_id = match dest {
+                Dest::All => 0,
+                Dest::Channel(c) => c,
+            };
+            let signed = match self.link.signing().key().copied() {
+                Some(key) => {
+                    let t = self.link.signing_mut().next_timestamp();
+                    signing::sign(raw.raw_bytes(), &key, link_id, t)
+                }
+                None => None,
+            };
+            let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
             let tag = match dest {
                 Dest::All => TO_ALL,
                 Dest::Channel(c) => c,
@@ -169,7 +192,7 @@ impl GroundPort {
             {
                 *dropped = dropped.saturating_add(frame.len() as u32);
             }
-        });
+        }
     }
 
     /// Hands out the frames waiting, one call per frame with where it goes, and empties the
