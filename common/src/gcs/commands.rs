@@ -170,6 +170,12 @@ impl GroundLink {
                 after = p;
                 r
             }
+            // QGroundControl 4 asks for it after AUTOPILOT_VERSION and falls back to MAVLink 1
+            // without an answer.
+            MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION => {
+                let _ = after.push(Pending::ProtocolVersion);
+                MavResult::MAV_RESULT_ACCEPTED
+            }
             MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
                 let _ = after.push(Pending::AutopilotVersion);
                 MavResult::MAV_RESULT_ACCEPTED
@@ -196,6 +202,8 @@ impl GroundLink {
     }
 
     /// `MAV_CMD_REQUEST_MESSAGE`: the result and, when accepted, what to send after the ACK.
+    // PROTOCOL_VERSION is deprecated in the dialect, yet QGroundControl 4 asks for it.
+    #[allow(deprecated)]
     fn request_message(&mut self, c: &Command, v: &VehicleSnapshot) -> (MavResult, After) {
         let mut after = After::new();
         let Some(id) = message_id(c.p[0]) else {
@@ -205,6 +213,7 @@ impl GroundLink {
             HEARTBEAT_DATA::ID => Some(Pending::Heartbeat),
             AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
             CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
+            PROTOCOL_VERSION_DATA::ID => Some(Pending::ProtocolVersion),
             AVAILABLE_MODES_DATA::ID => {
                 let n = FlightMode::ALL.len();
                 let index = c.p[1];

@@ -49,7 +49,7 @@ use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::VehicleRequests;
 use crate::vehicle::snapshot::VehicleSnapshot;
 use mission::{mission_message, MissionManager, MissionReply};
-use outbox::{Command, Pending, Text};
+use outbox::{Command, Pending, Text, TEXT_MAX};
 
 pub use outbox::{CommandAck, Outgoing};
 pub use peer::{Dest, Origin, Peer};
@@ -123,6 +123,8 @@ pub struct GroundLink {
     dropped: u32,
     rx_errors: u16,
     signing: Signing,
+    /// The `id` of the last status text sent in chunks.
+    text_id: u16,
 }
 
 impl Default for GroundLink {
@@ -148,6 +150,7 @@ impl GroundLink {
             dropped: 0,
             rx_errors: 0,
             signing: Signing::default(),
+            text_id: 0,
         }
     }
 
@@ -191,9 +194,10 @@ impl GroundLink {
         self.rx_errors = self.rx_errors.saturating_add(1);
     }
 
-    /// Queues a STATUSTEXT (event messages from the vehicle: failsafes, mode changes, ...).
-    /// Text longer than 50 bytes is cut; when the queue is full the message is dropped and
-    /// counted in [`GroundLink::dropped`].
+    /// Queues a status text (event messages from the vehicle: failsafes, mode changes, ...).
+    /// Text longer than 50 bytes goes out as STATUSTEXT chunks (MAVLink 2's `id` and
+    /// `chunk_seq`), up to 150 bytes; when the queue is full the text is dropped and counted in
+    /// [`GroundLink::dropped`].
     pub fn send_statustext(&mut self, severity: MavSeverity, text: &str) {
         let mut s = String::new();
         for c in text.chars() {
@@ -204,7 +208,7 @@ impl GroundLink {
         self.queue_text(severity, s);
     }
 
-    fn queue_text(&mut self, severity: MavSeverity, text: String<STATUSTEXT_LEN>) {
+    fn queue_text(&mut self, severity: MavSeverity, text: String<TEXT_MAX>) {
         if self.texts.push_back(Text { severity, text }).is_err() {
             self.dropped = self.dropped.wrapping_add(1);
         }
@@ -216,7 +220,7 @@ impl GroundLink {
     }
 
     fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
-        let mut s: String<STATUSTEXT_LEN> = String::new();
+        let mut s: String<TEXT_MAX> = String::new();
         // A text that does not fit is cut, never refused.
         let _ = s.write_fmt(args);
         self.queue_text(severity, s);
@@ -301,7 +305,7 @@ impl GroundLink {
             MavMessage::PARAM_REQUEST_READ(d) => {
                 self.on_param_read(d, stores.params, from);
             }
-            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params),
+            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params, from),
             MavMessage::MANUAL_CONTROL(d) => {
                 // Axes are -1000..1000 (throttle 0..1000); INT16_MAX marks an axis as unused.
                 let axis = |v: i16| {
@@ -498,13 +502,36 @@ impl GroundLink {
             }
         }
         while let Some(t) = self.texts.pop_front() {
-            let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
-                severity: t.severity,
-                text: t.text.as_str().into(),
-                id: 0,
-                chunk_seq: 0,
-            });
-            out(Dest::All, text);
+            let bytes = t.text.as_bytes();
+            if bytes.len() <= STATUSTEXT_LEN {
+                let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+                    severity: t.severity,
+                    text: t.text.as_str().into(),
+                    id: 0,
+                    chunk_seq: 0,
+                });
+                out(Dest::All, text);
+                continue;
+            }
+            // Chunks of one text share a non-zero id; the last is shorter than 50 bytes (its
+            // NUL ends the text), an empty one when the text fills its chunks exactly.
+            self.text_id = self.text_id.wrapping_add(1).max(1);
+            let chunks = bytes.len() / STATUSTEXT_LEN + 1;
+            for (seq, start) in (0..chunks).map(|i| (i, i.saturating_mul(STATUSTEXT_LEN))) {
+                let part = bytes.get(start..).unwrap_or(&[]);
+                let part = part.get(..STATUSTEXT_LEN).unwrap_or(part);
+                let mut text = [0u8; STATUSTEXT_LEN];
+                for (d, b) in text.iter_mut().zip(part) {
+                    *d = *b;
+                }
+                let chunk = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+                    severity: t.severity,
+                    text: text.into(),
+                    id: self.text_id,
+                    chunk_seq: seq as u8,
+                });
+                out(Dest::All, chunk);
+            }
         }
         if let Some((reply, to)) = self.missions.poll(now_us) {
             self.emit(
@@ -586,6 +613,28 @@ impl GroundLink {
         match p {
             // Sent as raw data by `poll`.
             Pending::Unsupported { .. } => {}
+            Pending::ParamError {
+                index,
+                name,
+                error,
+                to,
+            } => out(MavMessage::PARAM_ERROR(PARAM_ERROR_DATA {
+                param_index: index,
+                target_system: to.system,
+                target_component: to.component,
+                param_id: name.into(),
+                error,
+            })),
+            // Deprecated in the dialect since 2025, but QGroundControl 4 still asks for it.
+            #[allow(deprecated)]
+            Pending::ProtocolVersion => out(MavMessage::PROTOCOL_VERSION(PROTOCOL_VERSION_DATA {
+                // MAVLink 2 spoken (and sent); MAVLink 1 frames still read.
+                version: 200,
+                min_version: 100,
+                max_version: 200,
+                spec_version_hash: [0; 8],
+                library_version_hash: [0; 8],
+            })),
             Pending::Ack {
                 command,
                 result,

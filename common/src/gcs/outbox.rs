@@ -6,19 +6,21 @@ use super::streams::Stream;
 use crate::vehicle::modes::FlightMode;
 use heapless::String;
 use mavlink::dialects::common::{
-    MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, COMMAND_INT_DATA,
+    MavCmd, MavMessage, MavParamError, MavResult, MavSeverity, COMMAND_ACK_DATA, COMMAND_INT_DATA,
     COMMAND_LONG_DATA,
 };
 use mavlink::{MavlinkVersion, MessageData};
 
-/// Longest STATUSTEXT text.
+/// Longest text one STATUSTEXT carries; a longer one goes out in chunks.
 pub const STATUSTEXT_LEN: usize = 50;
+/// Longest status text the link keeps (three chunks).
+pub const TEXT_MAX: usize = 3 * STATUSTEXT_LEN;
 
 /// A STATUSTEXT waiting to be sent.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Text {
     pub severity: MavSeverity,
-    pub text: String<STATUSTEXT_LEN>,
+    pub text: String<TEXT_MAX>,
 }
 
 /// Something to send at the next poll.
@@ -35,6 +37,14 @@ pub(crate) enum Pending {
         to: Peer,
     },
     ParamValue(u16),
+    /// `PARAM_ERROR` for a name or an index, to the asker.
+    ParamError {
+        index: i16,
+        name: [u8; 16],
+        error: MavParamError,
+        to: Peer,
+    },
+    ProtocolVersion,
     Mission(MissionReply, Peer),
     MissionCurrent(Option<u16>),
     ItemReached(u16),

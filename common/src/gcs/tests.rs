@@ -2135,3 +2135,125 @@ fn a_nan_message_interval_is_denied_and_the_rate_kept() {
     let n = count_over(&mut l, &v, 1_000, 10, 30);
     assert!(n.abs_diff(150) <= 1, "default gave {n}");
 }
+
+#[test]
+#[allow(deprecated)] // PROTOCOL_VERSION: deprecated in the dialect, still asked for by QGC 4.
+fn protocol_version_is_answered_both_ways_with_mavlink_2() {
+    let mut l = link();
+    let v = healthy();
+    for msg in [
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [300.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    ] {
+        let out = exchange(&mut l, &v, 0, msg);
+        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+        let pv = out.iter().find_map(|m| match m {
+            MavMessage::PROTOCOL_VERSION(p) => Some(p.clone()),
+            _ => None,
+        });
+        let pv = pv.expect("PROTOCOL_VERSION after the ACK");
+        assert_eq!(
+            (pv.version, pv.min_version, pv.max_version),
+            (200, 100, 200)
+        );
+    }
+}
+
+#[test]
+fn a_long_status_text_goes_out_in_chunks_a_station_can_join() {
+    let mut l = link();
+    let v = healthy();
+    let long: std::string::String = (0..120)
+        .map(|i| char::from(b'a' + (i % 26) as u8))
+        .collect();
+    l.send_statustext(MavSeverity::MAV_SEVERITY_WARNING, &long);
+    let exact: std::string::String = "x".repeat(100);
+    l.send_statustext(MavSeverity::MAV_SEVERITY_INFO, &exact);
+    let chunks: Vec<STATUSTEXT_DATA> = poll(&mut l, &v, 0)
+        .into_iter()
+        .filter_map(|m| match m {
+            MavMessage::STATUSTEXT(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    // 120 bytes: 50, 50 and 20 (NUL-terminated); 100 bytes: 50, 50 and an empty closing chunk.
+    assert_eq!(chunks.len(), 6);
+    let (a, b) = chunks.split_at(3);
+    assert!(a.iter().all(|c| c.id == a[0].id) && a[0].id != 0);
+    assert!(b.iter().all(|c| c.id == b[0].id) && b[0].id != a[0].id);
+    assert_eq!(a.iter().map(|c| c.chunk_seq).collect::<Vec<_>>(), [0, 1, 2]);
+    // Joined as QGroundControl joins them: up to the first NUL.
+    let join = |cs: &[STATUSTEXT_DATA]| -> std::string::String {
+        let bytes: Vec<u8> = cs.iter().flat_map(|c| c.text.iter().copied()).collect();
+        let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+        std::string::String::from_utf8(bytes[..end].to_vec()).unwrap()
+    };
+    assert_eq!(join(a), long);
+    assert_eq!(join(b), exact);
+    assert_eq!(b[2].text[0], 0);
+}
+
+fn param_errors(out: &[MavMessage]) -> Vec<(i16, MavParamError)> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::PARAM_ERROR(e) => Some((e.param_index, e.error)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn unknown_names_and_refused_values_get_a_param_error() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        param_set("NO_SUCH", 1.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(-1, MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST)]
+    );
+    let read = MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+        param_index: -1,
+        target_system: 1,
+        target_component: 1,
+        param_id: "NO_SUCH".into(),
+    });
+    let out = exchange(&mut l, &v, 1, read);
+    assert_eq!(
+        param_errors(&out),
+        [(-1, MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST)]
+    );
+    // Out of bounds: PARAM_ERROR with its index, and the echo of the value kept.
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        param_set("RLL_KP", 9.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(0, MavParamError::MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)]
+    );
+    assert_eq!(param_values(&out)[0].param_value, 0.8);
+    // The wrong type for a real.
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        param_set("RLL_KP", 1.0, MavParamType::MAV_PARAM_TYPE_UINT8),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(0, MavParamError::MAV_PARAM_ERROR_TYPE_MISMATCH)]
+    );
+}
