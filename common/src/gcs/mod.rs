@@ -516,7 +516,7 @@ impl GroundLink {
             // Chunks of one text share a non-zero id; the last is shorter than 50 bytes (its
             // NUL ends the text), an empty one when the text fills its chunks exactly.
             self.text_id = self.text_id.wrapping_add(1).max(1);
-            let chunks = bytes.len() / STATUSTEXT_LEN + 1;
+            let chunks = (bytes.len() / STATUSTEXT_LEN).saturating_add(1);
             for (seq, start) in (0..chunks).map(|i| (i, i.saturating_mul(STATUSTEXT_LEN))) {
                 let part = bytes.get(start..).unwrap_or(&[]);
                 let part = part.get(..STATUSTEXT_LEN).unwrap_or(part);
