@@ -8,41 +8,12 @@ a ground station (255/190) and prints one line per check; exits 0 when every che
   4. an unsigned PARAM_SET from a second station is refused (the value stays);
   5. a signed PARAM_SET replayed byte for byte is refused (the value stays).
 """
-import os
-import sys
 import time
 
-os.environ["MAVLINK20"] = "1"
-from pymavlink import mavutil  # noqa: E402
+from station import MAV, check, connect, finish, wait
 
-PORT = int(sys.argv[1])
-KEY = bytes(range(32))
 NAME = b"NAV_LOIT_RAD"
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what, flush=True)
-    if not ok:
-        failures.append(what)
-
-
-def connect():
-    m = mavutil.mavlink_connection(
-        f"udpout:127.0.0.1:{PORT}", source_system=255, source_component=190
-    )
-    m.mav.heartbeat_send(6, 8, 0, 0, 0)
-    return m
-
-
-def wait(m, kind, cond=lambda msg: True, secs=5.0):
-    end = time.time() + secs
-    while time.time() < end:
-        msg = m.recv_match(type=kind, blocking=True, timeout=0.2)
-        if msg is not None and cond(msg):
-            return msg
-        m.mav.heartbeat_send(6, 8, 0, 0, 0)
-    return None
+KEY = bytes(range(32))
 
 
 def drain(m, secs=0.5):
@@ -60,7 +31,7 @@ def param_value(m, secs=3.0):
 
 
 def param_set(m, value):
-    m.mav.param_set_send(1, 1, NAME, value, mavutil.mavlink.MAV_PARAM_TYPE_REAL32)
+    m.mav.param_set_send(1, 1, NAME, value, MAV.MAV_PARAM_TYPE_REAL32)
 
 
 gcs = connect()
@@ -81,12 +52,12 @@ param_set(gcs, 61.0)
 check(param_value(gcs) == 61.0, "a signed PARAM_SET is taken")
 
 intruder = connect()
-intruder.mav.param_set_send(1, 1, NAME, 77.0, mavutil.mavlink.MAV_PARAM_TYPE_REAL32)
+intruder.mav.param_set_send(1, 1, NAME, 77.0, MAV.MAV_PARAM_TYPE_REAL32)
 check(param_value(gcs) == 61.0, "an unsigned PARAM_SET is refused")
 
 # A signed frame recorded on the wire and sent again later.
 recorded = gcs.mav.param_set_encode(
-    1, 1, NAME, 62.0, mavutil.mavlink.MAV_PARAM_TYPE_REAL32
+    1, 1, NAME, 62.0, MAV.MAV_PARAM_TYPE_REAL32
 ).pack(gcs.mav)
 gcs.write(recorded)
 check(param_value(gcs) == 62.0, "the recorded frame is taken the first time")
@@ -95,4 +66,4 @@ check(param_value(gcs) == 63.0, "a newer signed PARAM_SET is taken")
 gcs.write(recorded)
 check(param_value(gcs) == 63.0, "the replayed frame is refused")
 
-sys.exit(1 if failures else 0)
+finish()

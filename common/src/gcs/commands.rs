@@ -214,6 +214,9 @@ impl GroundLink {
             AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
             CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
             PROTOCOL_VERSION_DATA::ID => Some(Pending::ProtocolVersion),
+            COMPONENT_METADATA_DATA::ID if self.ftp.general().is_some() => {
+                Some(Pending::ComponentMetadata)
+            }
             AVAILABLE_MODES_DATA::ID => {
                 let n = FlightMode::ALL.len();
                 let index = c.p[1];
@@ -355,13 +358,16 @@ impl GroundLink {
                          // the design names it and older ground stations look for it.
     pub(super) fn autopilot_version(&self) -> MavMessage {
         type C = MavProtocolCapability;
-        let capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        let mut capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
             | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
             | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
             | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_RALLY;
+        if !self.ftp.files().is_empty() {
+            capabilities |= C::MAV_PROTOCOL_CAPABILITY_FTP;
+        }
         MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
             capabilities,
             uid: self.cfg.uid,

@@ -22,6 +22,7 @@
 
 pub mod client;
 pub mod commands;
+pub mod ftp;
 pub mod mission;
 pub mod modes;
 pub mod outbox;
@@ -82,6 +83,9 @@ pub struct LinkConfig {
     pub params_per_poll: u8,
     /// Hardware unique id reported in `AUTOPILOT_VERSION` (0 when unknown).
     pub uid: u64,
+    /// The files served over MAVLink FTP; with a `general.json` among them, the link answers
+    /// requests for `COMPONENT_METADATA` with its URI.
+    pub files: &'static [ftp::File],
 }
 
 impl Default for LinkConfig {
@@ -91,6 +95,7 @@ impl Default for LinkConfig {
             component_id: COMPONENT_ID,
             params_per_poll: 4,
             uid: 0,
+            files: &[],
         }
     }
 }
@@ -125,6 +130,7 @@ pub struct GroundLink {
     signing: Signing,
     /// The `id` of the last status text sent in chunks.
     text_id: u16,
+    ftp: ftp::Ftp,
 }
 
 impl Default for GroundLink {
@@ -151,6 +157,7 @@ impl GroundLink {
             rx_errors: 0,
             signing: Signing::default(),
             text_id: 0,
+            ftp: ftp::Ftp::new(cfg.files),
         }
     }
 
@@ -293,6 +300,9 @@ impl GroundLink {
                     "Signing off"
                 };
                 self.send_statustext(MavSeverity::MAV_SEVERITY_INFO, text);
+            }
+            MavMessage::FILE_TRANSFER_PROTOCOL(d) if d.target_network == 0 => {
+                self.ftp.handle(d, from, now_us);
             }
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
                 self.gcs_last_seen_us = Some(now_us);
@@ -494,6 +504,10 @@ impl GroundLink {
         }
         let mut out_msg = |d, m| out_raw(d, Outgoing::Message(m));
         let out = &mut out_msg;
+        let mut budget = ftp::BURST_PER_POLL;
+        while let Some((m, to)) = self.ftp.next(&mut budget) {
+            out(to.dest(), m);
+        }
         if now_us >= self.next_heartbeat_us {
             out(Dest::All, telemetry::heartbeat(v));
             self.next_heartbeat_us = self.next_heartbeat_us.saturating_add(HEARTBEAT_INTERVAL_US);
@@ -635,6 +649,15 @@ impl GroundLink {
                 spec_version_hash: [0; 8],
                 library_version_hash: [0; 8],
             })),
+            Pending::ComponentMetadata => {
+                if let Some(f) = self.ftp.general() {
+                    out(MavMessage::COMPONENT_METADATA(COMPONENT_METADATA_DATA {
+                        time_boot_ms: (now_us / 1000) as u32,
+                        file_crc: ftp::file_crc(f.bytes),
+                        uri: ftp::uri(f).as_str().into(),
+                    }));
+                }
+            }
             Pending::Ack {
                 command,
                 result,

@@ -45,6 +45,8 @@ pub(crate) enum Pending {
         to: Peer,
     },
     ProtocolVersion,
+    /// `COMPONENT_METADATA`: where the general metadata file is.
+    ComponentMetadata,
     Mission(MissionReply, Peer),
     MissionCurrent(Option<u16>),
     ItemReached(u16),

@@ -2257,3 +2257,104 @@ fn unknown_names_and_refused_values_get_a_param_error() {
         [(0, MavParamError::MAV_PARAM_ERROR_TYPE_MISMATCH)]
     );
 }
+
+static GENERAL_JSON: &[u8] = br#"{"version":1,"metadataTypes":[]}"#;
+static FILES: [super::ftp::File; 1] = [super::ftp::File {
+    name: super::ftp::GENERAL,
+    bytes: GENERAL_JSON,
+}];
+
+fn ftp_request(seq: u16, opcode: u8, data: &[u8]) -> MavMessage {
+    let mut payload = [0u8; 251];
+    payload[..2].copy_from_slice(&seq.to_le_bytes());
+    payload[3] = opcode;
+    payload[4] = data.len() as u8;
+    payload[12..12 + data.len()].copy_from_slice(data);
+    MavMessage::FILE_TRANSFER_PROTOCOL(FILE_TRANSFER_PROTOCOL_DATA {
+        target_network: 0,
+        target_system: 1,
+        target_component: 1,
+        payload,
+    })
+}
+
+/// `MAV_CMD_REQUEST_MESSAGE` for message `id`.
+fn request(id: f32) -> MavMessage {
+    cmd_long(
+        MavCmd::MAV_CMD_REQUEST_MESSAGE,
+        [id, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    )
+}
+
+/// The capabilities of the `AUTOPILOT_VERSION` among `out`.
+fn capabilities(out: &[MavMessage]) -> MavProtocolCapability {
+    let caps = out.iter().find_map(|m| match m {
+        MavMessage::AUTOPILOT_VERSION(d) => Some(d.capabilities),
+        _ => None,
+    });
+    caps.expect("AUTOPILOT_VERSION after the ACK")
+}
+
+#[test]
+fn component_metadata_points_to_the_general_file_which_ftp_serves_to_the_asker() {
+    let mut l = link();
+    l.link = GroundLink::new(LinkConfig {
+        files: &FILES,
+        ..LinkConfig::default()
+    });
+    let v = healthy();
+    let out = exchange(&mut l, &v, 2_000_000, request(397.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    let meta = out.iter().find_map(|m| match m {
+        MavMessage::COMPONENT_METADATA(d) => Some(d.clone()),
+        _ => None,
+    });
+    let meta = meta.expect("COMPONENT_METADATA after the ACK");
+    assert_eq!(meta.uri.to_str().unwrap(), "mftp://general.json");
+    assert_eq!(meta.file_crc, super::ftp::file_crc(GENERAL_JSON));
+    assert_eq!(meta.time_boot_ms, 2000);
+    // The deprecated COMPONENT_INFORMATION is not served: QGroundControl moves on at once.
+    let out = exchange(&mut l, &v, 2_000_000, request(395.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    // AUTOPILOT_VERSION says FTP is spoken.
+    let out = exchange(&mut l, &v, 2_000_000, request(148.0));
+    assert!(capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
+    // The file opens for the station on channel 2 and its answer goes there only.
+    l.handle_on(
+        2,
+        &hdr(),
+        &ftp_request(7, 4, b"/general.json"),
+        2_000_000,
+        &v,
+    );
+    let mut answers = Vec::new();
+    l.poll_to(2_000_000, &v, |d, m| {
+        if let MavMessage::FILE_TRANSFER_PROTOCOL(f) = m {
+            answers.push((d, f));
+        }
+    });
+    assert_eq!(answers.len(), 1);
+    let (dest, f) = &answers[0];
+    assert_eq!(*dest, Dest::Channel(2));
+    // Sequence plus one, ACK, four bytes of length.
+    assert_eq!(
+        (
+            u16::from_le_bytes([f.payload[0], f.payload[1]]),
+            f.payload[3]
+        ),
+        (8, 128)
+    );
+    let len = u32::from_le_bytes([f.payload[12], f.payload[13], f.payload[14], f.payload[15]]);
+    assert_eq!(len as usize, GENERAL_JSON.len());
+    assert_eq!((f.target_system, f.target_component), GCS);
+}
+
+#[test]
+fn without_served_files_component_metadata_is_unsupported_and_ftp_not_claimed() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(&mut l, &v, 0, request(397.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    let out = exchange(&mut l, &v, 0, request(148.0));
+    assert!(!capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
+}

@@ -3,7 +3,10 @@
 //! snapshot and stores; the link's answers, telemetry and the vehicle's notices encoded into
 //! one outgoing buffer, each frame tagged with where it goes.
 
-use common::gcs::{Dest, GroundLink, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID};
+use common::gcs::ftp::{self, File};
+use common::gcs::{
+    Dest, GroundLink, LinkConfig, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID,
+};
 use common::link::framing::{FrameParser, LinkStats, Sender};
 use common::link::signing;
 use common::vehicle::commander::Severity;
@@ -21,6 +24,19 @@ pub const CHANNELS: usize = 1;
 /// to eight more that spoke first (see `sitl::GcsUdp`).
 #[cfg(not(target_os = "none"))]
 pub const CHANNELS: usize = 9;
+
+/// The files served over MAVLink FTP: the component metadata the build script generated from
+/// the parameter registry (`build.rs`).
+pub static FILES: [File; 2] = [
+    File {
+        name: ftp::GENERAL,
+        bytes: include_bytes!(concat!(env!("OUT_DIR"), "/general.json")),
+    },
+    File {
+        name: "parameters.json.xz",
+        bytes: include_bytes!(concat!(env!("OUT_DIR"), "/parameters.json.xz")),
+    },
+];
 
 /// Tag of a frame for every channel in the output buffer.
 const TO_ALL: u8 = 0xFF;
@@ -55,7 +71,10 @@ impl GroundPort {
         Self {
             parsers: core::array::from_fn(|_| FrameParser::new()),
             tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
-            link: GroundLink::default(),
+            link: GroundLink::new(LinkConfig {
+                files: &FILES,
+                ..LinkConfig::default()
+            }),
             out: heapless::Vec::new(),
             bytes_dropped: 0,
         }
