@@ -134,8 +134,13 @@ impl SensorSuite {
         self.gyro_bias += gauss3(&mut self.rng_imu, [walk; 3]);
         let gyro_sigma = cfg.gyro_noise_power.map(|p| sigma(p, ts));
         let accel_sigma = cfg.accel_noise_power.map(|p| sigma(p, ts));
-        let gyro = t.omega_body + self.gyro_bias + gauss3(&mut self.rng_imu, gyro_sigma);
-        let accel = t.specific_force_body
+        let cal = &cfg.calibration;
+        let gyro = t.omega_body.component_mul(&Vector3::from(cal.gyro_scale))
+            + self.gyro_bias
+            + gauss3(&mut self.rng_imu, gyro_sigma);
+        let accel = t
+            .specific_force_body
+            .component_mul(&Vector3::from(cal.accel_scale))
             + Vector3::from(cfg.accel_bias_mps2)
             + gauss3(&mut self.rng_imu, accel_sigma);
         let mut out = SensorFrame {
@@ -155,6 +160,7 @@ impl SensorSuite {
             let ts = n as f64 / fr;
             let s = cfg.mag_noise_power_nt.map(|p| sigma(p, ts) * 1e-5);
             let field = ned_to_body(&t.attitude, &Vector3::from(cfg.mag_field_ned_gauss))
+                + Vector3::from(cfg.calibration.mag_offset_gauss)
                 + gauss3(&mut self.rng_mag, s);
             out.mag = Some(MagSample {
                 field: field.cast(),
@@ -174,8 +180,9 @@ impl SensorSuite {
             let ts = n as f64 / fr;
             let noise_pa = sigma(cfg.pd_noise_power_kpa, ts) * 1e3 * gauss(&mut self.rng_pitot);
             let q = 0.5 * air.density * t.airspeed_mps * t.airspeed_mps;
+            let cal = &cfg.calibration;
             out.pitot = Some(PitotSample {
-                diff_pressure_pa: (q + noise_pa) as f32,
+                diff_pressure_pa: (cal.pitot_scale * q + cal.pitot_offset_pa + noise_pa) as f32,
             });
         }
 
@@ -183,7 +190,15 @@ impl SensorSuite {
         let g = &cfg.gps;
         let n = decimation(fr, g.rate_hz);
         if frame.is_multiple_of(n) {
-            let p = t.pos_ned + gauss3(&mut self.rng_gps, [g.horiz_m, g.horiz_m, g.vert_m]);
+            // The receiver's start-up error fades as its solution converges.
+            let startup = if g.startup_tau_s > 0.0 {
+                Vector3::from(g.startup_offset_m)
+                    * (-(time_us as f64 * 1e-6) / g.startup_tau_s).exp()
+            } else {
+                Vector3::zeros()
+            };
+            let p =
+                t.pos_ned + startup + gauss3(&mut self.rng_gps, [g.horiz_m, g.horiz_m, g.vert_m]);
             let v = t.vel_ned + gauss3(&mut self.rng_gps, [g.vel_mps; 3]);
             let fix = GpsFix {
                 position: offset_point(self.home, p.x, p.y),
