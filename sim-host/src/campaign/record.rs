@@ -439,3 +439,67 @@ pub fn fly_record(plan: &Plan, reproduce: String) -> (FlightRecord, Option<Fligh
     };
     (record, flown.ok().map(|f| f.0))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plant::ground::rest_state;
+    use crate::plant::ModelParams;
+
+    fn at_rest(a: &Aircraft) -> Sample {
+        let (state, _) = rest_state(&ModelParams::new(a), 0.0, 0.0, 0.0);
+        let e = Euler::from_quaternion(&state.attitude);
+        Sample {
+            alt: a.environment.home_alt_msl_m - state.pos_ned.z,
+            roll: e.phi,
+            pitch: e.theta,
+            yaw: e.psi,
+            ..Sample::default()
+        }
+    }
+
+    #[test]
+    fn at_rest_every_non_wheel_point_clears_the_runway_and_a_20_degree_roll_puts_a_tip_on_it() {
+        let a = Aircraft::ultrastick25e().unwrap();
+        let points = strike_points(&a, propeller_hub_m(&a, [0.0; 3]));
+        let home = a.environment.home_alt_msl_m;
+        let rest = at_rest(&a);
+        for p in &points {
+            let c = clearance(&rest, home, p);
+            // The tail skid sits 5 cm up in the three-point attitude; the propeller more.
+            assert!(c > 0.04, "{}: {c}", p.name);
+        }
+        // The tips are 0.635 m out and 0.16 m up: the ground is reached at asin(0.16/0.635),
+        // about 14.6 degrees.
+        let rolled = Sample {
+            roll: 20f64.to_radians(),
+            ..rest
+        };
+        let tip = points.iter().find(|p| p.name.starts_with("right wing tip")).unwrap();
+        assert!(clearance(&rolled, home, tip) < 0.0);
+        assert!(on_ground(&rest, &a, home));
+    }
+
+    #[test]
+    fn the_propeller_disc_reaches_its_radius_below_the_hub_whatever_the_roll() {
+        let a = Aircraft::ultrastick25e().unwrap();
+        let hub = propeller_hub_m(&a, [0.0; 3]);
+        assert!(hub[0] > 0.25, "a tractor's propeller is ahead of the CG: {hub:?}");
+        let p = Point {
+            name: "propeller".into(),
+            body: Vector3::from(hub),
+            disc_radius: 0.1524,
+        };
+        let level = Sample {
+            alt: 1.0,
+            ..Sample::default()
+        };
+        let rolled = Sample {
+            roll: 0.7,
+            ..level
+        };
+        let expect = 1.0 - hub[2] - 0.1524;
+        assert!((clearance(&level, 0.0, &p) - expect).abs() < 1e-12);
+        assert!((clearance(&rolled, 0.0, &p) - clearance(&level, 0.0, &p)).abs() < 0.05);
+    }
+}

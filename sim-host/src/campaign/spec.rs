@@ -329,7 +329,7 @@ impl CampaignSpec {
                     file: file.to_path_buf(),
                     key,
                     value,
-                    reason: e.into_inner().to_string(),
+                    reason: e.into_inner().message().to_string(),
                 }
             })?;
         spec.validate(file)?;

@@ -224,6 +224,7 @@ impl SensorSuite {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use common::math::geodetic::ned_offset;
 
     fn level_truth() -> Truth {
         Truth {
@@ -290,6 +291,49 @@ mod tests {
         assert!(times.len() >= 24);
         let mean = alts.iter().sum::<f32>() / alts.len() as f32;
         assert!((mean - 350.0).abs() < 3.0, "GPS altitude {mean}");
+    }
+
+    #[test]
+    fn calibration_errors_scale_and_offset_the_readings_and_the_gps_start_up_offset_fades() {
+        let mut cfg = SensorConfig::default();
+        // Noise and bias off, to read the calibration alone.
+        cfg.gyro_noise_power = [0.0; 3];
+        cfg.accel_noise_power = [0.0; 3];
+        cfg.gyro_bias_radps = [0.0; 3];
+        cfg.gyro_bias_walk = 0.0;
+        cfg.accel_bias_mps2 = [0.0; 3];
+        cfg.pd_noise_power_kpa = 0.0;
+        cfg.gps.horiz_m = 0.0;
+        cfg.gps.vert_m = 0.0;
+        cfg.gps.latency_s = 0.0;
+        cfg.calibration.accel_scale = [1.0, 1.0, 1.02];
+        cfg.calibration.gyro_scale = [1.1, 1.0, 1.0];
+        cfg.calibration.pitot_scale = 0.9;
+        cfg.calibration.pitot_offset_pa = 2.0;
+        cfg.gps.startup_offset_m = [4.0, 0.0, 0.0];
+        cfg.gps.startup_tau_s = 10.0;
+        let mut s = SensorSuite::new(cfg, GeoPoint::from_deg(44.7, -93.0), 0.0, 3);
+        let t = Truth {
+            omega_body: Vector3::new(0.1, 0.0, 0.0),
+            ..level_truth()
+        };
+        let (f, fix) = s.sample(&t);
+        let imu = f.imu.unwrap();
+        assert!((f64::from(imu.accel.z) + 9.8056 * 1.02).abs() < 1e-4);
+        assert!((f64::from(imu.gyro.x) - 0.11).abs() < 1e-6);
+        // 0.9 * 175.32 Pa + 2 Pa.
+        let dp = f64::from(f.pitot.unwrap().diff_pressure_pa);
+        assert!((dp - (0.9 * 175.32 + 2.0)).abs() < 0.05, "{dp}");
+        let north = |fix: GpsFix| ned_offset::<f64>(GeoPoint::from_deg(44.7, -93.0), fix.position).0;
+        assert!((north(fix.unwrap()) - 4.0).abs() < 0.02);
+        // 10 s later, one time constant: 4/e.
+        let mut last = None;
+        for _ in 0..1000 {
+            if let (_, Some(x)) = s.sample(&t) {
+                last = Some(x);
+            }
+        }
+        assert!((north(last.unwrap()) - 4.0 / std::f64::consts::E).abs() < 0.05);
     }
 
     #[test]
