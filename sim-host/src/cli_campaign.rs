@@ -153,8 +153,15 @@ pub(crate) fn campaign_command(
     let t = &run.timing;
     // Wall-clock figures go to standard error and timing.json, never into the report.
     eprintln!(
-        "{} flights in {:.1} s on {} threads: {:.2} flights/s, {:.3} flights/s per thread",
-        t.flights, t.wall_s, t.threads, t.flights_per_s, t.flights_per_s_per_thread
+        "{} flights in {:.1} s on {} threads: {:.2} flights/s, {:.3} flights/s per thread; \
+         {:.1} s of CPU: {:.3} flights per CPU-second",
+        t.flights,
+        t.wall_s,
+        t.threads,
+        t.flights_per_s,
+        t.flights_per_s_per_thread,
+        t.cpu_s,
+        t.flights_per_cpu_s
     );
     if r.json {
         emit(&to_json(&run.report)?)?;

@@ -44,7 +44,10 @@ fn an_unknown_key_is_refused_with_the_file_the_key_and_the_value() {
         msg.contains("runs/wind.toml") && msg.contains("`wind.gusts_kt`") && msg.contains("12"),
         "{msg}"
     );
-    assert!(msg.contains("unknown key") && msg.contains("speed_mps"), "{msg}");
+    assert!(
+        msg.contains("unknown key") && msg.contains("speed_mps"),
+        "{msg}"
+    );
     let msg = refused("[weather]\nrain = true\n");
     assert!(msg.contains("`weather`"), "{msg}");
 }
@@ -60,23 +63,38 @@ fn a_negative_spread_is_refused_with_the_file_the_key_and_the_value() {
         "{msg}"
     );
     let msg = refused("[mass]\ncg_shift_m = [0.01, -0.002, 0.0]\n");
-    assert!(msg.contains("`mass.cg_shift_m[1]`") && msg.contains("-0.002"), "{msg}");
+    assert!(
+        msg.contains("`mass.cg_shift_m[1]`") && msg.contains("-0.002"),
+        "{msg}"
+    );
 }
 
 #[test]
 fn an_impossible_range_is_refused_with_the_file_the_key_and_the_value() {
     let msg = refused("[wind]\nspeed_mps = [8, 2]\n");
-    assert!(msg.contains("`wind.speed_mps`") && msg.contains("[8, 2]"), "{msg}");
+    assert!(
+        msg.contains("`wind.speed_mps`") && msg.contains("[8, 2]"),
+        "{msg}"
+    );
     // More wind than the simulator flies in.
     let msg = refused("[wind]\nspeed_mps = [0, 30]\n");
-    assert!(msg.contains("`wind.speed_mps`") && msg.contains("0..15"), "{msg}");
+    assert!(
+        msg.contains("`wind.speed_mps`") && msg.contains("0..15"),
+        "{msg}"
+    );
     let msg = refused("[wind]\nturbulence = [\"light\", \"gale\"]\n");
-    assert!(msg.contains("`wind.turbulence[1]`") && msg.contains("gale"), "{msg}");
+    assert!(
+        msg.contains("`wind.turbulence[1]`") && msg.contains("gale"),
+        "{msg}"
+    );
     // A spread that would flip a coefficient's sign.
     let msg = refused("[aero]\ncoefficient_spread = 1.5\n");
     assert!(msg.contains("1.5") && msg.contains("at most"), "{msg}");
     let msg = refused("[sensors]\ngps_latency_s = \"long\"\n");
-    assert!(msg.contains("`sensors.gps_latency_s`") && msg.contains("long"), "{msg}");
+    assert!(
+        msg.contains("`sensors.gps_latency_s`") && msg.contains("long"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -88,7 +106,10 @@ fn a_flights_draws_follow_from_the_seed_and_its_index_alone() {
     assert_eq!(a.flight_seed, b.flight_seed);
     assert_eq!(a.aircraft, b.aircraft);
     assert_ne!(small.plan(6).draws, a.draws);
-    assert_ne!(campaign(10, 8, MissionChoice::Default).plan(5).draws, a.draws);
+    assert_ne!(
+        campaign(10, 8, MissionChoice::Default).plan(5).draws,
+        a.draws
+    );
     // Taking a spread away leaves every other quantity's draw as it was.
     let mut calm_aero = campaign(10, 7, MissionChoice::Default);
     calm_aero.spec.aero.coefficient_spread = 0.0;
@@ -117,7 +138,12 @@ fn every_dispersed_aircraft_of_a_thousand_flights_is_a_valid_aircraft_within_its
         // Into the wind: the landing never has a tailwind.
         let hw = p.draws.get("derived.headwind_mps").unwrap();
         assert!(hw >= -1e-9, "flight {i}: headwind {hw}");
-        assert!(p.config.script.params.iter().all(|(n, _)| n == "EKF_GPS_DELAY"));
+        assert!(p
+            .config
+            .script
+            .params
+            .iter()
+            .all(|(n, _)| n == "EKF_GPS_DELAY"));
     }
 }
 
@@ -129,15 +155,30 @@ fn a_generated_mission_takes_off_and_lands_along_its_runway() {
         let hdg = p.config.runway_heading.unwrap();
         let l = p.landing.unwrap();
         let d = (l.direction_rad - hdg).sin().abs() + (1.0 - (l.direction_rad - hdg).cos());
-        assert!(d < 1e-3, "flight {i}: lands at {} on a runway of {hdg}", l.direction_rad);
-        assert!(l.point_ne.0.hypot(l.point_ne.1) < 0.05, "flight {i}: {:?}", l.point_ne);
+        assert!(
+            d < 1e-3,
+            "flight {i}: lands at {} on a runway of {hdg}",
+            l.direction_rad
+        );
+        assert!(
+            l.point_ne.0.hypot(l.point_ne.1) < 0.05,
+            "flight {i}: {:?}",
+            l.point_ne
+        );
         let items = &p.config.script.mission;
-        assert_eq!(items[0].command, mavlink::dialects::common::MavCmd::MAV_CMD_NAV_TAKEOFF);
+        assert_eq!(
+            items[0].command,
+            mavlink::dialects::common::MavCmd::MAV_CMD_NAV_TAKEOFF
+        );
         assert!(items.len() >= 10);
         assert!(p.draws.get("mission.length_m").is_some());
     }
     // The default mission records no generated numbers.
-    assert!(campaign(5, 3, MissionChoice::Default).plan(0).draws.get("mission.length_m").is_none());
+    assert!(campaign(5, 3, MissionChoice::Default)
+        .plan(0)
+        .draws
+        .get("mission.length_m")
+        .is_none());
 }
 
 #[test]
@@ -175,8 +216,14 @@ fn merged_shards_equal_the_unsharded_campaign_byte_for_byte() {
     let merged = dir.path().join("merged");
     merge(&shards, &merged).unwrap();
     for f in RESULT_FILES {
-        let (a, b) = (std::fs::read(whole.join(f)).unwrap(), std::fs::read(merged.join(f)).unwrap());
-        assert!(a == b, "{f} differs between the unsharded and the merged campaign");
+        let (a, b) = (
+            std::fs::read(whole.join(f)).unwrap(),
+            std::fs::read(merged.join(f)).unwrap(),
+        );
+        assert!(
+            a == b,
+            "{f} differs between the unsharded and the merged campaign"
+        );
     }
     let (_, back) = read_campaign(&whole).unwrap();
     let (again, _) = c.fly(1);
@@ -200,11 +247,20 @@ fn merge_refuses_a_shard_of_another_campaign_a_missing_one_and_one_given_twice()
     let s0 = write("a0", &a, Shard { index: 0, count: 2 });
     let other = write("b1", &b, Shard { index: 1, count: 2 });
     let out = dir.path().join("out");
-    let msg = merge(&[s0.clone(), other.clone()], &out).unwrap_err().to_string();
-    assert!(msg.contains("another campaign") && msg.contains("`seed`"), "{msg}");
-    let msg = merge(std::slice::from_ref(&s0), &out).unwrap_err().to_string();
+    let msg = merge(&[s0.clone(), other.clone()], &out)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        msg.contains("another campaign") && msg.contains("`seed`"),
+        "{msg}"
+    );
+    let msg = merge(std::slice::from_ref(&s0), &out)
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("1/2") && msg.contains("missing"), "{msg}");
-    let msg = merge(&[s0.clone(), s0.clone()], &out).unwrap_err().to_string();
+    let msg = merge(&[s0.clone(), s0.clone()], &out)
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("given twice"), "{msg}");
     let mut spread = campaign(0, 1, MissionChoice::Default);
     spread.spec.wind.speed_mps = [0.0, 5.0];

@@ -309,15 +309,7 @@ impl GeneratedSpots {
         b.waypoint(dir * TAKEOFF_M, side, hp)
             .waypoint(-dir * FINAL_M, side, hp)
             .waypoint(-dir * FINAL_M, 0.0, hp)
-            .item(
-                MavCmd::MAV_CMD_NAV_LAND,
-                [0.0, 0.0, 0.0, f32::NAN],
-                Some(Spot {
-                    north_m: 0.0,
-                    east_m: 0.0,
-                    height_m: 0.0,
-                }),
-            )
+            .land(0.0, 0.0)
             .build()
     }
 }

@@ -4,9 +4,11 @@
 
 use super::record::FlightRecord;
 use super::report::{Report, FIGURES};
+use super::stats::quantile;
 use super::verdict::TOUCHDOWN_M;
 use crate::report::plot::{ensure_font, FONT};
 use anyhow::{anyhow, Context};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -35,6 +37,26 @@ fn span(v: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// Points `(x, y, passed)`, the failing flights in red, the passing ones last, on top: they
+/// are the fewer when a campaign goes badly.
+fn dots<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    pts: &[(f64, f64, bool)],
+    radius: i32,
+) -> anyhow::Result<()> {
+    for ok in [false, true] {
+        let color = if ok { PASS } else { FAIL };
+        chart
+            .draw_series(
+                pts.iter()
+                    .filter(|p| p.2 == ok)
+                    .map(|p| Circle::new((p.0, p.1), radius, color.filled())),
+            )
+            .map_err(e)?;
+    }
+    Ok(())
+}
+
 /// A grid of histograms, one per figure of [`FIGURES`], failing flights stacked in red.
 pub fn histograms(records: &[FlightRecord], path: &Path) -> anyhow::Result<()> {
     ensure_font();
@@ -56,13 +78,18 @@ pub fn histograms(records: &[FlightRecord], path: &Path) -> anyhow::Result<()> {
             .iter()
             .filter_map(|r| get(&r.figures).map(|v| (v, r.verdict.pass)))
             .collect();
-        let (lo, hi) = span(vals.iter().map(|v| v.0));
+        // The bins span the 1 % to 99 % quantiles: a few wild flights (a touchdown a
+        // kilometre away) would otherwise crush everyone else into one bin. What lies
+        // beyond is counted in the end bins.
+        let mut sorted: Vec<f64> = vals.iter().map(|v| v.0).collect();
+        sorted.sort_by(f64::total_cmp);
+        let (lo, hi) = span([quantile(&sorted, 0.01), quantile(&sorted, 0.99)].into_iter());
         let bins = 30;
         let width = (hi - lo) / bins as f64;
         let mut pass = vec![0u32; bins];
         let mut fail = vec![0u32; bins];
         for (v, ok) in &vals {
-            let b = (((v - lo) / width) as usize).min(bins - 1);
+            let b = (((v - lo) / width).max(0.0) as usize).min(bins - 1);
             if *ok {
                 pass[b] += 1;
             } else {
@@ -119,17 +146,23 @@ pub fn touchdowns(records: &[FlightRecord], path: &Path) -> anyhow::Result<()> {
             Some((f.touchdown_along_m?, f.touchdown_cross_m?, r.verdict.pass))
         })
         .collect();
-    let (a0, a1) = span(pts.iter().map(|p| p.0).chain([-TOUCHDOWN_M, TOUCHDOWN_M]));
-    let (c0, c1) = span(pts.iter().map(|p| p.1).chain([-TOUCHDOWN_M, TOUCHDOWN_M]));
-    // Equal scales on both axes: a circle stays a circle.
-    let half = 0.5 * (a1 - a0).max(c1 - c0);
-    let (am, cm) = (0.5 * (a0 + a1), 0.5 * (c0 + c1));
+    // Four times the criterion's radius around the point, equal scales on both axes (a
+    // circle stays a circle); the touchdowns beyond are counted in the caption.
+    let half = 4.0 * TOUCHDOWN_M;
+    let (am, cm) = (0.0, 0.0);
+    let outside = pts
+        .iter()
+        .filter(|p| p.0.abs() > half || p.1.abs() > half)
+        .count();
     let root = BitMapBackend::new(path, (900, 900)).into_drawing_area();
     root.fill(&WHITE).map_err(e)?;
     let mut chart = ChartBuilder::on(&root)
         .margin(12)
         .caption(
-            format!("{} touchdowns (failing flights in red)", pts.len()),
+            format!(
+                "{} touchdowns, {outside} beyond this view (failing flights in red)",
+                pts.len()
+            ),
             (FONT, 20),
         )
         .x_label_area_size(40)
@@ -153,16 +186,12 @@ pub fn touchdowns(records: &[FlightRecord], path: &Path) -> anyhow::Result<()> {
     chart
         .draw_series(LineSeries::new(circle, BLACK.stroke_width(1)))
         .map_err(e)?;
-    for ok in [true, false] {
-        let color = if ok { PASS } else { FAIL };
-        chart
-            .draw_series(
-                pts.iter()
-                    .filter(|p| p.2 == ok)
-                    .map(|p| Circle::new((p.1, p.0), 3, color.filled())),
-            )
-            .map_err(e)?;
-    }
+    let shown: Vec<(f64, f64, bool)> = pts
+        .iter()
+        .filter(|p| p.0.abs() <= half && p.1.abs() <= half)
+        .map(|p| (p.1, p.0, p.2))
+        .collect();
+    dots(&mut chart, &shown, 3)?;
     root.present()
         .with_context(|| format!("cannot write PNG file `{}`", path.display()))
 }
@@ -205,16 +234,9 @@ pub fn sensitivity(report: &Report, records: &[FlightRecord], path: &Path) -> an
             .y_labels(5)
             .draw()
             .map_err(e)?;
-        for ok in [true, false] {
-            let color = if ok { PASS } else { FAIL };
-            chart
-                .draw_series(
-                    pts.iter()
-                        .filter(|p| p.2 == ok)
-                        .map(|p| Circle::new((p.0, p.1.max(-1.0)), 2, color.filled())),
-                )
-                .map_err(e)?;
-        }
+        let clipped: Vec<(f64, f64, bool)> =
+            pts.iter().map(|p| (p.0, p.1.max(-1.0), p.2)).collect();
+        dots(&mut chart, &clipped, 2)?;
     }
     root.present()
         .with_context(|| format!("cannot write PNG file `{}`", path.display()))

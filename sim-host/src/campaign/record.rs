@@ -187,7 +187,7 @@ fn clearance(s: &Sample, home_alt: f64, p: &Point) -> f64 {
 fn phase_name(index: u8) -> String {
     use common::navigation::Phase as P;
     let known = [
-        (P::Idle, "idle"),
+        (P::Idle, "idle (armed, mission not started)"),
         (P::TakeoffRoll, "take-off roll"),
         (P::TakeoffClimb, "take-off climb"),
         (P::Waypoint, "waypoint"),
@@ -239,19 +239,19 @@ fn excursions(samples: &[Sample], points: &[Point], home_alt: f64) -> Excursions
     x
 }
 
-/// The truth is on the ground: some wheel or other point within 5 cm of it (the main legs
-/// compress 1.4 cm at rest).
-fn on_ground(s: &Sample, a: &Aircraft, home_alt: f64) -> bool {
+/// The truth is on the ground: some point of the airframe, wheel or not, within 5 cm of it
+/// (the main legs compress 1.4 cm at rest; an aircraft on its back is on the ground too).
+fn on_ground(s: &Sample, a: &Aircraft, points: &[Point], home_alt: f64) -> bool {
     let g = &a.ground;
-    let wheels = [g.main_wheel_left_m, g.main_wheel_right_m, g.tail_wheel_m];
-    wheels.iter().any(|w| {
-        let p = Point {
-            name: String::new(),
-            body: Vector3::from(*w),
-            disc_radius: 0.0,
-        };
-        clearance(s, home_alt, &p) < 0.05
-    })
+    let wheels = [g.main_wheel_left_m, g.main_wheel_right_m, g.tail_wheel_m].map(|w| Point {
+        name: String::new(),
+        body: Vector3::from(w),
+        disc_radius: 0.0,
+    });
+    wheels
+        .iter()
+        .chain(points)
+        .any(|p| clearance(s, home_alt, p) < 0.05)
 }
 
 /// What the autopilot says of itself once the flight has stopped.
@@ -370,7 +370,7 @@ pub fn figures_and_facts(
     }
     let truth_on_ground = samples
         .last()
-        .is_some_and(|x| on_ground(x, aircraft, home_alt));
+        .is_some_and(|x| on_ground(x, aircraft, &points, home_alt));
     let says_on_ground = end.landed == LandedState::OnGround;
     let facts = Facts {
         error: None,
@@ -475,16 +475,34 @@ mod tests {
             roll: 20f64.to_radians(),
             ..rest
         };
-        let tip = points.iter().find(|p| p.name.starts_with("right wing tip")).unwrap();
+        let tip = points
+            .iter()
+            .find(|p| p.name.starts_with("right wing tip"))
+            .unwrap();
         assert!(clearance(&rolled, home, tip) < 0.0);
-        assert!(on_ground(&rest, &a, home));
+        assert!(on_ground(&rest, &a, &points, home));
+        let aloft = Sample {
+            alt: rest.alt + 1.0,
+            ..rest
+        };
+        assert!(!on_ground(&aloft, &a, &points, home));
+        // On its back, wheels up: on the ground all the same.
+        let inverted = Sample {
+            roll: std::f64::consts::PI,
+            alt: home + 0.05,
+            ..rest
+        };
+        assert!(on_ground(&inverted, &a, &points, home));
     }
 
     #[test]
     fn the_propeller_disc_reaches_its_radius_below_the_hub_whatever_the_roll() {
         let a = Aircraft::ultrastick25e().unwrap();
         let hub = propeller_hub_m(&a, [0.0; 3]);
-        assert!(hub[0] > 0.25, "a tractor's propeller is ahead of the CG: {hub:?}");
+        assert!(
+            hub[0] > 0.25,
+            "a tractor's propeller is ahead of the CG: {hub:?}"
+        );
         let p = Point {
             name: "propeller".into(),
             body: Vector3::from(hub),
@@ -494,10 +512,7 @@ mod tests {
             alt: 1.0,
             ..Sample::default()
         };
-        let rolled = Sample {
-            roll: 0.7,
-            ..level
-        };
+        let rolled = Sample { roll: 0.7, ..level };
         let expect = 1.0 - hub[2] - 0.1524;
         assert!((clearance(&level, 0.0, &p) - expect).abs() < 1e-12);
         assert!((clearance(&rolled, 0.0, &p) - clearance(&level, 0.0, &p)).abs() < 0.05);

@@ -450,7 +450,9 @@ pub fn markdown(r: &Report, images: &Images) -> String {
         pct(hi)
     );
     for c in &r.criteria {
-        let _ = writeln!(md, "| `{}` | {} | {} |", c.name, c.description, c.failed);
+        // A bar inside a table cell would end it.
+        let what = c.description.replace('|', "\\|");
+        let _ = writeln!(md, "| `{}` | {what} | {} |", c.name, c.failed);
     }
     if !r.causes.is_empty() {
         let _ = writeln!(

@@ -50,6 +50,18 @@ pub struct Timing {
     pub flights_per_s_per_thread: f64,
     /// Simulated seconds flown, summed.
     pub simulated_s: f64,
+    /// CPU time of the process over the flights, s (all threads).
+    pub cpu_s: f64,
+    /// Flights per CPU-second: flights per second per core when every core is this run's,
+    /// whatever else the machine was doing.
+    pub flights_per_cpu_s: f64,
+}
+
+/// The process's CPU time, s (all threads), from its CPU clock.
+fn cpu_time_s() -> f64 {
+    use nix::time::{clock_gettime, ClockId};
+    clock_gettime(ClockId::CLOCK_PROCESS_CPUTIME_ID)
+        .map_or(f64::NAN, |t| t.tv_sec() as f64 + t.tv_nsec() as f64 * 1e-9)
 }
 
 /// Builds the campaign the arguments describe.
@@ -87,9 +99,9 @@ pub fn run_campaign(c: &Campaign, a: &CampaignArgs, progress: bool) -> anyhow::R
     } else {
         a.jobs
     };
-    let start = Instant::now();
+    let (start, cpu0) = (Instant::now(), cpu_time_s());
     let records = c.run(a.shard, threads, progress)?;
-    let wall_s = start.elapsed().as_secs_f64();
+    let (wall_s, cpu_s) = (start.elapsed().as_secs_f64(), cpu_time_s() - cpu0);
     let flights = records.len() as u64;
     let timing = Timing {
         flights,
@@ -98,6 +110,8 @@ pub fn run_campaign(c: &Campaign, a: &CampaignArgs, progress: bool) -> anyhow::R
         flights_per_s: flights as f64 / wall_s,
         flights_per_s_per_thread: flights as f64 / wall_s / threads as f64,
         simulated_s: records.iter().filter_map(|r| r.figures.sim_s).sum(),
+        cpu_s,
+        flights_per_cpu_s: flights as f64 / cpu_s,
     };
     let report = output::write_campaign(&a.out, &c.meta(a.shard), &records)?;
     std::fs::write(a.out.join(TIMING_FILE), to_json(&timing)? + "\n")

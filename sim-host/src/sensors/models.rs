@@ -295,14 +295,16 @@ mod tests {
 
     #[test]
     fn calibration_errors_scale_and_offset_the_readings_and_the_gps_start_up_offset_fades() {
-        let mut cfg = SensorConfig::default();
         // Noise and bias off, to read the calibration alone.
-        cfg.gyro_noise_power = [0.0; 3];
-        cfg.accel_noise_power = [0.0; 3];
-        cfg.gyro_bias_radps = [0.0; 3];
-        cfg.gyro_bias_walk = 0.0;
-        cfg.accel_bias_mps2 = [0.0; 3];
-        cfg.pd_noise_power_kpa = 0.0;
+        let mut cfg = SensorConfig {
+            gyro_noise_power: [0.0; 3],
+            accel_noise_power: [0.0; 3],
+            gyro_bias_radps: [0.0; 3],
+            gyro_bias_walk: 0.0,
+            accel_bias_mps2: [0.0; 3],
+            pd_noise_power_kpa: 0.0,
+            ..SensorConfig::default()
+        };
         cfg.gps.horiz_m = 0.0;
         cfg.gps.vert_m = 0.0;
         cfg.gps.latency_s = 0.0;
@@ -324,7 +326,8 @@ mod tests {
         // 0.9 * 175.32 Pa + 2 Pa.
         let dp = f64::from(f.pitot.unwrap().diff_pressure_pa);
         assert!((dp - (0.9 * 175.32 + 2.0)).abs() < 0.05, "{dp}");
-        let north = |fix: GpsFix| ned_offset::<f64>(GeoPoint::from_deg(44.7, -93.0), fix.position).0;
+        let north =
+            |fix: GpsFix| ned_offset::<f64>(GeoPoint::from_deg(44.7, -93.0), fix.position).0;
         assert!((north(fix.unwrap()) - 4.0).abs() < 0.02);
         // 10 s later, one time constant: 4/e.
         let mut last = None;
