@@ -268,3 +268,39 @@ fn merge_refuses_a_shard_of_another_campaign_a_missing_one_and_one_given_twice()
     let msg = merge(&[s0, s1], &out).unwrap_err().to_string();
     assert!(msg.contains("campaign.wind.speed_mps"), "{msg}");
 }
+
+#[test]
+fn the_command_line_prints_the_campaign_in_force_and_refuses_a_bad_file_before_flying() {
+    let bin = env!("CARGO_BIN_EXE_sim-host");
+    let out = std::process::Command::new(bin)
+        .args(["campaign", "--print-campaign"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let printed = String::from_utf8(out.stdout).unwrap();
+    let spec = CampaignSpec::from_toml_str(&printed, Path::new("printed")).unwrap();
+    assert_eq!(spec, CampaignSpec::default());
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bad.toml");
+    std::fs::write(&file, "[servos]\nrate_limit_spread = -0.3\n").unwrap();
+    let out = std::process::Command::new(bin)
+        .args(["campaign", "--runs", "2", "--campaign"])
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("bad.toml")
+            && err.contains("`servos.rate_limit_spread`")
+            && err.contains("-0.3"),
+        "{err}"
+    );
+    assert!(
+        !dir.path().join("out").exists(),
+        "nothing flown, nothing written"
+    );
+}

@@ -495,8 +495,8 @@ pub fn markdown(r: &Report, images: &Images) -> String {
         md,
         "## Which dispersions matter\n\nEach dispersed quantity against the outcome: Spearman's \
          rank correlation with the verdict's margin (the smallest of `1 - value/limit` over \
-         touchdown distance, sink rate, bank and pitch; positive: larger values give safer \
-         flights) and with four figures, and the pass rate in each fifth of the flights \
+         touchdown distance, sink rate, bank and pitch, and of the smallest clearance over 5 cm; \
+         positive: larger values give safer flights) and with four figures, and the pass rate in each fifth of the flights \
          ordered by the quantity. With {} flights a correlation beyond about +-{:.2} is \
          unlikely by chance (two standard errors). The {} strongest; every quantity is in \
          `report.json`.\n\n| quantity | rho margin | rho touchdown | rho sink | rho altitude RMS | rho airspeed RMS | pass rate by fifth, lowest first |\n|---|---|---|---|---|---|---|",

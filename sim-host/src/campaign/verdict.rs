@@ -19,6 +19,9 @@ pub const LOC_PITCH_DEG: f64 = 35.0;
 pub const TOUCHDOWN_M: f64 = 30.0;
 /// Sink rate at touchdown under this, m/s.
 pub const SINK_MPS: f64 = 2.0;
+/// Clearance that counts as a full margin against a strike, m: about what the undispersed
+/// aircraft keeps at rest under its tail and its propeller (5 cm).
+pub const CLEARANCE_REF_M: f64 = 0.05;
 
 /// One named criterion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -141,8 +144,9 @@ pub struct Verdict {
     /// The criteria not met, by name, in [`Criterion::ALL`] order.
     pub failed: Vec<String>,
     /// The smallest margin to a threshold: `1 - value / limit` over touchdown distance, sink
-    /// rate, bank and pitch (1: far from every limit, 0: on one, negative: beyond); -1 when a
-    /// criterion without a continuous figure failed. Orders flights from worst to best.
+    /// rate, bank and pitch, and the smallest clearance over [`CLEARANCE_REF_M`] (1: far from
+    /// every limit, 0: on one, negative: beyond); -1 when a criterion without a continuous
+    /// figure failed. Orders flights from worst to best.
     pub margin: f64,
     /// What went wrong first (`None` for a passing flight): the earliest of the failures
     /// that have a time, in words, with the phase of flight.
@@ -181,11 +185,14 @@ pub fn judge(f: &Facts) -> Verdict {
         (f.max_bank_deg, LOC_BANK_DEG),
         (f.max_pitch_deg, LOC_PITCH_DEG),
     ];
+    let clearance = f
+        .min_clearance_m
+        .map_or(-1.0, |c| (c / CLEARANCE_REF_M).min(1.0));
     let mut margin = ratios
         .iter()
         .map(|(v, limit)| v.map_or(-1.0, |v| 1.0 - v / limit))
-        .fold(1.0, f64::min);
-    let continuous = ["control", "touchdown", "sink"];
+        .fold(clearance, f64::min);
+    let continuous = ["control", "touchdown", "sink", "no_strike"];
     if failed.iter().any(|c| !continuous.contains(&c.as_str())) {
         margin = margin.min(-1.0);
     }
@@ -265,7 +272,7 @@ mod tests {
     fn a_good_flight_passes_with_its_margin_set_by_the_bank() {
         let v = judge(&good());
         assert!(v.pass && v.cause.is_none(), "{v:?}");
-        // 1 - 40/60 = 0.333 is the smallest of 0.8, 0.6, 0.333, 0.657.
+        // 1 - 40/60 = 0.333 is the smallest of 0.8, 0.6, 0.333, 0.657 and 0.05/0.05 = 1.
         assert!((v.margin - 1.0 / 3.0).abs() < 1e-12, "{}", v.margin);
     }
 
