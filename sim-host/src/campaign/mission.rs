@@ -13,7 +13,7 @@ use std::path::PathBuf;
 pub enum MissionChoice {
     /// [`default_mission`].
     Default,
-    /// One generated per flight ([`generated_mission`]).
+    /// One generated per flight from its draws ([`GeneratedSpots`]).
     Generated,
     /// A QGroundControl `.plan` or `QGC WPL 110` file: its mission and geofence.
     File {

@@ -65,7 +65,8 @@ pub const FIGURES: [FigureDef; 17] = [
 ];
 
 /// The figures each dispersion is correlated with in the report.
-const SENSITIVITY_FIGURES: [&str; 4] = ["touchdown_m", "sink_mps", "alt_rms_m", "airspeed_rms_mps"];
+pub const SENSITIVITY_FIGURES: [&str; 4] =
+    ["touchdown_m", "sink_mps", "alt_rms_m", "airspeed_rms_mps"];
 
 /// Failing flights listed in the Markdown report (all are in `report.json`).
 pub const MAX_LISTED: usize = 50;
