@@ -630,3 +630,9 @@ fn pymavlink_names_and_sets_every_mode_with_the_shipped_mode_map() {
     // pymavlink's own heartbeat decoding and set_mode (see the script's docstring).
     pymavlink_script("pymavlink_modes.py");
 }
+
+#[test]
+fn home_set_by_arming_on_the_ground_is_held_to_the_millimetre_while_the_estimator_learns() {
+    // pymavlink reads HOME_POSITION and GLOBAL_POSITION_INT (see the script's docstring).
+    pymavlink_script("pymavlink_home.py");
+}

@@ -152,10 +152,12 @@ pub struct EstimatedState {
     pub pos_ned: Vector3<f32>,
     /// Horizontal position.
     pub position: GeoPoint,
-    /// Altitude above mean sea level, m (barometric until the first GPS fix).
+    /// Altitude above mean sea level, m: home's altitude plus the height above it (barometric
+    /// alone until the first GPS fix).
     pub alt_amsl_m: f32,
-    /// The NED origin, once set; its altitude is `alt_amsl_m + pos_ned.z`, so it moves as
-    /// the estimator learns the barometer's offset.
+    /// The NED origin (`alt_amsl_m + pos_ned.z` is its altitude): provisional from the first
+    /// good fix, its altitude following what the estimator learns of the barometer's offset;
+    /// held unchanged once set by arming or `DO_SET_HOME`.
     pub home: Option<Home>,
     /// Velocity over ground in NED, m/s.
     pub vel_ned: Vector3<f32>,
@@ -206,6 +208,9 @@ pub struct Estimator {
     home: Option<Home>,
     /// The barometer offset when home was set: heights above home follow the barometer.
     home_baro_offset: f32,
+    /// Home as set by arming or `DO_SET_HOME`, held as reported from then on; `None` while
+    /// the first fix's provisional home follows what the estimator learns.
+    home_held: Option<Home>,
     mag_nis: f32,
     vel_nis: f32,
     aided_fixes: u32,
@@ -238,6 +243,7 @@ impl Estimator {
             density: DEFAULT_DENSITY,
             home: None,
             home_baro_offset: 0.0,
+            home_held: None,
             mag_nis: 0.0,
             vel_nis: 0.0,
             aided_fixes: 0,
@@ -648,9 +654,10 @@ impl Estimator {
             && h.gps.healthy
     }
 
-    /// Moves home (`DO_SET_HOME`, `MAV_CMD_DO_SET_HOME`): positions are from then on NED
-    /// from `home`, altitudes unchanged. Refused (false) for an invalid point or altitude, or
-    /// before the first fix has set a home.
+    /// Sets home (arming on the ground, `DO_SET_HOME`): positions are from then on NED from
+    /// `home`, altitudes unchanged, and home is held where it was put (see
+    /// [`EstimatedState::home`]). Refused (false) for an invalid point or altitude, or before
+    /// the first fix has set a provisional home.
     pub fn set_home(&mut self, home: Home) -> bool {
         let Some(old) = self.home else {
             return false;
@@ -658,12 +665,26 @@ impl Estimator {
         if !home.point.is_valid() || !limits::in_range(home.alt_amsl_m, limits::GPS_ALT_M) {
             return false;
         }
+        let reported = self
+            .home_held
+            .map_or(old.alt_amsl_m - self.baro_drift_m(), |h| h.alt_amsl_m);
+        // The origin and the altitude it is fused at move together, so the barometer's
+        // offset, and with it the height above home, carry on from where they were.
+        let up = home.alt_amsl_m - reported;
         let (n, e): (f32, f32) = ned_offset(home.point, old.point);
-        self.ins
-            .shift_origin(&Vector3::new(n, e, home.alt_amsl_m - old.alt_amsl_m));
-        self.home = Some(home);
-        self.home_baro_offset = self.ins.baro_offset();
+        self.ins.shift_origin(&Vector3::new(n, e, up));
+        self.home = Some(Home {
+            point: home.point,
+            alt_amsl_m: old.alt_amsl_m + up,
+        });
+        self.home_held = Some(home);
         true
+    }
+
+    /// What the estimator has learnt of the barometer's offset since the first fix set home,
+    /// m: how far heights above home and the GPS-aided altitude have come apart.
+    pub fn baro_drift_m(&self) -> f32 {
+        self.ins.baro_offset() - self.home_baro_offset
     }
 
     /// Averaged normalised GPS velocity innovation (about 1 when the estimate agrees with GPS).
@@ -700,25 +721,31 @@ impl Estimator {
         } else {
             (self.airspeed.value(), false)
         };
-        let (position, alt_amsl_m) = match self.home {
-            Some(h) => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
-            None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
-        };
         // Height above home is the barometer's rise since home was set (as on PX4 and
         // ArduPilot), not the GPS-aided altitude's: while GPS averages its altitude noise
         // down, the altitude above sea level moves by a metre or more, and a home fixed on
-        // that scale would move the runway under a landing. Home's reported altitude moves
-        // instead, by what the estimator has since learnt of the barometer's offset.
-        let drift = self.ins.baro_offset() - self.home_baro_offset;
-        let (pos, home) = match self.home {
-            Some(h) if drift.is_finite() => (
-                Vector3::new(pos.x, pos.y, pos.z - drift),
-                Some(Home {
-                    alt_amsl_m: h.alt_amsl_m - drift,
-                    ..h
-                }),
-            ),
-            other => (pos, other),
+        // that scale would move the runway under a landing. The first fix's home is
+        // provisional: its altitude follows what the estimator learns of the barometer's
+        // offset. Once set (arming), home is held, and altitudes above sea level are given in
+        // its datum, home's altitude plus the height above it, so that what a ground station
+        // shows of home and of the aircraft never drifts apart in flight.
+        let drift = self.baro_drift_m();
+        let pos = if self.home.is_some() && drift.is_finite() {
+            Vector3::new(pos.x, pos.y, pos.z - drift)
+        } else {
+            pos
+        };
+        let home = match (self.home_held, self.home) {
+            (Some(held), _) => Some(held),
+            (None, Some(h)) if drift.is_finite() => Some(Home {
+                alt_amsl_m: h.alt_amsl_m - drift,
+                ..h
+            }),
+            (None, h) => h,
+        };
+        let (position, alt_amsl_m) = match home {
+            Some(h) => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
+            None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
         };
         EstimatedState {
             time_s: self.t,

@@ -267,9 +267,14 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
             sig(e.heading_max_deg, 3),
         ]);
         t.row([
-            "altitude (m)".into(),
+            "altitude in home's datum (m)".into(),
             sig(e.alt_rms_m, 3),
             sig(e.alt_max_m, 3),
+        ]);
+        t.row([
+            "home's altitude, set at arming (m)".into(),
+            sig(e.home_alt_error_m, 3),
+            "".into(),
         ]);
         t.row([
             "airspeed (m/s)".into(),

@@ -30,8 +30,10 @@ pub struct EstimatorErrors {
     pub pitch_rms_deg: f64,
     /// Heading RMS error, deg.
     pub heading_rms_deg: f64,
-    /// Altitude RMS error, m.
+    /// Altitude RMS error in home's datum (see [`HomeDatum`]), m.
     pub alt_rms_m: f64,
+    /// Error of home's altitude above sea level as set at arming, m (0 before arming).
+    pub home_alt_error_m: f64,
     /// Airspeed RMS error, m/s.
     pub airspeed_rms_mps: f64,
     /// Horizontal wind RMS error against the steady wind, m/s.
@@ -136,7 +138,8 @@ pub struct MissionSummary {
     pub xtrack_max_m: f64,
     /// Cross-track error while circling a loiter item, RMS, m.
     pub orbit_xtrack_rms_m: f64,
-    /// Altitude error (guidance's altitude minus the true altitude) over the waypoint and loiter
+    /// Altitude error (guidance's altitude minus the true altitude, in home's datum: see
+    /// [`HomeDatum`]) over the waypoint and loiter
     /// items, RMS, m.
     pub alt_rms_m: f64,
     /// Airspeed error (commanded minus true) over the same items, RMS, m/s.
@@ -230,8 +233,9 @@ pub fn mission_summary(
     let cruising = samples.iter().filter(|s| {
         s.armed && (s.nav_phase == Phase::Waypoint as u8 || s.nav_phase == Phase::Loiter as u8)
     });
+    let datum = HomeDatum::of(samples);
     let (alt, va): (Vec<f64>, Vec<f64>) = cruising
-        .map(|s| (s.sp_alt - s.alt, s.sp_airspeed - s.airspeed))
+        .map(|s| (s.sp_alt - datum.truth_alt(s), s.sp_airspeed - s.airspeed))
         .unzip();
     let touchdown = touchdown.map(|t| {
         let (n, e) = (t.pos_ned.x, t.pos_ned.y);
@@ -333,8 +337,47 @@ fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
+/// Home's altitude as the autopilot holds it. Home is set at arming to the altitude above sea
+/// level the estimator has then, and held in that datum: from then on its altitudes above sea
+/// level (the estimate, the set points) differ from the truth's by that constant error, while
+/// the heights above home it flies by do not. Altitude errors are counted in home's datum: the
+/// truth shifted by the error home was set with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HomeDatum {
+    /// Arming time, s (infinite when never armed).
+    pub set_at_s: f64,
+    /// Estimated minus true altitude above sea level at arming, m.
+    pub error_m: f64,
+}
+
+impl HomeDatum {
+    /// The datum of a flight's samples.
+    pub fn of(samples: &[Sample]) -> Self {
+        samples.iter().find(|s| s.armed).map_or(
+            Self {
+                set_at_s: f64::INFINITY,
+                error_m: 0.0,
+            },
+            |s| Self {
+                set_at_s: s.t,
+                error_m: s.est_alt - s.alt,
+            },
+        )
+    }
+
+    /// The true altitude of a sample in home's datum, m.
+    pub fn truth_alt(&self, s: &Sample) -> f64 {
+        if s.t >= self.set_at_s {
+            s.alt + self.error_m
+        } else {
+            s.alt
+        }
+    }
+}
+
 /// Estimator errors over the samples from `delay_s` after the first `converged` on.
 pub fn estimator_errors(samples: &[Sample], delay_s: f64) -> Option<EstimatorErrors> {
+    let datum = HomeDatum::of(samples);
     let t0 = samples.iter().find(|s| s.converged)?.t + delay_s;
     let first = samples.iter().position(|s| s.t >= t0)?;
     let s = &samples[first..];
@@ -342,7 +385,7 @@ pub fn estimator_errors(samples: &[Sample], delay_s: f64) -> Option<EstimatorErr
     let roll = col(&|x| wrap_pi(x.est_roll - x.roll) * DEG);
     let pitch = col(&|x| wrap_pi(x.est_pitch - x.pitch) * DEG);
     let yaw = col(&|x| wrap_pi(x.est_yaw - x.yaw) * DEG);
-    let alt = col(&|x| x.est_alt - x.alt);
+    let alt = col(&|x| x.est_alt - datum.truth_alt(x));
     let va = col(&|x| x.est_airspeed - x.airspeed);
     let wind = col(&|x| (x.est_wind[0] - x.wind_steady[0]).hypot(x.est_wind[1] - x.wind_steady[1]));
     let wind_t = col(&|x| (x.est_wind[0] - x.wind[0]).hypot(x.est_wind[1] - x.wind[1]));
@@ -353,6 +396,7 @@ pub fn estimator_errors(samples: &[Sample], delay_s: f64) -> Option<EstimatorErr
         pitch_rms_deg: rms(&pitch),
         heading_rms_deg: rms(&yaw),
         alt_rms_m: rms(&alt),
+        home_alt_error_m: datum.error_m,
         airspeed_rms_mps: rms(&va),
         wind_rms_mps: rms(&wind),
         wind_total_rms_mps: rms(&wind_t),
@@ -368,6 +412,7 @@ fn segments(samples: &[Sample], gcs: &GroundStation, home_alt: f64) -> Vec<Segme
     let Some(t0) = gcs.armed_at_s() else {
         return Vec::new();
     };
+    let datum = HomeDatum::of(samples);
     let end = samples.last().map_or(0.0, |s| s.t);
     let steps = &gcs.script().steps;
     let t: Vec<f64> = samples.iter().map(|s| s.t).collect();
@@ -391,7 +436,7 @@ fn segments(samples: &[Sample], gcs: &GroundStation, home_alt: f64) -> Vec<Segme
         let alt_hold_error_max_m = idx
             .iter()
             .filter(|&&k| samples[k].t >= ts + 15.0)
-            .map(|&k| (samples[k].sp_alt - samples[k].alt).abs())
+            .map(|&k| (samples[k].sp_alt - datum.truth_alt(&samples[k])).abs())
             .fold(0.0, f64::max);
         let (signal, command, y, y0) = match step.action {
             Action::AltitudeAboveHome(h) => {
