@@ -8,6 +8,7 @@ pub mod linearize;
 pub mod navigation;
 pub mod params;
 pub mod scenario;
+pub mod sim;
 pub mod trim;
 pub mod validation;
 

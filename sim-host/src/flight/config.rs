@@ -4,6 +4,7 @@
 use super::script::Script;
 use crate::environment::wind::Turbulence;
 use crate::sensors::models::SensorFaults;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Everything that defines a flight.
@@ -44,6 +45,14 @@ pub struct FlightConfig {
     /// The pilot's radio: stick positions from a time on, sent as RC_CHANNELS at 50 Hz on
     /// the simulator link (none: no radio).
     pub rc_sticks: Vec<RcSticks>,
+    /// Fly the scripted ground station. Without it (`sim-host sim`) whoever flies the
+    /// autopilot does so on its own ground link, and `script` is not used.
+    pub scripted_station: bool,
+    /// End the flight, as flown so far, when the autopilot closes the simulator link (a
+    /// standalone simulator's end) instead of calling it a failure.
+    pub until_link_closes: bool,
+    /// Set from outside (Ctrl-C) to end the flight at the next frame, as flown so far.
+    pub stop: Option<&'static AtomicBool>,
 }
 
 /// Stick positions held from a time on.
@@ -86,6 +95,11 @@ pub enum Fault {
 }
 
 impl FlightConfig {
+    /// Whether the flight has been asked to stop.
+    pub fn stopped(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
     /// The faults active at `t_s`.
     pub fn faults_at(&self, t_s: f64) -> SensorFaults {
         let mut f = SensorFaults::default();
@@ -125,8 +139,38 @@ impl Default for FlightConfig {
             runway_heading: None,
             faults: Vec::new(),
             rc_sticks: Vec::new(),
+            scripted_station: true,
+            until_link_closes: false,
+            stop: None,
         }
     }
+}
+
+/// Parses a sensor fault as the command line spells it: `KIND:FROM-TO` in seconds of
+/// simulated time, KIND one of gps, pitot, mag, baro (`gps:60-90`).
+pub fn parse_fault(s: &str) -> Result<FaultWindow, String> {
+    let err = |why: &str| {
+        format!("fault `{s}`: {why} (expected KIND:FROM-TO, e.g. gps:60-90; KIND gps, pitot, mag or baro)")
+    };
+    let (kind, window) = s.split_once(':').ok_or_else(|| err("no `:`"))?;
+    let fault = match kind.trim() {
+        "gps" => Fault::GpsLost,
+        "pitot" => Fault::PitotFailed,
+        "mag" => Fault::MagFailed,
+        "baro" => Fault::BaroFailed,
+        _ => return Err(err("unknown sensor")),
+    };
+    let (from, to) = window.split_once('-').ok_or_else(|| err("no `-`"))?;
+    let num = |x: &str| x.trim().parse::<f64>().map_err(|e| err(&e.to_string()));
+    let (from_s, to_s) = (num(from)?, num(to)?);
+    if !(from_s.is_finite() && to_s.is_finite() && 0.0 <= from_s && from_s < to_s) {
+        return Err(err("the window must run forwards from 0 s or later"));
+    }
+    Ok(FaultWindow {
+        fault,
+        from_s,
+        to_s,
+    })
 }
 
 /// Parses a turbulence severity as the command line spells it.
