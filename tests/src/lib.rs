@@ -1,5 +1,7 @@
 //! Shared helpers of the system tests in `tests/tests/`.
 
+pub mod station;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -56,4 +58,31 @@ pub fn tool_available(name: &str) -> bool {
         eprintln!("SKIPPED: {name} is not installed");
     }
     found
+}
+
+/// Builds `sim-host` (release) with its `mcu-libm` feature, the host build computing sines,
+/// arctangents and exponentials with the libm crate as the MCU image does, into
+/// `target/mcu-libm`; returns the binary's path.
+pub fn build_sim_host_with_mcu_libm() -> PathBuf {
+    let root = workspace_root();
+    let target_dir = root.join("target").join("mcu-libm");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(&root)
+        .args([
+            "build",
+            "-p",
+            "sim-host",
+            "--release",
+            "--features",
+            "mcu-libm",
+        ])
+        .env("CARGO_TARGET_DIR", &target_dir)
+        .status()
+        .expect("cargo runs");
+    assert!(
+        status.success(),
+        "build of sim-host --features mcu-libm failed"
+    );
+    target_dir.join("release/sim-host")
 }
