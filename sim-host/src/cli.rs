@@ -131,6 +131,12 @@ pub(crate) enum Command {
         /// of it, `sim-host scenario all --results`'s, is kept).
         #[arg(long, default_value = "docs/RESULTS.md")]
         results: PathBuf,
+        /// Who flies: inproc (the host build in this process) or qemu (the MCU image, about
+        /// five minutes a flight).
+        #[arg(long, default_value = "inproc")]
+        link: commands::fly::LinkKind,
+        #[command(flatten)]
+        mcu: McuArgs,
     },
     /// The autopilot's parameters: tables, the Markdown of docs/PARAMETERS.md (--markdown),
     /// or the parameter metadata file QGroundControl reads (--json).

@@ -152,19 +152,45 @@ fn run() -> anyhow::Result<ExitCode> {
         }
         Some(Command::Fly(args)) => fly_command(&aircraft, args),
         Some(Command::Sim(args)) => sim_command(&aircraft, args),
-        Some(Command::Navigation { out, img, results }) => {
+        Some(Command::Navigation {
+            out,
+            img,
+            results,
+            link,
+            mcu,
+        }) => {
+            anyhow::ensure!(
+                matches!(
+                    link,
+                    commands::fly::LinkKind::Inproc | commands::fly::LinkKind::Qemu
+                ),
+                "navigation --link {}: inproc or qemu",
+                link.name()
+            );
             let existing = std::fs::read_to_string(&out).ok();
+            let on_qemu = if link == commands::fly::LinkKind::Qemu {
+                " --link qemu"
+            } else {
+                ""
+            };
             let command = format!(
-                "cargo run --release -p sim-host -- navigation --out {} --img {} --results {}",
+                "cargo run --release -p sim-host -- navigation --out {} --img {} --results {}{on_qemu}",
                 out.display(),
                 img.display(),
                 results.display()
             );
+            let opts = commands::fly::FlyOptions {
+                link,
+                qemu: mcu.config(),
+                bind: "127.0.0.1:0".into(),
+                ..Default::default()
+            };
             let docs = commands::navigation::navigation_markdown(
                 &aircraft,
                 &command,
                 &img,
                 existing.as_deref(),
+                &opts,
             )?;
             std::fs::write(&out, docs.navigation)
                 .with_context(|| format!("cannot write `{}`", out.display()))?;

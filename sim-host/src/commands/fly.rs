@@ -436,7 +436,11 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
     run.row(["wall clock".to_string(), format!("{:.2} s", s.wall_s)]);
     run.row([
         "real-time factor".to_string(),
-        format!("{:.0}x", s.real_time_factor),
+        if s.real_time_factor < 10.0 {
+            format!("{:.2}x", s.real_time_factor)
+        } else {
+            format!("{:.0}x", s.real_time_factor)
+        },
     ]);
     run.row(["frames".to_string(), s.frames.to_string()]);
     run.row(["ended".to_string(), s.ended.describe().to_string()]);
@@ -539,6 +543,16 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
     tables
 }
 
+/// A figure to three significant digits, or "n/a" where it was not measured (the errors
+/// against guidance of an autopilot seen only through its links).
+fn known(x: f64, digits: usize) -> String {
+    if x.is_nan() {
+        "n/a".into()
+    } else {
+        sig(x, digits)
+    }
+}
+
 /// The figures of a mission flight.
 pub fn mission_table(m: &MissionSummary) -> Table {
     let mut t = Table::new("Mission", &["quantity", "value"]);
@@ -558,18 +572,21 @@ pub fn mission_table(m: &MissionSummary) -> Table {
         "cross-track, straight legs (m)",
         format!(
             "{} RMS, {} max",
-            sig(m.xtrack_rms_m, 3),
-            sig(m.xtrack_max_m, 3)
+            known(m.xtrack_rms_m, 3),
+            known(m.xtrack_max_m, 3)
         ),
     );
     row(
         "cross-track, on loiter circles (m)",
-        format!("{} RMS", sig(m.orbit_xtrack_rms_m, 3)),
+        format!("{} RMS", known(m.orbit_xtrack_rms_m, 3)),
     );
-    row("altitude error (m)", format!("{} RMS", sig(m.alt_rms_m, 3)));
+    row(
+        "altitude error (m)",
+        format!("{} RMS", known(m.alt_rms_m, 3)),
+    );
     row(
         "airspeed error (m/s)",
-        format!("{} RMS", sig(m.airspeed_rms_mps, 3)),
+        format!("{} RMS", known(m.airspeed_rms_mps, 3)),
     );
     row("flight time (s)", format!("{:.1}", m.flight_time_s));
     row("motor energy (Wh)", format!("{:.2}", m.energy_wh));

@@ -81,23 +81,31 @@ impl Ready {
 
 static CTRL_C: AtomicBool = AtomicBool::new(false);
 
-extern "C" fn on_ctrl_c(_: nix::libc::c_int) {
-    CTRL_C.store(true, Ordering::Relaxed);
-}
-
 /// Makes Ctrl-C (SIGINT) end the flight at its next frame, with the log written; a second
 /// Ctrl-C ends the process at once. Returns the flag for [`FlightConfig::stop`].
+///
+/// Call it before any thread starts: SIGINT is blocked in this thread, and so in every thread
+/// started after it, and one thread waits for it. No read of a socket is then cut short by
+/// the signal (a read with a timeout is not restarted after a handler). Child processes
+/// (QEMU) start with no signal blocked.
 pub fn stop_on_ctrl_c() -> &'static AtomicBool {
-    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
-    let action = SigAction::new(
-        SigHandler::Handler(on_ctrl_c),
-        SaFlags::SA_RESETHAND | SaFlags::SA_RESTART,
-        SigSet::empty(),
-    );
-    // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
-    if let Err(e) = unsafe { sigaction(Signal::SIGINT, &action) } {
-        eprintln!("sim-host: Ctrl-C will end the process without writing the log ({e})");
-    }
+    use nix::sys::signal::{SigSet, Signal};
+    static WAITER: std::sync::Once = std::sync::Once::new();
+    WAITER.call_once(|| {
+        let mut set = SigSet::empty();
+        set.add(Signal::SIGINT);
+        if let Err(e) = set.thread_block() {
+            eprintln!("sim-host: Ctrl-C will end the process without writing the log ({e})");
+            return;
+        }
+        std::thread::spawn(move || {
+            while set.wait().is_ok() {
+                if CTRL_C.swap(true, Ordering::Relaxed) {
+                    std::process::exit(130);
+                }
+            }
+        });
+    });
     &CTRL_C
 }
 
@@ -174,7 +182,11 @@ pub fn sim_report(
             loop {
                 match server.wait_for_peer(Duration::from_millis(200)) {
                     Ok(_) => break,
-                    Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                    Err(e)
+                        if matches!(
+                            e.kind(),
+                            std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                        ) => {}
                     Err(e) => return Err(e).with_context(|| waiting("udp")),
                 }
                 stop_requested(&cfg).with_context(|| waiting("udp"))?;

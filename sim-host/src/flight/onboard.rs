@@ -163,7 +163,14 @@ impl StationSocket {
             let n = match r {
                 Ok((n, from)) if from == self.to => n,
                 Ok(_) => continue,
-                Err(e) if e.kind() == io::ErrorKind::ConnectionRefused => continue,
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        io::ErrorKind::ConnectionRefused | io::ErrorKind::Interrupted
+                    ) =>
+                {
+                    continue
+                }
                 Err(e) if timed_out(&e) && left.is_zero() => return out,
                 Err(e) if timed_out(&e) => continue,
                 Err(_) => return out,

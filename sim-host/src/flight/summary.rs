@@ -120,7 +120,7 @@ pub struct FlightSummary {
     pub turbulence: &'static str,
     /// Steady wind, NED, m/s.
     pub wind_ned: [f64; 3],
-    /// Arming accepted at, s.
+    /// Arming accepted at, s (without a scripted station: the first armed answer).
     pub armed_at_s: Option<f64>,
     /// Estimator errors from the first `converged` to the end.
     pub estimator: Option<EstimatorErrors>,
@@ -519,7 +519,11 @@ pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts)
         seed: cfg.seed,
         turbulence: turbulence_name(cfg.turbulence),
         wind_ned: cfg.wind_ned,
-        armed_at_s: f.gcs.and_then(|g| g.armed_at_s()),
+        // When the station's arming was accepted; without a station, the first armed answer.
+        armed_at_s: match f.gcs {
+            Some(g) => g.armed_at_s(),
+            None => samples.iter().find(|s| s.armed).map(|s| s.t),
+        },
         estimator: estimator_errors(samples, 0.0),
         estimator_settled: estimator_errors(samples, SETTLE_S),
         segments: f

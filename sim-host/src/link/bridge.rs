@@ -83,7 +83,9 @@ impl GroundBridge {
                     let n = match uart.read(&mut buf) {
                         Ok(0) => break,
                         Ok(n) => n,
-                        Err(e) if timed_out(&e) => continue,
+                        Err(e) if timed_out(&e) || e.kind() == io::ErrorKind::Interrupted => {
+                            continue
+                        }
                         Err(_) => break,
                     };
                     let to: Vec<SocketAddr> = remote
@@ -125,7 +127,9 @@ impl GroundBridge {
                 while !stop.load(Ordering::Relaxed) {
                     let (n, from) = match sock_in.recv_from(&mut buf) {
                         Ok(r) => r,
-                        Err(e) if timed_out(&e) => continue,
+                        Err(e) if timed_out(&e) || e.kind() == io::ErrorKind::Interrupted => {
+                            continue
+                        }
                         // ICMP from an earlier send to a station that has gone.
                         Err(e) if e.kind() == io::ErrorKind::ConnectionRefused => continue,
                         Err(_) => break,

@@ -150,9 +150,12 @@ impl<T: Transport> Lockstep<T> {
     ) -> Result<R, LinkError> {
         let start = Instant::now();
         loop {
-            let n = self
-                .transport
-                .recv(&mut self.rx, Duration::from_millis(50))?;
+            let n = match self.transport.recv(&mut self.rx, Duration::from_millis(50)) {
+                Ok(n) => n,
+                // A signal cut the wait short: nothing arrived, the wait goes on.
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => 0,
+                Err(e) => return Err(e.into()),
+            };
             let mut found = None;
             let tlog = &mut self.tlog;
             let mut log_err = Ok(());

@@ -320,6 +320,7 @@ impl Transport for QemuLink {
                 None => Ok(0),
             },
             Ok(n) => Ok(n),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => Err(e),
             Err(e) => Err(self.explain(e)),
         }
     }
