@@ -644,3 +644,33 @@ fn the_radio_flies_stabilized_through_rc_channels() {
         "Stabilized throughout"
     );
 }
+
+#[test]
+fn leaving_the_truth_out_of_the_frames_changes_no_answer_of_an_autopilot_flying_on_its_estimate() {
+    // Over QEMU's UARTs the truth (HIL_STATE_QUATERNION) is left out unless the autopilot flies
+    // on it; the flight must be the same without it.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let fly_with = |truth_frames: bool, sub: &str| {
+        let cfg = FlightConfig {
+            duration_s: 60.0,
+            truth_frames,
+            ..sim_host::flight::missions::runway_mission(
+                sim_host::flight::missions::default_mission(
+                    sim_host::plant::ModelParams::new(&aircraft()).home,
+                ),
+            )
+        };
+        let opts = FlyOptions {
+            out: Some(dir.path().join(sub)),
+            plots: false,
+            ..FlyOptions::default()
+        };
+        fly_report(&aircraft(), &cfg, &opts).expect("flight");
+        let tlog = std::fs::read(dir.path().join(sub).join("flight.tlog")).expect("tlog");
+        sim_host::flight::compare::answers(&tlog)
+    };
+    let (with, without) = (fly_with(true, "with"), fly_with(false, "without"));
+    let c = sim_host::flight::compare::compare_answers(&with, &without);
+    assert_eq!(c.compared, 6000);
+    assert!(c.identical(), "{c:?}");
+}

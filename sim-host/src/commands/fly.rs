@@ -187,9 +187,16 @@ fn fly_qemu(
     // The bridge is the autopilot's ground link; no port into an application here.
     let cfg = FlightConfig {
         ground_link: None,
+        truth_frames: uart_truth_frames(cfg),
         ..cfg.clone()
     };
     run_on(aircraft, &cfg, sim, &mut onboard, tlog)
+}
+
+/// Whether the truth goes to the MCU image: only when it flies on it. Each byte a UART
+/// receives costs QEMU a pass of its main loop, and the truth is some 40 % of a frame.
+fn uart_truth_frames(cfg: &FlightConfig) -> bool {
+    cfg.truth_frames && cfg.flies_on_truth()
 }
 
 /// File of the MCU image's defmt log (QEMU's semihosting output) in the output directory.
@@ -385,10 +392,15 @@ pub fn compare_with_host(
         plots: false,
         ..opts.clone()
     };
-    // The host flight is not for watching: no ground-station port, no pacing.
+    // The host flight is not for watching: no ground-station port, no pacing; the frames
+    // are those the other flight had.
     let host_cfg = FlightConfig {
         ground_link: None,
         realtime: false,
+        truth_frames: match opts.link {
+            LinkKind::Qemu => uart_truth_frames(&with_params(cfg, opts)),
+            _ => cfg.truth_frames,
+        },
         ..cfg.clone()
     };
     let host = fly_report(aircraft, &host_cfg, &host_opts)?;

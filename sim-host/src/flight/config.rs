@@ -53,6 +53,10 @@ pub struct FlightConfig {
     pub until_link_closes: bool,
     /// Set from outside (Ctrl-C) to end the flight at the next frame, as flown so far.
     pub stop: Option<&'static AtomicBool>,
+    /// Send the truth (HIL_STATE_QUATERNION) with every sensor frame. An autopilot flies on it
+    /// only with `SIM_USE_TRUTH` set; over a slow link (a UART in QEMU, where each byte costs)
+    /// it may be left out otherwise.
+    pub truth_frames: bool,
 }
 
 /// Stick positions held from a time on.
@@ -95,6 +99,16 @@ pub enum Fault {
 }
 
 impl FlightConfig {
+    /// Whether the scripted station has the autopilot fly on the truth (`SIM_USE_TRUTH`).
+    pub fn flies_on_truth(&self) -> bool {
+        self.scripted_station
+            && self
+                .script
+                .params
+                .iter()
+                .any(|(n, v)| n == "SIM_USE_TRUTH" && *v != 0.0)
+    }
+
     /// Whether the flight has been asked to stop.
     pub fn stopped(&self) -> bool {
         self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
@@ -142,6 +156,7 @@ impl Default for FlightConfig {
             scripted_station: true,
             until_link_closes: false,
             stop: None,
+            truth_frames: true,
         }
     }
 }

@@ -215,9 +215,11 @@ pub fn fly<T: Transport, O: Onboard<T>>(
                 )));
             }
         }
-        msgs.push(MavMessage::HIL_STATE_QUATERNION(truth_frame(
-            time_us, &truth, &plant, alt_amsl,
-        )));
+        if cfg.truth_frames {
+            msgs.push(MavMessage::HIL_STATE_QUATERNION(truth_frame(
+                time_us, &truth, &plant, alt_amsl,
+            )));
+        }
         msgs.push(MavMessage::HIL_SENSOR(encode_hil_sensor(
             &frame,
             alt_amsl as f32,
