@@ -210,3 +210,29 @@ pub fn turbulence_name(t: Turbulence) -> &'static str {
         Turbulence::Severe => "severe",
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fault_reads_as_a_sensor_and_a_window_and_a_bad_one_says_what_is_expected() {
+        let f = parse_fault("gps:60-90.5").expect("valid");
+        assert_eq!((f.fault, f.from_s, f.to_s), (Fault::GpsLost, 60.0, 90.5));
+        assert_eq!(
+            parse_fault("baro:0-1").map(|f| f.fault),
+            Ok(Fault::BaroFailed)
+        );
+        for bad in [
+            "gyro:1-2",
+            "gps:9-3",
+            "gps:1",
+            "gps",
+            "pitot:-1-2",
+            "mag:x-2",
+        ] {
+            let e = parse_fault(bad).expect_err(bad);
+            assert!(e.contains("KIND:FROM-TO"), "{bad}: {e}");
+        }
+    }
+}
