@@ -19,27 +19,30 @@ pub fn workspace_root() -> PathBuf {
 /// never wait on each other's lock. A fresh toolchain lacks the target; adding it is
 /// idempotent and quick once present.
 pub fn build_mcu_firmware() -> PathBuf {
-    let root = workspace_root();
     let _ = Command::new("rustup")
         .args(["target", "add", "thumbv7em-none-eabihf"])
         .status();
-    let target_dir = root.join("target").join("cross");
+    let dir = cargo_build(
+        "cross",
+        &["-p", "firmware", "--target", "thumbv7em-none-eabihf"],
+    );
+    dir.join("thumbv7em-none-eabihf/release/firmware")
+}
+
+/// `cargo build --release ARGS` into `target/DIR` (a target directory of its own, so that the
+/// build does not wait for the lock of the one running the tests); returns that directory.
+fn cargo_build(dir: &str, args: &[&str]) -> PathBuf {
+    let target_dir = workspace_root().join("target").join(dir);
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "-p",
-            "firmware",
-            "--release",
-            "--target",
-            "thumbv7em-none-eabihf",
-        ])
+        .current_dir(workspace_root())
+        .args(["build", "--release"])
+        .args(args)
         .env("CARGO_TARGET_DIR", &target_dir)
         .status()
         .expect("cargo runs");
-    assert!(status.success(), "thumbv7em build of firmware failed");
-    target_dir.join("thumbv7em-none-eabihf/release/firmware")
+    assert!(status.success(), "cargo build --release {args:?} failed");
+    target_dir
 }
 
 /// Whether an external tool is installed. Under CI (`CI` set) a missing tool is an error, so a
@@ -64,25 +67,5 @@ pub fn tool_available(name: &str) -> bool {
 /// arctangents and exponentials with the libm crate as the MCU image does, into
 /// `target/mcu-libm`; returns the binary's path.
 pub fn build_sim_host_with_mcu_libm() -> PathBuf {
-    let root = workspace_root();
-    let target_dir = root.join("target").join("mcu-libm");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "-p",
-            "sim-host",
-            "--release",
-            "--features",
-            "mcu-libm",
-        ])
-        .env("CARGO_TARGET_DIR", &target_dir)
-        .status()
-        .expect("cargo runs");
-    assert!(
-        status.success(),
-        "build of sim-host --features mcu-libm failed"
-    );
-    target_dir.join("release/sim-host")
+    cargo_build("mcu-libm", &["-p", "sim-host", "--features", "mcu-libm"]).join("release/sim-host")
 }

@@ -350,4 +350,18 @@ impl Station {
         })
         .unwrap_or(false)
     }
+
+    /// Waits up to `secs` for the autopilot's heartbeat and checks that it describes a fixed
+    /// wing with a generic autopilot (DESIGN.md's identity).
+    pub fn fixed_wing_heartbeat(&mut self, secs: f64) -> HEARTBEAT_DATA {
+        let hb = self
+            .wait(secs, |m| match m {
+                MavMessage::HEARTBEAT(h) => Some(h.clone()),
+                _ => None,
+            })
+            .expect("the autopilot's heartbeat");
+        assert_eq!(hb.mavtype, MavType::MAV_TYPE_FIXED_WING);
+        assert_eq!(hb.autopilot, MavAutopilot::MAV_AUTOPILOT_GENERIC);
+        hb
+    }
 }

@@ -124,14 +124,7 @@ fn start(duration_s: f64, speed: f64, silent_at_s: f64) -> (Station, JoinHandle<
         .parse()
         .expect("address");
     let mut station = Station::new(socket, to);
-    let hb = station
-        .wait(10.0, |m| match m {
-            MavMessage::HEARTBEAT(h) => Some(h.clone()),
-            _ => None,
-        })
-        .expect("autopilot heartbeat over UDP");
-    assert_eq!(hb.mavtype, MavType::MAV_TYPE_FIXED_WING);
-    assert_eq!(hb.autopilot, MavAutopilot::MAV_AUTOPILOT_GENERIC);
+    station.fixed_wing_heartbeat(10.0);
     (station, handle)
 }
 

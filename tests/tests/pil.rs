@@ -243,37 +243,39 @@ fn a_missing_image_is_an_error_that_names_the_command_that_builds_it() {
     );
 }
 
-#[test]
-fn a_missing_qemu_is_an_error_that_names_the_package_to_install() {
+/// Flies on a stand-in for QEMU whose run does `body` (its `--version` answers as QEMU's does),
+/// the image a placeholder file; returns the error and how long it took to come.
+fn fake_qemu_flight(program: Option<&str>, body: &str) -> (String, Duration) {
     let dir = tempfile::tempdir().expect("tempdir");
     let elf = dir.path().join("firmware");
     std::fs::write(&elf, b"not run").expect("file");
+    let program = match program {
+        Some(p) => PathBuf::from(p),
+        None => fake_qemu(
+            dir.path(),
+            &format!("[ \"$1\" = --version ] && exit 0\n{body}"),
+        ),
+    };
     let qemu = QemuConfig {
         elf,
-        program: PathBuf::from("/nonexistent/qemu-system-arm"),
+        program,
         ..QemuConfig::default()
     };
-    let (e, _, _) = failing_flight(qemu, Duration::from_secs(5));
+    let (e, took, _) = failing_flight(qemu, Duration::from_secs(5));
+    (e, took)
+}
+
+#[test]
+fn a_missing_qemu_is_an_error_that_names_the_package_to_install() {
+    let (e, _) = fake_qemu_flight(Some("/nonexistent/qemu-system-arm"), "");
     assert!(e.contains("apt-get install qemu-system-arm"), "{e}");
 }
 
 #[test]
 fn a_qemu_that_dies_at_start_ends_the_flight_with_its_status_and_what_it_said() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let elf = dir.path().join("firmware");
-    std::fs::write(&elf, b"not run").expect("file");
-    // `--version` answers as QEMU does; a run prints an error and exits with 3.
-    let program = fake_qemu(
-        dir.path(),
-        "[ \"$1\" = --version ] && exit 0\necho 'qemu-system-arm: cannot load the image' >&2\nexit 3",
-    );
-    let (e, took, _) = failing_flight(
-        QemuConfig {
-            elf,
-            program,
-            ..QemuConfig::default()
-        },
-        Duration::from_secs(5),
+    let (e, took) = fake_qemu_flight(
+        None,
+        "echo 'qemu-system-arm: cannot load the image' >&2\nexit 3",
     );
     assert!(
         e.contains("exited with status 3") && e.contains("cannot load the image"),
@@ -284,21 +286,7 @@ fn a_qemu_that_dies_at_start_ends_the_flight_with_its_status_and_what_it_said() 
 
 #[test]
 fn a_qemu_that_never_connects_ends_the_flight_within_its_connection_wait() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let elf = dir.path().join("firmware");
-    std::fs::write(&elf, b"not run").expect("file");
-    let program = fake_qemu(
-        dir.path(),
-        "[ \"$1\" = --version ] && exit 0\nexec sleep 60",
-    );
-    let (e, took, _) = failing_flight(
-        QemuConfig {
-            elf,
-            program,
-            ..QemuConfig::default()
-        },
-        Duration::from_secs(5),
-    );
+    let (e, took) = fake_qemu_flight(None, "exec sleep 60");
     assert!(
         e.contains("USART1 (the simulator link) did not connect")
             && e.contains("is running but did not connect it within 5s"),

@@ -63,13 +63,7 @@ fn start_sim(
 /// mission's length.
 fn upload_arm_and_start(gcs: &mut Station, speed: f64) -> u16 {
     let params = ModelParams::new(&aircraft());
-    let hb = gcs
-        .wait(20.0, |m| match m {
-            MavMessage::HEARTBEAT(h) => Some(h.clone()),
-            _ => None,
-        })
-        .expect("the autopilot's heartbeat");
-    assert_eq!(hb.mavtype, MavType::MAV_TYPE_FIXED_WING);
+    gcs.fixed_wing_heartbeat(20.0);
     let delay = aircraft().sensors.gps.latency_s as f32;
     assert!(gcs.set_param("EKF_GPS_DELAY", delay), "EKF_GPS_DELAY set");
     let mission = default_mission(params.home);
