@@ -326,7 +326,7 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
     };
     let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
     let compared = if a.compare_host {
-        Some(commands::fly::compare_with_host(aircraft, &cfg, &opts)?)
+        Some(commands::compare::compare_with_host(aircraft, &cfg, &opts)?)
     } else {
         None
     };

@@ -12,7 +12,9 @@
 //! host build answers bit for bit as the image (the ignored test at the end; docs/PIL.md).
 
 use sim_host::aircraft::Aircraft;
-use sim_host::commands::fly::{compare_with_host, fly_report, FlyOptions, LinkKind, MCU_LOG};
+use sim_host::commands::compare::compare_with_host;
+use sim_host::commands::fly::{fly_report, FlyOptions, LinkKind};
+use sim_host::commands::flying::MCU_LOG;
 use sim_host::flight::missions::{default_mission, runway_mission};
 use sim_host::flight::summary::Ending;
 use sim_host::flight::FlightConfig;

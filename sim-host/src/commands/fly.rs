@@ -1,24 +1,23 @@
 //! `sim-host fly`: the firmware flies the plant over the simulator link, commanded by a
 //! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
 
+use super::flying::{finish_report, fly_qemu, run_on, MCU_LOG};
 use crate::aircraft::Aircraft;
-use crate::flight::compare::{answers, compare_answers, AnswerComparison};
 use crate::flight::config::FlightConfig;
-use crate::flight::onboard::{spawn_firmware, InprocOnboard, Onboard, OutsideOnboard};
-use crate::flight::plots::write_log_and_plots;
-use crate::flight::runner::{fly, FlightError, FlightOutcome};
+use crate::flight::onboard::{spawn_firmware, InprocOnboard};
+use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::MissionSummary;
-use crate::link::lockstep::Lockstep;
-use crate::link::qemu::{boot, QemuConfig};
-use crate::link::tlog::TlogWriter;
-use crate::link::transport::{Inproc, PtyServer, TcpServer, Transport, UdpServer};
+use crate::link::qemu::QemuConfig;
+use crate::link::transport::{Inproc, PtyServer, TcpServer, UdpServer};
+use crate::report::sig;
 use crate::report::table::Table;
-use crate::report::{sig, to_json};
 use anyhow::Context;
 use firmware::app::App;
 use firmware::sitl::SimEndpoint;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
+
+pub use super::flying::{write_flight_files, FlyReport};
 
 /// Which transport carries the simulator link.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,16 +101,8 @@ impl Default for FlyOptions {
     }
 }
 
-/// A flown flight and the files it left.
-#[derive(Clone, Debug)]
-pub struct FlyReport {
-    /// Log and summary.
-    pub outcome: FlightOutcome,
-    /// Files written.
-    pub files: Vec<PathBuf>,
-}
-
-fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
+/// The flight of `cfg` with the parameters `opts` asks the station to set.
+pub(crate) fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
     let mut cfg = cfg.clone();
     if let Some(g) = opts.gain_set {
         cfg.script.params.push(("SYS_GAIN_SET".into(), g as f32));
@@ -125,94 +116,6 @@ fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
         cfg.script.params.push(("SIM_USE_TRUTH".into(), 1.0));
     }
     cfg
-}
-
-/// A flight, or why it could not be flown: the outer error is this side's (a file that
-/// cannot be written), the inner one the flight's.
-type Flown = anyhow::Result<Result<FlightOutcome, FlightError>>;
-
-fn run_on<T: Transport, O: Onboard<T>>(
-    aircraft: &Aircraft,
-    cfg: &FlightConfig,
-    transport: T,
-    onboard: &mut O,
-    tlog: Option<&Path>,
-) -> Flown {
-    run_on_with(aircraft, cfg, transport, onboard, tlog, |_| Ok(()))
-}
-
-/// [`run_on`], with `before` run on the link first (waiting for an autopilot to speak).
-pub(crate) fn run_on_with<T: Transport, O: Onboard<T>>(
-    aircraft: &Aircraft,
-    cfg: &FlightConfig,
-    transport: T,
-    onboard: &mut O,
-    tlog: Option<&Path>,
-    before: impl FnOnce(&mut Lockstep<T>) -> anyhow::Result<()>,
-) -> Flown {
-    let mut link = Lockstep::new(transport, cfg.link_timeout);
-    if let Some(p) = tlog {
-        let w =
-            TlogWriter::create(p).with_context(|| format!("cannot create `{}`", p.display()))?;
-        link = link.with_tlog(w);
-    }
-    before(&mut link)?;
-    let flown = fly(aircraft, cfg, &mut link, onboard);
-    // The log of a flight that failed is kept as well.
-    link.finish().context("cannot write the tlog")?;
-    Ok(flown)
-}
-
-/// Boots the MCU image in QEMU and flies `cfg` against it, the scripted station on the UDP
-/// side of its ground bridge. The bridge serves `cfg.ground_link` when one is asked for
-/// (QGroundControl watching), else a free port for the scripted station alone.
-fn fly_qemu(
-    aircraft: &Aircraft,
-    cfg: &FlightConfig,
-    qemu: &QemuConfig,
-    out: Option<&Path>,
-    tlog: Option<&Path>,
-) -> Flown {
-    let (bind, remote) = match &cfg.ground_link {
-        Some((b, r)) => (b.clone(), Some(r.clone())),
-        None => ("127.0.0.1:0".to_string(), None),
-    };
-    let qemu = QemuConfig {
-        log: out.map(|d| d.join(MCU_LOG)),
-        ..qemu.clone()
-    };
-    let (sim, bridge) = boot(&qemu, &bind, remote.as_deref(), || stop_requested(cfg))?;
-    let mut onboard = OutsideOnboard::with_station(bridge.local_addr())
-        .context("cannot open the scripted station's socket")?;
-    // The bridge is the autopilot's ground link; no port into an application here.
-    let cfg = FlightConfig {
-        ground_link: None,
-        truth_frames: uart_truth_frames(cfg),
-        ..cfg.clone()
-    };
-    run_on(aircraft, &cfg, sim, &mut onboard, tlog)
-}
-
-/// Whether the truth goes to the MCU image: only when it flies on it. Each byte a UART
-/// receives costs QEMU a pass of its main loop, and the truth is half of the bytes of a frame
-/// (76 of 152 on average).
-fn uart_truth_frames(cfg: &FlightConfig) -> bool {
-    cfg.truth_frames && cfg.flies_on_truth()
-}
-
-/// File of the MCU image's defmt log (QEMU's semihosting output) in the output directory.
-pub const MCU_LOG: &str = "mcu.defmt";
-
-/// An error once the flight has been asked to stop (Ctrl-C), for the waits before it.
-pub(crate) fn stop_requested(cfg: &FlightConfig) -> std::io::Result<()> {
-    if cfg.stopped() {
-        Err(std::io::Error::new(
-            std::io::ErrorKind::Interrupted,
-            "stopped (Ctrl-C)",
-        ))
-    } else {
-        Ok(())
-    }
 }
 
 /// Flies `cfg` over the transport of `opts`, and writes the files into `opts.out` (also when
@@ -283,162 +186,6 @@ pub fn fly_report(
         files.extend(opts.out.as_ref().map(|d| d.join(MCU_LOG)));
     }
     finish_report(flown, opts.out.as_deref(), opts.plots, files)
-}
-
-/// Writes the files of a flight into `out` (those of a failed flight too, up to the failure:
-/// the error then says where they are) beside `files` already written.
-pub(crate) fn finish_report(
-    flown: Result<FlightOutcome, FlightError>,
-    out: Option<&Path>,
-    plots: bool,
-    mut files: Vec<PathBuf>,
-) -> anyhow::Result<FlyReport> {
-    match flown {
-        Ok(outcome) => {
-            if let Some(dir) = out {
-                files.extend(write_flight_files(dir, &outcome, plots)?);
-            }
-            Ok(FlyReport { outcome, files })
-        }
-        Err(e) => match (e.partial(), out) {
-            (Some(partial), Some(dir)) => {
-                write_flight_files(dir, partial, plots)?;
-                Err(anyhow::Error::new(e).context(format!(
-                    "the flight failed; its log up to the failure is in `{}`",
-                    dir.display()
-                )))
-            }
-            _ => Err(e.into()),
-        },
-    }
-}
-
-/// A flight flown again by the host build in this process, and the two autopilots' answers
-/// compared.
-#[derive(Clone, Debug)]
-pub struct HostComparison {
-    /// The host build's flight.
-    pub host: FlightOutcome,
-    /// The answers of the flight compared (first) with the host build's (second).
-    pub answers: AnswerComparison,
-}
-
-impl HostComparison {
-    /// The comparison as a table, with the pace of both flights.
-    pub fn table(&self, flight: &FlightOutcome, link: LinkKind) -> Table {
-        let a = &self.answers;
-        let mut t = Table::new(
-            format!(
-                "Answers of the {} flight against the host build's",
-                link.name()
-            ),
-            &["quantity", "value"],
-        );
-        let pace = |o: &FlightOutcome| {
-            format!(
-                "{:.1} s simulated in {:.2} s: {:.2}x real time",
-                o.summary.sim_s, o.summary.wall_s, o.summary.real_time_factor
-            )
-        };
-        t.row([format!("pace, {}", link.name()), pace(flight)]);
-        t.row(["pace, host build in-process".to_string(), pace(&self.host)]);
-        t.row([
-            "HIL_ACTUATOR_CONTROLS compared".to_string(),
-            format!("{} ({} and {} answers)", a.compared, a.frames_a, a.frames_b),
-        ]);
-        t.row([
-            "identical bit for bit".to_string(),
-            match a.first_difference {
-                None => format!("all {}", a.compared),
-                Some(d) => format!(
-                    "the first {}; frame {} (t = {:.2} s) differs in {}: {:e} vs {:e}",
-                    a.identical_frames,
-                    d.frame,
-                    d.time_s,
-                    d.control.map_or("time, mode or flags", |c| [
-                        "roll", "pitch", "yaw", "throttle"
-                    ][c]),
-                    d.a,
-                    d.b
-                ),
-            },
-        ]);
-        t.row([
-            "largest difference (roll, pitch, yaw, throttle)".to_string(),
-            a.max_abs_diff
-                .iter()
-                .map(|d| format!("{d:.3e}"))
-                .collect::<Vec<_>>()
-                .join(", "),
-        ]);
-        t
-    }
-}
-
-/// Flies `cfg` again with the host build in this process (same seed, same script) into
-/// `<out>/host`, and compares its answers with those of the flight `fly_report(aircraft,
-/// cfg, opts)` flew into `<out>`, read from both `.tlog`s.
-pub fn compare_with_host(
-    aircraft: &Aircraft,
-    cfg: &FlightConfig,
-    opts: &FlyOptions,
-) -> anyhow::Result<HostComparison> {
-    let dir = opts
-        .out
-        .as_ref()
-        .context("comparing answers needs an output directory for the .tlog files")?;
-    let host_opts = FlyOptions {
-        link: LinkKind::Inproc,
-        out: Some(dir.join("host")),
-        plots: false,
-        ..opts.clone()
-    };
-    // The host flight is not for watching: no ground-station port, no pacing; the frames
-    // are those the other flight had.
-    let host_cfg = FlightConfig {
-        ground_link: None,
-        realtime: false,
-        truth_frames: match opts.link {
-            LinkKind::Qemu => uart_truth_frames(&with_params(cfg, opts)),
-            _ => cfg.truth_frames,
-        },
-        ..cfg.clone()
-    };
-    let host = fly_report(aircraft, &host_cfg, &host_opts)?;
-    let read =
-        |p: &Path| std::fs::read(p).with_context(|| format!("cannot read `{}`", p.display()));
-    let a = answers(&read(&dir.join("flight.tlog"))?);
-    let b = answers(&read(&dir.join("host").join("flight.tlog"))?);
-    Ok(HostComparison {
-        host: host.outcome,
-        answers: compare_answers(&a, &b),
-    })
-}
-
-/// Writes the CSV log (and the PNG plots when `plots`) and `summary.json` into `dir`.
-pub fn write_flight_files(
-    dir: &Path,
-    outcome: &FlightOutcome,
-    plots: bool,
-) -> anyhow::Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    if plots {
-        files.extend(write_log_and_plots(dir, &outcome.samples)?);
-    } else {
-        let csv = dir.join("flight.csv");
-        let rows: Vec<Vec<f64>> = outcome
-            .samples
-            .iter()
-            .map(crate::flight::record::csv_row)
-            .collect();
-        crate::report::csv_out::write_csv(&csv, &crate::flight::record::csv_headers(), &rows)?;
-        files.push(csv);
-    }
-    let json = dir.join("summary.json");
-    std::fs::write(&json, to_json(&outcome.summary)?)
-        .with_context(|| format!("cannot write `{}`", json.display()))?;
-    files.push(json);
-    Ok(files)
 }
 
 /// The short summary printed after a flight.

@@ -1,9 +1,11 @@
 //! The analysis commands as library functions: each returns its results (for `--json` and for
 //! tests) and the tables it prints, so the CLI only chooses the output form.
 
+pub mod compare;
 pub mod design;
 pub mod doublet;
 pub mod fly;
+pub mod flying;
 pub mod linearize;
 pub mod navigation;
 pub mod params;

@@ -8,7 +8,8 @@
 //! on the autopilot's own ground link. The flight ends when the autopilot closes the link, at
 //! the duration, or on Ctrl-C; in each case the log, `.tlog`, plots and summary are written.
 
-use super::fly::{run_on_with, stop_requested, FlyReport, LinkKind, MCU_LOG};
+use super::fly::LinkKind;
+use super::flying::{finish_report, run_on_with, stop_requested, FlyReport, MCU_LOG};
 use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
 use crate::flight::onboard::OutsideOnboard;
@@ -232,5 +233,5 @@ pub fn sim_report(
     if opts.link == LinkKind::Qemu {
         files.extend(opts.out.as_ref().map(|d| d.join(MCU_LOG)));
     }
-    super::fly::finish_report(flown, opts.out.as_deref(), opts.plots, files)
+    finish_report(flown, opts.out.as_deref(), opts.plots, files)
 }
