@@ -208,6 +208,16 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
         "armed at".to_string(),
         s.armed_at_s.map_or("never".into(), |t| format!("{t:.1} s")),
     ]);
+    if let (None, Some(td)) = (&s.mission, &s.touchdown) {
+        // No mission known here (`sim-host sim`): where and how the wheels met the runway.
+        run.row([
+            "touchdown".to_string(),
+            format!(
+                "at {:.1} s, {:.1} m N {:.1} m E of home, sink {:.2} m/s, {:.1} m/s over ground, {} bounce(s)",
+                td.time_s, td.north_m, td.east_m, td.sink_rate_mps, td.ground_speed_mps, td.bounces
+            ),
+        ]);
+    }
     run.row([
         "wind, turbulence".to_string(),
         format!(
