@@ -4,32 +4,44 @@
 //! autopilot tick:
 //!
 //! ```text
-//! sensors -> estimator -> (navigation, guidance) -> control -> actuator outputs
+//! sensors -> estimator -> vehicle (commander) -> navigation -> guidance -> control -> actuators
 //! ```
 //!
-//! - [`math`]: the one definition of every frame change, rotation, geodetic conversion and
-//!   the standard atmosphere, generic over the float type so the f64 plant and the f32
-//!   firmware share it.
-//! - [`params`]: how each stage declares its parameters (name, default, bounds, unit).
-//! - [`sensors`]: the raw sensor samples the estimator consumes.
+//! - [`sensors`]: the samples a sensor frame carries, and their plausibility limits.
 //! - [`estimator`]: attitude, position, velocity, air data and wind from raw sensors.
-//! - [`navigation`]: the mission executor, path manager (waypoint switching with fillets),
-//!   take-off, landing, return and loiter behaviours, mission validation and the geofence.
-//! - [`guidance`]: vector-field path following: a line or orbit to course, altitude and
-//!   airspeed commands.
+//! - [`vehicle`]: the stages wired together: flight modes, requests, the commander (arming,
+//!   mode entry, failsafe reactions, the navigator hand-off), the one parameter registry, the
+//!   clock that follows the sensor frames, and the snapshot the vehicle reports.
 //! - [`failsafe`]: what the aircraft does on its own when the ground link, GPS, the airspeed
 //!   sensor or the geofence fails it.
-//! - [`control`]: the successive-loop-closure autopilot of the thesis.
-//! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
+//! - [`navigation`]: the plan (stored mission, fence, rally points), the navigator and its
+//!   behaviours (mission, take-off, loiter, landing, return), the path manager (fillets),
+//!   mission checks and the geofence.
+//! - [`guidance`]: vector-field path following: a line or orbit to course, altitude and
+//!   airspeed commands.
+//! - [`control`]: the successive-loop-closure autopilot of the thesis, each stage with its
+//!   gains.
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
-//! - [`gcs`]: the ground-station link logic (heartbeat, parameters, missions, commands,
+//!
+//! Beside the tick:
+//! - [`params`]: how each stage declares its parameters, and the one store of their values.
+//! - [`gcs`]: the ground-station protocols (routing, parameters, missions, commands,
 //!   telemetry), transport-agnostic.
+//! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
 //! - [`storage`]: power-cut-safe persistence of parameters and missions in flash.
+//! - [`math`]: the one definition of every frame change, rotation, geodetic conversion,
+//!   gravity and the standard atmosphere, generic over the float type so the f64 plant and
+//!   the f32 firmware share it.
 //!
 //! Every stage is a plain struct with an explicit `step`/`update` taking its inputs and time
 //! step: no globals, no I/O, no clock reads.
 #![no_std]
 #![forbid(unsafe_code)]
+// Nothing from outside may stop the autopilot: no unwrap, no expect, no unchecked index.
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)
+)]
 
 pub mod actuators;
 pub mod control;

@@ -2,9 +2,10 @@
 //! same [`App`] the MCU runs.
 
 use crate::app::App;
+use common::gcs::Dest;
 use common::storage::{
-    load_missions, load_params, save_missions, save_params, AbRegion, RamFlash, MISSION_MAGIC,
-    PARAMS_MAGIC,
+    load, load_missions, load_params, save, save_missions, save_params, AbRegion, RamFlash,
+    SigningRecord, MISSION_MAGIC, PARAMS_MAGIC, SIGNING_MAGIC,
 };
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs, UdpSocket};
@@ -241,7 +242,9 @@ pub fn run_with(
         }
         last_rx = Instant::now();
         let mut out = Vec::new();
-        app.on_sim_bytes(&buf[..n], &mut |b| out.extend_from_slice(b));
+        app.on_sim_bytes(buf.get(..n).unwrap_or(&[]), &mut |b| {
+            out.extend_from_slice(b)
+        });
         if !out.is_empty() {
             link.write_all_bytes(&out)?;
         }
@@ -258,10 +261,13 @@ pub struct FileStorage {
     path: Option<PathBuf>,
     flash: RamFlash<STORAGE_BYTES>,
     missions_seen: Option<u32>,
+    signing_seen: Option<u32>,
+    /// Boot without the saved signing key (the bench recovery of a lost key).
+    forget_key: bool,
 }
 
 const SECTOR: u32 = 16 * 1024;
-const STORAGE_BYTES: usize = 4 * SECTOR as usize;
+const STORAGE_BYTES: usize = 6 * SECTOR as usize;
 const PARAMS_REGION: AbRegion = AbRegion {
     magic: PARAMS_MAGIC,
     slot_a: 0,
@@ -272,6 +278,12 @@ const MISSIONS_REGION: AbRegion = AbRegion {
     magic: MISSION_MAGIC,
     slot_a: 2 * SECTOR,
     slot_b: 3 * SECTOR,
+    slot_len: SECTOR,
+};
+const SIGNING_REGION: AbRegion = AbRegion {
+    magic: SIGNING_MAGIC,
+    slot_a: 4 * SECTOR,
+    slot_b: 5 * SECTOR,
     slot_len: SECTOR,
 };
 
@@ -286,7 +298,16 @@ impl FileStorage {
             path,
             flash: RamFlash::from_image(&image, SECTOR),
             missions_seen: None,
+            signing_seen: None,
+            forget_key: false,
         }
+    }
+
+    /// Boots without the saved MAVLink signing key, and saves that at the next change: the
+    /// bench recovery of a lost key (`firmware --signing-reset`).
+    pub fn forget_signing_key(mut self) -> Self {
+        self.forget_key = true;
+        self
     }
 
     /// Loads saved parameters and missions into the autopilot.
@@ -311,7 +332,25 @@ impl FileStorage {
             Ok(None) => {}
             Err(e) => notes.push(format!("saved missions unreadable: {e:?}")),
         }
+        match load::<_, SigningRecord>(&mut self.flash, &SIGNING_REGION, &mut scratch) {
+            Ok(Some(r)) if self.forget_key => {
+                app.signing_mut().load(None, r.value.timestamp);
+                notes.push("signing key forgotten (--signing-reset)".into());
+            }
+            Ok(Some(r)) => {
+                app.signing_mut().load(r.value.key, r.value.timestamp);
+                if r.value.key.is_some() {
+                    notes.push("signing key loaded: unsigned writes are refused".into());
+                }
+            }
+            Ok(None) => {}
+            Err(e) => notes.push(format!("saved signing key unreadable: {e:?}")),
+        }
         self.missions_seen = Some(app.vehicle().plan().change_count());
+        self.signing_seen = Some(app.signing_mut().change_count());
+        if self.forget_key {
+            self.signing_seen = None;
+        }
         app.vehicle_mut().params_mut().mark_saved();
         notes
     }
@@ -328,6 +367,17 @@ impl FileStorage {
                 &mut scratch,
             )
             .map_err(|e| io::Error::other(format!("parameter save: {e:?}")))?;
+            changed = true;
+        }
+        let signing = app.signing_mut();
+        if Some(signing.change_count()) != self.signing_seen {
+            let record = SigningRecord {
+                key: signing.key().copied(),
+                timestamp: signing.timestamp(),
+            };
+            self.signing_seen = Some(signing.change_count());
+            save(&mut self.flash, &SIGNING_REGION, &record, &mut scratch)
+                .map_err(|e| io::Error::other(format!("signing key save: {e:?}")))?;
             changed = true;
         }
         let plan = app.vehicle().plan();
@@ -351,15 +401,21 @@ impl FileStorage {
 }
 
 /// The ground-station link over UDP: telemetry to a fixed remote (QGroundControl listens on
-/// 14550) and to every peer that has sent us a frame (MAVSDK, pymavlink, test clients).
+/// 14550) and to every station that has sent us a frame lately (MAVSDK, pymavlink, test
+/// clients). Each station has its own channel: the fixed remote 0, the others 1 to
+/// [`MAX_GCS_PEERS`]; answers go back only to the station that asked, telemetry to all.
 pub struct GcsUdp {
     socket: UdpSocket,
     remote: Option<SocketAddr>,
-    peers: Vec<SocketAddr>,
+    /// Stations that spoke first, with when each was last heard.
+    peers: [Option<(SocketAddr, Instant)>; MAX_GCS_PEERS],
 }
 
-/// Most ground stations a SITL link answers at once.
+/// Most stations besides the fixed remote a SITL link serves at once; a new one takes the
+/// place of the one heard longest ago.
 pub const MAX_GCS_PEERS: usize = 8;
+/// A station silent this long is forgotten (QGroundControl sends a heartbeat every second).
+pub const PEER_TIMEOUT: Duration = Duration::from_secs(10);
 
 impl GcsUdp {
     /// Binds `bind` and sends to `remote` as well as to whoever speaks.
@@ -373,7 +429,7 @@ impl GcsUdp {
         Ok(Self {
             socket,
             remote,
-            peers: Vec::new(),
+            peers: [None; MAX_GCS_PEERS],
         })
     }
 
@@ -382,19 +438,39 @@ impl GcsUdp {
         self.socket.local_addr()
     }
 
+    /// The channel of a station that sent a datagram at `now`: the fixed remote's, its own,
+    /// a free one, or the one of the station heard longest ago.
+    fn channel_of(&mut self, from: SocketAddr, now: Instant) -> u8 {
+        if Some(from) == self.remote {
+            return 0;
+        }
+        let slot = self
+            .peers
+            .iter()
+            .position(|p| p.is_some_and(|(a, _)| a == from))
+            .or_else(|| {
+                self.peers.iter().position(|p| {
+                    p.is_none_or(|(_, heard)| now.duration_since(heard) > PEER_TIMEOUT)
+                })
+            })
+            .unwrap_or_else(|| {
+                let heard = |i: &usize| self.peers.get(*i).copied().flatten().map(|(_, h)| h);
+                (0..MAX_GCS_PEERS).min_by_key(heard).unwrap_or(0)
+            });
+        if let Some(p) = self.peers.get_mut(slot) {
+            *p = Some((from, now));
+        }
+        slot as u8 + 1
+    }
+
     /// Takes every waiting datagram into the autopilot, then sends its answers.
     pub fn service(&mut self, app: &mut App) -> io::Result<()> {
         let mut buf = [0u8; 2048];
         loop {
             match self.socket.recv_from(&mut buf) {
                 Ok((n, from)) => {
-                    if Some(from) != self.remote
-                        && !self.peers.contains(&from)
-                        && self.peers.len() < MAX_GCS_PEERS
-                    {
-                        self.peers.push(from);
-                    }
-                    app.on_gcs_bytes(&buf[..n]);
+                    let channel = self.channel_of(from, Instant::now());
+                    app.on_gcs_datagram(channel, buf.get(..n).unwrap_or(&[]));
                 }
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
                 // A peer that went away makes the next recv report it (ICMP); keep going.
@@ -406,14 +482,37 @@ impl GcsUdp {
         Ok(())
     }
 
-    /// Sends what the autopilot has for the ground stations.
+    /// Sends what the autopilot has for the ground stations, one frame per datagram: to
+    /// everyone, or back to the station it answers.
     pub fn flush(&mut self, app: &mut App) {
+        let now = Instant::now();
         let (socket, remote, peers) = (&self.socket, self.remote, &self.peers);
-        app.drain_gcs(&mut |bytes| {
-            // Frames are cut at frame boundaries by the app; one datagram per drain is fine
-            // below 8 KiB, the loopback datagram limit is far above that.
-            for to in remote.iter().chain(peers.iter()) {
-                let _ = socket.send_to(bytes, to);
+        let live = move |c: usize| {
+            peers
+                .get(c)
+                .copied()
+                .flatten()
+                .filter(|(_, heard)| now.duration_since(*heard) <= PEER_TIMEOUT)
+                .map(|(a, _)| a)
+        };
+        app.drain_gcs_to(&mut |dest, frame| match dest {
+            Dest::All => {
+                for to in remote
+                    .into_iter()
+                    .chain((0..MAX_GCS_PEERS).filter_map(live))
+                {
+                    let _ = socket.send_to(frame, to);
+                }
+            }
+            Dest::Channel(0) => {
+                if let Some(to) = remote {
+                    let _ = socket.send_to(frame, to);
+                }
+            }
+            Dest::Channel(c) => {
+                if let Some(to) = live(usize::from(c) - 1) {
+                    let _ = socket.send_to(frame, to);
+                }
             }
         });
     }
@@ -444,6 +543,10 @@ struct Args {
     /// File holding the saved parameters and missions (the SITL flash); `none` for none.
     #[arg(long, default_value = "sitl-storage.bin")]
     storage: String,
+    /// Boot without the saved MAVLink signing key (the bench recovery of a lost key): the
+    /// ground link accepts unsigned frames again until a new key is set.
+    #[arg(long)]
+    signing_reset: bool,
 }
 
 /// Entry point of the SITL build.
@@ -463,6 +566,9 @@ pub fn main() -> std::process::ExitCode {
     let mut app = App::new();
     let mut storage =
         FileStorage::open((args.storage != "none").then(|| PathBuf::from(&args.storage)));
+    if args.signing_reset {
+        storage = storage.forget_signing_key();
+    }
     for note in storage.load_into(&mut app) {
         eprintln!("firmware: {note}");
     }
@@ -501,5 +607,41 @@ pub fn main() -> std::process::ExitCode {
                 std::process::ExitCode::FAILURE
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mavlink::dialects::common::SETUP_SIGNING_DATA;
+
+    #[test]
+    fn a_signing_key_survives_a_reboot_and_the_bench_reset_forgets_it() {
+        let path = std::env::temp_dir().join(format!("sitl-signing-{}.bin", std::process::id()));
+        let _ = std::fs::remove_file(&path);
+        let mut app = App::new();
+        let mut storage = FileStorage::open(Some(path.clone()));
+        storage.load_into(&mut app);
+        let setup = SETUP_SIGNING_DATA {
+            initial_timestamp: 1_000_000,
+            target_system: 1,
+            target_component: 1,
+            secret_key: [42; 32],
+        };
+        assert!(app.signing_mut().setup(&setup, false));
+        storage.save_changes(&mut app).expect("saved");
+
+        let mut rebooted = App::new();
+        FileStorage::open(Some(path.clone())).load_into(&mut rebooted);
+        assert_eq!(rebooted.signing_mut().key(), Some(&[42; 32]));
+        // The signing clock carries on from where it was saved, never older.
+        assert!(rebooted.signing_mut().timestamp() >= 1_000_000);
+
+        let mut reset = App::new();
+        FileStorage::open(Some(path.clone()))
+            .forget_signing_key()
+            .load_into(&mut reset);
+        assert_eq!(reset.signing_mut().key(), None);
+        let _ = std::fs::remove_file(&path);
     }
 }

@@ -2,6 +2,7 @@
 //! snapshot, answered with `COMMAND_ACK`, accepted ones queued as requests.
 
 use super::outbox::{After, Command, Pending};
+use super::peer::Peer;
 use super::streams::Stream;
 use super::{telemetry, GroundLink, Stores, FORCE_ARM_MAGIC, HEARTBEAT_INTERVAL_US};
 use crate::navigation::plan::MissionStore;
@@ -19,7 +20,7 @@ impl GroundLink {
     pub(super) fn on_command(
         &mut self,
         c: Command,
-        from: (u8, u8),
+        from: Peer,
         now_us: u64,
         v: &VehicleSnapshot,
         stores: &mut Stores,
@@ -133,10 +134,11 @@ impl GroundLink {
                     // The heartbeat stays at 1 Hz.
                     Some(HEARTBEAT_DATA::ID) => MavResult::MAV_RESULT_DENIED,
                     Some(id) => match Stream::from_message_id(id) {
-                        Some(s) => {
-                            self.streams.set_interval(s, c.p[1], now_us);
+                        // A NaN interval asks for nothing: refused, the rate kept.
+                        Some(s) if self.streams.set_interval(s, c.p[1], now_us) => {
                             MavResult::MAV_RESULT_ACCEPTED
                         }
+                        Some(_) => MavResult::MAV_RESULT_DENIED,
                         None => MavResult::MAV_RESULT_UNSUPPORTED,
                     },
                     None => MavResult::MAV_RESULT_DENIED,
@@ -168,6 +170,12 @@ impl GroundLink {
                 after = p;
                 r
             }
+            // QGroundControl 4 asks for it after AUTOPILOT_VERSION and falls back to MAVLink 1
+            // without an answer.
+            MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION => {
+                let _ = after.push(Pending::ProtocolVersion);
+                MavResult::MAV_RESULT_ACCEPTED
+            }
             MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
                 let _ = after.push(Pending::AutopilotVersion);
                 MavResult::MAV_RESULT_ACCEPTED
@@ -189,11 +197,13 @@ impl GroundLink {
         };
         self.ack(c.cmd, result, from);
         for p in after {
-            self.push(p);
+            self.push_to(p, from.dest());
         }
     }
 
     /// `MAV_CMD_REQUEST_MESSAGE`: the result and, when accepted, what to send after the ACK.
+    // PROTOCOL_VERSION is deprecated in the dialect, yet QGroundControl 4 asks for it.
+    #[allow(deprecated)]
     fn request_message(&mut self, c: &Command, v: &VehicleSnapshot) -> (MavResult, After) {
         let mut after = After::new();
         let Some(id) = message_id(c.p[0]) else {
@@ -203,6 +213,10 @@ impl GroundLink {
             HEARTBEAT_DATA::ID => Some(Pending::Heartbeat),
             AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
             CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
+            PROTOCOL_VERSION_DATA::ID => Some(Pending::ProtocolVersion),
+            COMPONENT_METADATA_DATA::ID if self.ftp.general().is_some() => {
+                Some(Pending::ComponentMetadata)
+            }
             AVAILABLE_MODES_DATA::ID => {
                 let n = FlightMode::ALL.len();
                 let index = c.p[1];
@@ -213,7 +227,7 @@ impl GroundLink {
                     }
                     return (MavResult::MAV_RESULT_ACCEPTED, after);
                 } else if index >= 1.0 && index <= n as f32 && libm::truncf(index) == index {
-                    Some(Pending::AvailableMode(index as u8 - 1))
+                    Some(Pending::AvailableMode((index as u8).saturating_sub(1)))
                 } else {
                     return (MavResult::MAV_RESULT_DENIED, after);
                 }
@@ -344,13 +358,16 @@ impl GroundLink {
                          // the design names it and older ground stations look for it.
     pub(super) fn autopilot_version(&self) -> MavMessage {
         type C = MavProtocolCapability;
-        let capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        let mut capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
             | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
             | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
             | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_RALLY;
+        if !self.ftp.files().is_empty() {
+            capabilities |= C::MAV_PROTOCOL_CAPABILITY_FTP;
+        }
         MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
             capabilities,
             uid: self.cfg.uid,
@@ -377,6 +394,8 @@ fn message_id(p: f32) -> Option<u32> {
     }
 }
 
+// Runs at compile time only, on the crate's own version numbers.
+#[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
 const fn parse_u8(s: &str) -> u32 {
     let b = s.as_bytes();
     let mut v = 0u32;

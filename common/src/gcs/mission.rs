@@ -6,6 +6,7 @@
 //! stored list only when its last item has arrived, so a failed or cancelled upload keeps the
 //! old plan. Home is not item 0: item 0 is the first thing to fly.
 
+use super::peer::Peer;
 use crate::navigation::fence::validate_fence;
 use crate::navigation::plan::{MissionItem, MissionStore, PlanKind, MISSION_CAPACITY};
 use crate::navigation::validate::{validate_mission, PlanRules, ValidationWarning};
@@ -134,13 +135,13 @@ enum Transfer {
         kind: PlanKind,
         count: u16,
         next: u16,
-        partner: (u8, u8),
+        partner: Peer,
         last_us: u64,
         retries: u8,
     },
     Download {
         kind: PlanKind,
-        partner: (u8, u8),
+        partner: Peer,
         last_us: u64,
     },
 }
@@ -164,7 +165,7 @@ pub struct MissionManager {
     staging: Vec<MissionItem, MISSION_CAPACITY>,
     transfer: Transfer,
     /// Last upload that completed, so a repeated last item is answered with the same ACK.
-    last_done: Option<(PlanKind, u16, (u8, u8))>,
+    last_done: Option<(PlanKind, u16, Peer)>,
     warnings: Vec<ValidationWarning, 8>,
 }
 
@@ -190,7 +191,7 @@ impl MissionManager {
         self.transfer != Transfer::Idle
     }
 
-    fn busy_with_other(&self, partner: (u8, u8)) -> bool {
+    fn busy_with_other(&self, partner: Peer) -> bool {
         match self.transfer {
             Transfer::Idle => false,
             Transfer::Upload { partner: p, .. } => p != partner,
@@ -204,7 +205,7 @@ impl MissionManager {
         store: &mut MissionStore,
         mtype: MavMissionType,
         count: u16,
-        partner: (u8, u8),
+        partner: Peer,
         now_us: u64,
     ) -> MissionReply {
         let Some(kind) = plan_kind(mtype) else {
@@ -243,7 +244,7 @@ impl MissionManager {
         store: &mut MissionStore,
         rules: &PlanRules,
         d: &MISSION_ITEM_INT_DATA,
-        partner: (u8, u8),
+        partner: Peer,
         now_us: u64,
     ) -> Option<MissionReply> {
         let Transfer::Upload {
@@ -294,7 +295,7 @@ impl MissionManager {
                 MavMissionResult::MAV_MISSION_NO_SPACE,
             ));
         }
-        let next = next + 1;
+        let next = next.saturating_add(1);
         if next >= count {
             let result = if let Err(r) = self.check(kind, rules) {
                 r
@@ -340,7 +341,7 @@ impl MissionManager {
         &mut self,
         store: &MissionStore,
         mtype: MavMissionType,
-        partner: (u8, u8),
+        partner: Peer,
         now_us: u64,
     ) -> MissionReply {
         let Some(kind) = plan_kind(mtype) else {
@@ -368,7 +369,7 @@ impl MissionManager {
         store: &MissionStore,
         mtype: MavMissionType,
         seq: u16,
-        partner: (u8, u8),
+        partner: Peer,
         now_us: u64,
     ) -> MissionReply {
         let Some(kind) = plan_kind(mtype) else {
@@ -414,7 +415,7 @@ impl MissionManager {
     }
 
     /// `MISSION_ACK` from the ground station: ends a download, or cancels an upload.
-    pub(crate) fn on_ack(&mut self, mtype: MavMissionType, partner: (u8, u8)) {
+    pub(crate) fn on_ack(&mut self, mtype: MavMissionType, partner: Peer) {
         match self.transfer {
             Transfer::Download {
                 kind, partner: p, ..
@@ -451,7 +452,7 @@ impl MissionManager {
 
     /// Timers: re-request a lost item, give up after [`UPLOAD_MAX_RETRIES`], forget a
     /// download nobody finishes. Returns what to send and to whom.
-    pub(crate) fn poll(&mut self, now_us: u64) -> Option<(MissionReply, (u8, u8))> {
+    pub(crate) fn poll(&mut self, now_us: u64) -> Option<(MissionReply, Peer)> {
         match &mut self.transfer {
             Transfer::Idle => None,
             Transfer::Upload {
@@ -473,7 +474,7 @@ impl MissionManager {
                         partner,
                     ));
                 }
-                *retries += 1;
+                *retries = retries.saturating_add(1);
                 *last_us = now_us;
                 Some((MissionReply::Request(kind, next), partner))
             }

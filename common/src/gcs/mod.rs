@@ -17,12 +17,18 @@
 //! PX4's `custom_mode` encoding (see [`modes`]). `docs/GROUND-STATION.md` describes the
 //! behaviour a ground station sees.
 
+// Counts, lengths and offsets here come from outside: every operation on them is checked.
+#![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
+
 pub mod client;
 pub mod commands;
+pub mod ftp;
 pub mod mission;
 pub mod modes;
 pub mod outbox;
 pub mod params;
+pub mod peer;
+pub mod signing;
 pub mod streams;
 pub mod telemetry;
 
@@ -44,9 +50,13 @@ use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::VehicleRequests;
 use crate::vehicle::snapshot::VehicleSnapshot;
 use mission::{mission_message, MissionManager, MissionReply};
-use outbox::{Command, Pending, Text};
+use outbox::{Command, Pending, Text, TEXT_MAX};
+
+pub use outbox::{CommandAck, Outgoing};
+pub use peer::{Dest, Origin, Peer};
 
 pub use outbox::STATUSTEXT_LEN;
+use signing::Signing;
 use streams::{Scheduler, Stream};
 
 /// Our MAVLink system id.
@@ -73,6 +83,9 @@ pub struct LinkConfig {
     pub params_per_poll: u8,
     /// Hardware unique id reported in `AUTOPILOT_VERSION` (0 when unknown).
     pub uid: u64,
+    /// The files served over MAVLink FTP; with a `general.json` among them, the link answers
+    /// requests for `COMPONENT_METADATA` with its URI.
+    pub files: &'static [ftp::File],
 }
 
 impl Default for LinkConfig {
@@ -82,6 +95,7 @@ impl Default for LinkConfig {
             component_id: COMPONENT_ID,
             params_per_poll: 4,
             uid: 0,
+            files: &[],
         }
     }
 }
@@ -103,15 +117,20 @@ pub struct GroundLink {
     cfg: LinkConfig,
     missions: MissionManager,
     streams: Scheduler,
-    pending: Deque<Pending, PENDING_CAPACITY>,
+    pending: Deque<(Pending, Dest), PENDING_CAPACITY>,
     texts: Deque<Text, TEXT_CAPACITY>,
     requests: VehicleRequests,
-    param_next: Option<u16>,
+    /// The next index of a parameter list download, and the channel that asked for it.
+    param_next: Option<(u16, u8)>,
     next_heartbeat_us: u64,
     gcs_last_seen_us: Option<u64>,
     last_mode: Option<FlightMode>,
     dropped: u32,
     rx_errors: u16,
+    signing: Signing,
+    /// The `id` of the last status text sent in chunks.
+    text_id: u16,
+    ftp: ftp::Ftp,
 }
 
 impl Default for GroundLink {
@@ -136,7 +155,20 @@ impl GroundLink {
             last_mode: None,
             dropped: 0,
             rx_errors: 0,
+            signing: Signing::default(),
+            text_id: 0,
+            ftp: ftp::Ftp::new(cfg.files),
         }
+    }
+
+    /// MAVLink 2 signing: the key and its policy.
+    pub fn signing(&self) -> &Signing {
+        &self.signing
+    }
+
+    /// MAVLink 2 signing, writable (loading a persisted key at start-up).
+    pub fn signing_mut(&mut self) -> &mut Signing {
+        &mut self.signing
     }
 
     /// The mission protocol's state (a transfer in progress).
@@ -169,9 +201,10 @@ impl GroundLink {
         self.rx_errors = self.rx_errors.saturating_add(1);
     }
 
-    /// Queues a STATUSTEXT (event messages from the vehicle: failsafes, mode changes, ...).
-    /// Text longer than 50 bytes is cut; when the queue is full the message is dropped and
-    /// counted in [`GroundLink::dropped`].
+    /// Queues a status text (event messages from the vehicle: failsafes, mode changes, ...).
+    /// Text longer than 50 bytes goes out as STATUSTEXT chunks (MAVLink 2's `id` and
+    /// `chunk_seq`), up to 150 bytes; when the queue is full the text is dropped and counted in
+    /// [`GroundLink::dropped`].
     pub fn send_statustext(&mut self, severity: MavSeverity, text: &str) {
         let mut s = String::new();
         for c in text.chars() {
@@ -182,7 +215,7 @@ impl GroundLink {
         self.queue_text(severity, s);
     }
 
-    fn queue_text(&mut self, severity: MavSeverity, text: String<STATUSTEXT_LEN>) {
+    fn queue_text(&mut self, severity: MavSeverity, text: String<TEXT_MAX>) {
         if self.texts.push_back(Text { severity, text }).is_err() {
             self.dropped = self.dropped.wrapping_add(1);
         }
@@ -194,20 +227,27 @@ impl GroundLink {
     }
 
     fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
-        let mut s: String<STATUSTEXT_LEN> = String::new();
+        let mut s: String<TEXT_MAX> = String::new();
         // A text that does not fit is cut, never refused.
         let _ = s.write_fmt(args);
         self.queue_text(severity, s);
     }
 
+    /// Queues a message for every station.
     fn push(&mut self, p: Pending) {
-        if self.pending.push_back(p).is_err() {
+        self.push_to(p, Dest::All);
+    }
+
+    fn push_to(&mut self, p: Pending, dest: Dest) {
+        if self.pending.push_back((p, dest)).is_err() {
             self.dropped = self.dropped.wrapping_add(1);
         }
     }
 
-    /// Consumes one message from the ground station. Messages addressed to another system or
-    /// component, and our own echoes, are ignored.
+    /// Consumes one message from a ground station, received on the board's `channel` (with
+    /// its signature block, when it was signed and a key is installed). Messages addressed to
+    /// another system or component, our own echoes, and whatever the signing policy refuses
+    /// are ignored.
     // SET_MODE, MISSION_REQUEST, MISSION_SET_CURRENT and MISSION_ITEM are deprecated but still
     // sent by pymavlink and older ground stations; answering them is part of compatibility.
     #[allow(deprecated)]
@@ -218,7 +258,9 @@ impl GroundLink {
         now_us: u64,
         vehicle: &VehicleSnapshot,
         stores: &mut Stores,
+        origin: Origin,
     ) {
+        let Origin { channel, signed } = origin;
         let Ok(sys) = u8::try_from(header.system_id) else {
             return;
         };
@@ -235,19 +277,45 @@ impl GroundLink {
                 return;
             }
         }
-        let from = (sys, header.component_id);
+        if self
+            .signing
+            .admit(sys, header.component_id, msg, signed)
+            .is_err()
+        {
+            return;
+        }
+        let from = Peer {
+            system: sys,
+            component: header.component_id,
+            channel,
+        };
         match msg {
+            MavMessage::SETUP_SIGNING(d) => {
+                let with_key = signed.is_some_and(|s| s.valid);
+                let text = if !self.signing.setup(d, with_key) {
+                    "Signing setup refused: not signed with the key"
+                } else if self.signing.key().is_some() {
+                    "Signing on: unsigned writes are refused"
+                } else {
+                    "Signing off"
+                };
+                self.send_statustext(MavSeverity::MAV_SEVERITY_INFO, text);
+            }
+            MavMessage::FILE_TRANSFER_PROTOCOL(d) if d.target_network == 0 => {
+                self.ftp.handle(d, from, now_us);
+            }
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
                 self.gcs_last_seen_us = Some(now_us);
             }
             MavMessage::PARAM_REQUEST_LIST(_) => {
-                // A new request restarts the stream: every index once, in order.
-                self.param_next = Some(0);
+                // A new request restarts the stream: every index once, in order, to the
+                // channel that asked.
+                self.param_next = Some((0, channel));
             }
             MavMessage::PARAM_REQUEST_READ(d) => {
-                self.on_param_read(d, stores.params);
+                self.on_param_read(d, stores.params, from);
             }
-            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params),
+            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params, from),
             MavMessage::MANUAL_CONTROL(d) => {
                 // Axes are -1000..1000 (throttle 0..1000); INT16_MAX marks an axis as unused.
                 let axis = |v: i16| {
@@ -306,12 +374,12 @@ impl GroundLink {
                 let r = self
                     .missions
                     .on_count(stores.plan, d.mission_type, d.count, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_ITEM_INT(d) => {
                 let plan = &mut *stores.plan;
                 if let Some(r) = self.missions.on_item(plan, &stores.rules, d, from, now_us) {
-                    self.push(Pending::Mission(r, from));
+                    self.push_to(Pending::Mission(r, from), from.dest());
                 }
                 for w in self.missions.take_warnings() {
                     self.mission_warning(w);
@@ -320,52 +388,82 @@ impl GroundLink {
             // Float items lose precision; this autopilot asks for MISSION_ITEM_INT only.
             MavMessage::MISSION_ITEM(d) if self.missions.busy() => {
                 self.missions.on_ack(d.mission_type, from);
-                self.push(Pending::Mission(
-                    MissionReply::Ack(d.mission_type, MavMissionResult::MAV_MISSION_UNSUPPORTED),
-                    from,
-                ));
+                let nack =
+                    MissionReply::Ack(d.mission_type, MavMissionResult::MAV_MISSION_UNSUPPORTED);
+                self.push_to(Pending::Mission(nack, from), from.dest());
             }
             MavMessage::MISSION_REQUEST_LIST(d) => {
                 let r = self
                     .missions
                     .on_request_list(stores.plan, d.mission_type, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_REQUEST_INT(d) => {
                 let r = self
                     .missions
                     .on_request(stores.plan, d.mission_type, d.seq, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_REQUEST(d) => {
                 // Legacy request: answered with MISSION_ITEM_INT all the same.
                 let r = self
                     .missions
                     .on_request(stores.plan, d.mission_type, d.seq, from, now_us);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_ACK(d) => self.missions.on_ack(d.mission_type, from),
             MavMessage::MISSION_CLEAR_ALL(d) => {
                 let r = self.missions.on_clear(stores.plan, d.mission_type);
-                self.push(Pending::Mission(r, from));
+                self.push_to(Pending::Mission(r, from), from.dest());
             }
             MavMessage::MISSION_SET_CURRENT(d) => {
                 // The message has no ACK: a bad index gets a STATUSTEXT and the current item.
                 let ok = self.set_mission_current(d.seq, stores.plan);
                 if !ok {
-                    self.push(Pending::MissionCurrent(None));
+                    self.push_to(Pending::MissionCurrent(None), from.dest());
                 }
             }
             _ => {}
         }
     }
 
-    fn ack(&mut self, command: MavCmd, result: MavResult, to: (u8, u8)) {
-        self.push(Pending::Ack {
-            command,
-            result,
-            to,
-        });
+    /// A frame whose checksum matched but whose payload the dialect could not decode: a
+    /// command with an id this autopilot does not know gets `MAV_RESULT_UNSUPPORTED`, as the
+    /// command protocol asks, when it is addressed to us.
+    pub fn handle_undecoded(&mut self, header: &MavHeader, id: u32, payload: &[u8], channel: u8) {
+        // Whether it was signed cannot be told here: with signing on, no answer.
+        if self.signing.key().is_some() {
+            return;
+        }
+        let Some((command, ts, tc)) = outbox::undecoded_command(id, payload) else {
+            return;
+        };
+        let Ok(sys) = u8::try_from(header.system_id) else {
+            return;
+        };
+        let ours =
+            (ts == 0 || ts == self.cfg.system_id) && (tc == 0 || tc == self.cfg.component_id);
+        let echo = sys == self.cfg.system_id && header.component_id == self.cfg.component_id;
+        if !ours || echo {
+            return;
+        }
+        let to = Peer {
+            system: sys,
+            component: header.component_id,
+            channel,
+        };
+        self.push_to(Pending::Unsupported { command, to }, to.dest());
+    }
+
+    fn ack(&mut self, command: MavCmd, result: MavResult, to: Peer) {
+        self.push_to(
+            Pending::Ack {
+                command,
+                result,
+                to,
+            },
+            to.dest(),
+        );
     }
 
     /// The vehicle's mission progress: a new current item (MISSION_CURRENT at once, besides
@@ -379,49 +477,101 @@ impl GroundLink {
         }
     }
 
-    /// Emits everything due at `now_us`: answers to handled messages, the heartbeat, status
-    /// texts, mission retries, the parameter stream, then telemetry streams.
-    pub fn poll<F: FnMut(MavMessage)>(
+    /// Emits everything due at `now_us`, each with where it goes: answers to handled messages
+    /// (back on the asker's channel), the heartbeat, status texts, mission retries, the
+    /// parameter stream, then telemetry streams.
+    pub fn poll<F: FnMut(Dest, Outgoing)>(
         &mut self,
         now_us: u64,
         v: &VehicleSnapshot,
         stores: &Stores,
-        mut out: F,
+        mut out_raw: F,
     ) {
-        while let Some(p) = self.pending.pop_front() {
-            self.emit(p, now_us, v, stores, &mut out);
+        self.signing.tick(now_us);
+        while let Some((p, dest)) = self.pending.pop_front() {
+            if let Pending::Unsupported { command, to } = p {
+                let ack = CommandAck {
+                    command,
+                    result: MavResult::MAV_RESULT_UNSUPPORTED,
+                    target: to.address(),
+                };
+                out_raw(dest, Outgoing::Ack(ack));
+                continue;
+            }
+            self.emit(p, dest, now_us, v, stores, &mut |d, m| {
+                out_raw(d, Outgoing::Message(m))
+            });
+        }
+        let mut out_msg = |d, m| out_raw(d, Outgoing::Message(m));
+        let out = &mut out_msg;
+        let mut budget = ftp::BURST_PER_POLL;
+        while let Some((m, to)) = self.ftp.next(&mut budget) {
+            out(to.dest(), m);
         }
         if now_us >= self.next_heartbeat_us {
-            out(telemetry::heartbeat(v));
+            out(Dest::All, telemetry::heartbeat(v));
             self.next_heartbeat_us = self.next_heartbeat_us.saturating_add(HEARTBEAT_INTERVAL_US);
             if self.next_heartbeat_us <= now_us {
                 self.next_heartbeat_us = now_us.saturating_add(HEARTBEAT_INTERVAL_US);
             }
         }
         while let Some(t) = self.texts.pop_front() {
-            out(MavMessage::STATUSTEXT(STATUSTEXT_DATA {
-                severity: t.severity,
-                text: t.text.as_str().into(),
-                id: 0,
-                chunk_seq: 0,
-            }));
+            let bytes = t.text.as_bytes();
+            if bytes.len() <= STATUSTEXT_LEN {
+                let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+                    severity: t.severity,
+                    text: t.text.as_str().into(),
+                    id: 0,
+                    chunk_seq: 0,
+                });
+                out(Dest::All, text);
+                continue;
+            }
+            // Chunks of one text share a non-zero id; the last is shorter than 50 bytes (its
+            // NUL ends the text), an empty one when the text fills its chunks exactly.
+            self.text_id = self.text_id.wrapping_add(1).max(1);
+            let chunks = (bytes.len() / STATUSTEXT_LEN).saturating_add(1);
+            for (seq, start) in (0..chunks).map(|i| (i, i.saturating_mul(STATUSTEXT_LEN))) {
+                let part = bytes.get(start..).unwrap_or(&[]);
+                let part = part.get(..STATUSTEXT_LEN).unwrap_or(part);
+                let mut text = [0u8; STATUSTEXT_LEN];
+                for (d, b) in text.iter_mut().zip(part) {
+                    *d = *b;
+                }
+                let chunk = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+                    severity: t.severity,
+                    text: text.into(),
+                    id: self.text_id,
+                    chunk_seq: seq as u8,
+                });
+                out(Dest::All, chunk);
+            }
         }
         if let Some((reply, to)) = self.missions.poll(now_us) {
-            self.emit(Pending::Mission(reply, to), now_us, v, stores, &mut out);
+            self.emit(
+                Pending::Mission(reply, to),
+                to.dest(),
+                now_us,
+                v,
+                stores,
+                out,
+            );
         }
         if self.last_mode != Some(v.mode) {
             if self.last_mode.is_some() {
-                out(telemetry::current_mode(v, self.intended_mode(v)));
+                out(Dest::All, telemetry::current_mode(v, self.intended_mode(v)));
             }
             self.last_mode = Some(v.mode);
         }
-        self.stream_params(stores.params, &mut out);
+        self.stream_params(stores.params, out);
         let mut due: heapless::Vec<Stream, { streams::STREAM_COUNT }> = heapless::Vec::new();
         self.streams.run(now_us, |s| {
             let _ = due.push(s);
         });
         for s in due {
-            self.emit_stream(s, now_us, v, stores.plan, &mut out);
+            if let Some(m) = self.stream_message(s, now_us, v, stores.plan) {
+                out(Dest::All, m);
+            }
         }
     }
 
@@ -437,15 +587,14 @@ impl GroundLink {
         )
     }
 
-    fn emit_stream<F: FnMut(MavMessage)>(
+    fn stream_message(
         &self,
         s: Stream,
         now_us: u64,
         v: &VehicleSnapshot,
         plan: &MissionStore,
-        out: &mut F,
-    ) {
-        let m = match s {
+    ) -> Option<MavMessage> {
+        Some(match s {
             Stream::SysStatus => telemetry::sys_status(v, self.rx_errors),
             Stream::GpsRawInt => telemetry::gps_raw_int(v),
             Stream::Attitude => telemetry::attitude(v, now_us),
@@ -459,25 +608,56 @@ impl GroundLink {
             Stream::NavControllerOutput => telemetry::nav_controller_output(v),
             Stream::VfrHud => telemetry::vfr_hud(v),
             Stream::BatteryStatus => telemetry::battery_status(v),
-            Stream::HomePosition => match telemetry::home_position(v, now_us) {
-                Some(m) => m,
-                None => return,
-            },
+            Stream::HomePosition => telemetry::home_position(v, now_us)?,
             Stream::ExtendedSysState => telemetry::extended_sys_state(v),
             Stream::CurrentMode => telemetry::current_mode(v, self.intended_mode(v)),
-        };
-        out(m);
+        })
     }
 
-    fn emit<F: FnMut(MavMessage)>(
+    fn emit<F: FnMut(Dest, MavMessage)>(
         &self,
         p: Pending,
+        dest: Dest,
         now_us: u64,
         v: &VehicleSnapshot,
         stores: &Stores,
         out: &mut F,
     ) {
+        let mut out = |m| out(dest, m);
         match p {
+            // Sent as raw data by `poll`.
+            Pending::Unsupported { .. } => {}
+            Pending::ParamError {
+                index,
+                name,
+                error,
+                to,
+            } => out(MavMessage::PARAM_ERROR(PARAM_ERROR_DATA {
+                param_index: index,
+                target_system: to.system,
+                target_component: to.component,
+                param_id: name.into(),
+                error,
+            })),
+            // Deprecated in the dialect since 2025, but QGroundControl 4 still asks for it.
+            #[allow(deprecated)]
+            Pending::ProtocolVersion => out(MavMessage::PROTOCOL_VERSION(PROTOCOL_VERSION_DATA {
+                // MAVLink 2 spoken (and sent); MAVLink 1 frames still read.
+                version: 200,
+                min_version: 100,
+                max_version: 200,
+                spec_version_hash: [0; 8],
+                library_version_hash: [0; 8],
+            })),
+            Pending::ComponentMetadata => {
+                if let Some(f) = self.ftp.general() {
+                    out(MavMessage::COMPONENT_METADATA(COMPONENT_METADATA_DATA {
+                        time_boot_ms: (now_us / 1000) as u32,
+                        file_crc: ftp::file_crc(f.bytes),
+                        uri: ftp::uri(f).as_str().into(),
+                    }));
+                }
+            }
             Pending::Ack {
                 command,
                 result,
@@ -487,8 +667,8 @@ impl GroundLink {
                 result,
                 progress: 0,
                 result_param2: 0,
-                target_system: to.0,
-                target_component: to.1,
+                target_system: to.system,
+                target_component: to.component,
             })),
             Pending::ParamValue(i) => {
                 if let Some(m) = params::param_value(stores.params, usize::from(i)) {
@@ -496,7 +676,7 @@ impl GroundLink {
                 }
             }
             Pending::Mission(reply, to) => {
-                if let Some(m) = mission_message(reply, to, stores.plan, v.mission_seq) {
+                if let Some(m) = mission_message(reply, to.address(), stores.plan, v.mission_seq) {
                     out(m);
                 }
             }
@@ -517,7 +697,12 @@ impl GroundLink {
             }
             Pending::CurrentMode => out(telemetry::current_mode(v, self.intended_mode(v))),
             Pending::Heartbeat => out(telemetry::heartbeat(v)),
-            Pending::Stream(s) => self.emit_stream(s, now_us, v, stores.plan, out),
+            Pending::Stream(s) => {
+                let m = self.stream_message(s, now_us, v, stores.plan);
+                if let Some(m) = m {
+                    out(m);
+                }
+            }
             Pending::MessageInterval { id, interval_us } => {
                 out(MavMessage::MESSAGE_INTERVAL(MESSAGE_INTERVAL_DATA {
                     interval_us,

@@ -1,19 +1,26 @@
 //! What the link has to send: answers waiting for the next poll, and status texts.
 
 use super::mission::MissionReply;
+use super::peer::Peer;
 use super::streams::Stream;
 use crate::vehicle::modes::FlightMode;
 use heapless::String;
-use mavlink::dialects::common::{MavCmd, MavResult, MavSeverity};
+use mavlink::dialects::common::{
+    MavCmd, MavMessage, MavParamError, MavResult, MavSeverity, COMMAND_ACK_DATA, COMMAND_INT_DATA,
+    COMMAND_LONG_DATA,
+};
+use mavlink::{MavlinkVersion, MessageData};
 
-/// Longest STATUSTEXT text.
+/// Longest text one STATUSTEXT carries; a longer one goes out in chunks.
 pub const STATUSTEXT_LEN: usize = 50;
+/// Longest status text the link keeps (three chunks).
+pub const TEXT_MAX: usize = 3 * STATUSTEXT_LEN;
 
 /// A STATUSTEXT waiting to be sent.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Text {
     pub severity: MavSeverity,
-    pub text: String<STATUSTEXT_LEN>,
+    pub text: String<TEXT_MAX>,
 }
 
 /// Something to send at the next poll.
@@ -22,10 +29,25 @@ pub(crate) enum Pending {
     Ack {
         command: MavCmd,
         result: MavResult,
-        to: (u8, u8),
+        to: Peer,
+    },
+    /// `COMMAND_ACK` for a command id the dialect does not know.
+    Unsupported {
+        command: u16,
+        to: Peer,
     },
     ParamValue(u16),
-    Mission(MissionReply, (u8, u8)),
+    /// `PARAM_ERROR` for a name or an index, to the asker.
+    ParamError {
+        index: i16,
+        name: [u8; 16],
+        error: MavParamError,
+        to: Peer,
+    },
+    ProtocolVersion,
+    /// `COMPONENT_METADATA`: where the general metadata file is.
+    ComponentMetadata,
+    Mission(MissionReply, Peer),
     MissionCurrent(Option<u16>),
     ItemReached(u16),
     AutopilotVersion,
@@ -47,4 +69,82 @@ pub(crate) type After = heapless::Vec<Pending, { FlightMode::ALL.len() }>;
 pub(crate) struct Command {
     pub cmd: MavCmd,
     pub p: [f32; 7],
+}
+
+/// What the link hands its owner to send (for the moment it takes to encode it: the size of
+/// a message is no burden).
+#[derive(Clone, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+pub enum Outgoing {
+    /// A message of the dialect.
+    Message(MavMessage),
+    /// A `COMMAND_ACK` for a command id the dialect's `MAV_CMD` does not name (so
+    /// `COMMAND_ACK_DATA` cannot carry it).
+    Ack(CommandAck),
+}
+
+/// `COMMAND_ACK` with the command as a number: the answer MAVLink's command protocol asks for
+/// to a command this autopilot does not know (`MAV_RESULT_UNSUPPORTED`), whatever its id.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommandAck {
+    /// The command id, as received.
+    pub command: u16,
+    /// The result.
+    pub result: MavResult,
+    /// Who asked (system, component).
+    pub target: (u8, u8),
+}
+
+impl MessageData for CommandAck {
+    type Message = MavMessage;
+    const ID: u32 = COMMAND_ACK_DATA::ID;
+    const NAME: &'static str = COMMAND_ACK_DATA::NAME;
+    const EXTRA_CRC: u8 = COMMAND_ACK_DATA::EXTRA_CRC;
+    const ENCODED_LEN: usize = COMMAND_ACK_DATA::ENCODED_LEN;
+
+    fn ser(&self, version: MavlinkVersion, payload: &mut [u8]) -> usize {
+        // The dialect's own layout with a placeholder command, then the real id in the
+        // command's two bytes (first in the payload: the largest field of the base).
+        let n = COMMAND_ACK_DATA {
+            command: MavCmd::MAV_CMD_NAV_WAYPOINT,
+            result: self.result,
+            progress: 0,
+            result_param2: 0,
+            target_system: self.target.0,
+            target_component: self.target.1,
+        }
+        .ser(version, payload);
+        if let Some(c) = payload.get_mut(..2) {
+            c.copy_from_slice(&self.command.to_le_bytes());
+        }
+        n
+    }
+
+    fn deser(version: MavlinkVersion, payload: &[u8]) -> Result<Self, mavlink::error::ParserError> {
+        let mut full = [0u8; COMMAND_ACK_DATA::ENCODED_LEN];
+        for (d, s) in full.iter_mut().zip(payload) {
+            *d = *s;
+        }
+        let command = u16::from_le_bytes([full[0], full[1]]);
+        let placeholder = (MavCmd::MAV_CMD_NAV_WAYPOINT as u16).to_le_bytes();
+        (full[0], full[1]) = (placeholder[0], placeholder[1]);
+        let d = COMMAND_ACK_DATA::deser(version, &full)?;
+        Ok(Self {
+            command,
+            result: d.result,
+            target: (d.target_system, d.target_component),
+        })
+    }
+}
+
+/// The command id and target of a `COMMAND_LONG` or `COMMAND_INT` frame that did not decode
+/// (its command id is not in the dialect): `(command, target system, target component)`.
+pub fn undecoded_command(id: u32, payload: &[u8]) -> Option<(u16, u8, u8)> {
+    if id != COMMAND_LONG_DATA::ID && id != COMMAND_INT_DATA::ID {
+        return None;
+    }
+    // Both put the command (u16) at byte 28 and the targets at 30 and 31; MAVLink 2 may have
+    // cut trailing zero bytes.
+    let byte = |i: usize| payload.get(i).copied().unwrap_or(0);
+    Some((u16::from_le_bytes([byte(28), byte(29)]), byte(30), byte(31)))
 }

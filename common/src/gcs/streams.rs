@@ -139,8 +139,12 @@ impl Scheduler {
             .filter(|&i| i > 0)
     }
 
-    /// Applies `SET_MESSAGE_INTERVAL`'s `interval_us` (-1 stop, 0 default, > 0 interval).
-    pub fn set_interval(&mut self, s: Stream, interval_us: f32, now_us: u64) {
+    /// Applies `SET_MESSAGE_INTERVAL`'s `interval_us` (-1 stop, 0 default, > 0 interval);
+    /// `false`, changing nothing, for NaN.
+    pub fn set_interval(&mut self, s: Stream, interval_us: f32, now_us: u64) -> bool {
+        if interval_us.is_nan() {
+            return false;
+        }
         let new = if interval_us < -0.5 {
             0
         } else if interval_us < 0.5 {
@@ -154,6 +158,7 @@ impl Scheduler {
             slot.interval_us = new;
             slot.due_us = now_us;
         }
+        true
     }
 
     /// Calls `emit` for each stream due at `now_us` and schedules its next emission. A late

@@ -174,8 +174,10 @@ pub fn sys_status(v: &VehicleSnapshot, rx_errors: u16) -> MavMessage {
         },
         drop_rate_comm: 0,
         errors_comm: rx_errors,
-        errors_count1: 0,
-        errors_count2: 0,
+        // Autopilot-specific counters: sensor frames refused for their time, and new time
+        // bases the clock took (see common::vehicle::clock).
+        errors_count1: u16::try_from(v.clock.refused).unwrap_or(u16::MAX),
+        errors_count2: u16::try_from(v.clock.resyncs).unwrap_or(u16::MAX),
         errors_count3: 0,
         errors_count4: 0,
         battery_remaining: if b.present && b.remaining >= 0.0 {
@@ -401,7 +403,7 @@ pub fn available_mode(index: usize, mode: FlightMode) -> MavMessage {
         custom_mode: mode.custom_mode(),
         properties: mode.properties(),
         number_modes: FlightMode::ALL.len() as u8,
-        mode_index: (index + 1) as u8,
+        mode_index: index.saturating_add(1) as u8,
         standard_mode: mode.standard(),
         mode_name: mode.name().into(),
     })

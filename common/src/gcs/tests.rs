@@ -81,15 +81,43 @@ impl core::ops::DerefMut for Bench {
 
 impl Bench {
     fn handle(&mut self, h: &MavHeader, msg: &MavMessage, now: u64, v: &VehicleSnapshot) {
+        self.handle_on(0, h, msg, now, v);
+    }
+
+    fn handle_on(
+        &mut self,
+        channel: u8,
+        h: &MavHeader,
+        msg: &MavMessage,
+        now: u64,
+        v: &VehicleSnapshot,
+    ) {
         let mut stores = Stores {
             params: &mut self.params,
             plan: &mut self.plan,
             rules: self.rules,
         };
-        self.link.handle(h, msg, now, v, &mut stores);
+        let origin = Origin {
+            channel,
+            signed: None,
+        };
+        self.link.handle(h, msg, now, v, &mut stores, origin);
     }
 
-    fn poll(&mut self, now: u64, v: &VehicleSnapshot, out: impl FnMut(MavMessage)) {
+    fn poll(&mut self, now: u64, v: &VehicleSnapshot, mut out: impl FnMut(MavMessage)) {
+        self.poll_to(now, v, |_, m| out(m));
+    }
+
+    /// The dialect's messages, with where they go; raw acknowledgements are dropped here.
+    fn poll_to(&mut self, now: u64, v: &VehicleSnapshot, mut out: impl FnMut(Dest, MavMessage)) {
+        self.poll_raw(now, v, |d, o| {
+            if let Outgoing::Message(m) = o {
+                out(d, m)
+            }
+        });
+    }
+
+    fn poll_raw(&mut self, now: u64, v: &VehicleSnapshot, out: impl FnMut(Dest, Outgoing)) {
         let stores = Stores {
             params: &mut self.params,
             plan: &mut self.plan,
@@ -2013,4 +2041,320 @@ fn change_speed_is_held_to_the_vehicles_airspeed_range() {
         )]
     );
     assert_eq!(l.take_requests().airspeed, None);
+}
+
+/// What the next poll sends back on `channel` (answers to its stations and broadcasts).
+fn poll_channel(l: &mut Bench, v: &VehicleSnapshot, now: u64, channel: u8) -> Vec<MavMessage> {
+    let mut out = Vec::new();
+    l.poll_to(now, v, |d, m| {
+        if d.reaches(channel) {
+            out.push(m);
+        }
+    });
+    out
+}
+
+#[test]
+fn two_stations_with_one_identity_on_two_channels_cannot_interleave_an_upload() {
+    let mut l = link();
+    let v = healthy();
+    let a = waypoints(3, 0);
+    let b = waypoints(5, 100);
+    // Both say "255/190"; only the board's channel tells them apart.
+    l.handle_on(0, &hdr(), &count_msg(3), 0, &v);
+    l.handle_on(1, &hdr(), &count_msg(5), 0, &v);
+    let mut to_a = Vec::new();
+    let mut to_b = Vec::new();
+    l.poll_to(0, &v, |d, m| match d {
+        Dest::Channel(0) => to_a.push(m),
+        Dest::Channel(1) => to_b.push(m),
+        _ => {}
+    });
+    assert_eq!(requests(&to_a), [0], "the first station's upload starts");
+    assert_eq!(
+        mission_acks(&to_b),
+        [MavMissionResult::MAV_MISSION_DENIED],
+        "the second is told the vehicle is busy, on its own channel only"
+    );
+    assert!(mission_acks(&to_a).is_empty());
+    // The second station sends its items anyway, interleaved with the first's.
+    let mut acks_a = Vec::new();
+    for (i, item_b) in b.iter().enumerate() {
+        if let Some(item) = a.get(i) {
+            let m = MavMessage::MISSION_ITEM_INT(item.clone());
+            l.handle_on(0, &hdr(), &m, 1, &v);
+            acks_a.extend(mission_acks(&poll_channel(&mut l, &v, 1, 0)));
+        }
+        let m = MavMessage::MISSION_ITEM_INT(item_b.clone());
+        l.handle_on(1, &hdr(), &m, 1, &v);
+    }
+    assert_eq!(acks_a, [MavMissionResult::MAV_MISSION_ACCEPTED]);
+    // The stored mission is the first station's, complete.
+    assert_eq!(l.plan.mission.len(), 3);
+    for (stored, sent) in l.plan.mission.iter().zip(&a) {
+        assert_eq!(stored.x, sent.x);
+    }
+}
+
+#[test]
+fn a_parameter_list_goes_to_the_channel_that_asked() {
+    let mut l = link();
+    let v = healthy();
+    let list = MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+        target_system: 1,
+        target_component: 1,
+    });
+    l.handle_on(2, &hdr(), &list, 0, &v);
+    let mut dests = Vec::new();
+    for k in 0..10 {
+        l.poll_to(k * 20_000, &v, |d, m| {
+            if matches!(m, MavMessage::PARAM_VALUE(_)) {
+                dests.push(d);
+            }
+        });
+    }
+    assert_eq!(dests.len(), 6);
+    assert!(dests.iter().all(|d| *d == Dest::Channel(2)), "{dests:?}");
+}
+
+#[test]
+fn a_nan_message_interval_is_denied_and_the_rate_kept() {
+    let mut l = link();
+    let v = healthy();
+    let set = |iv: f32| {
+        cmd_long(
+            MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+            [30.0, iv, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+    };
+    assert_eq!(
+        acks(&exchange(&mut l, &v, 0, set(f32::NAN)))[0].1,
+        MavResult::MAV_RESULT_DENIED
+    );
+    // ATTITUDE stays at its default 15 Hz, not the 1 kHz a NaN cast to an integer gave.
+    let n = count_over(&mut l, &v, 1_000, 10, 30);
+    assert!(n.abs_diff(150) <= 1, "default gave {n}");
+}
+
+#[test]
+#[allow(deprecated)] // PROTOCOL_VERSION: deprecated in the dialect, still asked for by QGC 4.
+fn protocol_version_is_answered_both_ways_with_mavlink_2() {
+    let mut l = link();
+    let v = healthy();
+    for msg in [
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [300.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    ] {
+        let out = exchange(&mut l, &v, 0, msg);
+        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+        let pv = out.iter().find_map(|m| match m {
+            MavMessage::PROTOCOL_VERSION(p) => Some(p.clone()),
+            _ => None,
+        });
+        let pv = pv.expect("PROTOCOL_VERSION after the ACK");
+        assert_eq!(
+            (pv.version, pv.min_version, pv.max_version),
+            (200, 100, 200)
+        );
+    }
+}
+
+#[test]
+fn a_long_status_text_goes_out_in_chunks_a_station_can_join() {
+    let mut l = link();
+    let v = healthy();
+    let long: std::string::String = (0..120)
+        .map(|i| char::from(b'a' + (i % 26) as u8))
+        .collect();
+    l.send_statustext(MavSeverity::MAV_SEVERITY_WARNING, &long);
+    let exact: std::string::String = "x".repeat(100);
+    l.send_statustext(MavSeverity::MAV_SEVERITY_INFO, &exact);
+    let chunks: Vec<STATUSTEXT_DATA> = poll(&mut l, &v, 0)
+        .into_iter()
+        .filter_map(|m| match m {
+            MavMessage::STATUSTEXT(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    // 120 bytes: 50, 50 and 20 (NUL-terminated); 100 bytes: 50, 50 and an empty closing chunk.
+    assert_eq!(chunks.len(), 6);
+    let (a, b) = chunks.split_at(3);
+    assert!(a.iter().all(|c| c.id == a[0].id) && a[0].id != 0);
+    assert!(b.iter().all(|c| c.id == b[0].id) && b[0].id != a[0].id);
+    assert_eq!(a.iter().map(|c| c.chunk_seq).collect::<Vec<_>>(), [0, 1, 2]);
+    // Joined as QGroundControl joins them: up to the first NUL.
+    let join = |cs: &[STATUSTEXT_DATA]| -> std::string::String {
+        let bytes: Vec<u8> = cs.iter().flat_map(|c| c.text.iter().copied()).collect();
+        let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+        std::string::String::from_utf8(bytes[..end].to_vec()).unwrap()
+    };
+    assert_eq!(join(a), long);
+    assert_eq!(join(b), exact);
+    assert_eq!(b[2].text[0], 0);
+}
+
+fn param_errors(out: &[MavMessage]) -> Vec<(i16, MavParamError)> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::PARAM_ERROR(e) => Some((e.param_index, e.error)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn unknown_names_and_refused_values_get_a_param_error() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        param_set("NO_SUCH", 1.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(-1, MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST)]
+    );
+    let read = MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+        param_index: -1,
+        target_system: 1,
+        target_component: 1,
+        param_id: "NO_SUCH".into(),
+    });
+    let out = exchange(&mut l, &v, 1, read);
+    assert_eq!(
+        param_errors(&out),
+        [(-1, MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST)]
+    );
+    // Out of bounds: PARAM_ERROR with its index, and the echo of the value kept.
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        param_set("RLL_KP", 9.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(0, MavParamError::MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)]
+    );
+    assert_eq!(param_values(&out)[0].param_value, 0.8);
+    // The wrong type for a real.
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        param_set("RLL_KP", 1.0, MavParamType::MAV_PARAM_TYPE_UINT8),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(0, MavParamError::MAV_PARAM_ERROR_TYPE_MISMATCH)]
+    );
+}
+
+static GENERAL_JSON: &[u8] = br#"{"version":1,"metadataTypes":[]}"#;
+static FILES: [super::ftp::File; 1] = [super::ftp::File {
+    name: super::ftp::GENERAL,
+    bytes: GENERAL_JSON,
+}];
+
+fn ftp_request(seq: u16, opcode: u8, data: &[u8]) -> MavMessage {
+    let mut payload = [0u8; 251];
+    payload[..2].copy_from_slice(&seq.to_le_bytes());
+    payload[3] = opcode;
+    payload[4] = data.len() as u8;
+    payload[12..12 + data.len()].copy_from_slice(data);
+    MavMessage::FILE_TRANSFER_PROTOCOL(FILE_TRANSFER_PROTOCOL_DATA {
+        target_network: 0,
+        target_system: 1,
+        target_component: 1,
+        payload,
+    })
+}
+
+/// `MAV_CMD_REQUEST_MESSAGE` for message `id`.
+fn request(id: f32) -> MavMessage {
+    cmd_long(
+        MavCmd::MAV_CMD_REQUEST_MESSAGE,
+        [id, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    )
+}
+
+/// The capabilities of the `AUTOPILOT_VERSION` among `out`.
+fn capabilities(out: &[MavMessage]) -> MavProtocolCapability {
+    let caps = out.iter().find_map(|m| match m {
+        MavMessage::AUTOPILOT_VERSION(d) => Some(d.capabilities),
+        _ => None,
+    });
+    caps.expect("AUTOPILOT_VERSION after the ACK")
+}
+
+#[test]
+fn component_metadata_points_to_the_general_file_which_ftp_serves_to_the_asker() {
+    let mut l = link();
+    l.link = GroundLink::new(LinkConfig {
+        files: &FILES,
+        ..LinkConfig::default()
+    });
+    let v = healthy();
+    let out = exchange(&mut l, &v, 2_000_000, request(397.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    let meta = out.iter().find_map(|m| match m {
+        MavMessage::COMPONENT_METADATA(d) => Some(d.clone()),
+        _ => None,
+    });
+    let meta = meta.expect("COMPONENT_METADATA after the ACK");
+    assert_eq!(meta.uri.to_str().unwrap(), "mftp://general.json");
+    assert_eq!(meta.file_crc, super::ftp::file_crc(GENERAL_JSON));
+    assert_eq!(meta.time_boot_ms, 2000);
+    // The deprecated COMPONENT_INFORMATION is not served: QGroundControl moves on at once.
+    let out = exchange(&mut l, &v, 2_000_000, request(395.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    // AUTOPILOT_VERSION says FTP is spoken.
+    let out = exchange(&mut l, &v, 2_000_000, request(148.0));
+    assert!(capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
+    // The file opens for the station on channel 2 and its answer goes there only.
+    l.handle_on(
+        2,
+        &hdr(),
+        &ftp_request(7, 4, b"/general.json"),
+        2_000_000,
+        &v,
+    );
+    let mut answers = Vec::new();
+    l.poll_to(2_000_000, &v, |d, m| {
+        if let MavMessage::FILE_TRANSFER_PROTOCOL(f) = m {
+            answers.push((d, f));
+        }
+    });
+    assert_eq!(answers.len(), 1);
+    let (dest, f) = &answers[0];
+    assert_eq!(*dest, Dest::Channel(2));
+    // Sequence plus one, ACK, four bytes of length.
+    assert_eq!(
+        (
+            u16::from_le_bytes([f.payload[0], f.payload[1]]),
+            f.payload[3]
+        ),
+        (8, 128)
+    );
+    let len = u32::from_le_bytes([f.payload[12], f.payload[13], f.payload[14], f.payload[15]]);
+    assert_eq!(len as usize, GENERAL_JSON.len());
+    assert_eq!((f.target_system, f.target_component), GCS);
+}
+
+#[test]
+fn without_served_files_component_metadata_is_unsupported_and_ftp_not_claimed() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(&mut l, &v, 0, request(397.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    let out = exchange(&mut l, &v, 0, request(148.0));
+    assert!(!capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
 }

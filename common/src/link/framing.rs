@@ -7,6 +7,7 @@
 //! payload. It takes bytes in whatever chunks a UART, a socket or a pipe delivers them, never
 //! allocates and never panics.
 
+use super::signing::{self, Key, Signed};
 use mavlink::dialects::common::MavMessage;
 use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message};
 
@@ -37,6 +38,38 @@ pub struct LinkStats {
     pub bytes_skipped: u32,
     /// Lost frames, from gaps in each sender's sequence numbers.
     pub seq_gaps: u32,
+    /// Frames cut short: still waiting for bytes when their datagram ended.
+    pub cut_short: u32,
+}
+
+impl core::ops::Add for LinkStats {
+    type Output = Self;
+    /// The counts of two parsers together (wrapping, as each counter does).
+    fn add(self, o: Self) -> Self {
+        Self {
+            frames_ok: self.frames_ok.wrapping_add(o.frames_ok),
+            crc_errors: self.crc_errors.wrapping_add(o.crc_errors),
+            unknown_ids: self.unknown_ids.wrapping_add(o.unknown_ids),
+            parse_errors: self.parse_errors.wrapping_add(o.parse_errors),
+            unsupported: self.unsupported.wrapping_add(o.unsupported),
+            bytes_skipped: self.bytes_skipped.wrapping_add(o.bytes_skipped),
+            seq_gaps: self.seq_gaps.wrapping_add(o.seq_gaps),
+            cut_short: self.cut_short.wrapping_add(o.cut_short),
+        }
+    }
+}
+
+/// A frame whose checksum matched but whose payload this dialect could not decode (an enum
+/// value it does not know): what a protocol may still answer (an unknown command gets
+/// `MAV_RESULT_UNSUPPORTED`).
+#[derive(Clone, Copy, Debug)]
+pub struct Undecoded<'a> {
+    /// Sender, sequence and component.
+    pub header: MavHeader,
+    /// Message id.
+    pub id: u32,
+    /// The payload as received (MAVLink 2 may have cut its trailing zeros).
+    pub payload: &'a [u8],
 }
 
 /// A decoded frame.
@@ -48,6 +81,9 @@ pub struct Frame {
     pub version: MavlinkVersion,
     /// The message.
     pub message: MavMessage,
+    /// For a signed MAVLink 2 frame read with a key installed: its signature block and
+    /// whether it matches the key (`None`: unsigned, or no key to check against).
+    pub signed: Option<Signed>,
 }
 
 /// Incremental MAVLink 1 and 2 frame parser.
@@ -56,6 +92,7 @@ pub struct FrameParser {
     len: usize,
     stats: LinkStats,
     last_seq: Option<(u32, u8)>,
+    key: Option<Key>,
 }
 
 impl Default for FrameParser {
@@ -69,8 +106,9 @@ impl Default for FrameParser {
 enum Check {
     NeedMore,
     Bad,
-    /// Skip a whole frame of this length (its CRC matched but its payload did not decode).
-    Skip(usize),
+    /// Skip a whole frame (its CRC matched but its payload did not decode): its header, id,
+    /// where its payload lies and its whole length.
+    Skip(MavHeader, u32, core::ops::Range<usize>, usize),
     Done(Frame, usize),
 }
 
@@ -88,9 +126,21 @@ impl FrameParser {
                 unsupported: 0,
                 bytes_skipped: 0,
                 seq_gaps: 0,
+                cut_short: 0,
             },
             last_seq: None,
+            key: None,
         }
+    }
+
+    /// The key signed frames are checked against (MAVLink 2 signing); `None`: not checked.
+    pub fn set_key(&mut self, key: Option<Key>) {
+        self.key = key;
+    }
+
+    /// The bytes held, waiting to form a frame.
+    fn held(&self) -> &[u8] {
+        self.buf.get(..self.len).unwrap_or(&[])
     }
 
     /// What the parser has counted so far.
@@ -99,22 +149,58 @@ impl FrameParser {
     }
 
     /// Feeds bytes; calls `on_frame` for every complete, valid frame in order.
-    pub fn push(&mut self, bytes: &[u8], mut on_frame: impl FnMut(Frame)) {
+    pub fn push(&mut self, bytes: &[u8], on_frame: impl FnMut(Frame)) {
+        self.push_with(bytes, on_frame, |_| {});
+    }
+
+    /// As [`FrameParser::push`], and calls `on_undecoded` for every frame whose checksum
+    /// matched but whose payload did not decode.
+    pub fn push_with(
+        &mut self,
+        bytes: &[u8],
+        mut on_frame: impl FnMut(Frame),
+        mut on_undecoded: impl FnMut(Undecoded<'_>),
+    ) {
         for &b in bytes {
             if self.len == 0 && b != STX_V1 && b != STX_V2 {
                 self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(1);
                 continue;
             }
-            if self.len < self.buf.len() {
-                self.buf[self.len] = b;
-                self.len += 1;
+            if let Some(slot) = self.buf.get_mut(self.len) {
+                *slot = b;
+                self.len = self.len.saturating_add(1);
             }
-            self.drain(&mut on_frame);
+            self.drain(&mut on_frame, &mut on_undecoded);
+        }
+    }
+
+    /// The transport says a datagram ended. On a datagram link (MAVLink over UDP) a frame never
+    /// spans two datagrams, so a candidate still waiting for bytes is not a frame (a corrupt
+    /// length byte, a truncated send): it is dropped and the frames behind it in the same
+    /// datagram are delivered now, not when later datagrams have filled the length it claimed.
+    pub fn end_of_datagram(&mut self, mut on_frame: impl FnMut(Frame)) {
+        self.end_of_datagram_with(&mut on_frame, &mut |_| {});
+    }
+
+    /// As [`FrameParser::end_of_datagram`], with [`FrameParser::push_with`]'s callbacks.
+    pub fn end_of_datagram_with(
+        &mut self,
+        on_frame: &mut impl FnMut(Frame),
+        on_undecoded: &mut impl FnMut(Undecoded<'_>),
+    ) {
+        while self.len > 0 {
+            self.stats.cut_short = self.stats.cut_short.wrapping_add(1);
+            self.resync();
+            self.drain(on_frame, on_undecoded);
         }
     }
 
     /// Checks the buffer until it needs more bytes.
-    fn drain(&mut self, on_frame: &mut impl FnMut(Frame)) {
+    fn drain(
+        &mut self,
+        on_frame: &mut impl FnMut(Frame),
+        on_undecoded: &mut impl FnMut(Undecoded<'_>),
+    ) {
         loop {
             match self.check() {
                 Check::NeedMore => return,
@@ -124,7 +210,15 @@ impl FrameParser {
                     on_frame(frame);
                     self.consume(n);
                 }
-                Check::Skip(n) => self.consume(n),
+                Check::Skip(header, id, payload, n) => {
+                    let payload = self.buf.get(payload).unwrap_or(&[]);
+                    on_undecoded(Undecoded {
+                        header,
+                        id,
+                        payload,
+                    });
+                    self.consume(n)
+                }
                 // A corrupt candidate: the real frame may start inside it, so resynchronise
                 // on the next marker after its first byte.
                 Check::Bad => self.resync(),
@@ -138,7 +232,7 @@ impl FrameParser {
     fn consume(&mut self, n: usize) {
         let n = n.min(self.len);
         self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
+        self.len = self.len.saturating_sub(n);
         self.skip_to_marker(0);
     }
 
@@ -147,7 +241,8 @@ impl FrameParser {
     }
 
     fn skip_to_marker(&mut self, from: usize) {
-        let start = self.buf[..self.len]
+        let start = self
+            .held()
             .iter()
             .enumerate()
             .skip(from)
@@ -155,7 +250,7 @@ impl FrameParser {
             .map_or(self.len, |(i, _)| i);
         self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(start as u32);
         self.buf.copy_within(start..self.len, 0);
-        self.len -= start;
+        self.len = self.len.saturating_sub(start);
     }
 
     fn note_sequence(&mut self, h: &MavHeader) {
@@ -178,6 +273,7 @@ impl FrameParser {
         if self.len < 3 {
             return Check::NeedMore;
         }
+
         let payload_len = usize::from(self.buf[1]);
         if stx == STX_V2 {
             let iflags = self.buf[2];
@@ -190,12 +286,16 @@ impl FrameParser {
             } else {
                 0
             };
+            // At most 1 + 9 + 255 + 2 + 13: no overflow.
+            #[allow(clippy::arithmetic_side_effects)]
             let total = 1 + V2_HEADER + payload_len + CHECKSUM + sig;
             if self.len < total {
                 return Check::NeedMore;
             }
             let mut raw = MAVLinkV2MessageRaw::new();
-            raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
+            if !copy_into(raw.as_mut_slice(), self.held(), total) {
+                return Check::Bad;
+            }
             let id = raw.message_id();
             if !raw.has_valid_crc::<MavMessage>() {
                 return self.classify_failure(id);
@@ -205,14 +305,29 @@ impl FrameParser {
                 component_id: raw.component_id(),
                 sequence: raw.sequence(),
             };
-            self.finish(header, MavlinkVersion::V2, id, raw.payload(), total)
+            let signed = match (&self.key, self.held().get(..total)) {
+                (Some(k), Some(frame)) => signing::check(frame, k),
+                _ => None,
+            };
+            let start = 1 + V2_HEADER;
+            let check = self.finish(header, MavlinkVersion::V2, id, raw.payload(), start, total);
+            match check {
+                Check::Done(mut f, n) => {
+                    f.signed = signed;
+                    Check::Done(f, n)
+                }
+                other => other,
+            }
         } else {
+            #[allow(clippy::arithmetic_side_effects)]
             let total = 1 + V1_HEADER + payload_len + CHECKSUM;
             if self.len < total {
                 return Check::NeedMore;
             }
             let mut raw = MAVLinkV1MessageRaw::new();
-            raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
+            if !copy_into(raw.as_mut_slice(), self.held(), total) {
+                return Check::Bad;
+            }
             let id = u32::from(raw.message_id());
             if !raw.has_valid_crc::<MavMessage>() {
                 return self.classify_failure(id);
@@ -222,7 +337,8 @@ impl FrameParser {
                 component_id: raw.component_id(),
                 sequence: raw.sequence(),
             };
-            self.finish(header, MavlinkVersion::V1, id, raw.payload(), total)
+            let start = 1 + V1_HEADER;
+            self.finish(header, MavlinkVersion::V1, id, raw.payload(), start, total)
         }
     }
 
@@ -245,6 +361,7 @@ impl FrameParser {
         version: MavlinkVersion,
         id: u32,
         payload: &[u8],
+        payload_start: usize,
         total: usize,
     ) -> Check {
         match MavMessage::parse(version, id, payload) {
@@ -253,14 +370,27 @@ impl FrameParser {
                     header,
                     version,
                     message,
+                    signed: None,
                 },
                 total,
             ),
             Err(_) => {
                 self.stats.parse_errors = self.stats.parse_errors.wrapping_add(1);
-                Check::Skip(total)
+                let range = payload_start..payload_start.saturating_add(payload.len());
+                Check::Skip(header, id, range, total)
             }
         }
+    }
+}
+
+/// Copies the first `n` bytes of `src` into `dst`; false when either is shorter.
+fn copy_into(dst: &mut [u8], src: &[u8], n: usize) -> bool {
+    match (dst.get_mut(..n), src.get(..n)) {
+        (Some(d), Some(s)) => {
+            d.copy_from_slice(s);
+            true
+        }
+        _ => false,
     }
 }
 
@@ -303,6 +433,14 @@ impl Sender {
     /// Encodes `message` as the next MAVLink 2 frame of this sender.
     pub fn encode(&mut self, message: &MavMessage) -> MAVLinkV2MessageRaw {
         encode_v2(self.next_header(), message)
+    }
+
+    /// Encodes one message's data (a type of the dialect's, or one written for a case the
+    /// dialect's types cannot express) as the next MAVLink 2 frame of this sender.
+    pub fn encode_data<D: mavlink::MessageData>(&mut self, data: &D) -> MAVLinkV2MessageRaw {
+        let mut raw = MAVLinkV2MessageRaw::new();
+        raw.serialize_message_data(self.next_header(), data);
+        raw
     }
 }
 
@@ -396,6 +534,64 @@ mod tests {
         assert_eq!(f.len(), 2);
         assert_eq!(f[0].version, MavlinkVersion::V1);
         assert_eq!(st.seq_gaps, 2);
+    }
+
+    #[test]
+    fn a_corrupt_length_does_not_hold_the_frames_behind_it_in_its_datagram() {
+        // A heartbeat whose length byte was hit (9 became 200), then two good ones, in one
+        // datagram: they arrive when the datagram ends, not after 200 more bytes.
+        let mut bad = heartbeat(0);
+        bad[1] = 200;
+        let mut s = bad;
+        s.extend(heartbeat(1));
+        s.extend(heartbeat(2));
+        let mut p = FrameParser::new();
+        let mut got = Vec::new();
+        p.push(&s, |f| got.push(f.header.sequence));
+        assert!(
+            got.is_empty(),
+            "held behind the corrupt length until the datagram ends"
+        );
+        p.end_of_datagram(|f| got.push(f.header.sequence));
+        assert_eq!(got, [1, 2]);
+        assert_eq!(p.stats().cut_short, 1);
+        // The next datagram starts clean.
+        p.push(&heartbeat(3), |f| got.push(f.header.sequence));
+        assert_eq!(got, [1, 2, 3]);
+    }
+
+    #[test]
+    fn a_frame_whose_payload_holds_a_whole_mavlink1_frame_still_arrives_byte_by_byte() {
+        use mavlink::dialects::common::{MavSeverity, STATUSTEXT_DATA};
+        // A MAVLink 1 heartbeat (17 bytes) inside a status text: while the text arrives, a
+        // complete, valid frame lies in the buffer behind its start.
+        let h = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 0,
+        };
+        let mut v1 = mavlink::MAVLinkV1MessageRaw::new();
+        v1.serialize_message(h, &MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()));
+        let mut text = [b'x'; 50];
+        text[10..10 + v1.raw_bytes().len()].copy_from_slice(v1.raw_bytes());
+        let msg = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+            severity: MavSeverity::MAV_SEVERITY_INFO,
+            text: text.into(),
+            id: 0,
+            chunk_seq: 0,
+        });
+        let s = encode_v2(h, &msg).raw_bytes().to_vec();
+        let (f, _) = frames(&s, 1);
+        assert!(
+            matches!(
+                f.as_slice(),
+                [Frame {
+                    message: MavMessage::STATUSTEXT(_),
+                    ..
+                }]
+            ),
+            "{f:?}"
+        );
     }
 
     #[test]

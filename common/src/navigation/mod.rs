@@ -1,16 +1,16 @@
 //! Navigation: what path to fly now.
 //!
-//! - [`executor`]: the [`Navigator`]: mission items to commands for the autopilot, plus the
-//!   return and loiter-here behaviours.
+//! - [`navigator`]: the [`Navigator`]: mission items to commands for the autopilot, plus the
+//!   take-off, loiter, landing, return and loiter-here behaviours.
 //! - [`path_manager`]: waypoint switching with fillets (Beard & McLain 11.2).
 //! - [`plan`]: the stored mission, geofence and rally lists, and their capacities.
 //! - [`items`]: mission items as the navigator reads them (commands, frames, altitudes).
 //! - [`validate`]: mission checks at upload, with the `MAV_MISSION_RESULT` of the first fault.
 //! - [`fence`]: the geofence (inclusion/exclusion polygons and circles, maximum height).
 
-pub mod executor;
 pub mod fence;
 pub mod items;
+pub mod navigator;
 pub mod path_manager;
 pub mod plan;
 pub mod validate;
@@ -20,8 +20,10 @@ pub(crate) mod sim;
 #[cfg(test)]
 mod tests;
 
-pub use executor::{HomeRequest, NavOutput, NavParams, NavState, NavWarning, Navigator, Phase};
 pub use fence::{breached, validate_fence, Breach, FenceParams};
+pub use navigator::io::{HomeRequest, NavOutput, NavState, NavWarning, Phase};
+pub use navigator::params::NavParams;
+pub use navigator::Navigator;
 pub use path_manager::{PathManager, PathParams, Waypoint};
 pub use plan::{MissionItem, MissionStore, PlanKind};
 pub use validate::{validate_mission, MissionLimits, Rejection, Validation, ValidationWarning};

@@ -320,7 +320,7 @@ mod tests {
         let mut m = PathManager::default();
         // The default is the turn over ground of 22 m/s (17 m/s of airspeed, 5 m/s of wind
         // behind) at 35 degrees of bank.
-        let r = 22.0f32 * 22.0 / (9.80665 * libm::tanf(35f32.to_radians()));
+        let r = 22.0f32 * 22.0 / (crate::math::GRAVITY * libm::tanf(35f32.to_radians()));
         assert!(
             (m.turn_radius() - r).abs() < 1.0,
             "{} vs {r}",

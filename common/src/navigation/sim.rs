@@ -7,7 +7,7 @@
 use crate::math::wrap_pi;
 use nalgebra::Vector3;
 
-const G: f32 = 9.80665;
+const G: f32 = crate::math::GRAVITY;
 
 pub(crate) struct Kinematic {
     pub pos: Vector3<f32>,

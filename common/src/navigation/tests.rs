@@ -2,8 +2,8 @@
 
 extern crate std;
 
-use super::executor::PARAMS as EXEC_PARAMS;
 use super::items::*;
+use super::navigator::params::PARAMS as EXEC_PARAMS;
 use super::path_manager::PARAMS as PATH_PARAMS;
 use super::plan::MissionItem;
 use super::sim::Kinematic;
@@ -89,7 +89,7 @@ impl Plane {
 
     fn apply(&mut self, c: &Commands, dt: f32) {
         let h = self.height();
-        let max_rate = 9.80665 / self.k.airspeed.max(5.0);
+        let max_rate = crate::math::GRAVITY / self.k.airspeed.max(5.0);
         match c.roll {
             RollMode::Course(chi) if h > 0.5 => {
                 let rate =
@@ -99,7 +99,8 @@ impl Plane {
             _ => {}
         }
         let va = self.k.airspeed;
-        let (climb, aspd_cmd) = match c.lon {
+        // The commands' altitudes are above mean sea level; the model flies heights above home.
+        let (climb, aspd_cmd) = match c.lon.shifted(-home().alt_amsl_m) {
             LonMode::Altitude { altitude, airspeed } => (
                 ((altitude - h) / self.k.tau_alt).clamp(-self.k.max_vz, self.k.max_vz),
                 airspeed,
@@ -259,6 +260,27 @@ fn waypoints_reached_in_order_then_circle_the_last() {
     let r = libm::hypotf(pos.x, pos.y - 400.0);
     assert!((r - 60.0).abs() < 5.0, "circle radius {r}");
     assert!((-pos.z - 100.0).abs() < 1.0);
+}
+
+/// The commands carry altitudes above mean sea level, the autopilot's datum: the guidance's
+/// height above home plus the home's altitude; the guidance output and the target stay in the
+/// navigator's frame from home.
+#[test]
+fn commands_are_above_mean_sea_level() {
+    let items = [wp(400.0, 0.0, 80.0), wp(400.0, 400.0, 100.0)];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 120.0, |_| false);
+    for (_, o, _) in &log.outs {
+        let g = o.guidance.expect("guidance");
+        let Some(LonMode::Altitude { altitude, .. }) = o.commands.map(|c| c.lon) else {
+            panic!("a waypoint without an altitude command: {:?}", o.commands);
+        };
+        assert_eq!(altitude, g.altitude + home().alt_amsl_m);
+    }
+    let (_, last, _) = log.outs.last().unwrap();
+    assert_eq!(last.target.map(|t| -t.z), Some(100.0));
 }
 
 /// DO_JUMP back to item 0 with repeat 2: the two waypoints are flown three times, then the
@@ -499,7 +521,8 @@ fn runway_takeoff() {
             assert_eq!(o.phase, Phase::TakeoffClimb);
             assert!(
                 matches!(c.lon, LonMode::TakeOff { altitude, clear_altitude, .. }
-                if altitude == 40.0 && clear_altitude == 10.0)
+                if altitude == 40.0 + home().alt_amsl_m
+                    && clear_altitude == 10.0 + home().alt_amsl_m)
             );
         }
         assert!(p.x.abs() < 0.5, "off the runway line by {}", p.x);
@@ -844,6 +867,7 @@ fn a_high_approach_comes_down_to_the_slope_without_diving() {
         let Some(LonMode::Glide { altitude, .. }) = o.commands.map(|c| c.lon) else {
             panic!("approach without a glide command: {:?}", o.commands);
         };
+        let altitude = altitude - home().alt_amsl_m;
         // The command was made from the height before this step.
         assert!(
             altitude >= prev_height - dive - 1e-3,

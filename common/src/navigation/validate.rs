@@ -1,8 +1,8 @@
 //! Mission checks at upload time: the first item that cannot be flown is refused with the
 //! `MAV_MISSION_RESULT` that names its fault; what can be flown but may surprise is a warning.
 
-use super::executor::NavParams;
 use super::items::{self, *};
+use super::navigator::params::NavParams;
 use super::plan::MissionItem;
 use crate::estimator::Home;
 use crate::math::geodetic::ned_offset;

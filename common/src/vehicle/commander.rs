@@ -17,8 +17,9 @@ use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
-use crate::navigation::executor::{HomeRequest, NavOutput, NavState, Navigator, Phase};
 use crate::navigation::fence::{breached, FenceParams};
+use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
+use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::{MissionItem, MissionStore, PlanKind};
 use crate::sensors::ManualInput;
 
@@ -126,13 +127,6 @@ pub fn trim_surfaces(g: &GainSet) -> Surfaces {
         rudder: g.lateral.trim_rudder,
         throttle: g.longitudinal.trim_throttle,
     }
-}
-
-/// The navigator's commands carry heights above home; the autopilot flies altitudes above
-/// mean sea level (the estimator's datum).
-fn amsl_commands(mut c: Commands, home_alt_amsl_m: f32) -> Commands {
-    c.lon = c.lon.shifted(home_alt_amsl_m);
-    c
 }
 
 /// The Takeoff mode's one item: climb out along the present heading to the return altitude.
@@ -514,7 +508,7 @@ impl Commander {
             self.armed = false;
             self.text(Severity::Info, "Landed, disarmed");
         }
-        let commands = out.commands.map(|c| amsl_commands(c, home.alt_amsl_m));
+        let commands = out.commands;
         self.nav = out;
         (commands, rehome)
     }

@@ -21,6 +21,7 @@
 //! - [`params`]: the one registry of every parameter.
 //! - [`report`], [`snapshot`]: the state the vehicle reports each tick.
 
+pub mod clock;
 pub mod commander;
 pub mod modes;
 pub mod params;
@@ -38,10 +39,11 @@ use crate::control::inputs::Measurements;
 use crate::estimator::{config as estimator_config, EstimatedState, Estimator};
 use crate::navigation::plan::MissionStore;
 use crate::navigation::validate::{MissionLimits, PlanRules};
-use crate::navigation::{executor, fence, path_manager, validate};
+use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::params::ParamStore;
 use crate::sensors::{GpsFix, ManualInput, SensorFrame};
 use crate::{failsafe, guidance};
+use clock::{Clock, ClockStats, Step};
 use commander::{trim_surfaces, Commander, Demand, Setpoints, Severity, Watch};
 use modes::FlightMode;
 use requests::VehicleRequests;
@@ -73,13 +75,14 @@ pub struct Vehicle {
     use_truth: bool,
     params_seen: Option<u32>,
     gain_set_seen: u8,
-    last_time_us: Option<u64>,
+    clock: Clock,
     last_imu_us: Option<u64>,
     last_control_us: Option<u64>,
-    stale_frames: u32,
     last_gps: Option<GpsFix>,
     truth: Option<Measurements>,
     surfaces: Surfaces,
+    /// The last frame was refused for its time.
+    refusing: bool,
 }
 
 impl Default for Vehicle {
@@ -102,13 +105,13 @@ impl Vehicle {
             use_truth: false,
             params_seen: None,
             gain_set_seen: 0,
-            last_time_us: None,
+            clock: Clock::default(),
             last_imu_us: None,
             last_control_us: None,
-            stale_frames: 0,
             last_gps: None,
             truth: None,
             surfaces: trim_surfaces(&GainSet::default()),
+            refusing: false,
         };
         v.apply_params();
         v
@@ -155,14 +158,19 @@ impl Vehicle {
         &self.commander
     }
 
-    /// The vehicle's clock: the time of the latest sensor frame, us.
+    /// The vehicle's clock, us (see [`clock`]); `None` before the first sensor frame.
     pub fn time_us(&self) -> Option<u64> {
-        self.last_time_us
+        self.clock.now_us()
+    }
+
+    /// Sensor frames the clock found stale, refused for a jump, or re-synchronised on.
+    pub fn clock_stats(&self) -> ClockStats {
+        self.clock.stats()
     }
 
     /// Sensor frames whose time did not advance.
     pub fn stale_frames(&self) -> u32 {
-        self.stale_frames
+        self.clock.stats().stale
     }
 
     /// The last accepted GPS fix.
@@ -201,9 +209,10 @@ impl Vehicle {
     /// What the ground link reports and checks.
     pub fn snapshot(&self) -> snapshot::VehicleSnapshot {
         let extras = report::Extras {
-            time_us: self.last_time_us,
+            time_us: self.clock.now_us(),
             gps: self.last_gps,
             throttle: self.surfaces.throttle,
+            clock: self.clock.stats(),
         };
         report::snapshot(&self.estimator.state(), &self.commander, &extras)
     }
@@ -215,17 +224,36 @@ impl Vehicle {
 
     /// One sensor frame: the samples to the estimator, then, with what the ground link
     /// handed over, requests, parameters and (every [`CONTROL_PERIOD_US`]) the control tick.
+    #[deny(clippy::arithmetic_side_effects)]
     pub fn on_sensors(&mut self, f: &SensorFrame, ground: &FromGround) {
-        let t = f.time_us;
-        if self.last_time_us.is_some_and(|last| t <= last) {
-            self.stale_frames = self.stale_frames.saturating_add(1);
+        let step = self.clock.on_frame(f.time_us, f.reset);
+        let t = self.clock.now_us().unwrap_or(0);
+        match step {
+            Step::Refused => {
+                // A frame whose time jumped is not used; one notice per run of them.
+                if !self.refusing {
+                    self.commander.notify(Notice::Text(
+                        Severity::Warning,
+                        "Sensor frame refused: its time jumped",
+                    ));
+                }
+                self.refusing = true;
+                self.tick(t, ground);
+                return;
+            }
+            Step::Resynced => self.commander.notify(Notice::Text(
+                Severity::Info,
+                "Sensor time base changed: clock resynchronised",
+            )),
+            Step::Started | Step::Advanced(_) | Step::Stale => {}
         }
-        self.last_time_us = Some(t.max(self.last_time_us.unwrap_or(0)));
+        self.refusing = false;
         // The gyro integrates over the time since the last *accepted* IMU sample, so a
         // rejected sample does not lose its share of the rotation.
         if let Some(imu) = f.imu {
             if let Some(last) = self.last_imu_us.filter(|&l| t > l) {
-                self.estimator.update_imu(&imu, (t - last) as f32 * 1e-6);
+                self.estimator
+                    .update_imu(&imu, t.saturating_sub(last) as f32 * 1e-6);
             }
             self.last_imu_us = Some(t);
         }
@@ -266,19 +294,20 @@ impl Vehicle {
     }
 
     /// Everything after the sensors: requests, parameters, control at 50 Hz.
+    #[deny(clippy::arithmetic_side_effects)]
     fn tick(&mut self, now_us: u64, ground: &FromGround) {
         self.apply(&ground.requests);
         self.apply_params();
         let due = self
             .last_control_us
-            .is_none_or(|t| now_us >= t + CONTROL_PERIOD_US);
+            .is_none_or(|t| now_us >= t.saturating_add(CONTROL_PERIOD_US));
         if !due {
             return;
         }
         let dt = self
             .last_control_us
             .map_or(CONTROL_PERIOD_US as f32 * 1e-6, |t| {
-                (now_us - t) as f32 * 1e-6
+                now_us.saturating_sub(t) as f32 * 1e-6
             });
         self.last_control_us = Some(now_us);
         // One estimate for the whole control step.
@@ -287,7 +316,7 @@ impl Vehicle {
             .check_failsafes(now_us, &e, &self.watch, &self.plan, ground.heard_us);
         let m = self.measurements(&e);
         let gains = *self.autopilot.gains();
-        let clock = self.last_time_us.unwrap_or(0);
+        let clock = self.clock.now_us().unwrap_or(0);
         let (demand, home) = self.commander.demand(clock, dt, &e, &self.plan, &gains);
         if let Some(h) = home {
             self.estimator.set_home(h);
@@ -354,7 +383,7 @@ impl Vehicle {
         let p = &self.params;
         self.estimator.set_config(p.load(&estimator_config::PARAMS));
         self.commander.navigator_mut().configure(
-            &p.load(&executor::PARAMS),
+            &p.load(&navigator::params::PARAMS),
             &p.load(&path_manager::PARAMS),
             &p.load(&guidance::PARAMS),
         );

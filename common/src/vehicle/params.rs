@@ -2,7 +2,7 @@
 //! station lists them, and the vehicle's own settings.
 
 use crate::control::{autopilot, gains, lateral, longitudinal};
-use crate::navigation::{executor, fence, path_manager, validate};
+use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::param;
 use crate::params::{independent, Group, ParamDef, Registry};
 use crate::{estimator, failsafe, guidance};
@@ -56,7 +56,7 @@ pub const REGISTRY: Registry = &[
     &estimator::config::PARAMS,
     &guidance::PARAMS,
     &path_manager::PARAMS,
-    &executor::PARAMS,
+    &navigator::params::PARAMS,
     &validate::PARAMS,
     &fence::PARAMS,
     &failsafe::PARAMS,

@@ -19,6 +19,8 @@ pub struct Extras {
     pub gps: Option<GpsFix>,
     /// Throttle commanded, 0..1.
     pub throttle: f32,
+    /// The clock's counters.
+    pub clock: super::clock::ClockStats,
 }
 
 /// The modes the vehicle can fly with this estimate: attitude for the altitude hold, a
@@ -118,6 +120,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         mission_seq,
         mission_state,
         cpu_load: 0.0,
+        clock: x.clock,
     }
 }
 

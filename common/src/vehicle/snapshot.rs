@@ -209,6 +209,8 @@ pub struct VehicleSnapshot {
     pub mission_state: MissionRunState,
     /// Share of the loop period used, 0..1.
     pub cpu_load: f32,
+    /// What the vehicle's clock refused of the sensor frames' timestamps.
+    pub clock: super::clock::ClockStats,
 }
 
 impl VehicleSnapshot {

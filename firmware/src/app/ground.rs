@@ -1,9 +1,14 @@
-//! The ground-station port: bytes from the ground station framed and handed to the
-//! [`GroundLink`] with the vehicle's snapshot and stores; the link's answers, telemetry and the
-//! vehicle's notices encoded into one outgoing buffer.
+//! The ground-station port: bytes from the ground stations framed (one parser per channel, so
+//! two stations never mix their bytes) and handed to the [`GroundLink`] with the vehicle's
+//! snapshot and stores; the link's answers, telemetry and the vehicle's notices encoded into
+//! one outgoing buffer, each frame tagged with where it goes.
 
-use common::gcs::{GroundLink, Stores, COMPONENT_ID, SYSTEM_ID};
+use common::gcs::ftp::{self, File};
+use common::gcs::{
+    Dest, GroundLink, LinkConfig, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID,
+};
 use common::link::framing::{FrameParser, LinkStats, Sender};
+use common::link::signing;
 use common::vehicle::commander::Severity;
 use common::vehicle::{FromGround, Notice, Vehicle};
 use mavlink::dialects::common::MavSeverity;
@@ -11,11 +16,37 @@ use mavlink::dialects::common::MavSeverity;
 /// Bytes waiting for the ground station at most (a full parameter burst and telemetry).
 pub const GCS_OUT: usize = 8192;
 
+/// Channels a board may have: one UART on the MCU; on the host a fixed ground station and up
+/// to eight more that spoke first (see `sitl::GcsUdp`).
+#[cfg(target_os = "none")]
+pub const CHANNELS: usize = 1;
+/// Channels a board may have: one UART on the MCU; on the host a fixed ground station and up
+/// to eight more that spoke first (see `sitl::GcsUdp`).
+#[cfg(not(target_os = "none"))]
+pub const CHANNELS: usize = 9;
+
+/// The files served over MAVLink FTP: the component metadata the build script generated from
+/// the parameter registry (`build.rs`).
+pub static FILES: [File; 2] = [
+    File {
+        name: ftp::GENERAL,
+        bytes: include_bytes!(concat!(env!("OUT_DIR"), "/general.json")),
+    },
+    File {
+        name: "parameters.json.xz",
+        bytes: include_bytes!(concat!(env!("OUT_DIR"), "/parameters.json.xz")),
+    },
+];
+
+/// Tag of a frame for every channel in the output buffer.
+const TO_ALL: u8 = 0xFF;
+
 /// The ground link with its framing and output buffer.
 pub struct GroundPort {
-    parser: FrameParser,
+    parsers: [FrameParser; CHANNELS],
     tx: Sender,
     link: GroundLink,
+    /// Frames waiting, each as `[destination, length lo, length hi, frame...]`.
     out: heapless::Vec<u8, GCS_OUT>,
     bytes_dropped: u32,
 }
@@ -38,9 +69,12 @@ impl GroundPort {
     /// A port with the autopilot's identity and nothing received.
     pub fn new() -> Self {
         Self {
-            parser: FrameParser::new(),
+            parsers: core::array::from_fn(|_| FrameParser::new()),
             tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
-            link: GroundLink::default(),
+            link: GroundLink::new(LinkConfig {
+                files: &FILES,
+                ..LinkConfig::default()
+            }),
             out: heapless::Vec::new(),
             bytes_dropped: 0,
         }
@@ -51,9 +85,16 @@ impl GroundPort {
         &self.link
     }
 
-    /// Framing counters.
+    /// MAVLink 2 signing of the link.
+    pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
+        self.link.signing_mut()
+    }
+
+    /// Framing counters, every channel together.
     pub fn stats(&self) -> LinkStats {
-        self.parser.stats()
+        self.parsers
+            .iter()
+            .fold(LinkStats::default(), |a, p| a + p.stats())
     }
 
     /// Bytes dropped because the output buffer was full.
@@ -69,10 +110,15 @@ impl GroundPort {
         }
     }
 
-    /// Bytes from the ground station: every complete frame to the link, what it accepted to
-    /// the vehicle, the answers into the output buffer.
-    pub fn on_bytes(&mut self, bytes: &[u8], vehicle: &mut Vehicle) {
-        let before = self.parser.stats();
+    /// Bytes from the ground stations on `channel` (refused beyond [`CHANNELS`]): every
+    /// complete frame to the link, what it accepted to the vehicle, the answers into the
+    /// output buffer. `datagram`: the bytes are one whole datagram (MAVLink over UDP), so a
+    /// frame still incomplete at its end is not a frame and the ones behind it go through now.
+    pub fn on_bytes(&mut self, channel: u8, bytes: &[u8], datagram: bool, vehicle: &mut Vehicle) {
+        let Some(parser) = self.parsers.get_mut(usize::from(channel)) else {
+            return;
+        };
+        let before = parser.stats();
         let now = vehicle.time_us().unwrap_or(0);
         let snapshot = vehicle.snapshot();
         let (params, plan, rules) = vehicle.stores();
@@ -81,11 +127,27 @@ impl GroundPort {
             plan,
             rules,
         };
-        let link = &mut self.link;
-        self.parser.push(bytes, |frame| {
-            link.handle(&frame.header, &frame.message, now, &snapshot, &mut stores);
-        });
-        let after = self.parser.stats();
+        // Signed frames are checked against the key in force when they arrive.
+        parser.set_key(self.link.signing().key().copied());
+        // Both callbacks answer through the link, one frame at a time, in order.
+        let link = core::cell::RefCell::new(&mut self.link);
+        let mut on_frame = |f: common::link::framing::Frame| {
+            let mut link = link.borrow_mut();
+            let origin = Origin {
+                channel,
+                signed: f.signed,
+            };
+            link.handle(&f.header, &f.message, now, &snapshot, &mut stores, origin)
+        };
+        let mut on_undecoded = |raw: common::link::framing::Undecoded<'_>| {
+            let mut link = link.borrow_mut();
+            link.handle_undecoded(&raw.header, raw.id, raw.payload, channel)
+        };
+        parser.push_with(bytes, &mut on_frame, &mut on_undecoded);
+        if datagram {
+            parser.end_of_datagram_with(&mut on_frame, &mut on_undecoded);
+        }
+        let after = parser.stats();
         let bad = after.crc_errors.wrapping_sub(before.crc_errors)
             + after.parse_errors.wrapping_sub(before.parse_errors);
         for _ in 0..bad.min(64) {
@@ -113,19 +175,61 @@ impl GroundPort {
             rules,
         };
         let (tx, buf, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
-        self.link.poll(now_us, &snapshot, &stores, |msg| {
-            let raw = tx.encode(&msg);
-            if buf.extend_from_slice(raw.raw_bytes()).is_err() {
-                *dropped = dropped.saturating_add(raw.raw_bytes().len() as u32);
+        let mut outgoing = heapless::Vec::<(Dest, Outgoing), 64>::new();
+        self.link.poll(now_us, &snapshot, &stores, |dest, msg| {
+            if outgoing.push((dest, msg)).is_err() {
+                *dropped = dropped.saturating_add(1);
             }
         });
+        for (dest, msg) in outgoing {
+            let raw = match msg {
+                Outgoing::Message(m) => tx.encode(&m),
+                Outgoing::Ack(a) => tx.encode_data(&a),
+            };
+            // With signing on, every frame is signed; the link id says which channel.
+            let link_id = match dest {
+                Dest::All => 0,
+                Dest::Channel(c) => c,
+            };
+            let signed = match self.link.signing().key().copied() {
+                Some(key) => {
+                    let t = self.link.signing_mut().next_timestamp();
+                    signing::sign(raw.raw_bytes(), &key, link_id, t)
+                }
+                None => None,
+            };
+            let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
+            let tag = match dest {
+                Dest::All => TO_ALL,
+                Dest::Channel(c) => c,
+            };
+            let [lo, hi] = (frame.len() as u16).to_le_bytes();
+            let fits = buf.len() + 3 + frame.len() <= buf.capacity();
+            if !fits
+                || buf.extend_from_slice(&[tag, lo, hi]).is_err()
+                || buf.extend_from_slice(frame).is_err()
+            {
+                *dropped = dropped.saturating_add(frame.len() as u32);
+            }
+        }
     }
 
-    /// Hands out the bytes waiting for the ground station.
-    pub fn drain(&mut self, out: &mut impl FnMut(&[u8])) {
-        if !self.out.is_empty() {
-            out(&self.out);
-            self.out.clear();
+    /// Hands out the frames waiting, one call per frame with where it goes, and empties the
+    /// buffer.
+    pub fn drain(&mut self, out: &mut impl FnMut(Dest, &[u8])) {
+        let mut rest: &[u8] = &self.out;
+        while let [tag, lo, hi, tail @ ..] = rest {
+            let n = usize::from(u16::from_le_bytes([*lo, *hi]));
+            let Some(frame) = tail.get(..n) else {
+                break;
+            };
+            let dest = match *tag {
+                TO_ALL => Dest::All,
+                c => Dest::Channel(c),
+            };
+            out(dest, frame);
+            rest = tail.get(n..).unwrap_or(&[]);
         }
+        self.out.clear();
     }
 }

@@ -20,7 +20,7 @@ pub mod simlink;
 use common::actuators::Surfaces;
 use common::estimator::EstimatedState;
 use common::failsafe::Reaction;
-use common::gcs::GroundLink;
+use common::gcs::{Dest, GroundLink};
 use common::link::framing::LinkStats;
 use common::navigation::NavOutput;
 use common::sensors::GpsFix;
@@ -141,6 +141,11 @@ impl App {
         self.ground.link()
     }
 
+    /// MAVLink 2 signing of the ground link (loading a persisted key at start-up).
+    pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
+        self.ground.signing_mut()
+    }
+
     /// What the ground link reports and checks.
     pub fn snapshot(&self) -> VehicleSnapshot {
         self.vehicle.snapshot()
@@ -152,13 +157,32 @@ impl App {
             .on_bytes(bytes, &mut self.vehicle, &mut self.ground, out);
     }
 
-    /// Feeds bytes from the ground station; the answers wait in [`App::drain_gcs`].
+    /// Feeds bytes from the ground station of a single-link board (channel 0); the answers
+    /// wait in [`App::drain_gcs`].
     pub fn on_gcs_bytes(&mut self, bytes: &[u8]) {
-        self.ground.on_bytes(bytes, &mut self.vehicle);
+        self.ground.on_bytes(0, bytes, false, &mut self.vehicle);
     }
 
-    /// Hands out the bytes waiting for the ground station.
+    /// Feeds one datagram from the ground stations on `channel` (a board with several: one
+    /// per UDP peer); the answers wait in [`App::drain_gcs_to`]. A frame cut short at the
+    /// datagram's end is dropped, so it never holds back the ones behind it.
+    pub fn on_gcs_datagram(&mut self, channel: u8, datagram: &[u8]) {
+        self.ground
+            .on_bytes(channel, datagram, true, &mut self.vehicle);
+    }
+
+    /// Hands out the frames waiting for the ground station of a single-link board (channel
+    /// 0), one call per frame.
     pub fn drain_gcs(&mut self, out: &mut impl FnMut(&[u8])) {
+        self.ground.drain(&mut |dest, frame| {
+            if dest.reaches(0) {
+                out(frame)
+            }
+        });
+    }
+
+    /// Hands out the frames waiting, one call per frame with where it goes.
+    pub fn drain_gcs_to(&mut self, out: &mut impl FnMut(Dest, &[u8])) {
         self.ground.drain(out);
     }
 }
@@ -188,8 +212,12 @@ mod tests {
     use std::vec::Vec;
 
     fn sensor_frame(k: u64) -> Vec<u8> {
+        frame_at(k * 10_000)
+    }
+
+    fn frame_at(time_us: u64) -> Vec<u8> {
         let f = SensorFrame {
-            time_us: k * 10_000,
+            time_us,
             imu: Some(ImuSample {
                 accel: nalgebra::Vector3::new(0.0, 0.0, -9.8),
                 gyro: nalgebra::Vector3::zeros(),
@@ -203,8 +231,12 @@ mod tests {
     }
 
     fn actuators(app: &mut App, k: u64) -> [f32; 16] {
+        answer(app, &sensor_frame(k))
+    }
+
+    fn answer(app: &mut App, frame: &[u8]) -> [f32; 16] {
         let mut out = Vec::new();
-        app.on_sim_bytes(&sensor_frame(k), &mut |b| out.extend_from_slice(b));
+        app.on_sim_bytes(frame, &mut |b| out.extend_from_slice(b));
         let mut p = FrameParser::new();
         let mut controls = [f32::NAN; 16];
         p.push(&out, |f| {
@@ -243,6 +275,9 @@ mod tests {
         // Disarmed: no throttle reaches the motor whatever the stick says.
         assert_eq!(c[3], 0.0);
         // Sticks that stop arriving fall back to the trim.
+        for k in 3..80 {
+            actuators(&mut app, k);
+        }
         let c = actuators(&mut app, 80);
         assert!(c[0].abs() < 0.1, "{c:?}");
     }
@@ -254,6 +289,165 @@ mod tests {
             core::mem::size_of::<App>() < 40 * 1024,
             "{}",
             core::mem::size_of::<App>()
+        );
+    }
+
+    fn roll_stick(app: &mut App, y: i16) {
+        let mut gcs = Sender::new(255, 190);
+        let stick = MavMessage::MANUAL_CONTROL(MANUAL_CONTROL_DATA {
+            y,
+            target: 1,
+            ..Default::default()
+        });
+        app.on_gcs_bytes(gcs.encode(&stick).raw_bytes());
+    }
+
+    fn heartbeats(app: &mut App) -> usize {
+        let mut n = 0;
+        let mut p = FrameParser::new();
+        app.drain_gcs(&mut |b| {
+            p.push(b, |f| {
+                n += usize::from(matches!(f.message, MavMessage::HEARTBEAT(_)))
+            })
+        });
+        n
+    }
+
+    /// Flies `frames` regular frames of 10 ms from `from_us`, moving the roll stick full right
+    /// half-way: the aileron follows within two control periods and the heartbeat keeps its
+    /// 1 Hz.
+    fn still_alive(app: &mut App, from_us: u64, frames: u64) {
+        heartbeats(app);
+        roll_stick(app, 0);
+        let mut rolled = false;
+        for k in 0..frames {
+            if k == frames / 2 {
+                roll_stick(app, 1000);
+            }
+            let c = answer(app, &frame_at(from_us + k * 10_000));
+            rolled |= k > frames / 2 + 4 && (c[0] - 1.0).abs() < 1e-5;
+        }
+        assert!(rolled, "the surfaces follow the sticks");
+        let beats = heartbeats(app);
+        assert!(beats as u64 >= frames / 100 - 1, "{beats} heartbeats");
+        roll_stick(app, 0);
+    }
+
+    #[test]
+    fn one_sensor_time_from_the_far_future_freezes_nothing() {
+        for hostile in [1u64 << 62, u64::MAX, u64::MAX - 1] {
+            let mut app = App::new();
+            still_alive(&mut app, 0, 200);
+            // One frame from the far future, then the simulator carries on.
+            answer(&mut app, &frame_at(hostile));
+            still_alive(&mut app, 2_000_000, 300);
+            assert_eq!(app.vehicle().clock_stats().refused, 1);
+        }
+    }
+
+    #[test]
+    fn a_simulator_three_seconds_back_costs_a_few_frames_not_three_seconds() {
+        let mut app = App::new();
+        still_alive(&mut app, 0, 500);
+        let before = app.vehicle().time_us().unwrap();
+        // The time base restarts 3 s earlier and continues regularly.
+        still_alive(&mut app, 2_000_000, 300);
+        assert_eq!(app.vehicle().clock_stats().resyncs, 1);
+        // The vehicle's clock never went back, and lost only the frames before the resync.
+        let after = app.vehicle().time_us().unwrap();
+        assert!(after > before + 2_900_000, "{before} -> {after}");
+    }
+
+    /// A `COMMAND_LONG` with a command id the dialect has no name for.
+    struct UnknownCommand(u16);
+
+    impl mavlink::MessageData for UnknownCommand {
+        type Message = MavMessage;
+        const ID: u32 = 76;
+        const NAME: &'static str = "COMMAND_LONG";
+        const EXTRA_CRC: u8 = 152;
+        const ENCODED_LEN: usize = 33;
+        fn ser(&self, _: mavlink::MavlinkVersion, p: &mut [u8]) -> usize {
+            p[..33].fill(0);
+            p[28..30].copy_from_slice(&self.0.to_le_bytes());
+            (p[30], p[31]) = (1, 1);
+            32
+        }
+        fn deser(
+            _: mavlink::MavlinkVersion,
+            _: &[u8],
+        ) -> Result<Self, mavlink::error::ParserError> {
+            Err(mavlink::error::ParserError::UnknownMessage { id: 76 })
+        }
+    }
+
+    #[test]
+    fn a_command_the_dialect_does_not_know_is_answered_unsupported() {
+        use mavlink::MessageData;
+        // The dialect's own checksum seed for COMMAND_LONG, so the frame is a valid one.
+        assert_eq!(
+            UnknownCommand::EXTRA_CRC,
+            mavlink::dialects::common::COMMAND_LONG_DATA::EXTRA_CRC
+        );
+        let mut app = App::new();
+        actuators(&mut app, 0);
+        for id in [31999u16, 12345, 42424] {
+            let mut gcs = Sender::new(255, 190);
+            app.on_gcs_bytes(gcs.encode_data(&UnknownCommand(id)).raw_bytes());
+            let mut acks = Vec::new();
+            let mut p = FrameParser::new();
+            app.drain_gcs(&mut |b| {
+                p.push_with(
+                    b,
+                    |_| {},
+                    |raw| {
+                        if raw.id == 77 {
+                            acks.push((
+                                u16::from_le_bytes([raw.payload[0], raw.payload[1]]),
+                                raw.payload[2],
+                            ));
+                        }
+                    },
+                )
+            });
+            // MAV_RESULT_UNSUPPORTED is 3.
+            assert_eq!(acks, [(id, 3)], "command {id}");
+        }
+    }
+
+    #[test]
+    fn a_throttle_limit_below_the_trim_is_refused_and_reads_back_as_flown() {
+        use mavlink::dialects::common::{MavParamType, PARAM_SET_DATA};
+        let mut app = App::new();
+        actuators(&mut app, 0);
+        let mut gcs = Sender::new(255, 190);
+        let set = MavMessage::PARAM_SET(PARAM_SET_DATA {
+            param_value: 0.3,
+            target_system: 1,
+            target_component: 1,
+            param_id: "THR_MAX".into(),
+            param_type: MavParamType::MAV_PARAM_TYPE_REAL32,
+        });
+        app.on_gcs_bytes(gcs.encode(&set).raw_bytes());
+        let mut echo = None;
+        let mut texts = Vec::new();
+        let mut p = FrameParser::new();
+        app.drain_gcs(&mut |b| {
+            p.push(b, |f| match f.message {
+                MavMessage::PARAM_VALUE(v) => echo = Some(v.param_value),
+                MavMessage::STATUSTEXT(t) => texts.push(t.text.to_str().unwrap_or("").to_string()),
+                _ => {}
+            })
+        });
+        // The trim throttle (0.569, Table 2.3) lies above 0.3: the stage could not fly it, so
+        // the store keeps 1.0 and the echo says so.
+        assert_eq!(echo, Some(1.0));
+        assert_eq!(app.vehicle().params().get("THR_MAX"), Some(1.0));
+        assert!(
+            texts
+                .iter()
+                .any(|t| t.contains("THR_MAX") && t.contains("contradicts")),
+            "{texts:?}"
         );
     }
 }

@@ -109,11 +109,11 @@ impl SimPort {
                 let (sensors, rejected) = simlink::decode_hil_sensor(d);
                 self.count_rejections(rejected);
                 self.health.sensor_frames += 1;
-                let t = sensors.time_us;
                 vehicle.on_sensors(&sensors, &ground.from_ground());
-                ground.poll(t, vehicle);
+                ground.poll(vehicle.time_us().unwrap_or(0), vehicle);
+                // The answer names the frame it answers, in the simulator's own time.
                 let answer = ActuatorFrame {
-                    time_us: t,
+                    time_us: sensors.time_us,
                     surfaces: vehicle.surfaces(),
                     armed: vehicle.armed(),
                 };

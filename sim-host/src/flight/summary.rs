@@ -249,7 +249,7 @@ pub fn mission_summary(
         .filter(|x| x.is_finite())
         .collect();
     // On the circle: from the first sample of each loiter within the acceptance radius (the
-    // executor's own test for arrival) to the end of that loiter.
+    // navigator's own test for arrival) to the end of that loiter.
     let mut orbit = Vec::new();
     let mut on_circle = false;
     for s in samples {

@@ -1,0 +1,164 @@
+//! What the navigator takes in (the estimate it flies on) and hands out (commands, progress,
+//! warnings, home requests).
+
+use crate::control::autopilot::Commands;
+use crate::estimator::{EstimatedState, Home};
+use crate::guidance::GuidanceOutput;
+use nalgebra::Vector3;
+
+/// What the navigator needs of the estimate.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NavState {
+    /// Position NED from home, m.
+    pub pos_ned: Vector3<f32>,
+    /// Velocity over ground NED, m/s.
+    pub vel_ned: Vector3<f32>,
+    /// Heading (yaw), rad.
+    pub heading: f32,
+    /// Airspeed, m/s.
+    pub airspeed: f32,
+}
+
+impl NavState {
+    /// The navigator's view of the estimator's state.
+    pub fn from_estimate(s: &EstimatedState) -> Self {
+        Self {
+            pos_ned: s.pos_ned,
+            vel_ned: s.vel_ned,
+            heading: s.euler.psi,
+            airspeed: s.airspeed,
+        }
+    }
+
+    /// Height above home, m.
+    pub fn height(&self) -> f32 {
+        -self.pos_ned.z
+    }
+
+    /// Horizontal speed over ground, m/s.
+    pub fn ground_speed(&self) -> f32 {
+        libm::hypotf(self.vel_ned.x, self.vel_ned.y)
+    }
+}
+
+/// Something the mission asked for that was not flown as written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum NavWarning {
+    /// An item with a command this navigator does not execute was skipped.
+    UnknownCommand {
+        /// Its sequence number.
+        seq: u16,
+        /// Its `MAV_CMD`.
+        command: u16,
+    },
+    /// A `DO_JUMP` with a target outside the mission was skipped.
+    BadJump {
+        /// Its sequence number.
+        seq: u16,
+    },
+    /// A jump loop with no navigation item in it: the mission was ended.
+    JumpLoop {
+        /// Sequence number where the walk stopped.
+        seq: u16,
+    },
+    /// A `DO_CHANGE_SPEED` this navigator cannot apply (climb or descent speed) was skipped.
+    UnsupportedSpeed {
+        /// Its sequence number.
+        seq: u16,
+    },
+    /// The mission is empty.
+    NoMission,
+}
+
+impl NavWarning {
+    /// The text the ground station shows (one STATUSTEXT).
+    pub fn text(&self) -> &'static str {
+        match self {
+            NavWarning::UnknownCommand { .. } => "Mission: unsupported item skipped",
+            NavWarning::BadJump { .. } => "Mission: DO_JUMP to a missing item skipped",
+            NavWarning::JumpLoop { .. } => "Mission: DO_JUMP loop, nothing to fly; ended",
+            NavWarning::UnsupportedSpeed { .. } => "Mission: speed change not supported, skipped",
+            NavWarning::NoMission => "Mission: nothing to fly",
+        }
+    }
+}
+
+/// Where the home should move (`DO_SET_HOME`); the firmware applies it to the estimator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum HomeRequest {
+    /// Home becomes the present position.
+    Here,
+    /// Home becomes this point.
+    At(Home),
+}
+
+/// What the navigator is doing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Phase {
+    /// Nothing started.
+    #[default]
+    Idle,
+    /// Take-off run on the runway.
+    TakeoffRoll,
+    /// Take-off climb.
+    TakeoffClimb,
+    /// Flying to a waypoint.
+    Waypoint,
+    /// Circling a loiter item.
+    Loiter,
+    /// Flying home (return).
+    Return,
+    /// Circling home after a return.
+    ReturnLoiter,
+    /// Landing approach.
+    Approach,
+    /// Landing flare.
+    Flare,
+    /// On the ground after a landing.
+    Landed,
+    /// Circling a point (loiter here, or an item that does not continue by itself).
+    Hold,
+    /// The mission is over; circling where it ended.
+    Complete,
+}
+
+/// Result of one step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NavOutput {
+    /// Commands for the autopilot, their altitudes above mean sea level (`None` while idle:
+    /// the caller keeps its own).
+    pub commands: Option<Commands>,
+    /// The guidance output behind the commands (cross-track error and so on), its altitude a
+    /// height above home.
+    pub guidance: Option<GuidanceOutput>,
+    /// The point flown to (or circled), NED from home.
+    pub target: Option<Vector3<f32>>,
+    /// Horizontal distance to `target`, m (NaN without one).
+    pub wp_dist_m: f32,
+    /// Bearing to `target`, rad (NaN without one).
+    pub target_bearing: f32,
+    /// The mission item being flown.
+    pub current_seq: Option<u16>,
+    /// A mission item finished on this step.
+    pub reached: Option<u16>,
+    /// What was skipped or refused on this step.
+    pub warnings: heapless::Vec<NavWarning, 4>,
+    /// A `DO_SET_HOME` ran on this step.
+    pub set_home: Option<HomeRequest>,
+    /// What the navigator is doing.
+    pub phase: Phase,
+    /// Stopped on the ground after a landing: the firmware may disarm.
+    pub landed: bool,
+    /// The path of a waypoint or loiter item is a straight line (not a fillet or circle).
+    pub straight: bool,
+}
+
+impl NavOutput {
+    /// Notes something skipped or refused on this step.
+    pub(super) fn warn(&mut self, w: NavWarning) {
+        // A fifth warning in one step is dropped; the first four say enough.
+        let _ = self.warnings.push(w);
+    }
+}

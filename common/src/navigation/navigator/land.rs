@@ -1,0 +1,276 @@
+//! Landing: approach, flare, touchdown and roll-out onto a point.
+//!
+//! Landing flies the line from the previous waypoint (or from where the item began) to the
+//! land point, level until it meets the glide slope, then down it (`LonMode::Glide`: the
+//! slope's flight-path angle fed forward, a slow integral of the height error, no diving
+//! back onto the slope). The slope aims short of the point by the flare's own length, so
+//! the wheels, not the slope, meet the ground at the point. Below the flare height the
+//! throttle is closed and the pitch follows a sink rate that shrinks with height (past the
+//! point a faster one, so that a gust's extra speed does not float the aircraft far down
+//! the runway); once the wheels have touched (low and rising again) the pitch goes to 0, as
+//! in a wheel landing, so the ground's kick on the main wheels does not bounce the aircraft
+//! back into the air; a second on the ground (height under `NAV_LND_TD_M`, sinking slower
+//! than 0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
+//! stopped.
+
+use super::guide::{follow, horizontal_dist, Flight};
+use super::io::{NavOutput, Phase};
+use super::params::NavParams;
+use crate::control::autopilot::Commands;
+use crate::control::lateral::{RollMode, RUDDER};
+use crate::control::longitudinal::LonMode;
+use crate::guidance::Path;
+use crate::math::DEG;
+use nalgebra::Vector3;
+
+/// Largest height the approach's integral may add to or take off the glide slope, m, and the
+/// largest height error it integrates: it is there for the metre the proportional loop
+/// leaves on the slope, not for a gust's (winding up on those flew the aircraft under the
+/// slope once it was back on it).
+const SLOPE_TRIM_MAX_M: f32 = 1.5;
+
+/// Ground speed under which a flaring aircraft counts as rolling on the runway, m/s: the
+/// estimated height alone carries the barometer's and GPS's offsets (tenths of a metre).
+const ROLLING_SPEED: f32 = 5.0;
+/// Ground speed under which a landed aircraft has stopped and may be disarmed, m/s: until
+/// then it is steered, since a taildragger rolling free swings round (a ground loop).
+const STOPPED_SPEED: f32 = 1.0;
+
+/// Time on the ground that makes a touchdown, s.
+const TOUCHDOWN_S: f32 = 1.0;
+/// Sink rate under which the aircraft counts as on the ground, m/s.
+const TOUCHDOWN_SINK: f32 = 0.5;
+/// Fastest sink a flare that has floated past the land point aims for, m/s: two thirds of the
+/// 1.5 m/s a small aircraft's landing gear is held to.
+const PAST_SINK_MAX: f32 = 1.0;
+/// Climb rate that, below the touchdown height, shows the wheels have touched and kicked the
+/// aircraft up, m/s.
+const BOUNCE_CLIMB: f32 = 0.3;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LandPhase {
+    Approach,
+    Flare,
+    Landed,
+}
+
+/// A landing in progress.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Landing {
+    origin: Vector3<f32>,
+    point: Vector3<f32>,
+    phase: LandPhase,
+    ground_time: f32,
+    /// The approach's integral of the height error, m (added to the altitude command).
+    slope_trim: f32,
+    /// The wheels have touched (low and rising again): the flare is over and the pitch
+    /// is held at 0 (a taildragger's main wheels, ahead of the centre of gravity, pitch it up
+    /// as they touch; holding the flare's attitude there lifts it off again).
+    touched: bool,
+}
+
+/// How far past the point where the glide slope meets the flare height the flare carries
+/// the aircraft at `ground_speed` (m/s) along the approach, m. The flare's sink rate falls
+/// linearly with height from the slope's `s_a` to the touchdown's `s_t` over the flare
+/// height `h_f`: height decays as `e^(-t/tau)` towards `-s_t tau` with `tau = h_f /
+/// (s_a - s_t)`, reaching the ground after `tau ln(s_a / s_t)`.
+fn flare_overrun(p: &NavParams, ground_speed: f32) -> f32 {
+    let tan_slope = libm::tanf(p.glide_slope);
+    let s_a = ground_speed * tan_slope;
+    let s_t = p.flare_sink;
+    if !(s_a > s_t && s_t > 0.0 && tan_slope > 0.0 && p.flare_alt > 0.0) {
+        return 0.0;
+    }
+    let tau = p.flare_alt / (s_a - s_t);
+    let flare_m = ground_speed * tau * libm::logf(s_a / s_t);
+    let overrun = flare_m - p.flare_alt / tan_slope;
+    if overrun.is_finite() {
+        overrun.max(0.0)
+    } else {
+        0.0
+    }
+}
+
+impl Landing {
+    /// An approach from `origin` to the touchdown `point` (both NED from home).
+    pub fn new(origin: Vector3<f32>, point: Vector3<f32>) -> Self {
+        Self {
+            origin,
+            point,
+            phase: LandPhase::Approach,
+            ground_time: 0.0,
+            slope_trim: 0.0,
+            touched: false,
+        }
+    }
+
+    /// A mission's landing on `point`, from `origin` (the previous waypoint, or where the
+    /// item began) unless that lies within 10 m of the point, then from `pos` (the present
+    /// position).
+    pub fn item(origin: Vector3<f32>, point: Vector3<f32>, pos: Vector3<f32>) -> Self {
+        let origin = if horizontal_dist(&origin, &point) > 10.0 {
+            origin
+        } else {
+            pos
+        };
+        Self::new(origin, point)
+    }
+
+    /// The touchdown has been made: the aircraft is on the ground.
+    pub fn landed(&self) -> bool {
+        self.phase == LandPhase::Landed
+    }
+
+    /// One step of the landing: its commands, guidance and phase into `out`.
+    pub fn step(&mut self, f: &Flight, out: &mut NavOutput) {
+        let p = f.params;
+        let state = f.state;
+        let dt = f.dt;
+        let pos = state.pos_ned;
+        let hagl = state.height() + self.point.z;
+        let line =
+            Path::line_between(&self.origin, &self.point, p.land_airspeed).unwrap_or(Path::Line {
+                origin: self.point,
+                direction: Vector3::x(),
+                airspeed: p.land_airspeed,
+            });
+        let mut g = f.guidance.step(&line, &pos, state.ground_speed());
+        // Level at the approach's start height until the glide slope, then down it, the
+        // command moving at the slope's rate over the ground so the autopilot can fly the
+        // flight-path angle that rate asks for.
+        let (signed_to_go, along_speed) = match line {
+            Path::Line { direction, .. } => {
+                let d = Vector3::new(direction.x, direction.y, 0.0);
+                let n = d.norm();
+                if n > 0.0 {
+                    ((self.point - pos).dot(&d) / n, state.vel_ned.dot(&d) / n)
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+            Path::Orbit { .. } => (0.0, 0.0),
+        };
+        let to_go = signed_to_go.max(0.0);
+        let start_h = -self.origin.z;
+        let tan_slope = libm::tanf(p.glide_slope);
+        // The slope aims short of the point by as far as the flare carries past where the
+        // slope meets the flare height, so that the wheels touch at the point.
+        let along = if along_speed.is_finite() {
+            along_speed.max(0.0)
+        } else {
+            0.0
+        };
+        let ahead = (to_go - flare_overrun(p, along)).max(0.0);
+        let on_slope = -self.point.z + tan_slope * ahead;
+        let top = start_h.max(-self.point.z);
+        g.altitude = on_slope.min(top);
+        let climb_rate = if ahead > 0.0 && on_slope < top {
+            -tan_slope * along
+        } else {
+            0.0
+        };
+        out.guidance = Some(g);
+        out.target = Some(self.point);
+        if self.phase == LandPhase::Approach && hagl < p.flare_alt {
+            self.phase = LandPhase::Flare;
+        }
+        if self.phase == LandPhase::Flare {
+            let sink = state.vel_ned.z;
+            let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
+            // Rising again this close to the ground is the wheels' kick (or a gust about to
+            // balloon the aircraft): from then on the flare's pitch-up is over.
+            if hagl < p.touchdown_alt && sink < -BOUNCE_CLIMB {
+                self.touched = true;
+            }
+            if on_ground && sink < TOUCHDOWN_SINK {
+                self.ground_time += dt;
+            } else {
+                self.ground_time = 0.0;
+            }
+            if self.ground_time >= TOUCHDOWN_S {
+                self.phase = LandPhase::Landed;
+            }
+        }
+        match self.phase {
+            LandPhase::Approach => {
+                out.phase = Phase::Approach;
+                // The altitude loop is proportional: on the slope it settles below it by what
+                // its gain needs to make the pitch the slower approach flies at (a metre on
+                // the Ultra Stick). A slow integral of the height error takes that out.
+                let err = g.altitude - state.height();
+                if climb_rate != 0.0 && libm::fabsf(err) < SLOPE_TRIM_MAX_M {
+                    self.slope_trim = (self.slope_trim + p.approach_i * err * dt)
+                        .clamp(-SLOPE_TRIM_MAX_M, SLOPE_TRIM_MAX_M);
+                }
+                // Caught high by a gust near the ground, the aircraft is not dived back onto
+                // the slope (that arrives at the flare sinking fast): the command stays within
+                // `NAV_APP_DIVE_M` below the present height, and the landing is long instead.
+                let cmd = (g.altitude + self.slope_trim).max(state.height() - p.approach_dive);
+                out.commands = Some(Commands {
+                    lon: LonMode::Glide {
+                        altitude: cmd,
+                        airspeed: g.airspeed,
+                        climb_rate,
+                    },
+                    ..follow(&g)
+                });
+            }
+            LandPhase::Flare => {
+                out.phase = Phase::Flare;
+                // The sink rate aimed for shrinks from the glide's to the touchdown's with
+                // height; pitch up as the aircraft sinks faster than that.
+                let approach_sink = along * tan_slope;
+                let frac = (hagl / p.flare_alt).clamp(0.0, 1.0);
+                let aim = p.flare_sink + (approach_sink - p.flare_sink).max(0.0) * frac;
+                // Floating past the point (a gust's extra speed at the flare), the flare gives
+                // up on the gentlest touchdown for a nearer one: a faster sink aimed for the
+                // farther past, up to `PAST_SINK_MAX`, and the nose may come down to level.
+                let past = -signed_to_go;
+                let (aim, floor) = if past > 0.0 && p.flare_past_k > 0.0 {
+                    (
+                        (aim + p.flare_past_k * past).min(PAST_SINK_MAX.max(aim)),
+                        0.0,
+                    )
+                } else {
+                    (aim, p.flare_pitch)
+                };
+                let sink = state.vel_ned.z;
+                let pitch = if self.touched {
+                    0.0
+                } else if sink.is_finite() {
+                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(floor, 15.0 * DEG)
+                } else {
+                    p.flare_pitch
+                };
+                // The rudder steers the tail wheel once the wheels are about to touch; in the
+                // air it stays the yaw damper, so the aircraft keeps its crab in a crosswind
+                // (lining the nose up with the runway there would let it drift downwind).
+                let yaw = if hagl < p.touchdown_alt {
+                    f.steer(g.course)
+                } else {
+                    RUDDER
+                };
+                out.commands = Some(Commands {
+                    roll: RollMode::Course(g.course),
+                    yaw,
+                    lon: LonMode::Pitch {
+                        pitch,
+                        throttle: p.flare_throttle * frac,
+                    },
+                });
+            }
+            LandPhase::Landed => {
+                out.phase = Phase::Landed;
+                out.landed = state.ground_speed() < STOPPED_SPEED;
+                out.commands = Some(Commands {
+                    roll: RollMode::Roll(0.0),
+                    yaw: f.steer(g.path_course),
+                    lon: LonMode::Pitch {
+                        pitch: 0.0,
+                        throttle: 0.0,
+                    },
+                });
+            }
+        }
+    }
+}

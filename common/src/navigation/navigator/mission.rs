@@ -1,0 +1,330 @@
+//! The mission walk: which item is flown, the `DO_*` items on the way, and the legs between
+//! waypoints.
+//!
+//! - `DO_*` items run when they become current, in the same step, and the walk goes on to the
+//!   next navigation item. An item this navigator does not fly is skipped with a
+//!   [`NavWarning`]: the mission never stalls on it.
+//! - `DO_JUMP` jumps `param2` times (`-1`: for ever, the only way to loop without end); its
+//!   count is kept per item and reset when the mission is started afresh. A walk that meets
+//!   more than `4 n + 8` items without reaching a navigation item (a jump loop with nothing to
+//!   fly) ends the mission with [`NavWarning::JumpLoop`].
+//! - `DO_CHANGE_SPEED` sets the airspeed of the legs and circles that follow, within
+//!   `NAV_ASPD_MIN..NAV_ASPD_MAX` (`-2`: back to `NAV_ASPD`); `DO_SET_HOME` asks the firmware
+//!   to move the home ([`HomeRequest`]).
+//! - Waypoints are joined by the fillet path manager; a waypoint followed by a landing turns
+//!   onto the final approach through a fillet too.
+//! - Items with an item-relative altitude frame are heights above home; absolute (AMSL) frames
+//!   are converted with the home altitude; a non-global frame or a NaN altitude keeps the
+//!   present altitude, a latitude/longitude of 0/0 the present position.
+
+use super::guide::{horizontal_dist, Flight, Orbit};
+use super::io::{HomeRequest, NavOutput, NavState, NavWarning, Phase};
+use super::params::NavParams;
+use crate::estimator::Home;
+use crate::math::wrap_pi;
+use crate::navigation::items::{
+    self, is_nav, DO_CHANGE_SPEED, DO_JUMP, DO_SET_HOME, NAV_LAND, NAV_WAYPOINT,
+};
+use crate::navigation::path_manager::{PathManager, Waypoint};
+use crate::navigation::plan::{MissionItem, MISSION_CAPACITY};
+use nalgebra::Vector3;
+
+/// How closely the course must point at the next item before a finished loiter is left,
+/// rad (15 deg).
+const EXIT_COURSE_TOL: f32 = 0.26;
+
+/// Where the walk through the mission stands.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct MissionWalk {
+    /// Mission item being flown, when the mission is.
+    pub seq: Option<u16>,
+    /// Jumps done per `DO_JUMP` item.
+    jumps: [u16; MISSION_CAPACITY],
+    /// `DO_CHANGE_SPEED` airspeed, m/s.
+    airspeed: Option<f32>,
+    /// The last waypoint reached (where a landing's approach comes from).
+    pub prev_waypoint: Option<Vector3<f32>>,
+}
+
+impl MissionWalk {
+    /// A walk that has not begun.
+    pub fn new() -> Self {
+        Self {
+            seq: None,
+            jumps: [0; MISSION_CAPACITY],
+            airspeed: None,
+            prev_waypoint: None,
+        }
+    }
+
+    /// Fresh jump counts, the cruise airspeed, no waypoint behind.
+    pub fn restart(&mut self) {
+        self.jumps = [0; MISSION_CAPACITY];
+        self.airspeed = None;
+        self.prev_waypoint = None;
+    }
+
+    /// The airspeed of the legs and circles, m/s: `DO_CHANGE_SPEED`'s, or `NAV_ASPD`.
+    pub fn cruise(&self, p: &NavParams) -> f32 {
+        self.airspeed.unwrap_or(p.airspeed)
+    }
+
+    /// Walks from item `seq` to the next navigation item, running `DO_*` items on the way, and
+    /// makes it current. `None` when there is none to fly: the mission is empty (then nothing
+    /// is current), a jump loop has nothing in it, or the walk fell off the end.
+    pub fn walk<'a>(
+        &mut self,
+        items: &'a [MissionItem],
+        mut seq: usize,
+        home: &Home,
+        p: &NavParams,
+        out: &mut NavOutput,
+    ) -> Option<(usize, &'a MissionItem)> {
+        if items.is_empty() {
+            out.warn(NavWarning::NoMission);
+            self.seq = None;
+            return None;
+        }
+        let mut budget = 4 * items.len() + 8;
+        loop {
+            let item = items.get(seq)?;
+            let s16 = u16::try_from(seq).unwrap_or(u16::MAX);
+            if budget == 0 {
+                out.warn(NavWarning::JumpLoop { seq: s16 });
+                return None;
+            }
+            budget -= 1;
+            match item.command {
+                DO_JUMP => match jump_target(item, items.len(), self.jumps.get(seq).copied()) {
+                    JumpStep::Jump(t) => {
+                        if let Some(c) = self.jumps.get_mut(seq) {
+                            *c = c.saturating_add(1);
+                        }
+                        seq = t;
+                    }
+                    JumpStep::Next => seq += 1,
+                    JumpStep::Bad => {
+                        out.warn(NavWarning::BadJump { seq: s16 });
+                        seq += 1;
+                    }
+                },
+                DO_CHANGE_SPEED => {
+                    let kind = item.param(0);
+                    let v = item.param(1);
+                    if kind == 0.0 || kind == 1.0 {
+                        if v > 0.0 {
+                            self.airspeed = Some(v.max(p.airspeed_min).min(p.airspeed_max));
+                        } else if v == -2.0 {
+                            self.airspeed = None;
+                        }
+                    } else {
+                        out.warn(NavWarning::UnsupportedSpeed { seq: s16 });
+                    }
+                    seq += 1;
+                }
+                DO_SET_HOME => {
+                    out.set_home = Some(if item.param(0) == 1.0 {
+                        HomeRequest::Here
+                    } else {
+                        match (items::point(item), items::alt_amsl(item, home)) {
+                            (Some(point), Some(alt_amsl_m)) => {
+                                HomeRequest::At(Home { point, alt_amsl_m })
+                            }
+                            (Some(point), None) => HomeRequest::At(Home {
+                                point,
+                                alt_amsl_m: home.alt_amsl_m,
+                            }),
+                            _ => HomeRequest::Here,
+                        }
+                    });
+                    seq += 1;
+                }
+                c if is_nav(c) => {
+                    self.seq = Some(s16);
+                    return Some((seq, item));
+                }
+                command => {
+                    out.warn(NavWarning::UnknownCommand { seq: s16, command });
+                    seq += 1;
+                }
+            }
+        }
+    }
+
+    /// The next navigation item after `seq` as the walk would find it (jumps followed, counts
+    /// not spent).
+    fn peek_nav<'a>(&self, items: &'a [MissionItem], seq: usize) -> Option<&'a MissionItem> {
+        let mut jumps = self.jumps;
+        let mut s = seq + 1;
+        for _ in 0..4 * items.len() + 8 {
+            let item = items.get(s)?;
+            match item.command {
+                DO_JUMP => match jump_target(item, items.len(), jumps.get(s).copied()) {
+                    JumpStep::Jump(t) => {
+                        if let Some(c) = jumps.get_mut(s) {
+                            *c = c.saturating_add(1);
+                        }
+                        s = t;
+                    }
+                    _ => s += 1,
+                },
+                c if is_nav(c) => return Some(item),
+                _ => s += 1,
+            }
+        }
+        None
+    }
+
+    /// Where the leg after waypoint item `seq` (at `target`) goes, when its corner is
+    /// rounded: a waypoint or the final approach of a landing follows.
+    pub fn corner_after(
+        &self,
+        items: &[MissionItem],
+        seq: usize,
+        home: &Home,
+        target: &Vector3<f32>,
+    ) -> Option<Vector3<f32>> {
+        self.peek_nav(items, seq)
+            .filter(|n| matches!(n.command, NAV_WAYPOINT | NAV_LAND))
+            .map(|n| items::target_ned(n, home, target))
+    }
+
+    /// True when the course over ground points within [`EXIT_COURSE_TOL`] of the next
+    /// navigation item that has a position (or when there is none, when it lies within one
+    /// and a half radii of the circle's centre, or with no ground speed to tell).
+    pub fn heading_for_next(
+        &self,
+        items: &[MissionItem],
+        home: &Home,
+        state: &NavState,
+        orbit: &Orbit,
+    ) -> bool {
+        let Some(seq) = self.seq else {
+            return true;
+        };
+        let pos = state.pos_ned;
+        let Some(next) = self
+            .peek_nav(items, usize::from(seq))
+            .filter(|n| items::point(n).is_some())
+        else {
+            return true;
+        };
+        let t = items::target_ned(next, home, &pos);
+        let vg = state.ground_speed();
+        if vg < 3.0 || horizontal_dist(&t, &orbit.center) < 1.5 * orbit.radius {
+            return true;
+        }
+        let bearing = libm::atan2f(t.y - pos.y, t.x - pos.x);
+        let course = libm::atan2f(state.vel_ned.y, state.vel_ned.x);
+        libm::fabsf(wrap_pi(bearing - course)) <= EXIT_COURSE_TOL
+    }
+}
+
+/// A leg to a waypoint item.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Leg {
+    origin: Vector3<f32>,
+    target: Vector3<f32>,
+    /// Acceptance radius, m.
+    accept: f32,
+    /// Airspeed, m/s.
+    airspeed: f32,
+    /// Where the next leg goes, when the corner at `target` is rounded.
+    next: Option<Vector3<f32>>,
+}
+
+impl Leg {
+    /// The leg of waypoint `item` from `origin` to `target` (NED from home), at `airspeed`
+    /// (m/s), rounding the corner towards `next`; its acceptance radius is `param2`, or
+    /// `NAV_ACC_RAD` when not positive.
+    pub fn item(
+        item: &MissionItem,
+        origin: Vector3<f32>,
+        target: Vector3<f32>,
+        next: Option<Vector3<f32>>,
+        airspeed: f32,
+        p: &NavParams,
+    ) -> Self {
+        let accept = if item.param(1) > 0.0 {
+            item.param(1)
+        } else {
+            p.accept_radius
+        };
+        Self {
+            origin,
+            target,
+            accept,
+            airspeed,
+            next,
+        }
+    }
+
+    /// The waypoint, NED from home.
+    pub fn target(&self) -> Vector3<f32> {
+        self.target
+    }
+
+    /// One step along the leg (the item `seq`): its commands into `out`. True when the
+    /// waypoint is reached; this step's commands then already follow the next leg.
+    pub fn step(
+        &self,
+        f: &Flight,
+        paths: &mut PathManager,
+        seq: Option<u16>,
+        out: &mut NavOutput,
+    ) -> bool {
+        let id = seq.unwrap_or(0);
+        let mk = |ned, id| Waypoint {
+            id,
+            ned,
+            airspeed: self.airspeed,
+            accept_radius: self.accept,
+        };
+        let mut window: heapless::Vec<Waypoint, 3> = heapless::Vec::new();
+        let _ = window.push(mk(self.origin, u16::MAX));
+        let _ = window.push(mk(self.target, id));
+        if let Some(n) = self.next {
+            let _ = window.push(mk(n, id.wrapping_add(1)));
+        }
+        let step = paths.step(&f.state.pos_ned, &window);
+        let reached = step.as_ref().and_then(|s| s.reached).is_some();
+        let path = step
+            .map(|s| s.path)
+            .unwrap_or(Orbit::loiter(self.target, f.params).path(self.airspeed));
+        f.emit(&path, Some(self.target), Phase::Waypoint, out);
+        reached
+    }
+}
+
+enum JumpStep {
+    Jump(usize),
+    Next,
+    Bad,
+}
+
+/// What a `DO_JUMP` does given the jumps it has done (`None`: its counter cannot be kept).
+fn jump_target(item: &MissionItem, len: usize, done: Option<u16>) -> JumpStep {
+    let target = item.param(0);
+    let repeat = item.param(1);
+    if !(target.is_finite()
+        && target >= 0.0
+        && target < len as f32
+        && libm::truncf(target) == target)
+    {
+        return JumpStep::Bad;
+    }
+    let Some(done) = done else {
+        return JumpStep::Bad;
+    };
+    // -1: for ever; otherwise a whole number of repeats.
+    let again = if repeat == -1.0 {
+        true
+    } else {
+        repeat.is_finite() && repeat >= 0.0 && f32::from(done) < libm::truncf(repeat)
+    };
+    if again {
+        JumpStep::Jump(target as usize)
+    } else {
+        JumpStep::Next
+    }
+}

@@ -1,0 +1,349 @@
+//! The navigator's parameters: their declarations (names, defaults, bounds, units) and the
+//! rule that keeps the airspeeds in order.
+
+use crate::math::DEG;
+use crate::param;
+use crate::params::{Group, ParamDef};
+
+/// Parameters of the navigator and its behaviours.
+pub const PARAMS: Group<NavParams> = Group {
+    name: "Navigator",
+    params: &[
+        param!(
+            ParamDef::real(
+                "NAV_ACC_RAD",
+                15.0,
+                1.0,
+                200.0,
+                "m",
+                "Waypoint acceptance radius when an item gives none",
+            ),
+            NavParams => accept_radius
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LOIT_RAD",
+                60.0,
+                10.0,
+                1000.0,
+                "m",
+                "Loiter radius when an item gives none",
+            ),
+            NavParams => loiter_radius
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ALT_ACC",
+                5.0,
+                0.5,
+                50.0,
+                "m",
+                "Altitude counted as reached (take-off, loiter to altitude, return)",
+            ),
+            NavParams => alt_accept
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ASPD",
+                17.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Cruise airspeed (the thesis's trim I)",
+            ),
+            NavParams => airspeed
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ASPD_MIN",
+                13.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Lowest airspeed DO_CHANGE_SPEED may set",
+            ),
+            NavParams => airspeed_min
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_ASPD_MAX",
+                25.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Highest airspeed DO_CHANGE_SPEED may set",
+            ),
+            NavParams => airspeed_max
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_RTL_ALT",
+                60.0,
+                10.0,
+                1000.0,
+                "m",
+                "Return altitude above home",
+            ),
+            NavParams => rtl_alt
+        ),
+        param!(
+            ParamDef::boolean(
+                "NAV_RTL_LAND",
+                false,
+                "Return mode lands at home after the return (on) or circles there (off)",
+            ),
+            NavParams => rtl_land, flag
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TKO_VR",
+                13.0,
+                5.0,
+                30.0,
+                "m/s",
+                "Take-off rotation airspeed",
+            ),
+            NavParams => takeoff_vr
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TKO_CLR_M",
+                10.0,
+                1.0,
+                100.0,
+                "m",
+                "Take-off regime (fixed pitch, full throttle) ends at this height",
+            ),
+            NavParams => takeoff_clear
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_SLP_DEG",
+                5.0,
+                1.0,
+                20.0,
+                "deg",
+                "Landing glide slope",
+            ),
+            NavParams => glide_slope, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_ASPD",
+                15.0,
+                8.0,
+                30.0,
+                "m/s",
+                "Landing approach airspeed",
+            ),
+            NavParams => land_airspeed
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_ALT",
+                1.5,
+                0.5,
+                20.0,
+                "m",
+                "Flare below this height above the land point",
+            ),
+            NavParams => flare_alt
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_PTCH_DEG",
+                3.0,
+                -5.0,
+                15.0,
+                "deg",
+                "Flare pitch at the touchdown sink rate",
+            ),
+            NavParams => flare_pitch, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_SINK",
+                0.4,
+                0.05,
+                3.0,
+                "m/s",
+                "Sink rate aimed for at touchdown",
+            ),
+            NavParams => flare_sink
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_K",
+                0.15,
+                0.0,
+                1.0,
+                "rad s/m",
+                "Flare pitch per m/s of sink rate above the aim",
+            ),
+            NavParams => flare_k
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_PAST_K",
+                0.05,
+                0.0,
+                1.0,
+                "1/s",
+                "Flare past the land point: sink rate aimed for rises this much per metre past it (0: no steering)",
+            ),
+            NavParams => flare_past_k
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_TD_M",
+                0.5,
+                0.05,
+                5.0,
+                "m",
+                "Touchdown: height above the land point under this for 1 s (or rolling slower than 5 m/s)",
+            ),
+            NavParams => touchdown_alt
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_THR",
+                0.0,
+                0.0,
+                1.0,
+                "",
+                "Throttle at the start of the flare, faded to zero at touchdown height (keeps the energy a gusty flare needs)",
+            ),
+            NavParams => flare_throttle
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_APP_DIVE_M",
+                1.0,
+                0.1,
+                50.0,
+                "m",
+                "Approach: the altitude command lies at most this far below the present height (above the slope the aircraft closes it gently instead of diving)",
+            ),
+            NavParams => approach_dive
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_APP_I",
+                0.1,
+                0.0,
+                1.0,
+                "1/s",
+                "Approach: integral gain on the height error below or above the glide slope (removes the proportional altitude loop's steady offset there)",
+            ),
+            NavParams => approach_i
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_STEER_K",
+                1.5,
+                0.0,
+                10.0,
+                "rad/rad",
+                "Ground steering: rudder (tail wheel) per radian of course error on the runway",
+            ),
+            NavParams => steer_k
+        ),
+    ],
+    base: || ZERO,
+    check: consistent,
+};
+
+/// The navigator's parameters in SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct NavParams {
+    /// Default acceptance radius, m.
+    pub accept_radius: f32,
+    /// Default loiter radius, m.
+    pub loiter_radius: f32,
+    /// Altitude acceptance, m.
+    pub alt_accept: f32,
+    /// Cruise airspeed, m/s.
+    pub airspeed: f32,
+    /// Lowest settable airspeed, m/s.
+    pub airspeed_min: f32,
+    /// Highest settable airspeed, m/s.
+    pub airspeed_max: f32,
+    /// Return altitude above home, m.
+    pub rtl_alt: f32,
+    /// Return mode lands.
+    pub rtl_land: bool,
+    /// Rotation airspeed, m/s.
+    pub takeoff_vr: f32,
+    /// Take-off regime clear height, m.
+    pub takeoff_clear: f32,
+    /// Glide slope, rad.
+    pub glide_slope: f32,
+    /// Approach airspeed, m/s.
+    pub land_airspeed: f32,
+    /// Flare height, m.
+    pub flare_alt: f32,
+    /// Flare pitch, rad.
+    pub flare_pitch: f32,
+    /// Touchdown sink rate, m/s.
+    pub flare_sink: f32,
+    /// Flare pitch gain, rad per m/s.
+    pub flare_k: f32,
+    /// Touchdown height, m.
+    pub touchdown_alt: f32,
+    /// Ground steering gain, rad of rudder per rad of course error.
+    pub steer_k: f32,
+    /// Approach integral gain on the height error, 1/s.
+    pub approach_i: f32,
+    /// Largest height the approach's command lies below the present height, m.
+    pub approach_dive: f32,
+    /// Flare's sink aim per metre past the land point, 1/s.
+    pub flare_past_k: f32,
+    /// Flare throttle at the flare height, 0..1.
+    pub flare_throttle: f32,
+}
+
+const ZERO: NavParams = NavParams {
+    accept_radius: 0.0,
+    loiter_radius: 0.0,
+    alt_accept: 0.0,
+    airspeed: 0.0,
+    airspeed_min: 0.0,
+    airspeed_max: 0.0,
+    rtl_alt: 0.0,
+    rtl_land: false,
+    takeoff_vr: 0.0,
+    takeoff_clear: 0.0,
+    glide_slope: 0.0,
+    land_airspeed: 0.0,
+    flare_alt: 0.0,
+    flare_pitch: 0.0,
+    flare_sink: 0.0,
+    flare_k: 0.0,
+    touchdown_alt: 0.0,
+    steer_k: 0.0,
+    approach_i: 0.0,
+    approach_dive: 0.0,
+    flare_past_k: 0.0,
+    flare_throttle: 0.0,
+};
+
+impl Default for NavParams {
+    fn default() -> Self {
+        PARAMS.defaults()
+    }
+}
+
+/// Airspeeds in order: cruise and approach inside the settable range.
+fn consistent(p: &NavParams) -> Result<(), &'static str> {
+    if p.airspeed_min >= p.airspeed_max {
+        return Err("NAV_ASPD_MIN");
+    }
+    if !(p.airspeed_min..=p.airspeed_max).contains(&p.airspeed) {
+        return Err("NAV_ASPD");
+    }
+    if !(p.airspeed_min..=p.airspeed_max).contains(&p.land_airspeed) {
+        return Err("NAV_LND_ASPD");
+    }
+    Ok(())
+}

@@ -1,0 +1,122 @@
+//! Take-off: the runway roll, rotation and climb-out of a `NAV_TAKEOFF` item.
+//!
+//! Take-off is a runway take-off: full throttle, wings level, pitch 0 until the rotation
+//! airspeed, then the thesis's take-off regime (`LonMode::TakeOff`: fixed pitch, full
+//! throttle to the clear height, then climb) to the item's altitude; the course is held along
+//! the runway once above the clear height.
+
+use super::guide::{horizontal_dist, Flight, Orbit};
+use super::io::{NavOutput, NavState, Phase};
+use super::params::NavParams;
+use crate::control::autopilot::Commands;
+use crate::control::lateral::{RollMode, RUDDER};
+use crate::control::longitudinal::LonMode;
+use crate::estimator::Home;
+use crate::guidance::Path;
+use crate::math::{wrap_pi, DEG};
+use crate::navigation::items;
+use crate::navigation::plan::MissionItem;
+use nalgebra::Vector3;
+
+/// A take-off in progress.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Takeoff {
+    /// Where the roll began, NED from home.
+    start: Vector3<f32>,
+    /// Runway course, rad.
+    course: f32,
+    /// Height above home the climb ends at, m.
+    height: f32,
+    /// Still on the runway, below the rotation airspeed.
+    rolling: bool,
+}
+
+impl Takeoff {
+    /// The take-off of `item`, whose position is `target` (NED from home): along the line to
+    /// that point when it lies more than 20 m away, else on the item's yaw (`param4`), else
+    /// on the present heading.
+    pub fn item(
+        item: &MissionItem,
+        target: Vector3<f32>,
+        home: &Home,
+        state: &NavState,
+        p: &NavParams,
+    ) -> Self {
+        let pos = state.pos_ned;
+        let course = match items::point(item) {
+            Some(_) if horizontal_dist(&target, &pos) > 20.0 => {
+                libm::atan2f(target.y - pos.y, target.x - pos.x)
+            }
+            _ if item.param(3).is_finite() => wrap_pi(item.param(3) * DEG),
+            _ => state.heading,
+        };
+        Self {
+            start: pos,
+            course,
+            height: items::height(item, home).unwrap_or(p.rtl_alt),
+            rolling: state.airspeed.is_nan() || state.airspeed < p.takeoff_vr,
+        }
+    }
+
+    /// The runway's course, rad.
+    pub fn runway(&self) -> f32 {
+        self.course
+    }
+
+    /// One step of the take-off: its commands into `out`. Once the climb has reached the
+    /// item's altitude (less `NAV_ALT_ACC`), the circle to hold there if the mission does not
+    /// go on.
+    pub fn step(&mut self, f: &Flight, out: &mut NavOutput) -> Option<Orbit> {
+        let p = f.params;
+        let state = f.state;
+        let pos = state.pos_ned;
+        let vg = state.ground_speed();
+        if self.rolling && state.airspeed >= p.takeoff_vr {
+            self.rolling = false;
+        }
+        let (dn, de) = (libm::cosf(self.course), libm::sinf(self.course));
+        let far = self.start + Vector3::new(dn, de, 0.0) * 1000.0;
+        let line = Path::line_between(&self.start, &far, f.cruise);
+        out.target = Some(far);
+        if self.rolling {
+            out.phase = Phase::TakeoffRoll;
+            // Along the runway line: the course to hold comes from the line's vector
+            // field, so a drift sideways is steered back, not just stopped.
+            let course = line
+                .map(|l| f.guidance.step(&l, &pos, vg).course)
+                .unwrap_or(self.course);
+            out.commands = Some(Commands {
+                roll: RollMode::Roll(0.0),
+                yaw: f.steer(course),
+                lon: LonMode::Pitch {
+                    pitch: 0.0,
+                    throttle: 1.0,
+                },
+            });
+        } else {
+            out.phase = Phase::TakeoffClimb;
+            let g = line.map(|l| f.guidance.step(&l, &pos, vg));
+            out.guidance = g;
+            // Along the runway line from lift-off: near the line the vector field asks
+            // for a few degrees of course, so little bank close to the ground.
+            let roll = match g {
+                Some(g) => RollMode::Course(g.course),
+                None => RollMode::Roll(0.0),
+            };
+            out.commands = Some(Commands {
+                roll,
+                yaw: RUDDER,
+                lon: LonMode::TakeOff {
+                    altitude: self.height,
+                    airspeed: f.cruise,
+                    clear_altitude: -self.start.z + p.takeoff_clear,
+                },
+            });
+        }
+        if !self.rolling && state.height() >= self.height - p.alt_accept {
+            Some(Orbit::loiter(Vector3::new(pos.x, pos.y, -self.height), p))
+        } else {
+            None
+        }
+    }
+}
