@@ -5,7 +5,10 @@
 //! the ground station over sockets.
 //!
 //! - MCU: `cargo run -p firmware --release --target thumbv7em-none-eabihf` boots the image in
-//!   QEMU's `netduinoplus2` (STM32F405) through the runner in `.cargo/config.toml`.
+//!   QEMU's `netduinoplus2` (STM32F405) through the runner in `.cargo/config.toml`; QEMU's
+//!   flags after `--` (`-serial tcp:127.0.0.1:4560,nodelay=on -serial udp:...`) put its UARTs
+//!   on a running `sim-host sim` and a ground station. `sim-host fly --link qemu` flies this
+//!   image in the loop (docs/PIL.md).
 //! - Host: `cargo run -p firmware` runs the SITL build.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]

@@ -112,6 +112,12 @@ pub(crate) enum Command {
     /// Fly the firmware against the plant over the simulator link, commanded by a scripted
     /// ground station: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet.
     Fly(FlyArgs),
+    /// The simulator alone, as PX4's simulators are: the plant waits on the runway (or in
+    /// the air) for any autopilot that speaks PX4's simulator interface, flies it in
+    /// lock-step until the autopilot closes the link, --duration or Ctrl-C, and writes the
+    /// log, .tlog, plots and summary. No scripted station: fly it from QGroundControl, MAVSDK
+    /// or pymavlink on the autopilot's own ground link.
+    Sim(SimArgs),
     /// Fly the default mission (calm air, and a 5 m/s wind with light turbulence over five
     /// seeds) and write the navigation results with ground-track plots.
     Navigation {
@@ -125,6 +131,12 @@ pub(crate) enum Command {
         /// of it, `sim-host scenario all --results`'s, is kept).
         #[arg(long, default_value = "docs/RESULTS.md")]
         results: PathBuf,
+        /// Who flies: inproc (the host build in this process) or qemu (the MCU image, about
+        /// five minutes a flight).
+        #[arg(long, default_value = "inproc")]
+        link: commands::fly::LinkKind,
+        #[command(flatten)]
+        mcu: McuArgs,
     },
     /// The autopilot's parameters: tables, the Markdown of docs/PARAMETERS.md (--markdown),
     /// or the parameter metadata file QGroundControl reads (--json).
@@ -147,17 +159,9 @@ pub(crate) enum Command {
     },
 }
 
+/// The air and the sensors of a flight, shared by `fly` and `sim`.
 #[derive(clap::Args)]
-pub(crate) struct FlyArgs {
-    /// Simulator link: inproc, tcp, udp or pty.
-    #[arg(long, default_value = "inproc")]
-    pub(crate) link: commands::fly::LinkKind,
-    /// Address the simulator listens on for tcp and udp.
-    #[arg(long, default_value = "127.0.0.1:4560")]
-    pub(crate) bind: String,
-    /// Pace the simulation to the wall clock.
-    #[arg(long)]
-    pub(crate) realtime: bool,
+pub(crate) struct EnvArgs {
     /// Steady wind N,E,D in m/s (the direction it blows towards).
     #[arg(long, value_parser = parse_wind, default_value = "0,0,0", allow_hyphen_values = true)]
     pub(crate) wind: [f64; 3],
@@ -167,12 +171,56 @@ pub(crate) struct FlyArgs {
     /// Seed of the sensor noise and turbulence.
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
-    /// Simulated time, s (default: long enough for the whole script).
-    #[arg(long)]
-    pub(crate) duration: Option<f64>,
     /// Plant integration step, s.
     #[arg(long, default_value_t = 0.001)]
     pub(crate) dt: f64,
+    /// A sensor fault over a window of simulated time, KIND:FROM-TO in s with KIND gps,
+    /// pitot, mag or baro; repeatable: `--fault gps:60-90`.
+    #[arg(long = "fault", value_name = "KIND:FROM-TO", value_parser = sim_host::flight::parse_fault)]
+    pub(crate) faults: Vec<sim_host::flight::FaultWindow>,
+}
+
+/// The MCU image and its emulator, for `--link qemu`.
+#[derive(clap::Args)]
+pub(crate) struct McuArgs {
+    /// The MCU image (ELF) for --link qemu; built by
+    /// `cargo build --release -p firmware --target thumbv7em-none-eabihf`.
+    #[arg(long, value_name = "PATH", default_value_os_t = sim_host::link::qemu::default_elf())]
+    pub(crate) elf: PathBuf,
+    /// The QEMU that runs it (a name on the PATH or a path).
+    #[arg(long, value_name = "PROGRAM", default_value = sim_host::link::qemu::DEFAULT_QEMU)]
+    pub(crate) qemu: PathBuf,
+}
+
+impl McuArgs {
+    pub(crate) fn config(&self) -> sim_host::link::qemu::QemuConfig {
+        sim_host::link::qemu::QemuConfig {
+            program: self.qemu.clone(),
+            elf: self.elf.clone(),
+            ..Default::default()
+        }
+    }
+}
+
+#[derive(clap::Args)]
+pub(crate) struct FlyArgs {
+    /// Simulator link: inproc, tcp, udp, pty (the host build, in this process) or qemu (the
+    /// MCU image on QEMU's emulated STM32F405).
+    #[arg(long, default_value = "inproc")]
+    pub(crate) link: commands::fly::LinkKind,
+    /// Address the simulator listens on for tcp and udp.
+    #[arg(long, default_value = "127.0.0.1:4560")]
+    pub(crate) bind: String,
+    /// Pace the simulation to the wall clock.
+    #[arg(long)]
+    pub(crate) realtime: bool,
+    #[command(flatten)]
+    pub(crate) env: EnvArgs,
+    #[command(flatten)]
+    pub(crate) mcu: McuArgs,
+    /// Simulated time, s (default: long enough for the whole script).
+    #[arg(long)]
+    pub(crate) duration: Option<f64>,
     /// Directory for flight.csv, flight.tlog, the PNG plots and summary.json.
     #[arg(long, default_value = "out/fly")]
     pub(crate) out: PathBuf,
@@ -189,6 +237,10 @@ pub(crate) struct FlyArgs {
     /// step figures on estimates vs on truth).
     #[arg(long, value_name = "FILE")]
     pub(crate) report: Option<PathBuf>,
+    /// Also fly the same flight with the host build in this process, and compare the
+    /// autopilots' answers (HIL_ACTUATOR_CONTROLS) frame by frame, and the pace of both.
+    #[arg(long)]
+    pub(crate) compare_host: bool,
     /// Print the summary as JSON.
     #[arg(long)]
     pub(crate) json: bool,
@@ -204,6 +256,56 @@ pub(crate) struct FlyArgs {
     /// the mission's own tuning; repeatable: `--param NAV_LND_SLP_DEG=6`.
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     pub(crate) params: Vec<(String, f32)>,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct SimArgs {
+    /// Simulator link: tcp (the autopilot connects to --bind, PX4's convention), udp (the
+    /// autopilot sends first), pty (a virtual serial line; its path is printed) or qemu (this
+    /// command boots the MCU image in QEMU on it).
+    #[arg(long, default_value = "tcp")]
+    pub(crate) link: commands::fly::LinkKind,
+    /// Address the simulator listens on for tcp and udp.
+    #[arg(long, default_value = "127.0.0.1:4560")]
+    pub(crate) bind: String,
+    /// Start trimmed in level flight 100 m above home at 17 m/s (a hand launch) instead of
+    /// at rest on the runway at home, heading north.
+    #[arg(long)]
+    pub(crate) air_start: bool,
+    /// Pace the simulation to the wall clock (for a pilot in QGroundControl).
+    #[arg(long)]
+    pub(crate) realtime: bool,
+    /// Wall-clock pace with --realtime: simulated seconds per wall second.
+    #[arg(long, default_value_t = 1.0)]
+    pub(crate) speed: f64,
+    /// Simulated time after which the simulator stops, s (default: until the autopilot
+    /// closes the link, or Ctrl-C).
+    #[arg(long)]
+    pub(crate) duration: Option<f64>,
+    /// How long to wait for an autopilot to connect, s (default: until one does, or Ctrl-C).
+    #[arg(long)]
+    pub(crate) wait: Option<f64>,
+    /// How long the autopilot may take to answer a sensor frame, s.
+    #[arg(long, default_value_t = 5.0)]
+    pub(crate) timeout: f64,
+    #[command(flatten)]
+    pub(crate) env: EnvArgs,
+    #[command(flatten)]
+    pub(crate) mcu: McuArgs,
+    /// With --link qemu: the UDP address of the MCU image's ground link (PX4 SITL's 18570),
+    /// where ground stations send.
+    #[arg(long, default_value = "127.0.0.1:18570")]
+    pub(crate) gcs_bind: String,
+    /// With --link qemu: where its telemetry goes besides every station that speaks
+    /// (QGroundControl listens on 14550); `none` for no fixed remote.
+    #[arg(long, default_value = "127.0.0.1:14550")]
+    pub(crate) gcs_remote: String,
+    /// Directory for flight.csv, flight.tlog, the PNG plots and summary.json.
+    #[arg(long, default_value = "out/sim")]
+    pub(crate) out: PathBuf,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub(crate) json: bool,
 }
 
 /// `NAME=VALUE` for `--param`, checked against the autopilot's parameters (name, bounds).

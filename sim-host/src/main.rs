@@ -5,7 +5,7 @@ mod cli_campaign;
 
 use anyhow::Context;
 use clap::Parser;
-use cli::{Cli, Command, FlyArgs};
+use cli::{Cli, Command, FlyArgs, SimArgs};
 use sim_host::aircraft::Aircraft;
 use sim_host::analysis::doublet::DoubletConfig;
 use sim_host::commands::{self, render, Format};
@@ -152,22 +152,49 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Fly(args)) => fly_command(&aircraft, args),
+        Some(Command::Sim(args)) => sim_command(&aircraft, args),
         Some(Command::Campaign(c)) => {
             cli_campaign::campaign_command(&aircraft, cli.aircraft.as_deref(), c, emit)
         }
-        Some(Command::Navigation { out, img, results }) => {
+        Some(Command::Navigation {
+            out,
+            img,
+            results,
+            link,
+            mcu,
+        }) => {
+            anyhow::ensure!(
+                matches!(
+                    link,
+                    commands::fly::LinkKind::Inproc | commands::fly::LinkKind::Qemu
+                ),
+                "navigation --link {}: inproc or qemu",
+                link.name()
+            );
             let existing = std::fs::read_to_string(&out).ok();
+            let on_qemu = if link == commands::fly::LinkKind::Qemu {
+                " --link qemu"
+            } else {
+                ""
+            };
             let command = format!(
-                "cargo run --release -p sim-host -- navigation --out {} --img {} --results {}",
+                "cargo run --release -p sim-host -- navigation --out {} --img {} --results {}{on_qemu}",
                 out.display(),
                 img.display(),
                 results.display()
             );
+            let opts = commands::fly::FlyOptions {
+                link,
+                qemu: mcu.config(),
+                bind: "127.0.0.1:0".into(),
+                ..Default::default()
+            };
             let docs = commands::navigation::navigation_markdown(
                 &aircraft,
                 &command,
                 &img,
                 existing.as_deref(),
+                &opts,
             )?;
             std::fs::write(&out, docs.navigation)
                 .with_context(|| format!("cannot write `{}`", out.display()))?;
@@ -254,19 +281,22 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         None => FlightConfig::default(),
     };
     let mut cfg = FlightConfig {
-        wind_ned: a.wind,
-        turbulence: a.turbulence,
-        seed: a.seed,
+        wind_ned: a.env.wind,
+        turbulence: a.env.turbulence,
+        seed: a.env.seed,
         realtime: a.realtime,
         speed: a.speed,
         progress: true,
-        dt_s: a.dt,
+        dt_s: a.env.dt,
         // With --realtime, QGroundControl can watch: telemetry to 14550, as from PX4 SITL.
         ground_link: a
             .realtime
             .then(|| ("127.0.0.1:18570".into(), "127.0.0.1:14550".into())),
+        // Ctrl-C ends the flight as flown so far (and QEMU with it).
+        stop: Some(commands::sim::stop_on_ctrl_c()),
         ..base
     };
+    cfg.faults.extend(a.env.faults.iter().copied());
     if let Some(d) = a.duration {
         cfg.duration_s = d;
     }
@@ -296,15 +326,31 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
             _ => None,
         },
         use_truth: a.truth,
+        qemu: a.mcu.config(),
     };
     let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
+    let compared = if a.compare_host {
+        Some(commands::compare::compare_with_host(aircraft, &cfg, &opts)?)
+    } else {
+        None
+    };
     if a.json {
-        emit(&to_json(&r.outcome.summary)?)?;
+        match &compared {
+            Some(c) => emit(&to_json(&serde_json::json!({
+                "flight": r.outcome.summary,
+                "host": c.host.summary,
+                "answers": c.answers,
+            }))?)?,
+            None => emit(&to_json(&r.outcome.summary)?)?,
+        }
     } else {
         emit(&render(
             &commands::fly::summary_tables(&r.outcome),
             Format::Text,
         ))?;
+        if let Some(c) = &compared {
+            emit(&render(&[c.table(&r.outcome, opts.link)], Format::Text))?;
+        }
         for f in &r.files {
             emit(&format!("wrote {}", f.display()))?;
         }
@@ -342,6 +388,63 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         std::fs::write(&path, md + &notes)
             .with_context(|| format!("cannot write `{}`", path.display()))?;
         emit(&format!("wrote {}", path.display()))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn sim_command(aircraft: &Aircraft, a: SimArgs) -> anyhow::Result<ExitCode> {
+    use sim_host::flight::FlightConfig;
+    let secs = |what: &str, s: f64| {
+        anyhow::ensure!(
+            s.is_finite() && s > 0.0,
+            "--{what} {s}: must be a positive number of seconds"
+        );
+        Ok(std::time::Duration::from_secs_f64(s))
+    };
+    let cfg = FlightConfig {
+        duration_s: a.duration.unwrap_or(f64::INFINITY),
+        wind_ned: a.env.wind,
+        turbulence: a.env.turbulence,
+        seed: a.env.seed,
+        dt_s: a.env.dt,
+        faults: a.env.faults.clone(),
+        realtime: a.realtime,
+        speed: a.speed,
+        progress: true,
+        runway_heading: (!a.air_start).then_some(0.0),
+        link_timeout: secs("timeout", a.timeout)?,
+        scripted_station: false,
+        until_link_closes: true,
+        stop: Some(commands::sim::stop_on_ctrl_c()),
+        ..FlightConfig::default()
+    };
+    let opts = commands::sim::SimOptions {
+        link: a.link,
+        bind: a.bind,
+        wait: a.wait.map(|w| secs("wait", w)).transpose()?,
+        out: Some(a.out.clone()),
+        plots: true,
+        qemu: a.mcu.config(),
+        gcs_bind: a.gcs_bind,
+        gcs_remote: (a.gcs_remote != "none").then_some(a.gcs_remote),
+    };
+    let gps_delay = aircraft.sensors.gps.latency_s;
+    let r = commands::sim::sim_report(aircraft, &cfg, &opts, |ready| {
+        eprintln!("sim-host sim: {}", ready.describe());
+        eprintln!(
+            "sim-host sim: the simulated GPS reports {gps_delay} s late: set the autopilot's EKF_GPS_DELAY to {gps_delay}; Ctrl-C ends the flight and writes the log"
+        );
+    })?;
+    if a.json {
+        emit(&to_json(&r.outcome.summary)?)?;
+    } else {
+        emit(&render(
+            &commands::fly::summary_tables(&r.outcome),
+            Format::Text,
+        ))?;
+        for f in &r.files {
+            emit(&format!("wrote {}", f.display()))?;
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -403,8 +403,12 @@ impl Transport for Tamper {
 
 struct TamperOnboard;
 impl Onboard<Tamper> for TamperOnboard {
-    fn with_app<R>(&mut self, link: &mut Lockstep<Tamper>, f: impl FnOnce(&mut App) -> R) -> R {
-        f(link.transport_mut().inner.app_mut())
+    fn with_app<R>(
+        &mut self,
+        link: &mut Lockstep<Tamper>,
+        f: impl FnOnce(&mut App) -> R,
+    ) -> Option<R> {
+        Some(f(link.transport_mut().inner.app_mut()))
     }
 }
 
@@ -445,7 +449,10 @@ fn final_alt_error(o: &FlightOutcome) -> f64 {
 fn garbage_on_the_sim_link_is_counted_and_changes_nothing() {
     // Bad checksums, truncated frames, unknown message ids and frames from another system.
     let (o, clean, answered) = tampered_flight(true, false);
-    let rx = o.summary.autopilot_rx;
+    let rx = o
+        .summary
+        .autopilot_rx
+        .expect("the autopilot runs in this process");
     let frames = o.summary.frames as u32;
     assert!(rx.framing.crc_errors >= frames / 7 + frames / 11, "{rx:?}");
     assert!(rx.framing.unknown_ids >= frames / 13, "{rx:?}");
@@ -465,7 +472,10 @@ fn absurd_sensor_values_are_rejected_and_the_autopilot_keeps_flying() {
     // Every 19th sensor frame: NaN gyro, 1e12 m/s^2, negative static and infinite dynamic
     // pressure.
     let (o, clean, answered) = tampered_flight(false, true);
-    let rx = o.summary.autopilot_rx;
+    let rx = o
+        .summary
+        .autopilot_rx
+        .expect("the autopilot runs in this process");
     let frames = o.summary.frames as u32;
     assert_eq!(rx.rejected[0], frames / 19, "IMU groups rejected: {rx:?}");
     assert!(rx.rejected[2] >= 1 && rx.rejected[3] >= 1, "{rx:?}");
@@ -526,8 +536,12 @@ impl Transport for Stops {
 
 struct StopsOnboard;
 impl Onboard<Stops> for StopsOnboard {
-    fn with_app<R>(&mut self, link: &mut Lockstep<Stops>, f: impl FnOnce(&mut App) -> R) -> R {
-        f(link.transport_mut().inner.app_mut())
+    fn with_app<R>(
+        &mut self,
+        link: &mut Lockstep<Stops>,
+        f: impl FnOnce(&mut App) -> R,
+    ) -> Option<R> {
+        Some(f(link.transport_mut().inner.app_mut()))
     }
 }
 
@@ -546,9 +560,14 @@ fn a_link_that_stops_is_reported_as_a_silent_autopilot() {
     let mut link = Lockstep::new(t, cfg.link_timeout);
     let start = std::time::Instant::now();
     match fly(&aircraft(), &cfg, &mut link, &mut StopsOnboard) {
-        Err(FlightError::Link(LinkError::Silent { frames, time_s, .. })) => {
+        Err(FlightError::Interrupted {
+            cause: LinkError::Silent { frames, time_s, .. },
+            partial,
+        }) => {
             assert_eq!(frames, 500);
             assert!((time_s - 5.0).abs() < 1e-9, "{time_s}");
+            // The flight up to the silence is kept: 500 frames answered and logged.
+            assert_eq!(partial.samples.len(), 500);
         }
         other => panic!(
             "expected a silent autopilot, got {:?}",
@@ -624,4 +643,34 @@ fn the_radio_flies_stabilized_through_rc_channels() {
             .all(|s| s.mode == 7),
         "Stabilized throughout"
     );
+}
+
+#[test]
+fn leaving_the_truth_out_of_the_frames_changes_no_answer_of_an_autopilot_flying_on_its_estimate() {
+    // Over QEMU's UARTs the truth (HIL_STATE_QUATERNION) is left out unless the autopilot flies
+    // on it; the flight must be the same without it.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let fly_with = |truth_frames: bool, sub: &str| {
+        let cfg = FlightConfig {
+            duration_s: 60.0,
+            truth_frames,
+            ..sim_host::flight::missions::runway_mission(
+                sim_host::flight::missions::default_mission(
+                    sim_host::plant::ModelParams::new(&aircraft()).home,
+                ),
+            )
+        };
+        let opts = FlyOptions {
+            out: Some(dir.path().join(sub)),
+            plots: false,
+            ..FlyOptions::default()
+        };
+        fly_report(&aircraft(), &cfg, &opts).expect("flight");
+        let tlog = std::fs::read(dir.path().join(sub).join("flight.tlog")).expect("tlog");
+        sim_host::flight::compare::answers(&tlog)
+    };
+    let (with, without) = (fly_with(true, "with"), fly_with(false, "without"));
+    let c = sim_host::flight::compare::compare_answers(&with, &without);
+    assert_eq!(c.compared, 6000);
+    assert!(c.identical(), "{c:?}");
 }

@@ -1,5 +1,7 @@
 //! Shared helpers of the system tests in `tests/tests/`.
 
+pub mod station;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -17,27 +19,30 @@ pub fn workspace_root() -> PathBuf {
 /// never wait on each other's lock. A fresh toolchain lacks the target; adding it is
 /// idempotent and quick once present.
 pub fn build_mcu_firmware() -> PathBuf {
-    let root = workspace_root();
     let _ = Command::new("rustup")
         .args(["target", "add", "thumbv7em-none-eabihf"])
         .status();
-    let target_dir = root.join("target").join("cross");
+    let dir = cargo_build(
+        "cross",
+        &["-p", "firmware", "--target", "thumbv7em-none-eabihf"],
+    );
+    dir.join("thumbv7em-none-eabihf/release/firmware")
+}
+
+/// `cargo build --release ARGS` into `target/DIR` (a target directory of its own, so that the
+/// build does not wait for the lock of the one running the tests); returns that directory.
+fn cargo_build(dir: &str, args: &[&str]) -> PathBuf {
+    let target_dir = workspace_root().join("target").join(dir);
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
-        .current_dir(&root)
-        .args([
-            "build",
-            "-p",
-            "firmware",
-            "--release",
-            "--target",
-            "thumbv7em-none-eabihf",
-        ])
+        .current_dir(workspace_root())
+        .args(["build", "--release"])
+        .args(args)
         .env("CARGO_TARGET_DIR", &target_dir)
         .status()
         .expect("cargo runs");
-    assert!(status.success(), "thumbv7em build of firmware failed");
-    target_dir.join("thumbv7em-none-eabihf/release/firmware")
+    assert!(status.success(), "cargo build --release {args:?} failed");
+    target_dir
 }
 
 /// Whether an external tool is installed. Under CI (`CI` set) a missing tool is an error, so a
@@ -56,4 +61,11 @@ pub fn tool_available(name: &str) -> bool {
         eprintln!("SKIPPED: {name} is not installed");
     }
     found
+}
+
+/// Builds `sim-host` (release) with its `mcu-libm` feature, the host build computing sines,
+/// arctangents and exponentials with the libm crate as the MCU image does, into
+/// `target/mcu-libm`; returns the binary's path.
+pub fn build_sim_host_with_mcu_libm() -> PathBuf {
+    cargo_build("mcu-libm", &["-p", "sim-host", "--features", "mcu-libm"]).join("release/sim-host")
 }

@@ -16,21 +16,19 @@
 //! keep the autopilot's link-loss failsafe (`FS_GCS_TOUT_S`, 5 s of the autopilot's time)
 //! from returning the aircraft home: a station that fell silent would fail the test.
 
-use common::gcs::client::{command_long, gcs_heartbeat};
 use common::math::geodetic::{ned_offset, GeoPoint};
 use common::math::Euler;
 use mavlink::dialects::common::*;
-use mavlink::{MavHeader, MavlinkReader, MavlinkVersion};
 use nalgebra::Vector3;
 use sim_host::aircraft::Aircraft;
 use sim_host::commands::fly::{fly_report, FlyOptions};
 use sim_host::flight::missions::default_mission;
 use sim_host::flight::{Action, FlightConfig, FlightOutcome, Sample, Script, ScriptStep};
 use sim_host::plant::{ground, ModelParams, State};
-use std::collections::VecDeque;
 use std::net::{SocketAddr, UdpSocket};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
+use system_tests::station::{free_port, Station, ME, TARGET};
 
 /// Simulated seconds per wall second: the ~350 s mission takes about 15 s.
 const SPEED: f64 = 25.0;
@@ -43,297 +41,8 @@ const FLIGHT_S: f64 = 380.0;
 /// Simulated time at which the scripted station says its (no-op) "arm" and falls silent, s:
 /// well after this station has armed (the estimator converges in about 10 s).
 const SCRIPT_SILENT_AT_S: f64 = 40.0;
-/// The autopilot's identity (DESIGN.md: system 1, component 1).
-const TARGET: (u8, u8) = (1, 1);
-/// This station's identity: QGroundControl's.
-const ME: (u8, u8) = (255, 190);
-
 fn aircraft() -> Aircraft {
     Aircraft::ultrastick25e().expect("built-in aircraft")
-}
-
-/// A free UDP port on the loopback (bound, read back and released for the flight to take).
-fn free_port() -> u16 {
-    UdpSocket::bind("127.0.0.1:0")
-        .and_then(|s| s.local_addr())
-        .expect("free port")
-        .port()
-}
-
-/// Everything the station has heard that a test asserts on, whatever it was waiting for.
-#[derive(Default)]
-struct Log {
-    /// Heartbeats of the autopilot: (armed, custom_mode), in arrival order.
-    heartbeats: Vec<(bool, u32)>,
-    /// MISSION_CURRENT: (seq, total, mission_state, mission_id).
-    current: Vec<(u16, u16, MissionState, u32)>,
-    /// MISSION_ITEM_REACHED, in arrival order.
-    reached: Vec<u16>,
-    /// STATUSTEXTs.
-    texts: Vec<String>,
-    /// Frames that were not from the autopilot.
-    foreign: usize,
-    /// Frames the `mavlink` crate could not parse.
-    unparsed: usize,
-}
-
-/// The ground station.
-struct Station {
-    socket: UdpSocket,
-    to: SocketAddr,
-    sequence: u8,
-    inbox: VecDeque<MavMessage>,
-    log: Log,
-    /// The autopilot's clock, from its time-stamped telemetry, ms.
-    autopilot_ms: Option<u32>,
-    /// Its clock when this station last sent a heartbeat, ms.
-    heartbeat_ms: Option<u32>,
-    heartbeat_wall: Instant,
-}
-
-impl Station {
-    /// A station on `socket` speaking to the autopilot's port `to`.
-    fn new(socket: UdpSocket, to: SocketAddr) -> Self {
-        socket.set_nonblocking(true).expect("non-blocking");
-        let mut s = Self {
-            socket,
-            to,
-            sequence: 0,
-            inbox: VecDeque::new(),
-            log: Log::default(),
-            autopilot_ms: None,
-            heartbeat_ms: None,
-            heartbeat_wall: Instant::now(),
-        };
-        s.heartbeat();
-        s
-    }
-
-    fn send(&mut self, m: &MavMessage) {
-        let header = MavHeader {
-            system_id: u32::from(ME.0),
-            component_id: ME.1,
-            sequence: self.sequence,
-        };
-        self.sequence = self.sequence.wrapping_add(1);
-        let mut buf = Vec::with_capacity(300);
-        mavlink::write_v2_msg(&mut buf, header, m).expect("encode");
-        self.socket.send_to(&buf, self.to).expect("send");
-    }
-
-    fn heartbeat(&mut self) {
-        self.send(&gcs_heartbeat());
-        self.heartbeat_ms = self.autopilot_ms;
-        self.heartbeat_wall = Instant::now();
-    }
-
-    /// Sends the heartbeat when due: 1 Hz of the autopilot's clock (what QGroundControl sends
-    /// to a vehicle flying in real time; at 1 Hz of wall time this faster-than-real-time
-    /// autopilot would hear it only every `SPEED` seconds and call the link lost), and at
-    /// least 1 Hz of wall time while its clock is not known.
-    fn heartbeat_if_due(&mut self) {
-        let due = match (self.autopilot_ms, self.heartbeat_ms) {
-            (Some(now), Some(last)) => now.saturating_sub(last) >= 1000,
-            (Some(_), None) => true,
-            (None, _) => self.heartbeat_wall.elapsed() >= Duration::from_secs(1),
-        };
-        if due {
-            self.heartbeat();
-        }
-    }
-
-    /// Takes every waiting datagram, logs what the tests read, keeps the heartbeat going.
-    fn pump(&mut self) {
-        let mut buf = [0u8; 65536];
-        loop {
-            let n = match self.socket.recv_from(&mut buf) {
-                Ok((n, _)) => n,
-                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break,
-                // The autopilot's port not open yet (ICMP from an earlier send).
-                Err(e) if e.kind() == std::io::ErrorKind::ConnectionRefused => continue,
-                Err(e) => panic!("receive: {e}"),
-            };
-            let mut reader = MavlinkReader::new(&buf[..n]);
-            loop {
-                match reader.read_message::<MavMessage>(MavlinkVersion::V2) {
-                    Ok((h, m)) => self.take(h, m),
-                    Err(mavlink::error::MessageReadError::Io(_)) => break,
-                    // A frame the dialect does not parse: counted, skipped.
-                    Err(mavlink::error::MessageReadError::Parse(_)) => {
-                        self.log.unparsed += 1;
-                        if self.log.unparsed > 10_000 {
-                            panic!("the autopilot's frames do not parse");
-                        }
-                    }
-                }
-            }
-        }
-        self.heartbeat_if_due();
-        std::thread::sleep(Duration::from_millis(1));
-    }
-
-    fn take(&mut self, h: MavHeader, m: MavMessage) {
-        if (h.system_id, h.component_id) != (u32::from(TARGET.0), TARGET.1) {
-            self.log.foreign += 1;
-            return;
-        }
-        let stamp = match &m {
-            MavMessage::ATTITUDE(a) => Some(a.time_boot_ms),
-            MavMessage::GLOBAL_POSITION_INT(g) => Some(g.time_boot_ms),
-            _ => None,
-        };
-        if let Some(t) = stamp {
-            self.autopilot_ms = Some(self.autopilot_ms.map_or(t, |a| a.max(t)));
-        }
-        match &m {
-            MavMessage::HEARTBEAT(hb) => self.log.heartbeats.push((
-                hb.base_mode
-                    .contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED),
-                hb.custom_mode,
-            )),
-            MavMessage::MISSION_CURRENT(c) => {
-                self.log
-                    .current
-                    .push((c.seq, c.total, c.mission_state, c.mission_id))
-            }
-            MavMessage::MISSION_ITEM_REACHED(r) => self.log.reached.push(r.seq),
-            MavMessage::STATUSTEXT(t) => self
-                .log
-                .texts
-                .push(t.text.to_str().unwrap_or("?").to_string()),
-            _ => {}
-        }
-        self.inbox.push_back(m);
-    }
-
-    /// Waits up to `secs` of wall time for the first message `pick` accepts; what it passes
-    /// over is dropped (the log has kept what matters).
-    fn wait<T>(&mut self, secs: f64, mut pick: impl FnMut(&MavMessage) -> Option<T>) -> Option<T> {
-        let end = Instant::now() + Duration::from_secs_f64(secs);
-        loop {
-            while let Some(m) = self.inbox.pop_front() {
-                if let Some(t) = pick(&m) {
-                    return Some(t);
-                }
-            }
-            if Instant::now() >= end {
-                return None;
-            }
-            self.pump();
-        }
-    }
-
-    fn command(&mut self, cmd: MavCmd, p: [f32; 7]) -> Option<MavResult> {
-        self.send(&command_long(cmd, p));
-        self.wait(2.0, |m| match m {
-            MavMessage::COMMAND_ACK(a) if a.command == cmd => Some(a.result),
-            _ => None,
-        })
-    }
-
-    /// The mission protocol's upload: MISSION_COUNT, then each item the autopilot asks for
-    /// with MISSION_REQUEST_INT, until its MISSION_ACK. Returns the ACK and the requests in
-    /// the order they came.
-    fn upload(&mut self, items: &[MISSION_ITEM_INT_DATA]) -> (MISSION_ACK_DATA, Vec<u16>) {
-        self.inbox.clear();
-        self.send(&MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
-            count: items.len() as u16,
-            target_system: TARGET.0,
-            target_component: TARGET.1,
-            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
-            opaque_id: 0,
-        }));
-        let mut requests = Vec::new();
-        let end = Instant::now() + Duration::from_secs(10);
-        while Instant::now() < end {
-            self.pump();
-            while let Some(m) = self.inbox.pop_front() {
-                match m {
-                    MavMessage::MISSION_REQUEST_INT(r)
-                        if r.mission_type == MavMissionType::MAV_MISSION_TYPE_MISSION
-                            && (r.target_system, r.target_component) == ME =>
-                    {
-                        requests.push(r.seq);
-                        let item = items
-                            .get(usize::from(r.seq))
-                            .unwrap_or_else(|| {
-                                panic!("request for item {} of {}", r.seq, items.len())
-                            })
-                            .clone();
-                        self.send(&MavMessage::MISSION_ITEM_INT(item));
-                    }
-                    MavMessage::MISSION_ACK(a)
-                        if a.mission_type == MavMissionType::MAV_MISSION_TYPE_MISSION =>
-                    {
-                        assert_eq!(
-                            (a.target_system, a.target_component),
-                            ME,
-                            "ACK addressed to the uploader"
-                        );
-                        return (a, requests);
-                    }
-                    _ => {}
-                }
-            }
-        }
-        panic!("no MISSION_ACK within 10 s (requests so far {requests:?})");
-    }
-
-    /// The mission protocol's download: MISSION_REQUEST_LIST, MISSION_COUNT, each item with
-    /// MISSION_REQUEST_INT (asked again after 0.5 s without an answer), then MISSION_ACK.
-    fn download(&mut self) -> Vec<MISSION_ITEM_INT_DATA> {
-        self.inbox.clear();
-        let list = MavMessage::MISSION_REQUEST_LIST(MISSION_REQUEST_LIST_DATA {
-            target_system: TARGET.0,
-            target_component: TARGET.1,
-            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
-        });
-        let mut count = None;
-        for _ in 0..5 {
-            self.send(&list);
-            count = self.wait(0.5, |m| match m {
-                MavMessage::MISSION_COUNT(c)
-                    if c.mission_type == MavMissionType::MAV_MISSION_TYPE_MISSION =>
-                {
-                    Some(c.count)
-                }
-                _ => None,
-            });
-            if count.is_some() {
-                break;
-            }
-        }
-        let count = count.expect("MISSION_COUNT");
-        let mut items = Vec::new();
-        for seq in 0..count {
-            let request = MavMessage::MISSION_REQUEST_INT(MISSION_REQUEST_INT_DATA {
-                seq,
-                target_system: TARGET.0,
-                target_component: TARGET.1,
-                mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
-            });
-            let mut got = None;
-            for _ in 0..5 {
-                self.send(&request);
-                got = self.wait(0.5, |m| match m {
-                    MavMessage::MISSION_ITEM_INT(i) if i.seq == seq => Some(i.clone()),
-                    _ => None,
-                });
-                if got.is_some() {
-                    break;
-                }
-            }
-            items.push(got.unwrap_or_else(|| panic!("item {seq} of {count}")));
-        }
-        self.send(&MavMessage::MISSION_ACK(MISSION_ACK_DATA {
-            target_system: TARGET.0,
-            target_component: TARGET.1,
-            mavtype: MavMissionResult::MAV_MISSION_ACCEPTED,
-            mission_type: MavMissionType::MAV_MISSION_TYPE_MISSION,
-            opaque_id: 0,
-        }));
-        items
-    }
 }
 
 /// The downloaded list is the uploaded one, field by field (floats bit for bit: the NaN
@@ -415,14 +124,7 @@ fn start(duration_s: f64, speed: f64, silent_at_s: f64) -> (Station, JoinHandle<
         .parse()
         .expect("address");
     let mut station = Station::new(socket, to);
-    let hb = station
-        .wait(10.0, |m| match m {
-            MavMessage::HEARTBEAT(h) => Some(h.clone()),
-            _ => None,
-        })
-        .expect("autopilot heartbeat over UDP");
-    assert_eq!(hb.mavtype, MavType::MAV_TYPE_FIXED_WING);
-    assert_eq!(hb.autopilot, MavAutopilot::MAV_AUTOPILOT_GENERIC);
+    station.fixed_wing_heartbeat(10.0);
     (station, handle)
 }
 
@@ -475,28 +177,9 @@ fn a_station_over_udp_uploads_the_mission_arms_starts_it_and_sees_it_flown_to_th
     let stored = gcs.download();
     assert_same_mission(&stored, &mission);
 
-    // Arm: refused (with a reason) until the estimator has converged, then accepted.
-    let mut refusals = 0;
-    let end = Instant::now() + Duration::from_secs(15);
-    let armed = loop {
-        assert!(
-            Instant::now() < end,
-            "not armed after {refusals} refusals: {:?}",
-            gcs.log.texts
-        );
-        match gcs.command(
-            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
-            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        ) {
-            Some(MavResult::MAV_RESULT_ACCEPTED) => break gcs.autopilot_ms,
-            Some(MavResult::MAV_RESULT_DENIED | MavResult::MAV_RESULT_TEMPORARILY_REJECTED) => {
-                refusals += 1;
-                // Half a second of the autopilot's time between tries.
-                std::thread::sleep(Duration::from_secs_f64(0.5 / SPEED));
-            }
-            other => panic!("arming answered {other:?}"),
-        }
-    };
+    // Arm: refused (with a reason) until the estimator has converged, then accepted; half a
+    // second of the autopilot's time between tries.
+    let (armed, refusals) = gcs.arm(Duration::from_secs(15), 0.5, SPEED);
     let start_result = gcs.command(MavCmd::MAV_CMD_MISSION_START, [0.0; 7]);
     assert_eq!(start_result, Some(MavResult::MAV_RESULT_ACCEPTED));
     let denied = gcs

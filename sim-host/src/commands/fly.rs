@@ -1,22 +1,23 @@
 //! `sim-host fly`: the firmware flies the plant over the simulator link, commanded by a
 //! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
 
+use super::flying::{finish_report, fly_qemu, run_on, MCU_LOG};
 use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
-use crate::flight::onboard::{spawn_firmware, InprocOnboard, Onboard};
-use crate::flight::plots::write_log_and_plots;
-use crate::flight::runner::{fly, FlightOutcome};
+use crate::flight::onboard::{spawn_firmware, InprocOnboard};
+use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::MissionSummary;
-use crate::link::lockstep::Lockstep;
-use crate::link::tlog::TlogWriter;
-use crate::link::transport::{Inproc, PtyServer, TcpServer, Transport, UdpServer};
+use crate::link::qemu::QemuConfig;
+use crate::link::transport::{Inproc, PtyServer, TcpServer, UdpServer};
+use crate::report::sig;
 use crate::report::table::Table;
-use crate::report::{sig, to_json};
 use anyhow::Context;
 use firmware::app::App;
 use firmware::sitl::SimEndpoint;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
+
+pub use super::flying::{write_flight_files, FlyReport};
 
 /// Which transport carries the simulator link.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,6 +30,9 @@ pub enum LinkKind {
     Udp,
     /// A pseudo-terminal pair (a virtual serial line).
     Pty,
+    /// The MCU image on QEMU's emulated STM32F405: USART1 on the simulator link, USART2 on
+    /// the ground link behind the UDP bridge.
+    Qemu,
 }
 
 impl std::str::FromStr for LinkKind {
@@ -39,7 +43,10 @@ impl std::str::FromStr for LinkKind {
             "tcp" => Ok(Self::Tcp),
             "udp" => Ok(Self::Udp),
             "pty" => Ok(Self::Pty),
-            _ => Err(format!("link `{s}`: expected inproc, tcp, udp or pty")),
+            "qemu" => Ok(Self::Qemu),
+            _ => Err(format!(
+                "link `{s}`: expected inproc, tcp, udp, pty or qemu"
+            )),
         }
     }
 }
@@ -52,6 +59,7 @@ impl LinkKind {
             Self::Tcp => "tcp",
             Self::Udp => "udp",
             Self::Pty => "pty",
+            Self::Qemu => "qemu",
         }
     }
 }
@@ -74,6 +82,8 @@ pub struct FlyOptions {
     pub upload_gains: Option<common::control::gains::GainSet>,
     /// Fly on the simulator's truth (`SIM_USE_TRUTH` = 1).
     pub use_truth: bool,
+    /// The MCU image and the QEMU that runs it, for [`LinkKind::Qemu`].
+    pub qemu: QemuConfig,
 }
 
 impl Default for FlyOptions {
@@ -86,20 +96,13 @@ impl Default for FlyOptions {
             gain_set: None,
             upload_gains: None,
             use_truth: false,
+            qemu: QemuConfig::default(),
         }
     }
 }
 
-/// A flown flight and the files it left.
-#[derive(Clone, Debug)]
-pub struct FlyReport {
-    /// Log and summary.
-    pub outcome: FlightOutcome,
-    /// Files written.
-    pub files: Vec<PathBuf>,
-}
-
-fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
+/// The flight of `cfg` with the parameters `opts` asks the station to set.
+pub(crate) fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
     let mut cfg = cfg.clone();
     if let Some(g) = opts.gain_set {
         cfg.script.params.push(("SYS_GAIN_SET".into(), g as f32));
@@ -115,25 +118,8 @@ fn with_params(cfg: &FlightConfig, opts: &FlyOptions) -> FlightConfig {
     cfg
 }
 
-fn run_on<T: Transport, O: Onboard<T>>(
-    aircraft: &Aircraft,
-    cfg: &FlightConfig,
-    transport: T,
-    onboard: &mut O,
-    tlog: Option<&Path>,
-) -> anyhow::Result<FlightOutcome> {
-    let mut link = Lockstep::new(transport, cfg.link_timeout);
-    if let Some(p) = tlog {
-        let w =
-            TlogWriter::create(p).with_context(|| format!("cannot create `{}`", p.display()))?;
-        link = link.with_tlog(w);
-    }
-    let outcome = fly(aircraft, cfg, &mut link, onboard)?;
-    link.finish().context("cannot write the tlog")?;
-    Ok(outcome)
-}
-
-/// Flies `cfg` over the transport of `opts`, and writes the files into `opts.out`.
+/// Flies `cfg` over the transport of `opts`, and writes the files into `opts.out` (also when
+/// the link fails during the flight: the error then says where the log is).
 pub fn fly_report(
     aircraft: &Aircraft,
     cfg: &FlightConfig,
@@ -148,7 +134,7 @@ pub fn fly_report(
     let tlog = tlog.as_deref();
     let wait = Duration::from_secs(10);
     let silence = cfg.link_timeout.max(Duration::from_secs(2));
-    let outcome = match opts.link {
+    let flown = match opts.link {
         LinkKind::Inproc => run_on(
             aircraft,
             &cfg,
@@ -193,30 +179,13 @@ pub fn fly_report(
             let mut fw = spawn_firmware(SimEndpoint::Serial(path), App::new(), wait, silence);
             run_on(aircraft, &cfg, pty, &mut fw, tlog)?
         }
+        LinkKind::Qemu => fly_qemu(aircraft, &cfg, &opts.qemu, opts.out.as_deref(), tlog)?,
     };
-    let mut files = Vec::new();
-    if let Some(dir) = &opts.out {
-        if let Some(t) = tlog {
-            files.push(t.to_path_buf());
-        }
-        if opts.plots {
-            files.extend(write_log_and_plots(dir, &outcome.samples)?);
-        } else {
-            let csv = dir.join("flight.csv");
-            let rows: Vec<Vec<f64>> = outcome
-                .samples
-                .iter()
-                .map(crate::flight::record::csv_row)
-                .collect();
-            crate::report::csv_out::write_csv(&csv, &crate::flight::record::csv_headers(), &rows)?;
-            files.push(csv);
-        }
-        let json = dir.join("summary.json");
-        std::fs::write(&json, to_json(&outcome.summary)?)
-            .with_context(|| format!("cannot write `{}`", json.display()))?;
-        files.push(json);
+    let mut files: Vec<PathBuf> = tlog.iter().map(|t| t.to_path_buf()).collect();
+    if opts.link == LinkKind::Qemu {
+        files.extend(opts.out.as_ref().map(|d| d.join(MCU_LOG)));
     }
-    Ok(FlyReport { outcome, files })
+    finish_report(flown, opts.out.as_deref(), opts.plots, files)
 }
 
 /// The short summary printed after a flight.
@@ -227,13 +196,28 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
     run.row(["wall clock".to_string(), format!("{:.2} s", s.wall_s)]);
     run.row([
         "real-time factor".to_string(),
-        format!("{:.0}x", s.real_time_factor),
+        if s.real_time_factor < 10.0 {
+            format!("{:.2}x", s.real_time_factor)
+        } else {
+            format!("{:.0}x", s.real_time_factor)
+        },
     ]);
     run.row(["frames".to_string(), s.frames.to_string()]);
+    run.row(["ended".to_string(), s.ended.describe().to_string()]);
     run.row([
         "armed at".to_string(),
         s.armed_at_s.map_or("never".into(), |t| format!("{t:.1} s")),
     ]);
+    if let (None, Some(td)) = (&s.mission, &s.touchdown) {
+        // No mission known here (`sim-host sim`): where and how the wheels met the runway.
+        run.row([
+            "touchdown".to_string(),
+            format!(
+                "at {:.1} s, {:.1} m N {:.1} m E of home, sink {:.2} m/s, {:.1} m/s over ground, {} bounce(s)",
+                td.time_s, td.north_m, td.east_m, td.sink_rate_mps, td.ground_speed_mps, td.bounces
+            ),
+        ]);
+    }
     run.row([
         "wind, turbulence".to_string(),
         format!(
@@ -334,6 +318,16 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
     tables
 }
 
+/// A figure to three significant digits, or "n/a" where it was not measured (the errors
+/// against guidance of an autopilot seen only through its links).
+fn known(x: f64, digits: usize) -> String {
+    if x.is_nan() {
+        "n/a".into()
+    } else {
+        sig(x, digits)
+    }
+}
+
 /// The figures of a mission flight.
 pub fn mission_table(m: &MissionSummary) -> Table {
     let mut t = Table::new("Mission", &["quantity", "value"]);
@@ -353,18 +347,21 @@ pub fn mission_table(m: &MissionSummary) -> Table {
         "cross-track, straight legs (m)",
         format!(
             "{} RMS, {} max",
-            sig(m.xtrack_rms_m, 3),
-            sig(m.xtrack_max_m, 3)
+            known(m.xtrack_rms_m, 3),
+            known(m.xtrack_max_m, 3)
         ),
     );
     row(
         "cross-track, on loiter circles (m)",
-        format!("{} RMS", sig(m.orbit_xtrack_rms_m, 3)),
+        format!("{} RMS", known(m.orbit_xtrack_rms_m, 3)),
     );
-    row("altitude error (m)", format!("{} RMS", sig(m.alt_rms_m, 3)));
+    row(
+        "altitude error (m)",
+        format!("{} RMS", known(m.alt_rms_m, 3)),
+    );
     row(
         "airspeed error (m/s)",
-        format!("{} RMS", sig(m.airspeed_rms_mps, 3)),
+        format!("{} RMS", known(m.airspeed_rms_mps, 3)),
     );
     row("flight time (s)", format!("{:.1}", m.flight_time_s));
     row("motor energy (Wh)", format!("{:.2}", m.energy_wh));

@@ -2,13 +2,16 @@
 //! tests) and the tables it prints, so the CLI only chooses the output form.
 
 pub mod campaign;
+pub mod compare;
 pub mod design;
 pub mod doublet;
 pub mod fly;
+pub mod flying;
 pub mod linearize;
 pub mod navigation;
 pub mod params;
 pub mod scenario;
+pub mod sim;
 pub mod trim;
 pub mod validation;
 

@@ -4,6 +4,7 @@
 use super::script::Script;
 use crate::environment::wind::Turbulence;
 use crate::sensors::models::SensorFaults;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Everything that defines a flight.
@@ -44,6 +45,18 @@ pub struct FlightConfig {
     /// The pilot's radio: stick positions from a time on, sent as RC_CHANNELS at 50 Hz on
     /// the simulator link (none: no radio).
     pub rc_sticks: Vec<RcSticks>,
+    /// Fly the scripted ground station. Without it (`sim-host sim`) whoever flies the
+    /// autopilot does so on its own ground link, and `script` is not used.
+    pub scripted_station: bool,
+    /// End the flight, as flown so far, when the autopilot closes the simulator link (a
+    /// standalone simulator's end) instead of calling it a failure.
+    pub until_link_closes: bool,
+    /// Set from outside (Ctrl-C) to end the flight at the next frame, as flown so far.
+    pub stop: Option<&'static AtomicBool>,
+    /// Send the truth (HIL_STATE_QUATERNION) with every sensor frame. An autopilot flies on it
+    /// only with `SIM_USE_TRUTH` set; over a slow link (a UART in QEMU, where each byte costs)
+    /// it may be left out otherwise.
+    pub truth_frames: bool,
 }
 
 /// Stick positions held from a time on.
@@ -86,6 +99,21 @@ pub enum Fault {
 }
 
 impl FlightConfig {
+    /// Whether the scripted station has the autopilot fly on the truth (`SIM_USE_TRUTH`).
+    pub fn flies_on_truth(&self) -> bool {
+        self.scripted_station
+            && self
+                .script
+                .params
+                .iter()
+                .any(|(n, v)| n == "SIM_USE_TRUTH" && *v != 0.0)
+    }
+
+    /// Whether the flight has been asked to stop.
+    pub fn stopped(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
     /// The faults active at `t_s`.
     pub fn faults_at(&self, t_s: f64) -> SensorFaults {
         let mut f = SensorFaults::default();
@@ -125,8 +153,39 @@ impl Default for FlightConfig {
             runway_heading: None,
             faults: Vec::new(),
             rc_sticks: Vec::new(),
+            scripted_station: true,
+            until_link_closes: false,
+            stop: None,
+            truth_frames: true,
         }
     }
+}
+
+/// Parses a sensor fault as the command line spells it: `KIND:FROM-TO` in seconds of
+/// simulated time, KIND one of gps, pitot, mag, baro (`gps:60-90`).
+pub fn parse_fault(s: &str) -> Result<FaultWindow, String> {
+    let err = |why: &str| {
+        format!("fault `{s}`: {why} (expected KIND:FROM-TO, e.g. gps:60-90; KIND gps, pitot, mag or baro)")
+    };
+    let (kind, window) = s.split_once(':').ok_or_else(|| err("no `:`"))?;
+    let fault = match kind.trim() {
+        "gps" => Fault::GpsLost,
+        "pitot" => Fault::PitotFailed,
+        "mag" => Fault::MagFailed,
+        "baro" => Fault::BaroFailed,
+        _ => return Err(err("unknown sensor")),
+    };
+    let (from, to) = window.split_once('-').ok_or_else(|| err("no `-`"))?;
+    let num = |x: &str| x.trim().parse::<f64>().map_err(|e| err(&e.to_string()));
+    let (from_s, to_s) = (num(from)?, num(to)?);
+    if !(from_s.is_finite() && to_s.is_finite() && 0.0 <= from_s && from_s < to_s) {
+        return Err(err("the window must run forwards from 0 s or later"));
+    }
+    Ok(FaultWindow {
+        fault,
+        from_s,
+        to_s,
+    })
 }
 
 /// Parses a turbulence severity as the command line spells it.
@@ -149,5 +208,31 @@ pub fn turbulence_name(t: Turbulence) -> &'static str {
         Turbulence::Light => "light",
         Turbulence::Moderate => "moderate",
         Turbulence::Severe => "severe",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fault_reads_as_a_sensor_and_a_window_and_a_bad_one_says_what_is_expected() {
+        let f = parse_fault("gps:60-90.5").expect("valid");
+        assert_eq!((f.fault, f.from_s, f.to_s), (Fault::GpsLost, 60.0, 90.5));
+        assert_eq!(
+            parse_fault("baro:0-1").map(|f| f.fault),
+            Ok(Fault::BaroFailed)
+        );
+        for bad in [
+            "gyro:1-2",
+            "gps:9-3",
+            "gps:1",
+            "gps",
+            "pitot:-1-2",
+            "mag:x-2",
+        ] {
+            let e = parse_fault(bad).expect_err(bad);
+            assert!(e.contains("KIND:FROM-TO"), "{bad}: {e}");
+        }
     }
 }

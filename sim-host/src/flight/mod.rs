@@ -22,6 +22,7 @@
 //! identity) to the autopilot's ground link. It waits for each COMMAND_ACK before the next
 //! sensor frame, so a command takes effect at the same frame on every transport.
 
+pub mod compare;
 pub mod config;
 pub mod missions;
 pub mod onboard;
@@ -31,8 +32,10 @@ pub mod runner;
 pub mod script;
 pub mod summary;
 
-pub use config::{parse_turbulence, turbulence_name, Fault, FaultWindow, FlightConfig, RcSticks};
-pub use onboard::{spawn_firmware, InprocOnboard, Onboard, ThreadOnboard};
+pub use config::{
+    parse_fault, parse_turbulence, turbulence_name, Fault, FaultWindow, FlightConfig, RcSticks,
+};
+pub use onboard::{spawn_firmware, InprocOnboard, Onboard, OutsideOnboard, ThreadOnboard};
 pub use record::Sample;
 pub use runner::{fly, FlightError, FlightOutcome};
 pub use script::{Action, Script, ScriptStep};

@@ -3,6 +3,9 @@
 //! - [`InprocOnboard`]: the firmware's [`App`] inside the in-process transport.
 //! - [`ThreadOnboard`]: the firmware in a thread of this process, on the firmware's own
 //!   SITL byte link ([`firmware::sitl::connect`]) over a real TCP or UDP socket or a pty.
+//! - [`OutsideOnboard`]: an autopilot this process cannot look into (the MCU image in QEMU,
+//!   an autopilot that connected to `sim-host sim`): the scripted station, if any, speaks to
+//!   its ground link over UDP, and the log holds the truth and the autopilot's answers only.
 //!
 //! A thread rather than a child process: the flight log records the autopilot's estimate and
 //! setpoints beside the truth at every frame, and the ground-station script must reach the
@@ -13,19 +16,54 @@
 
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::{Inproc, Transport};
+use common::link::framing::FrameParser;
 use firmware::app::App;
-use firmware::sitl::{self, SimEndpoint};
+use firmware::sitl::{self, timed_out, SimEndpoint};
+use mavlink::dialects::common::MavMessage;
 use std::io;
+use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// Access to the autopilot's application: its ground link and, for the log, its state.
+/// What the scripted station waits for after it has spoken, on a link where answers take
+/// time (in this process they are there at once).
+pub enum Await<'a> {
+    /// Nothing: take what has arrived.
+    Nothing,
+    /// The first frame `done` accepts (an acknowledgement, the next mission request), for at
+    /// most [`ANSWER_WAIT`].
+    Answer(&'a mut dyn FnMut(&MavMessage) -> bool),
+    /// Whatever arrives within this time (the last telemetry of a flight).
+    Linger(Duration),
+}
+
+/// How long the scripted station waits for an answer over a real link: far longer than a
+/// ground link's round trip, short enough that a lost answer costs little.
+pub const ANSWER_WAIT: Duration = Duration::from_secs(2);
+
+/// Access to the autopilot: its ground link for the scripted station and, where the
+/// application runs in this process, its state for the log.
 pub trait Onboard<T: Transport> {
-    /// Runs `f` on the application. Called only between lock-step exchanges, when the
-    /// autopilot is waiting for the next sensor frame.
-    fn with_app<R>(&mut self, link: &mut Lockstep<T>, f: impl FnOnce(&mut App) -> R) -> R;
+    /// Runs `f` on the application when it runs in this process (`None`: an autopilot seen
+    /// only through its links). Called only between lock-step exchanges, when the autopilot
+    /// is waiting for the next sensor frame.
+    fn with_app<R>(&mut self, link: &mut Lockstep<T>, f: impl FnOnce(&mut App) -> R) -> Option<R>;
+
+    /// The scripted station's turn on the autopilot's ground link: `bytes` (a frame, or
+    /// nothing) to the autopilot, and back everything it has sent the station since.
+    fn talk(&mut self, link: &mut Lockstep<T>, bytes: &[u8], _wait: Await) -> Vec<u8> {
+        self.with_app(link, |app| {
+            if !bytes.is_empty() {
+                app.on_gcs_bytes(bytes);
+            }
+            let mut out = Vec::new();
+            app.drain_gcs(&mut |b| out.extend_from_slice(b));
+            out
+        })
+        .unwrap_or_default()
+    }
 }
 
 /// The application inside the in-process transport.
@@ -33,8 +71,122 @@ pub trait Onboard<T: Transport> {
 pub struct InprocOnboard;
 
 impl Onboard<Inproc> for InprocOnboard {
-    fn with_app<R>(&mut self, link: &mut Lockstep<Inproc>, f: impl FnOnce(&mut App) -> R) -> R {
-        f(link.transport_mut().app_mut())
+    fn with_app<R>(
+        &mut self,
+        link: &mut Lockstep<Inproc>,
+        f: impl FnOnce(&mut App) -> R,
+    ) -> Option<R> {
+        Some(f(link.transport_mut().app_mut()))
+    }
+}
+
+/// An autopilot outside this process, reached through its links only.
+pub struct OutsideOnboard {
+    station: Option<StationSocket>,
+}
+
+impl OutsideOnboard {
+    /// No ground station here: whoever flies the autopilot does so on its own ground link.
+    pub fn unattended() -> Self {
+        Self { station: None }
+    }
+
+    /// The scripted station speaks to the autopilot's ground link at `ground` (UDP).
+    pub fn with_station(ground: SocketAddr) -> io::Result<Self> {
+        Ok(Self {
+            station: Some(StationSocket::open(ground)?),
+        })
+    }
+}
+
+impl<T: Transport> Onboard<T> for OutsideOnboard {
+    fn with_app<R>(
+        &mut self,
+        _link: &mut Lockstep<T>,
+        _f: impl FnOnce(&mut App) -> R,
+    ) -> Option<R> {
+        None
+    }
+
+    fn talk(&mut self, _link: &mut Lockstep<T>, bytes: &[u8], wait: Await) -> Vec<u8> {
+        match self.station.as_mut() {
+            Some(s) => s.talk(bytes, wait),
+            None => Vec::new(),
+        }
+    }
+}
+
+/// The scripted station's UDP socket to an autopilot's ground link, as QGroundControl's: it
+/// sends one frame per datagram and hears the frames the ground link sends back.
+struct StationSocket {
+    socket: UdpSocket,
+    to: SocketAddr,
+    parser: FrameParser,
+}
+
+impl StationSocket {
+    fn open(to: SocketAddr) -> io::Result<Self> {
+        let socket = UdpSocket::bind(("127.0.0.1", 0))?;
+        Ok(Self {
+            socket,
+            to,
+            parser: FrameParser::new(),
+        })
+    }
+
+    /// Sends `bytes`, then reads as `wait` says. A station whose autopilot has gone reads
+    /// nothing; the simulator link reports that.
+    fn talk(&mut self, bytes: &[u8], mut wait: Await) -> Vec<u8> {
+        if !bytes.is_empty() {
+            let _ = self.socket.send_to(bytes, self.to);
+        }
+        let start = Instant::now();
+        let until = match wait {
+            Await::Nothing => Duration::ZERO,
+            Await::Answer(_) => ANSWER_WAIT,
+            Await::Linger(d) => d,
+        };
+        let mut out = Vec::new();
+        let mut buf = [0u8; 2048];
+        loop {
+            let left = until.saturating_sub(start.elapsed());
+            let r = if left.is_zero() {
+                self.socket
+                    .set_nonblocking(true)
+                    .and_then(|()| self.socket.recv_from(&mut buf))
+            } else {
+                self.socket
+                    .set_nonblocking(false)
+                    .and_then(|()| self.socket.set_read_timeout(Some(left)))
+                    .and_then(|()| self.socket.recv_from(&mut buf))
+            };
+            let n = match r {
+                Ok((n, from)) if from == self.to => n,
+                Ok(_) => continue,
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        io::ErrorKind::ConnectionRefused | io::ErrorKind::Interrupted
+                    ) =>
+                {
+                    continue
+                }
+                Err(e) if timed_out(&e) && left.is_zero() => return out,
+                Err(e) if timed_out(&e) => continue,
+                Err(_) => return out,
+            };
+            out.extend_from_slice(&buf[..n]);
+            let mut answered = false;
+            if let Await::Answer(done) = &mut wait {
+                self.parser
+                    .push(&buf[..n], |f| answered |= done(&f.message));
+            }
+            if answered {
+                // What else has already arrived comes with it.
+                out.extend(self.talk(&[], Await::Nothing));
+                return out;
+            }
+        }
     }
 }
 
@@ -67,11 +219,11 @@ impl Drop for ThreadOnboard {
 }
 
 impl<T: Transport> Onboard<T> for ThreadOnboard {
-    fn with_app<R>(&mut self, _link: &mut Lockstep<T>, f: impl FnOnce(&mut App) -> R) -> R {
+    fn with_app<R>(&mut self, _link: &mut Lockstep<T>, f: impl FnOnce(&mut App) -> R) -> Option<R> {
         // A poisoned lock means the firmware thread panicked mid-frame; its state is still
         // the last one it wrote, which is what the log wants.
         let mut g = self.app.lock().unwrap_or_else(|p| p.into_inner());
-        f(&mut g)
+        Some(f(&mut g))
     }
 }
 

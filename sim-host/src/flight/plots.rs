@@ -41,7 +41,12 @@ pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec
     let p: Vec<&Sample> = samples.iter().step_by(10).collect();
     let t: Vec<f64> = p.iter().map(|s| s.t).collect();
     let col = |f: &dyn Fn(&Sample) -> f64| p.iter().map(|s| f(s)).collect::<Vec<f64>>();
-    let fig = |name: &str, f: Figure| -> anyhow::Result<PathBuf> {
+    let fig = |name: &str, mut f: Figure| -> anyhow::Result<PathBuf> {
+        // An autopilot seen only through its links (QEMU, `sim-host sim`) leaves its estimate
+        // and setpoints out of the log: no line for them.
+        for p in &mut f.panels {
+            p.series.retain(|s| s.y.iter().any(|v| v.is_finite()));
+        }
         let path = dir.join(name);
         f.save_png(&path)?;
         Ok(path)

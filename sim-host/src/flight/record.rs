@@ -143,8 +143,25 @@ impl NavView {
     }
 }
 
+/// What the autopilot holds at one frame, for the log: only an autopilot running in this
+/// process can be looked into.
+#[derive(Clone, Copy, Debug)]
+pub struct AutopilotView {
+    /// The estimator's state.
+    pub estimate: EstimatedState,
+    /// The estimated position north and east of the simulator's home, m.
+    pub est_ne: (f64, f64),
+    /// What the autopilot holds.
+    pub setpoints: Setpoints,
+    /// The mode flown.
+    pub mode: FlightMode,
+    /// The navigator.
+    pub nav: NavView,
+}
+
 impl Sample {
-    /// Builds a sample from the truth and what the autopilot holds.
+    /// Builds a sample from the truth, the autopilot's answer and, when it can be looked
+    /// into, what the autopilot holds (without it those columns are NaN, the mode 0).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         t: f64,
@@ -152,24 +169,14 @@ impl Sample {
         alt_amsl: f64,
         wind: &Vector3<f64>,
         wind_steady: &Vector3<f64>,
-        e: &EstimatedState,
-        est_ne: (f64, f64),
-        sp: &Setpoints,
-        mode: FlightMode,
+        view: Option<&AutopilotView>,
         armed: bool,
         s: &Surfaces,
-        nav: &NavView,
     ) -> Self {
         let (eu, course, _) = truth_angles(truth);
-        // The true position's error from the path: the estimate's, plus the estimate's own
-        // error across the path.
-        let (dn, de) = (truth.pos_ned.x - est_ne.0, truth.pos_ned.y - est_ne.1);
-        let xtrack = nav.xtrack + dn * nav.across.0 + de * nav.across.1;
-        Self {
+        let mut sample = Self {
             t,
             armed,
-            mode: mode.px4().0,
-            converged: e.converged,
             north: truth.pos_ned.x,
             east: truth.pos_ned.y,
             alt: alt_amsl,
@@ -180,32 +187,82 @@ impl Sample {
             airspeed: truth.airspeed_mps,
             wind: [wind.x, wind.y, wind.z],
             wind_steady: [wind_steady.x, wind_steady.y, wind_steady.z],
-            est_north: if e.position_valid { est_ne.0 } else { f64::NAN },
-            est_east: if e.position_valid { est_ne.1 } else { f64::NAN },
-            est_alt: f64::from(e.alt_amsl_m),
-            est_roll: f64::from(e.euler.phi),
-            est_pitch: f64::from(e.euler.theta),
-            est_yaw: f64::from(e.euler.psi),
-            est_course: f64::from(e.course),
-            est_airspeed: f64::from(e.airspeed),
-            est_wind: [
-                f64::from(e.wind_ned.x),
-                f64::from(e.wind_ned.y),
-                f64::from(e.wind_ned.z),
-            ],
-            sp_course: f64::from(sp.course),
-            sp_alt: f64::from(sp.alt_amsl_m),
-            sp_airspeed: f64::from(sp.airspeed),
             elevator: f64::from(s.elevator),
             aileron: f64::from(s.aileron),
             rudder: f64::from(s.rudder),
             throttle: f64::from(s.throttle),
-            xtrack,
-            est_xtrack: nav.xtrack,
-            nav_phase: nav.phase as u8,
-            mission_seq: nav.seq.map_or(-1, i32::from),
-            straight: nav.straight,
+            ..Self::unknown_autopilot()
+        };
+        if let Some(v) = view {
+            sample.hold(truth, v);
         }
+        sample
+    }
+
+    /// A sample whose autopilot columns say "not known".
+    fn unknown_autopilot() -> Self {
+        let nan = f64::NAN;
+        Self {
+            mode: 0,
+            converged: false,
+            est_north: nan,
+            est_east: nan,
+            est_alt: nan,
+            est_roll: nan,
+            est_pitch: nan,
+            est_yaw: nan,
+            est_course: nan,
+            est_airspeed: nan,
+            est_wind: [nan; 3],
+            sp_course: nan,
+            sp_alt: nan,
+            sp_airspeed: nan,
+            xtrack: nan,
+            est_xtrack: nan,
+            nav_phase: Phase::Idle as u8,
+            mission_seq: -1,
+            straight: false,
+            ..Self::default()
+        }
+    }
+
+    /// Fills the autopilot's columns.
+    fn hold(&mut self, truth: &Truth, v: &AutopilotView) {
+        let (e, sp, nav) = (&v.estimate, &v.setpoints, &v.nav);
+        // The true position's error from the path: the estimate's, plus the estimate's own
+        // error across the path.
+        let (dn, de) = (truth.pos_ned.x - v.est_ne.0, truth.pos_ned.y - v.est_ne.1);
+        self.xtrack = nav.xtrack + dn * nav.across.0 + de * nav.across.1;
+        self.mode = v.mode.px4().0;
+        self.converged = e.converged;
+        self.est_north = if e.position_valid {
+            v.est_ne.0
+        } else {
+            f64::NAN
+        };
+        self.est_east = if e.position_valid {
+            v.est_ne.1
+        } else {
+            f64::NAN
+        };
+        self.est_alt = f64::from(e.alt_amsl_m);
+        self.est_roll = f64::from(e.euler.phi);
+        self.est_pitch = f64::from(e.euler.theta);
+        self.est_yaw = f64::from(e.euler.psi);
+        self.est_course = f64::from(e.course);
+        self.est_airspeed = f64::from(e.airspeed);
+        self.est_wind = [
+            f64::from(e.wind_ned.x),
+            f64::from(e.wind_ned.y),
+            f64::from(e.wind_ned.z),
+        ];
+        self.sp_course = f64::from(sp.course);
+        self.sp_alt = f64::from(sp.alt_amsl_m);
+        self.sp_airspeed = f64::from(sp.airspeed);
+        self.est_xtrack = nav.xtrack;
+        self.nav_phase = nav.phase as u8;
+        self.mission_seq = nav.seq.map_or(-1, i32::from);
+        self.straight = nav.straight;
     }
 }
 

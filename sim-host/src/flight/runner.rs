@@ -2,9 +2,11 @@
 
 use super::config::FlightConfig;
 use super::onboard::Onboard;
-use super::record::{NavView, Sample};
+use super::record::{AutopilotView, NavView, Sample};
 use super::script::GroundStation;
-use super::summary::{mission_summary, summarise, FlightSummary};
+use super::summary::{
+    mission_summary, summarise, touchdown_summary, Ending, FlightFacts, FlightSummary,
+};
 use crate::aircraft::Aircraft;
 use crate::analysis::trim::{trim_with, TrimTarget};
 use crate::environment::wind::Wind;
@@ -28,12 +30,36 @@ use std::time::{Duration, Instant};
 /// Why a flight stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum FlightError {
-    /// The autopilot stopped answering (or never started).
+    /// The autopilot never started answering.
     #[error(transparent)]
     Link(#[from] LinkError),
+    /// The autopilot stopped answering, or its link failed, during the flight: the flight
+    /// as flown up to then comes with the error, so that its log can be kept.
+    #[error("{cause} (the flight ended at t = {:.2} s after {} frames)", partial.summary.sim_s, partial.summary.frames)]
+    Interrupted {
+        /// What happened.
+        cause: LinkError,
+        /// The flight up to the failure.
+        partial: Box<FlightOutcome>,
+    },
     /// The configuration cannot be flown.
     #[error("flight configuration: {0}")]
     Config(String),
+}
+
+impl FlightError {
+    /// The flight flown before the failure, if any.
+    pub fn partial(&self) -> Option<&FlightOutcome> {
+        match self {
+            FlightError::Interrupted { partial, .. } => Some(partial),
+            _ => None,
+        }
+    }
+}
+
+/// Whether a link error is the autopilot closing its end.
+fn closed(e: &LinkError) -> bool {
+    matches!(e, LinkError::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof)
 }
 
 /// A flown flight: the log and its summary.
@@ -47,7 +73,8 @@ pub struct FlightOutcome {
 
 fn validate(cfg: &FlightConfig, frame_s: f64) -> Result<(), FlightError> {
     let bad = |m: String| Err(FlightError::Config(m));
-    if !(cfg.duration_s.is_finite() && cfg.duration_s > 0.0) {
+    // Infinite: until the link closes or Ctrl-C (`sim-host sim`).
+    if cfg.duration_s.is_nan() || cfg.duration_s <= 0.0 {
         return bad(format!("duration {} s: must be positive", cfg.duration_s));
     }
     if !(cfg.speed.is_finite() && cfg.speed > 0.0) {
@@ -145,26 +172,25 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             ),
         );
     }
-    let mut gcs = GroundStation::new(script, home_alt);
+    let mut gcs = cfg
+        .scripted_station
+        .then(|| GroundStation::new(script, home_alt));
     link.wait_for_autopilot(cfg.link_timeout)?;
 
+    // An endless flight (`sim-host sim` without --duration) saturates to u64::MAX frames.
     let frames = (cfg.duration_s / frame_s).round() as u64;
-    let bar = if cfg.progress {
-        let b = indicatif::ProgressBar::new(frames);
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{spinner} simulated {msg} [{bar:30}] {percent}% {elapsed_precise}",
-        ) {
-            b.set_style(style.progress_chars("=> "));
-        }
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress_bar(cfg.progress, cfg.duration_s.is_finite().then_some(frames));
     let start = Instant::now();
-    let mut samples = Vec::with_capacity(frames as usize + 1);
+    let mut samples = Vec::with_capacity(frames.min(1 << 20) as usize + 1);
     let mut armed_frames = 0u64;
     let mut energy_j = 0.0;
+    let mut ended = Ending::Duration;
+    let mut failure = None;
     for k in 0..frames {
+        if cfg.stopped() {
+            ended = Ending::Stopped;
+            break;
+        }
         let time_us = sensors.next_time_us();
         let t_s = time_us as f64 * 1e-6;
         let truth = Truth {
@@ -189,9 +215,11 @@ pub fn fly<T: Transport, O: Onboard<T>>(
                 )));
             }
         }
-        msgs.push(MavMessage::HIL_STATE_QUATERNION(truth_frame(
-            time_us, &truth, &plant, alt_amsl,
-        )));
+        if cfg.truth_frames {
+            msgs.push(MavMessage::HIL_STATE_QUATERNION(truth_frame(
+                time_us, &truth, &plant, alt_amsl,
+            )));
+        }
         msgs.push(MavMessage::HIL_SENSOR(encode_hil_sensor(
             &frame,
             alt_amsl as f32,
@@ -205,8 +233,21 @@ pub fn fly<T: Transport, O: Onboard<T>>(
                 let _ = b.service(app);
             });
         }
-        gcs.poll(t_s, link, onboard);
-        let answer = link.exchange(time_us, &msgs)?;
+        if let Some(g) = gcs.as_mut() {
+            g.poll(t_s, link, onboard);
+        }
+        let answer = match link.exchange(time_us, &msgs) {
+            Ok(a) => a,
+            Err(e) if cfg.until_link_closes && closed(&e) => {
+                ended = Ending::LinkClosed;
+                break;
+            }
+            Err(e) => {
+                ended = Ending::LinkFailed;
+                failure = Some(e);
+                break;
+            }
+        };
         let landed = cfg.stop_when_landed
             && armed_frames > 0
             && !answer.armed
@@ -221,9 +262,18 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             trim_controls
         };
         let view = onboard.with_app(link, |app| {
-            let e = app.estimate();
-            let nav = NavView::of(app.navigation(), app.mode().needs_navigator(), &e.pos_ned);
-            (app.estimate(), app.setpoints(), app.mode(), nav)
+            let estimate = app.estimate();
+            AutopilotView {
+                est_ne: ned_offset::<f64>(home, estimate.position),
+                nav: NavView::of(
+                    app.navigation(),
+                    app.mode().needs_navigator(),
+                    &estimate.pos_ned,
+                ),
+                estimate,
+                setpoints: app.setpoints(),
+                mode: app.mode(),
+            }
         });
         samples.push(Sample::new(
             t_s,
@@ -231,22 +281,21 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             alt_amsl,
             &env.wind_ned,
             &Vector3::from(cfg.wind_ned),
-            &view.0,
-            ned_offset::<f64>(home, view.0.position),
-            &view.1,
-            view.2,
+            view.as_ref(),
             answer.armed,
             &answer.surfaces,
-            &view.3,
         ));
         if landed {
             // The frame that disarmed is logged; the stations read what came with it.
-            gcs.poll(t_s, link, onboard);
+            if let Some(g) = gcs.as_mut() {
+                g.poll(t_s, link, onboard);
+            }
             if let Some(b) = bridge.as_mut() {
                 onboard.with_app(link, |app| {
                     let _ = b.service(app);
                 });
             }
+            ended = Ending::Landed;
             break;
         }
 
@@ -270,36 +319,44 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     }
     bar.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
+    if let (Some(g), Some(t)) = (gcs.as_mut(), samples.last().map(|s| s.t)) {
+        g.finish(t, link, onboard);
+    }
     let health = onboard.with_app(link, |app| (app.sim_health(), app.sim_link_stats()));
     let mut summary = summarise(
         cfg,
         &samples,
-        &gcs,
-        samples.len() as u64,
-        frame_s,
-        armed_frames,
-        wall_s,
-        link.stats(),
-        health,
-        home_alt,
+        &FlightFacts {
+            gcs: gcs.as_ref(),
+            frames: samples.len() as u64,
+            frame_s,
+            armed_frames,
+            wall_s,
+            sim_rx: link.stats(),
+            health,
+            home_alt,
+            ended,
+        },
     );
-    if !cfg.script.mission.is_empty() {
-        let land_point = cfg
-            .script
-            .mission
-            .iter()
-            .rev()
-            .find(|i| i.command == mavlink::dialects::common::MavCmd::MAV_CMD_NAV_LAND)
-            .map(|i| {
-                ned_offset::<f64>(
-                    home,
-                    common::math::geodetic::GeoPoint {
-                        lat_e7: i.x,
-                        lon_e7: i.y,
-                    },
-                )
-            });
-        let reached: Vec<u16> = gcs.reached.iter().map(|r| r.1).collect();
+    let land_point = cfg
+        .script
+        .mission
+        .iter()
+        .rev()
+        .find(|i| i.command == mavlink::dialects::common::MavCmd::MAV_CMD_NAV_LAND)
+        .map(|i| {
+            ned_offset::<f64>(
+                home,
+                common::math::geodetic::GeoPoint {
+                    lat_e7: i.x,
+                    lon_e7: i.y,
+                },
+            )
+        })
+        .filter(|_| gcs.is_some());
+    summary.touchdown = plant.touchdown().map(|t| touchdown_summary(t, land_point));
+    if let Some(g) = gcs.as_ref().filter(|_| !cfg.script.mission.is_empty()) {
+        let reached: Vec<u16> = g.reached.iter().map(|r| r.1).collect();
         summary.mission = Some(mission_summary(
             &cfg.script.mission,
             land_point,
@@ -310,7 +367,35 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             frame_s,
         ));
     }
-    Ok(FlightOutcome { samples, summary })
+    let outcome = FlightOutcome { samples, summary };
+    match failure {
+        Some(cause) => Err(FlightError::Interrupted {
+            cause,
+            partial: Box::new(outcome),
+        }),
+        None => Ok(outcome),
+    }
+}
+
+/// The progress bar: a bar towards `frames`, or a spinner for an endless flight.
+fn progress_bar(show: bool, frames: Option<u64>) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let (b, template) = match frames {
+        Some(n) => (
+            indicatif::ProgressBar::new(n),
+            "{spinner} simulated {msg} [{bar:30}] {percent}% {elapsed_precise}",
+        ),
+        None => (
+            indicatif::ProgressBar::new_spinner(),
+            "{spinner} simulated {msg} {elapsed_precise}",
+        ),
+    };
+    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+        b.set_style(style.progress_chars("=> "));
+    }
+    b
 }
 
 /// HIL_STATE_QUATERNION from the truth: logged and, with `SIM_USE_TRUTH`, flown on.

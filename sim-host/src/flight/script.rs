@@ -2,8 +2,13 @@
 //! parameters, the mission and geofence uploaded with the mission protocol, arming (retried
 //! each second until the autopilot accepts), then timed commands, each a COMMAND_LONG answered
 //! by a COMMAND_ACK.
+//!
+//! Each request waits for its answer (PARAM_VALUE, the next MISSION_REQUEST_INT or the
+//! MISSION_ACK, COMMAND_ACK) before the next sensor frame goes out. The autopilot handles a
+//! ground frame as it arrives, so the request has taken effect at the same frame whether the
+//! autopilot runs in this process or beyond a UDP socket and a UART.
 
-use super::onboard::Onboard;
+use super::onboard::{Await, Onboard};
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::Transport;
 use common::gcs::client::{command_long, gcs_heartbeat};
@@ -13,6 +18,10 @@ use mavlink::dialects::common::{
     MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
 };
 use serde::Serialize;
+
+/// How long the station listens after the last frame of a flight: the frames of that frame
+/// (the last MISSION_ITEM_REACHED, the disarming) cross a UART, the bridge and a socket.
+const LAST_WORDS: std::time::Duration = std::time::Duration::from_millis(300);
 
 /// System id of the ground station (QGroundControl's).
 pub const GCS_SYSTEM_ID: u8 = 255;
@@ -197,12 +206,13 @@ impl GroundStation {
                     param_id: name.as_str().into(),
                     param_type: MavParamType::MAV_PARAM_TYPE_REAL32,
                 });
-                self.exchange(t_s, link, onboard, &msg);
+                let mut done = |m: &MavMessage| matches!(m, MavMessage::PARAM_VALUE(v) if v.param_id.to_str().is_ok_and(|id| id == name));
+                self.exchange(t_s, link, onboard, &msg, Await::Answer(&mut done));
             }
         }
         if !self.silent && t_s >= self.next_heartbeat_s {
             self.next_heartbeat_s = t_s + 1.0;
-            self.exchange(t_s, link, onboard, &gcs_heartbeat());
+            self.exchange(t_s, link, onboard, &gcs_heartbeat(), Await::Nothing);
         }
         if !self.uploaded {
             self.uploaded = true;
@@ -252,7 +262,18 @@ impl GroundStation {
             None => {}
         }
         // Telemetry keeps flowing; read it so nothing is dropped and texts are kept.
-        self.send_bytes(t_s, link, onboard, &[]);
+        self.send_bytes(t_s, link, onboard, &[], Await::Nothing);
+    }
+
+    /// Reads what the autopilot said about the last frame of a flight (over a real link it
+    /// is still on its way).
+    pub fn finish<T: Transport, O: Onboard<T>>(
+        &mut self,
+        t_s: f64,
+        link: &mut Lockstep<T>,
+        onboard: &mut O,
+    ) {
+        self.send_bytes(t_s, link, onboard, &[], Await::Linger(LAST_WORDS));
     }
 
     /// The COMMAND_LONG of a command action (`None` for the station's own link actions).
@@ -319,7 +340,12 @@ impl GroundStation {
             mission_type: kind,
             opaque_id: 0,
         });
-        let mut answer = self.exchange(t_s, link, onboard, &count);
+        let mut done = |m: &MavMessage| match m {
+            MavMessage::MISSION_ACK(a) => a.mission_type == kind,
+            MavMessage::MISSION_REQUEST_INT(r) => r.mission_type == kind,
+            _ => false,
+        };
+        let mut answer = self.exchange(t_s, link, onboard, &count, Await::Answer(&mut done));
         // Each round trip is answered at once in-process; the bound only stops a runaway.
         for _ in 0..4 * items.len() + 4 {
             let mut next = None;
@@ -339,7 +365,13 @@ impl GroundStation {
             item.mission_type = kind;
             item.target_system = 1;
             item.target_component = 1;
-            answer = self.exchange(t_s, link, onboard, &MavMessage::MISSION_ITEM_INT(item));
+            answer = self.exchange(
+                t_s,
+                link,
+                onboard,
+                &MavMessage::MISSION_ITEM_INT(item),
+                Await::Answer(&mut done),
+            );
         }
         MavMissionResult::MAV_MISSION_ERROR
     }
@@ -350,9 +382,10 @@ impl GroundStation {
         link: &mut Lockstep<T>,
         onboard: &mut O,
         msg: &MavMessage,
+        wait: Await,
     ) -> Vec<MavMessage> {
         let raw = self.sender.encode(msg);
-        self.send_bytes(t_s, link, onboard, raw.raw_bytes())
+        self.send_bytes(t_s, link, onboard, raw.raw_bytes(), wait)
     }
 
     fn command<T: Transport, O: Onboard<T>>(
@@ -367,7 +400,9 @@ impl GroundStation {
             MavMessage::COMMAND_LONG(c) => Some(c.command),
             _ => None,
         };
-        let answer = self.exchange(t_s, link, onboard, msg);
+        let mut done =
+            |m: &MavMessage| matches!(m, MavMessage::COMMAND_ACK(a) if Some(a.command) == cmd);
+        let answer = self.exchange(t_s, link, onboard, msg, Await::Answer(&mut done));
         let result = answer.iter().find_map(|m| match m {
             MavMessage::COMMAND_ACK(a) if Some(a.command) == cmd => Some(a.result),
             _ => None,
@@ -388,14 +423,9 @@ impl GroundStation {
         link: &mut Lockstep<T>,
         onboard: &mut O,
         bytes: &[u8],
+        wait: Await,
     ) -> Vec<MavMessage> {
-        let mut answer = Vec::new();
-        onboard.with_app(link, |app| {
-            if !bytes.is_empty() {
-                app.on_gcs_bytes(bytes);
-            }
-            app.drain_gcs(&mut |b| answer.extend_from_slice(b));
-        });
+        let answer = onboard.talk(link, bytes, wait);
         let mut messages = Vec::new();
         let (texts, reached) = (&mut self.texts, &mut self.reached);
         self.parser.push(&answer, |f| {

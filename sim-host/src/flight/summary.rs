@@ -72,9 +72,40 @@ pub struct Segment {
     pub alt_hold_error_max_m: f64,
 }
 
+/// Why a flight ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ending {
+    /// Its duration was flown.
+    Duration,
+    /// The autopilot landed and disarmed (`stop_when_landed`).
+    Landed,
+    /// The autopilot closed the simulator link (`until_link_closes`).
+    LinkClosed,
+    /// The user stopped it (Ctrl-C).
+    Stopped,
+    /// The simulator link failed; the flight is returned inside the error.
+    LinkFailed,
+}
+
+impl Ending {
+    /// In words, for the printed summary.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Ending::Duration => "its duration was flown",
+            Ending::Landed => "landed and disarmed",
+            Ending::LinkClosed => "the autopilot closed the simulator link",
+            Ending::Stopped => "stopped (Ctrl-C)",
+            Ending::LinkFailed => "the simulator link failed",
+        }
+    }
+}
+
 /// Figures of a flight.
 #[derive(Clone, Debug, Serialize)]
 pub struct FlightSummary {
+    /// Why the flight ended.
+    pub ended: Ending,
     /// Sensor frames exchanged.
     pub frames: u64,
     /// Frames the autopilot flew (armed).
@@ -91,7 +122,7 @@ pub struct FlightSummary {
     pub turbulence: &'static str,
     /// Steady wind, NED, m/s.
     pub wind_ned: [f64; 3],
-    /// Arming accepted at, s.
+    /// Arming accepted at, s (without a scripted station: the first armed answer).
     pub armed_at_s: Option<f64>,
     /// Estimator errors from the first `converged` to the end.
     pub estimator: Option<EstimatorErrors>,
@@ -106,8 +137,12 @@ pub struct FlightSummary {
     pub texts: Vec<(f64, String)>,
     /// Framing counters of the autopilot's answers (simulator side).
     pub sim_rx: LinkStatsJson,
-    /// The autopilot's counters of what it received.
-    pub autopilot_rx: AutopilotRx,
+    /// The autopilot's counters of what it received (`None`: an autopilot outside this
+    /// process keeps them to itself).
+    pub autopilot_rx: Option<AutopilotRx>,
+    /// The first contact of the last landing, wherever it was (a mission's figures measure
+    /// it from its landing point).
+    pub touchdown: Option<TouchdownSummary>,
     /// Mission and geofence uploads: what, when, the MISSION_ACK result.
     pub uploads: Vec<(String, f64, String)>,
     /// How the mission went, when one was uploaded.
@@ -237,43 +272,47 @@ pub fn mission_summary(
     let (alt, va): (Vec<f64>, Vec<f64>) = cruising
         .map(|s| (s.sp_alt - datum.truth_alt(s), s.sp_airspeed - s.airspeed))
         .unzip();
-    let touchdown = touchdown.map(|t| {
-        let (n, e) = (t.pos_ned.x, t.pos_ned.y);
-        let (distance_m, along_m) = match land_point {
-            Some((ln, le)) => {
-                let v = t.vel_ned;
-                let h = v.x.hypot(v.y).max(1e-9);
-                (
-                    (n - ln).hypot(e - le),
-                    ((n - ln) * v.x + (e - le) * v.y) / h,
-                )
-            }
-            None => (f64::NAN, f64::NAN),
-        };
-        TouchdownSummary {
-            time_s: t.time_s,
-            north_m: n,
-            east_m: e,
-            distance_m,
-            along_m,
-            sink_rate_mps: t.sink_rate_mps(),
-            ground_speed_mps: t.vel_ned.x.hypot(t.vel_ned.y),
-            bounces: t.bounces,
-        }
-    });
+    let touchdown = touchdown.map(|t| touchdown_summary(t, land_point));
     MissionSummary {
         items: mission.len(),
         all_reached: nav_items.iter().all(|i| reached.contains(i)),
         nav_items,
         reached: reached.to_vec(),
         xtrack_rms_m: rms(&leg),
-        xtrack_max_m: leg.iter().fold(0.0, |m, x| m.max(x.abs())),
+        // No straight leg known (an autopilot not looked into): no figure rather than 0.
+        xtrack_max_m: leg.iter().fold(f64::NAN, |m, x| m.max(x.abs())),
         orbit_xtrack_rms_m: rms(&orbit),
         alt_rms_m: rms(&alt),
         airspeed_rms_mps: rms(&va),
         flight_time_s: samples.iter().filter(|s| s.armed).count() as f64 * frame_s,
         energy_wh: energy_j / 3600.0,
         touchdown,
+    }
+}
+
+/// The figures of a touchdown; distances from `land_point` (north, east of home), NaN without.
+pub fn touchdown_summary(t: &Touchdown, land_point: Option<(f64, f64)>) -> TouchdownSummary {
+    let (n, e) = (t.pos_ned.x, t.pos_ned.y);
+    let (distance_m, along_m) = match land_point {
+        Some((ln, le)) => {
+            let v = t.vel_ned;
+            let h = v.x.hypot(v.y).max(1e-9);
+            (
+                (n - ln).hypot(e - le),
+                ((n - ln) * v.x + (e - le) * v.y) / h,
+            )
+        }
+        None => (f64::NAN, f64::NAN),
+    };
+    TouchdownSummary {
+        time_s: t.time_s,
+        north_m: n,
+        east_m: e,
+        distance_m,
+        along_m,
+        sink_rate_mps: t.sink_rate_mps(),
+        ground_speed_mps: t.vel_ned.x.hypot(t.vel_ned.y),
+        bounces: t.bounces,
     }
 }
 
@@ -483,40 +522,63 @@ fn segments(samples: &[Sample], gcs: &GroundStation, home_alt: f64) -> Vec<Segme
     out
 }
 
+/// What the flight loop hands [`summarise`] beside the log.
+pub(crate) struct FlightFacts<'a> {
+    /// The scripted station, when there was one.
+    pub gcs: Option<&'a GroundStation>,
+    /// Frames exchanged.
+    pub frames: u64,
+    /// Sensor frame period, s.
+    pub frame_s: f64,
+    /// Frames the autopilot flew.
+    pub armed_frames: u64,
+    /// Wall-clock time, s.
+    pub wall_s: f64,
+    /// Framing counters of the autopilot's answers.
+    pub sim_rx: LinkStats,
+    /// The autopilot's own counters, when it can be looked into.
+    pub health: Option<(SimLinkHealth, LinkStats)>,
+    /// Field elevation, m AMSL.
+    pub home_alt: f64,
+    /// Why the flight ended.
+    pub ended: Ending,
+}
+
 /// Builds the summary of a flight.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn summarise(
-    cfg: &FlightConfig,
-    samples: &[Sample],
-    gcs: &GroundStation,
-    frames: u64,
-    frame_s: f64,
-    armed_frames: u64,
-    wall_s: f64,
-    sim_rx: LinkStats,
-    (health, ap_stats): (SimLinkHealth, LinkStats),
-    home_alt: f64,
-) -> FlightSummary {
-    let sim_s = frames as f64 * frame_s;
+pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts) -> FlightSummary {
+    let sim_s = f.frames as f64 * f.frame_s;
     FlightSummary {
-        uploads: gcs.uploads.clone(),
+        ended: f.ended,
+        uploads: f.gcs.map(|g| g.uploads.clone()).unwrap_or_default(),
         mission: None,
-        frames,
-        armed_frames,
+        touchdown: None,
+        frames: f.frames,
+        armed_frames: f.armed_frames,
         sim_s,
-        wall_s,
-        real_time_factor: if wall_s > 0.0 { sim_s / wall_s } else { 0.0 },
+        wall_s: f.wall_s,
+        real_time_factor: if f.wall_s > 0.0 {
+            sim_s / f.wall_s
+        } else {
+            0.0
+        },
         seed: cfg.seed,
         turbulence: turbulence_name(cfg.turbulence),
         wind_ned: cfg.wind_ned,
-        armed_at_s: gcs.armed_at_s(),
+        // When the station's arming was accepted; without a station, the first armed answer.
+        armed_at_s: match f.gcs {
+            Some(g) => g.armed_at_s(),
+            None => samples.iter().find(|s| s.armed).map(|s| s.t),
+        },
         estimator: estimator_errors(samples, 0.0),
         estimator_settled: estimator_errors(samples, SETTLE_S),
-        segments: segments(samples, gcs, home_alt),
-        commands: gcs.commands.clone(),
-        texts: gcs.texts.clone(),
-        sim_rx: sim_rx.into(),
-        autopilot_rx: AutopilotRx {
+        segments: f
+            .gcs
+            .map(|g| segments(samples, g, f.home_alt))
+            .unwrap_or_default(),
+        commands: f.gcs.map(|g| g.commands.clone()).unwrap_or_default(),
+        texts: f.gcs.map(|g| g.texts.clone()).unwrap_or_default(),
+        sim_rx: f.sim_rx.into(),
+        autopilot_rx: f.health.map(|(health, ap_stats)| AutopilotRx {
             framing: ap_stats.into(),
             sensor_frames: health.sensor_frames,
             gps_frames: health.gps_frames,
@@ -530,6 +592,6 @@ pub(crate) fn summarise(
                 health.rejected_gps,
             ],
             stale_frames: health.stale_frames,
-        },
+        }),
     }
 }

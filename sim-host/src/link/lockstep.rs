@@ -18,7 +18,7 @@ pub const SIM_COMPONENT_ID: u8 = 51;
 #[derive(Debug, thiserror::Error)]
 pub enum LinkError {
     /// The autopilot did not answer a sensor frame in time.
-    #[error("the autopilot is silent: no HIL_ACTUATOR_CONTROLS for the frame at t = {time_s:.3} s within {waited:?} ({frames} frames answered before)")]
+    #[error("the autopilot is silent: no HIL_ACTUATOR_CONTROLS for the frame at t = {time_s:.3} s within {waited:?} ({frames} frames answered before){}", why.as_ref().map(|w| format!("; {w}")).unwrap_or_default())]
     Silent {
         /// Simulation time of the unanswered frame, s.
         time_s: f64,
@@ -26,6 +26,8 @@ pub enum LinkError {
         waited: Duration,
         /// Frames answered before this one.
         frames: u64,
+        /// What the transport knows of the autopilot's state (its process ended, ...).
+        why: Option<String>,
     },
     /// The transport failed.
     #[error("simulator link: {0}")]
@@ -40,6 +42,7 @@ pub struct Lockstep<T: Transport> {
     tlog: Option<TlogWriter>,
     timeout: Duration,
     answered: u64,
+    heard: bool,
     buf: Vec<u8>,
     rx: Vec<u8>,
 }
@@ -54,6 +57,7 @@ impl<T: Transport> Lockstep<T> {
             tlog: None,
             timeout,
             answered: 0,
+            heard: false,
             buf: Vec::with_capacity(512),
             rx: vec![0; 4096],
         }
@@ -96,10 +100,17 @@ impl<T: Transport> Lockstep<T> {
     /// Waits until the autopilot has spoken (its boot heartbeat): a UART drops what arrives
     /// before the autopilot has enabled it, and a UDP simulator learns its peer that way, so
     /// no sensor frame is sent before.
+    ///
+    /// Once the autopilot has spoken, this returns at once (a caller may wait in slices).
     pub fn wait_for_autopilot(&mut self, timeout: Duration) -> Result<(), LinkError> {
+        if self.heard {
+            return Ok(());
+        }
         self.await_frame(0, timeout, |f| {
             (f.header.system_id == u32::from(SIM_SYSTEM_ID)).then_some(())
-        })
+        })?;
+        self.heard = true;
+        Ok(())
     }
 
     /// Sends `messages` (stamped `time_us`) in one write and waits for the autopilot's
@@ -139,9 +150,12 @@ impl<T: Transport> Lockstep<T> {
     ) -> Result<R, LinkError> {
         let start = Instant::now();
         loop {
-            let n = self
-                .transport
-                .recv(&mut self.rx, Duration::from_millis(50))?;
+            let n = match self.transport.recv(&mut self.rx, Duration::from_millis(50)) {
+                Ok(n) => n,
+                // A signal cut the wait short: nothing arrived, the wait goes on.
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => 0,
+                Err(e) => return Err(e.into()),
+            };
             let mut found = None;
             let tlog = &mut self.tlog;
             let mut log_err = Ok(());
@@ -167,6 +181,7 @@ impl<T: Transport> Lockstep<T> {
                     time_s: time_us as f64 * 1e-6,
                     waited: timeout,
                     frames: self.answered,
+                    why: self.transport.diagnose(),
                 });
             }
         }

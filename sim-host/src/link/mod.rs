@@ -4,8 +4,11 @@
 //! loop); [`lockstep::Lockstep`] sends each sensor frame and waits for the autopilot's answer
 //! before the plant may advance, so a run is deterministic and as fast as the CPU allows;
 //! [`tlog`] records every frame both ways in the `.tlog` format pymavlink and QGroundControl
-//! read.
+//! read; [`qemu`] runs the MCU image on QEMU's emulated STM32F405 with its ground UART
+//! behind the [`bridge`] to UDP.
 
+pub mod bridge;
 pub mod lockstep;
+pub mod qemu;
 pub mod tlog;
 pub mod transport;

@@ -23,6 +23,11 @@ pub trait Transport {
     fn recv(&mut self, buf: &mut [u8], timeout: Duration) -> io::Result<usize>;
     /// A description for messages ("tcp 127.0.0.1:4560", ...).
     fn describe(&self) -> String;
+    /// What is known about an autopilot that has stopped answering (whether the process
+    /// behind the link still runs, and what it said), for the error that ends the flight.
+    fn diagnose(&mut self) -> Option<String> {
+        None
+    }
 }
 
 /// TCP: the simulator listens and accepts one autopilot.
@@ -41,8 +46,19 @@ impl TcpServer {
     ) -> io::Result<Self> {
         let listener = TcpListener::bind(addr)?;
         on_listening(listener.local_addr()?);
+        Self::accept(&listener, Some(wait), || Ok(()))
+    }
+
+    /// Accepts one autopilot on `listener`, waiting at most `wait` (`None`: until it comes);
+    /// `check` runs between attempts and ends the wait with its error (a process that was to
+    /// connect has died, the user pressed Ctrl-C).
+    pub fn accept(
+        listener: &TcpListener,
+        wait: Option<Duration>,
+        mut check: impl FnMut() -> io::Result<()>,
+    ) -> io::Result<Self> {
         listener.set_nonblocking(true)?;
-        let deadline = Instant::now() + wait;
+        let deadline = wait.map(|w| Instant::now() + w);
         loop {
             match listener.accept() {
                 Ok((stream, peer)) => {
@@ -50,18 +66,30 @@ impl TcpServer {
                     stream.set_nodelay(true)?;
                     return Ok(Self { stream, peer });
                 }
-                Err(e) if timed_out(&e) && Instant::now() < deadline => {
-                    std::thread::sleep(Duration::from_millis(5));
-                }
                 Err(e) if timed_out(&e) => {
-                    return Err(io::Error::new(
-                        io::ErrorKind::TimedOut,
-                        format!("no autopilot connected to {addr} within {wait:?}"),
-                    ))
+                    if deadline.is_some_and(|d| Instant::now() >= d) {
+                        return Err(io::Error::new(
+                            io::ErrorKind::TimedOut,
+                            format!(
+                                "no autopilot connected to {} within {:?}",
+                                listener.local_addr()?,
+                                wait.unwrap_or_default()
+                            ),
+                        ));
+                    }
+                    check()?;
+                    std::thread::sleep(Duration::from_millis(5));
                 }
                 Err(e) => return Err(e),
             }
         }
+    }
+}
+
+impl TcpServer {
+    /// The connection, for a caller that reads and writes it itself.
+    pub fn into_stream(self) -> TcpStream {
+        self.stream
     }
 }
 
