@@ -465,6 +465,13 @@ impl GcsUdp {
 
     /// Takes every waiting datagram into the autopilot, then sends its answers.
     pub fn service(&mut self, app: &mut App) -> io::Result<()> {
+        self.receive(app)?;
+        self.flush(app);
+        Ok(())
+    }
+
+    /// Hands every datagram waiting to the autopilot, each on its station's channel.
+    pub fn receive(&mut self, app: &mut App) -> io::Result<()> {
         let mut buf = [0u8; 2048];
         loop {
             match self.socket.recv_from(&mut buf) {
@@ -472,49 +479,53 @@ impl GcsUdp {
                     let channel = self.channel_of(from, Instant::now());
                     app.on_gcs_datagram(channel, buf.get(..n).unwrap_or(&[]));
                 }
-                Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => return Ok(()),
                 // A peer that went away makes the next recv report it (ICMP); keep going.
                 Err(e) if e.kind() == io::ErrorKind::ConnectionRefused => continue,
                 Err(e) => return Err(e),
             }
         }
-        self.flush(app);
-        Ok(())
     }
 
     /// Sends what the autopilot has for the ground stations, one frame per datagram: to
     /// everyone, or back to the station it answers.
     pub fn flush(&mut self, app: &mut App) {
+        app.drain_gcs_to(&mut |dest, frame| self.send(dest, frame));
+    }
+
+    /// Sends one frame the autopilot addressed to `dest`: to everyone (the remote and every
+    /// station heard lately), or to the stations of one channel (0: the remote).
+    pub fn send(&self, dest: Dest, frame: &[u8]) {
         let now = Instant::now();
-        let (socket, remote, peers) = (&self.socket, self.remote, &self.peers);
-        let live = move |c: usize| {
-            peers
+        let live = |c: usize| {
+            self.peers
                 .get(c)
                 .copied()
                 .flatten()
                 .filter(|(_, heard)| now.duration_since(*heard) <= PEER_TIMEOUT)
                 .map(|(a, _)| a)
         };
-        app.drain_gcs_to(&mut |dest, frame| match dest {
+        match dest {
             Dest::All => {
-                for to in remote
+                for to in self
+                    .remote
                     .into_iter()
                     .chain((0..MAX_GCS_PEERS).filter_map(live))
                 {
-                    let _ = socket.send_to(frame, to);
+                    let _ = self.socket.send_to(frame, to);
                 }
             }
             Dest::Channel(0) => {
-                if let Some(to) = remote {
-                    let _ = socket.send_to(frame, to);
+                if let Some(to) = self.remote {
+                    let _ = self.socket.send_to(frame, to);
                 }
             }
             Dest::Channel(c) => {
                 if let Some(to) = live(usize::from(c) - 1) {
-                    let _ = socket.send_to(frame, to);
+                    let _ = self.socket.send_to(frame, to);
                 }
             }
-        });
+        }
     }
 }
 

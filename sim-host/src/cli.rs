@@ -221,7 +221,8 @@ pub(crate) struct FlyArgs {
     /// Simulated time, s (default: long enough for the whole script).
     #[arg(long)]
     pub(crate) duration: Option<f64>,
-    /// Directory for flight.csv, flight.tlog, the PNG plots and summary.json.
+    /// Directory for flight.csv, flight.tlog (the ground link as the scripted station saw
+    /// it), simlink.tlog, the PNG plots and summary.json.
     #[arg(long, default_value = "out/fly")]
     pub(crate) out: PathBuf,
     /// Gain set loaded before arming (SYS_GAIN_SET): 0 designed, 1 designed_t310,
@@ -300,7 +301,8 @@ pub(crate) struct SimArgs {
     /// (QGroundControl listens on 14550); `none` for no fixed remote.
     #[arg(long, default_value = "127.0.0.1:14550")]
     pub(crate) gcs_remote: String,
-    /// Directory for flight.csv, flight.tlog, the PNG plots and summary.json.
+    /// Directory for flight.csv, simlink.tlog (the simulator link; the ground link is the
+    /// stations' own to record), the PNG plots and summary.json.
     #[arg(long, default_value = "out/sim")]
     pub(crate) out: PathBuf,
     /// Print the summary as JSON.

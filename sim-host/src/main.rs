@@ -465,7 +465,7 @@ fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
         &commands::fly::summary_tables(&r.outcome),
         Format::Text,
     ))?;
-    emit("\nfiles in out/fly (flight.csv, flight.tlog, PNG plots, summary.json)")?;
+    emit("\nfiles in out/fly (flight.csv, flight.tlog of the ground link, simlink.tlog, PNG plots, summary.json)")?;
     emit("(see `sim-host --help` for fly, trim, linearize, doublet, design and validation)")?;
     Ok(ExitCode::SUCCESS)
 }

@@ -80,11 +80,39 @@ fn the_same_flight_is_bit_identical_over_inproc_tcp_udp_and_pty() {
             ..FlyOptions::default()
         };
         let r = fly_report(&aircraft(), &cfg, &opts).expect("flight");
-        let tlog = std::fs::read(out.join("flight.tlog")).expect("tlog");
+        let tlog = std::fs::read(out.join("simlink.tlog")).expect("tlog");
         let csv = std::fs::read(out.join("flight.csv")).expect("csv");
-        (r.outcome, tlog, csv)
+        let ground = std::fs::read(out.join("flight.tlog")).expect("ground tlog");
+        (r.outcome, tlog, csv, ground)
     };
-    let (a, tlog_a, csv_a) = run(LinkKind::Inproc);
+    let (a, tlog_a, csv_a, ground_a) = run(LinkKind::Inproc);
+    // The flight's .tlog is the ground link as the station saw it, both ways: the vehicle's
+    // heartbeats and telemetry, the station's heartbeats, its arming command and the answer.
+    let ground = read_tlog(&ground_a);
+    let mut parser = FrameParser::new();
+    let (mut vehicle_hb, mut station_hb, mut arm, mut ack, mut attitude) = (0, 0, 0, 0, 0);
+    for (_, f) in &ground {
+        parser.push(f, |fr| match &fr.message {
+            MavMessage::HEARTBEAT(_) if fr.header.system_id == 1 => vehicle_hb += 1,
+            MavMessage::HEARTBEAT(_) if fr.header.system_id == 255 => station_hb += 1,
+            MavMessage::COMMAND_LONG(_) => arm += 1,
+            MavMessage::COMMAND_ACK(_) => ack += 1,
+            MavMessage::ATTITUDE(_) => attitude += 1,
+            _ => {}
+        });
+    }
+    assert_eq!(parser.stats().frames_ok as usize, ground.len());
+    assert_eq!(parser.stats().crc_errors, 0);
+    assert!(ground.windows(2).all(|w| w[0].0 <= w[1].0), "time order");
+    let secs = a.summary.sim_s;
+    eprintln!(
+        "ground tlog: {} frames, {vehicle_hb} vehicle and {station_hb} station heartbeats, {arm} commands, {ack} acks, {attitude} ATTITUDE over {secs:.0} s",
+        ground.len()
+    );
+    // Heartbeats at 1 Hz each way, ATTITUDE at its default rate (several a second).
+    assert!(vehicle_hb as f64 >= secs - 2.0 && station_hb as f64 >= secs - 2.0);
+    assert!(arm >= 1 && ack >= arm, "commands {arm}, acks {ack}");
+    assert!(attitude as f64 > 2.0 * secs, "ATTITUDE {attitude}");
     // The flight did something worth comparing: armed, turned, ten frames a second logged.
     accepted(&a);
     assert!(a.summary.armed_frames > 1000, "{}", a.summary.armed_frames);
@@ -107,7 +135,8 @@ fn the_same_flight_is_bit_identical_over_inproc_tcp_udp_and_pty() {
     assert_eq!(sensors, a.summary.frames);
     assert!(frames.windows(2).all(|w| w[0].0 <= w[1].0), "time order");
     for link in [LinkKind::Tcp, LinkKind::Udp, LinkKind::Pty] {
-        let (b, tlog_b, csv_b) = run(link);
+        let (b, tlog_b, csv_b, ground_b) = run(link);
+        assert!(ground_a == ground_b, "{}: ground tlog differs", link.name());
         assert_eq!(tlog_a.len(), tlog_b.len(), "{}: tlog length", link.name());
         assert!(tlog_a == tlog_b, "{}: tlog bytes differ", link.name());
         assert!(csv_a == csv_b, "{}: CSV differs", link.name());
@@ -666,11 +695,62 @@ fn leaving_the_truth_out_of_the_frames_changes_no_answer_of_an_autopilot_flying_
             ..FlyOptions::default()
         };
         fly_report(&aircraft(), &cfg, &opts).expect("flight");
-        let tlog = std::fs::read(dir.path().join(sub).join("flight.tlog")).expect("tlog");
+        let tlog = std::fs::read(dir.path().join(sub).join("simlink.tlog")).expect("tlog");
         sim_host::flight::compare::answers(&tlog)
     };
     let (with, without) = (fly_with(true, "with"), fly_with(false, "without"));
     let c = sim_host::flight::compare::compare_answers(&with, &without);
     assert_eq!(c.compared, 6000);
     assert!(c.identical(), "{c:?}");
+}
+
+/// A station on the port beside the script (QGroundControl watching `fly --realtime`) and the
+/// script share the autopilot's one outgoing queue: each must still see every message it is
+/// owed. Over the default mission both hear every MISSION_ITEM_REACHED (a broadcast).
+#[test]
+fn a_station_beside_the_script_and_the_script_both_hear_every_item_reached() {
+    use sim_host::flight::missions::{default_mission, runway_mission};
+    let station = std::net::UdpSocket::bind("127.0.0.1:0").expect("station socket");
+    station
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .expect("timeout");
+    let remote = station.local_addr().expect("address").to_string();
+    let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let listening = done.clone();
+    let heard = std::thread::spawn(move || {
+        let (mut parser, mut reached, mut buf) = (FrameParser::new(), Vec::new(), [0u8; 2048]);
+        while !listening.load(std::sync::atomic::Ordering::Relaxed) {
+            if let Ok(n) = station.recv(&mut buf) {
+                parser.push(&buf[..n], |f| {
+                    if let MavMessage::MISSION_ITEM_REACHED(r) = &f.message {
+                        reached.push(r.seq);
+                    }
+                });
+            }
+        }
+        reached
+    });
+    let cfg = FlightConfig {
+        ground_link: Some(("127.0.0.1:0".into(), remote)),
+        ..runway_mission(default_mission(
+            sim_host::plant::ModelParams::new(&aircraft()).home,
+        ))
+    };
+    let r = fly_report(&aircraft(), &cfg, &FlyOptions::default()).expect("flight");
+    // The last datagrams are on their way over loopback.
+    std::thread::sleep(Duration::from_millis(500));
+    done.store(true, std::sync::atomic::Ordering::Relaxed);
+    let beside = heard.join().expect("station thread");
+    let m = r.outcome.summary.mission.expect("mission flown");
+    assert!(
+        m.all_reached,
+        "the script heard {:?} of {:?}",
+        m.reached, m.nav_items
+    );
+    let mut beside_items = beside.clone();
+    beside_items.dedup();
+    assert_eq!(
+        beside_items, m.reached,
+        "the station beside heard {beside:?}"
+    );
 }

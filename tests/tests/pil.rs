@@ -312,7 +312,7 @@ fn qemu_signalled_after(dir: &Path, secs: u32, signal: &str) -> Option<QemuConfi
 fn kept_log(dir: &Path) -> (usize, serde_json::Value) {
     let csv = std::fs::read_to_string(dir.join("flight.csv")).expect("flight.csv kept");
     let json = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json kept");
-    assert!(dir.join("flight.tlog").is_file() && dir.join(MCU_LOG).is_file());
+    assert!(dir.join("simlink.tlog").is_file() && dir.join(MCU_LOG).is_file());
     (
         csv.lines().count() - 1,
         serde_json::from_str(&json).expect("JSON"),

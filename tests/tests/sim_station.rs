@@ -182,7 +182,7 @@ fn a_station_flies_the_default_mission_through_sim_host_sim_and_the_host_build()
     );
     assert!(distance < 20.0 && td.sink_rate_mps < 1.5, "{td:?}");
     assert!(!r.outcome.samples.last().expect("samples").armed);
-    for f in ["flight.tlog", "flight.csv", "summary.json"] {
+    for f in ["simlink.tlog", "flight.csv", "summary.json"] {
         assert!(out.path().join(f).is_file(), "{f} written");
     }
 }
@@ -246,7 +246,7 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     );
     assert!(last.armed && last.alt > 40.0, "{last:?}");
     assert_eq!(s.sim_rx.crc_errors, 0);
-    for f in ["flight.tlog", "flight.csv", "summary.json", "mcu.defmt"] {
+    for f in ["simlink.tlog", "flight.csv", "summary.json", "mcu.defmt"] {
         assert!(out.path().join(f).is_file(), "{f} written");
     }
 }

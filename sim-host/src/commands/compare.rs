@@ -2,7 +2,7 @@
 //! process, and the two autopilots' answers compared frame by frame, with the pace of both.
 
 use super::fly::{fly_report, with_params, FlyOptions, LinkKind};
-use super::flying::uart_truth_frames;
+use super::flying::{uart_truth_frames, SIM_TLOG};
 use crate::aircraft::Aircraft;
 use crate::flight::compare::{answers, compare_answers, AnswerComparison};
 use crate::flight::config::FlightConfig;
@@ -105,8 +105,8 @@ pub fn compare_with_host(
     let host = fly_report(aircraft, &host_cfg, &host_opts)?;
     let read =
         |p: &Path| std::fs::read(p).with_context(|| format!("cannot read `{}`", p.display()));
-    let a = answers(&read(&dir.join("flight.tlog"))?);
-    let b = answers(&read(&dir.join("host").join("flight.tlog"))?);
+    let a = answers(&read(&dir.join(SIM_TLOG))?);
+    let b = answers(&read(&dir.join("host").join(SIM_TLOG))?);
     Ok(HostComparison {
         host: host.outcome,
         answers: compare_answers(&a, &b),

@@ -1,7 +1,7 @@
 //! `sim-host fly`: the firmware flies the plant over the simulator link, commanded by a
 //! scripted ground station; writes the log, a `.tlog`, plots and a JSON summary.
 
-use super::flying::{finish_report, fly_qemu, run_on, MCU_LOG};
+use super::flying::{finish_report, fly_qemu, run_on, GROUND_TLOG, MCU_LOG, SIM_TLOG};
 use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
 use crate::flight::onboard::{spawn_firmware, InprocOnboard};
@@ -125,12 +125,15 @@ pub fn fly_report(
     cfg: &FlightConfig,
     opts: &FlyOptions,
 ) -> anyhow::Result<FlyReport> {
-    let cfg = with_params(cfg, opts);
+    let mut cfg = with_params(cfg, opts);
     if let Some(dir) = &opts.out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create `{}`", dir.display()))?;
     }
-    let tlog = opts.out.as_ref().map(|d| d.join("flight.tlog"));
+    if cfg.scripted_station {
+        cfg.ground_tlog = opts.out.as_ref().map(|d| d.join(GROUND_TLOG));
+    }
+    let tlog = opts.out.as_ref().map(|d| d.join(SIM_TLOG));
     let tlog = tlog.as_deref();
     let wait = Duration::from_secs(10);
     let silence = cfg.link_timeout.max(Duration::from_secs(2));
@@ -181,7 +184,8 @@ pub fn fly_report(
         }
         LinkKind::Qemu => fly_qemu(aircraft, &cfg, &opts.qemu, opts.out.as_deref(), tlog)?,
     };
-    let mut files: Vec<PathBuf> = tlog.iter().map(|t| t.to_path_buf()).collect();
+    let mut files: Vec<PathBuf> = cfg.ground_tlog.iter().cloned().collect();
+    files.extend(tlog.map(std::path::Path::to_path_buf));
     if opts.link == LinkKind::Qemu {
         files.extend(opts.out.as_ref().map(|d| d.join(MCU_LOG)));
     }

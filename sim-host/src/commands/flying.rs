@@ -97,6 +97,13 @@ pub(crate) fn uart_truth_frames(cfg: &FlightConfig) -> bool {
     cfg.truth_frames && cfg.flies_on_truth()
 }
 
+/// File of the ground link as the scripted station saw it, both ways (QGroundControl's
+/// replay and MAVExplorer open it as a flight).
+pub const GROUND_TLOG: &str = "flight.tlog";
+
+/// File of the simulator link, both ways (sensor frames and the autopilot's answers).
+pub const SIM_TLOG: &str = "simlink.tlog";
+
 /// File of the MCU image's defmt log (QEMU's semihosting output) in the output directory.
 pub const MCU_LOG: &str = "mcu.defmt";
 

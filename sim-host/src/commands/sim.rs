@@ -9,7 +9,7 @@
 //! the duration, or on Ctrl-C; in each case the log, `.tlog`, plots and summary are written.
 
 use super::fly::LinkKind;
-use super::flying::{finish_report, run_on_with, stop_requested, FlyReport, MCU_LOG};
+use super::flying::{finish_report, run_on_with, stop_requested, FlyReport, MCU_LOG, SIM_TLOG};
 use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
 use crate::flight::onboard::OutsideOnboard;
@@ -151,7 +151,9 @@ pub fn sim_report(
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create `{}`", dir.display()))?;
     }
-    let tlog = opts.out.as_ref().map(|d| d.join("flight.tlog"));
+    // The ground link runs between the autopilot and its stations, not through here: the
+    // station records it (QGroundControl writes its own .tlog).
+    let tlog = opts.out.as_ref().map(|d| d.join(SIM_TLOG));
     let tlog = tlog.as_deref();
     let mut onboard = OutsideOnboard::unattended();
     let waiting = |what: &str| format!("no autopilot connected to the {what} simulator link");

@@ -45,6 +45,9 @@ pub struct FlightConfig {
     /// The pilot's radio: stick positions from a time on, sent as RC_CHANNELS at 50 Hz on
     /// the simulator link (none: no radio).
     pub rc_sticks: Vec<RcSticks>,
+    /// Where the scripted station records the ground link, both ways, as a ground station
+    /// records it (the flight's `.tlog`); the simulator link has its own file.
+    pub ground_tlog: Option<std::path::PathBuf>,
     /// Fly the scripted ground station. Without it (`sim-host sim`) whoever flies the
     /// autopilot does so on its own ground link, and `script` is not used.
     pub scripted_station: bool,
@@ -150,6 +153,7 @@ impl Default for FlightConfig {
             script,
             link_timeout: Duration::from_secs(5),
             ground_link: None,
+            ground_tlog: None,
             runway_heading: None,
             faults: Vec::new(),
             rc_sticks: Vec::new(),

@@ -16,6 +16,7 @@
 
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::{Inproc, Transport};
+use common::gcs::Dest;
 use common::link::framing::FrameParser;
 use firmware::app::App;
 use firmware::sitl::{self, timed_out, SimEndpoint};
@@ -52,14 +53,30 @@ pub trait Onboard<T: Transport> {
     fn with_app<R>(&mut self, link: &mut Lockstep<T>, f: impl FnOnce(&mut App) -> R) -> Option<R>;
 
     /// The scripted station's turn on the autopilot's ground link: `bytes` (a frame, or
-    /// nothing) to the autopilot, and back everything it has sent the station since.
-    fn talk(&mut self, link: &mut Lockstep<T>, bytes: &[u8], _wait: Await) -> Vec<u8> {
+    /// nothing) to the autopilot, and back everything it has sent the station since. The
+    /// station takes the application's one outgoing queue: with `others`, every frame taken
+    /// is also handed on there with its destination, for the other stations of a port beside
+    /// the script (broadcasts are owed to them as well).
+    fn talk(
+        &mut self,
+        link: &mut Lockstep<T>,
+        bytes: &[u8],
+        _wait: Await,
+        mut others: Option<&mut Vec<(Dest, Vec<u8>)>>,
+    ) -> Vec<u8> {
         self.with_app(link, |app| {
             if !bytes.is_empty() {
                 app.on_gcs_bytes(bytes);
             }
             let mut out = Vec::new();
-            app.drain_gcs(&mut |b| out.extend_from_slice(b));
+            app.drain_gcs_to(&mut |dest, frame| {
+                if dest.reaches(0) {
+                    out.extend_from_slice(frame);
+                }
+                if let Some(o) = others.as_mut() {
+                    o.push((dest, frame.to_vec()));
+                }
+            });
             out
         })
         .unwrap_or_default()
@@ -108,7 +125,14 @@ impl<T: Transport> Onboard<T> for OutsideOnboard {
         None
     }
 
-    fn talk(&mut self, _link: &mut Lockstep<T>, bytes: &[u8], wait: Await) -> Vec<u8> {
+    /// Other stations reach this autopilot on its own ground link: nothing to hand on.
+    fn talk(
+        &mut self,
+        _link: &mut Lockstep<T>,
+        bytes: &[u8],
+        wait: Await,
+        _others: Option<&mut Vec<(Dest, Vec<u8>)>>,
+    ) -> Vec<u8> {
         match self.station.as_mut() {
             Some(s) => s.talk(bytes, wait),
             None => Vec::new(),

@@ -11,6 +11,7 @@ use crate::aircraft::Aircraft;
 use crate::analysis::trim::{trim_with, TrimTarget};
 use crate::environment::wind::Wind;
 use crate::link::lockstep::{LinkError, Lockstep};
+use crate::link::tlog::TlogWriter;
 use crate::link::transport::Transport;
 use crate::plant::inputs::{Controls, Environment};
 use crate::plant::params::ModelParams;
@@ -54,6 +55,34 @@ impl FlightError {
             FlightError::Interrupted { partial, .. } => Some(partial),
             _ => None,
         }
+    }
+}
+
+/// The ground stations' turn: frames from the port beside the script (QGroundControl
+/// watching) into the autopilot, then the script, which takes the autopilot's queue and
+/// hands every frame on to that port too, so that both see every message they are owed
+/// (with no script, the port takes the queue itself).
+fn serve_stations<T: Transport, O: Onboard<T>>(
+    t_s: f64,
+    gcs: Option<&mut GroundStation>,
+    bridge: Option<&mut firmware::sitl::GcsUdp>,
+    link: &mut Lockstep<T>,
+    onboard: &mut O,
+) {
+    match (gcs, bridge) {
+        (Some(g), Some(b)) => {
+            // A station that misbehaves must not stop the flight.
+            onboard.with_app(link, |app| b.receive(app).ok());
+            g.poll(t_s, link, onboard);
+            for (dest, frame) in g.take_beside() {
+                b.send(dest, &frame);
+            }
+        }
+        (Some(g), None) => g.poll(t_s, link, onboard),
+        (None, Some(b)) => {
+            onboard.with_app(link, |app| b.service(app).ok());
+        }
+        (None, None) => {}
     }
 }
 
@@ -172,9 +201,22 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             ),
         );
     }
-    let mut gcs = cfg
-        .scripted_station
-        .then(|| GroundStation::new(script, home_alt));
+    let mut gcs = match cfg.scripted_station {
+        true => {
+            let mut g = GroundStation::new(script, home_alt);
+            if let Some(p) = &cfg.ground_tlog {
+                let w = TlogWriter::create(p).map_err(|e| {
+                    FlightError::Config(format!("cannot create `{}`: {e}", p.display()))
+                })?;
+                g = g.with_tlog(w);
+            }
+            if bridge.is_some() {
+                g = g.with_stations_beside();
+            }
+            Some(g)
+        }
+        false => None,
+    };
     link.wait_for_autopilot(cfg.link_timeout)?;
 
     // An endless flight (`sim-host sim` without --duration) saturates to u64::MAX frames.
@@ -225,17 +267,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             alt_amsl as f32,
         )));
 
-        // The station's port first: it takes the telemetry of the last frame (the script
-        // reads only the answers to its own commands).
-        if let Some(b) = bridge.as_mut() {
-            onboard.with_app(link, |app| {
-                // A station that misbehaves must not stop the flight.
-                let _ = b.service(app);
-            });
-        }
-        if let Some(g) = gcs.as_mut() {
-            g.poll(t_s, link, onboard);
-        }
+        serve_stations(t_s, gcs.as_mut(), bridge.as_mut(), link, onboard);
         let answer = match link.exchange(time_us, &msgs) {
             Ok(a) => a,
             Err(e) if cfg.until_link_closes && closed(&e) => {
@@ -287,14 +319,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         ));
         if landed {
             // The frame that disarmed is logged; the stations read what came with it.
-            if let Some(g) = gcs.as_mut() {
-                g.poll(t_s, link, onboard);
-            }
-            if let Some(b) = bridge.as_mut() {
-                onboard.with_app(link, |app| {
-                    let _ = b.service(app);
-                });
-            }
+            serve_stations(t_s, gcs.as_mut(), bridge.as_mut(), link, onboard);
             ended = Ending::Landed;
             break;
         }
@@ -321,6 +346,10 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     let wall_s = start.elapsed().as_secs_f64();
     if let (Some(g), Some(t)) = (gcs.as_mut(), samples.last().map(|s| s.t)) {
         g.finish(t, link, onboard);
+    }
+    if let Some(Err(e)) = gcs.as_mut().map(GroundStation::finish_tlog) {
+        // The flight is flown and its other files are still to be written.
+        eprintln!("warning: the ground link's .tlog is incomplete: {e}");
     }
     let health = onboard.with_app(link, |app| (app.sim_health(), app.sim_link_stats()));
     let mut summary = summarise(

@@ -10,8 +10,10 @@
 
 use super::onboard::{Await, Onboard};
 use crate::link::lockstep::Lockstep;
+use crate::link::tlog::{split_frames, TlogWriter};
 use crate::link::transport::Transport;
 use common::gcs::client::{command_long, gcs_heartbeat};
+use common::gcs::Dest;
 use common::link::framing::{FrameParser, Sender};
 use mavlink::dialects::common::{
     MavCmd, MavMessage, MavMissionResult, MavMissionType, MavParamType, MavResult,
@@ -155,6 +157,11 @@ pub struct GroundStation {
     uploaded: bool,
     next_heartbeat_s: f64,
     silent: bool,
+    /// Frames the station took from the autopilot's queue for the stations beside it
+    /// (`Some` when there are any).
+    beside: Option<Vec<(Dest, Vec<u8>)>>,
+    /// The station's own view of the link, both ways, as a ground station records it.
+    tlog: Option<TlogWriter>,
 }
 
 impl GroundStation {
@@ -176,7 +183,36 @@ impl GroundStation {
             uploaded: false,
             next_heartbeat_s: 0.0,
             silent: false,
+            beside: None,
+            tlog: None,
         }
+    }
+
+    /// Records the station's link, both ways, into `tlog` (the flight's `.tlog`).
+    pub fn with_tlog(mut self, tlog: TlogWriter) -> Self {
+        self.tlog = Some(tlog);
+        self
+    }
+
+    /// Hands every frame it takes from the autopilot on to [`Self::take_beside`] as well,
+    /// for stations on a port beside the script.
+    pub fn with_stations_beside(mut self) -> Self {
+        self.beside = Some(Vec::new());
+        self
+    }
+
+    /// The frames taken for the stations beside the script since the last call, each with
+    /// where the autopilot addressed it.
+    pub fn take_beside(&mut self) -> Vec<(Dest, Vec<u8>)> {
+        self.beside.as_mut().map(std::mem::take).unwrap_or_default()
+    }
+
+    /// Flushes and hands back the `.tlog` writer, if any.
+    pub fn finish_tlog(&mut self) -> std::io::Result<Option<TlogWriter>> {
+        if let Some(t) = self.tlog.as_mut() {
+            t.flush()?;
+        }
+        Ok(self.tlog.take())
     }
 
     /// When the autopilot accepted arming, s.
@@ -425,7 +461,17 @@ impl GroundStation {
         bytes: &[u8],
         wait: Await,
     ) -> Vec<MavMessage> {
-        let answer = onboard.talk(link, bytes, wait);
+        let answer = onboard.talk(link, bytes, wait, self.beside.as_mut());
+        if let Some(t) = self.tlog.as_mut() {
+            let t_us = (t_s * 1e6).round() as u64;
+            // A log that cannot be written must not stop the flight; its end says so.
+            for frame in std::iter::once(bytes)
+                .filter(|b| !b.is_empty())
+                .chain(split_frames(&answer))
+            {
+                let _ = t.write(t_us, frame);
+            }
+        }
         let mut messages = Vec::new();
         let (texts, reached) = (&mut self.texts, &mut self.reached);
         self.parser.push(&answer, |f| {

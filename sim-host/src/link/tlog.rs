@@ -45,6 +45,31 @@ impl TlogWriter {
     }
 }
 
+/// Length of the MAVLink frame at the start of `bytes` from its header (`None`: no frame
+/// starts there, or its header is cut short).
+pub fn frame_len(bytes: &[u8]) -> Option<usize> {
+    let len = usize::from(*bytes.get(1)?);
+    match bytes.first()? {
+        0xFD => {
+            let signed = bytes.get(2)? & 1 != 0;
+            Some(12 + len + if signed { 13 } else { 0 })
+        }
+        0xFE => Some(8 + len),
+        _ => None,
+    }
+}
+
+/// The whole frames of a byte stream that holds whole frames back to back (what a ground
+/// link's queue hands out); a torn tail is left out.
+pub fn split_frames(mut bytes: &[u8]) -> impl Iterator<Item = &[u8]> {
+    std::iter::from_fn(move || {
+        let n = frame_len(bytes).filter(|&n| n <= bytes.len())?;
+        let (frame, rest) = bytes.split_at(n);
+        bytes = rest;
+        Some(frame)
+    })
+}
+
 /// Reads a `.tlog` back: (time since the simulation epoch in us, frame bytes) per record.
 ///
 /// Frames are delimited with the MAVLink length byte, as pymavlink does.
@@ -55,15 +80,8 @@ pub fn read_tlog(bytes: &[u8]) -> Vec<(u64, Vec<u8>)> {
         let mut t = [0u8; 8];
         t.copy_from_slice(&bytes[i..i + 8]);
         let time = u64::from_be_bytes(t).saturating_sub(SIM_EPOCH_US);
-        let stx = bytes[i + 8];
-        let len = usize::from(bytes[i + 9]);
-        let total = match stx {
-            0xFD => {
-                let signed = bytes[i + 10] & 1 != 0;
-                12 + len + if signed { 13 } else { 0 }
-            }
-            0xFE => 8 + len,
-            _ => break,
+        let Some(total) = frame_len(&bytes[i + 8..]) else {
+            break;
         };
         if i + 8 + total > bytes.len() {
             break;
