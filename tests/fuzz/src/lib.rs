@@ -1,0 +1,24 @@
+//! The fuzz targets' logic, one module per target (`fuzz_targets/` holds the thin entry
+//! points), and what they share: frames as a simulator and a ground station send them, and the
+//! invariants checked on what the autopilot sends back. `docs/RELIABILITY.md` lists the targets
+//! and what each asserts.
+
+// Deprecated MAVLink messages (MISSION_ITEM, MISSION_REQUEST, SET_MODE) are still sent by
+// ground stations: the targets send them on purpose.
+#![allow(deprecated)]
+
+pub mod frames;
+pub mod gcs;
+pub mod sim_link;
+pub mod watch;
+pub mod ground_link;
+pub mod mission_protocol;
+pub mod param_protocol;
+pub mod storage;
+pub mod mission_file;
+
+/// Whether to print each input's actions (`FUZZ_TRACE=1` while reproducing a crash).
+pub fn trace() -> bool {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| std::env::var_os("FUZZ_TRACE").is_some())
+}
