@@ -1,0 +1,107 @@
+//! The cases the fuzz targets in `tests/fuzz/` found, each kept as a plain test so it stays
+//! fixed without the fuzzer (`docs/RELIABILITY.md` tells each story).
+
+use common::gcs::{Dest, GroundLink, Outgoing, Stores};
+use common::navigation::plan::{MissionStore, PlanKind};
+use common::navigation::validate::PlanRules;
+use common::params::ParamStore;
+use common::vehicle::params::REGISTRY;
+use common::vehicle::Vehicle;
+use mavlink::dialects::common::*;
+use mavlink::MavHeader;
+
+/// A ground station talking to a bare ground link with its stores.
+struct Station {
+    link: GroundLink,
+    params: ParamStore,
+    plan: MissionStore,
+}
+
+impl Station {
+    fn new() -> Self {
+        Self {
+            link: GroundLink::default(),
+            params: ParamStore::new(REGISTRY),
+            plan: MissionStore::default(),
+        }
+    }
+
+    /// Sends `msg` from station 255/190 and returns the mission acknowledgements it gets.
+    fn send(&mut self, msg: MavMessage) -> Vec<MavMissionResult> {
+        let header = MavHeader {
+            system_id: 255,
+            component_id: 190,
+            sequence: 0,
+        };
+        let snapshot = Vehicle::new().snapshot();
+        let mut stores = Stores {
+            params: &mut self.params,
+            plan: &mut self.plan,
+            rules: PlanRules {
+                home: None,
+                limits: Default::default(),
+                nav: Default::default(),
+            },
+        };
+        self.link
+            .handle(&header, &msg, 0, &snapshot, &mut stores, 0);
+        let mut acks = Vec::new();
+        self.link.poll(0, &snapshot, &stores, |_: Dest, out| {
+            if let Outgoing::Message(MavMessage::MISSION_ACK(a)) = out {
+                acks.push(a.mavtype);
+            }
+        });
+        acks
+    }
+}
+
+fn count(n: u16) -> MavMessage {
+    MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+        count: n,
+        target_system: 1,
+        target_component: 1,
+        ..MISSION_COUNT_DATA::DEFAULT
+    })
+}
+
+fn waypoint() -> MavMessage {
+    MavMessage::MISSION_ITEM_INT(MISSION_ITEM_INT_DATA {
+        x: 473_977_420,
+        y: 85_455_940,
+        z: 50.0,
+        seq: 0,
+        command: MavCmd::MAV_CMD_NAV_WAYPOINT,
+        target_system: 1,
+        target_component: 1,
+        frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        autocontinue: 1,
+        ..MISSION_ITEM_INT_DATA::DEFAULT
+    })
+}
+
+#[test]
+fn a_repeated_last_item_is_not_accepted_once_its_mission_was_cleared() {
+    for clear in [
+        count(0),
+        MavMessage::MISSION_CLEAR_ALL(MISSION_CLEAR_ALL_DATA {
+            target_system: 1,
+            target_component: 1,
+            ..MISSION_CLEAR_ALL_DATA::DEFAULT
+        }),
+    ] {
+        let mut s = Station::new();
+        s.send(count(1));
+        let accepted = vec![MavMissionResult::MAV_MISSION_ACCEPTED];
+        assert_eq!(s.send(waypoint()), accepted);
+        // The ACK was lost: the repeated item gets the same answer.
+        assert_eq!(s.send(waypoint()), accepted);
+        assert_eq!(s.send(clear.clone()), accepted);
+        assert!(s.plan.items(PlanKind::Mission).is_empty());
+        // The item arrives once more: the station must not be told its mission is stored.
+        assert!(
+            !s.send(waypoint())
+                .contains(&MavMissionResult::MAV_MISSION_ACCEPTED),
+            "after {clear:?}"
+        );
+    }
+}
