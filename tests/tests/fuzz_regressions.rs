@@ -105,3 +105,30 @@ fn a_repeated_last_item_is_not_accepted_once_its_mission_was_cleared() {
         );
     }
 }
+
+#[test]
+fn a_number_too_large_for_a_float_in_a_mission_file_is_refused_not_made_infinite() {
+    use sim_host::mission_file::parse_mission_text;
+    use std::path::Path;
+    let item = |p1: &str| {
+        format!(
+            r#"{{"fileType":"Plan","version":1,"mission":{{"version":2,"items":[{{"type":"SimpleItem","command":31,"frame":0,"autoContinue":true,"params":[{p1},0,0,0,0,0,0]}}]}}}}"#
+        )
+    };
+    assert!(parse_mission_text(&item("1e38"), Path::new("a.plan")).is_ok());
+    let err = parse_mission_text(&item("1e230"), Path::new("a.plan")).unwrap_err();
+    assert!(
+        err.to_string().contains("too large for a 32-bit float"),
+        "{err}"
+    );
+    let circle = r#"{"fileType":"Plan","version":1,"mission":{"version":2,"items":[]},"geoFence":{"version":2,"circles":[{"inclusion":true,"circle":{"center":[47,8],"radius":1e39}}]}}"#;
+    assert!(parse_mission_text(circle, Path::new("a.plan")).is_err());
+    let rally = r#"{"fileType":"Plan","version":1,"mission":{"version":2,"items":[]},"rallyPoints":{"version":2,"points":[[47,8,1e39]]}}"#;
+    assert!(parse_mission_text(rally, Path::new("a.plan")).is_err());
+    let wpl = "QGC WPL 110\n0\t1\t0\t16\t0\t0\t0\t0\t47\t8\t400\t1\n1\t0\t3\t16\t1e39\t0\t0\t0\t47\t8\t50\t1\n";
+    let err = parse_mission_text(wpl, Path::new("a.waypoints")).unwrap_err();
+    assert!(
+        err.to_string().contains("too large for a 32-bit float"),
+        "{err}"
+    );
+}
