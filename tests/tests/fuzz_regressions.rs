@@ -132,3 +132,48 @@ fn a_number_too_large_for_a_float_in_a_mission_file_is_refused_not_made_infinite
         "{err}"
     );
 }
+
+#[test]
+fn a_power_cut_during_a_save_keeps_the_copy_that_loads_when_the_newest_one_does_not() {
+    use common::storage::{load_params, save, save_params, AbRegion, RamFlash, PARAMS_MAGIC};
+    const SECTOR: u32 = 16 * 1024;
+    const REGION: AbRegion = AbRegion {
+        magic: PARAMS_MAGIC,
+        slot_a: 0,
+        slot_b: SECTOR,
+        slot_len: SECTOR,
+    };
+    let mut scratch = vec![0u8; SECTOR as usize];
+    let value = |f: &mut RamFlash<{ 2 * SECTOR as usize }>| {
+        let mut store = ParamStore::new(REGISTRY);
+        let mut scratch = vec![0u8; SECTOR as usize];
+        load_params(f, &REGION, &mut store, &mut scratch)
+            .ok()
+            .flatten()
+            .and_then(|_| store.get("NAV_ACC_RAD"))
+    };
+    let mut base = RamFlash::<{ 2 * SECTOR as usize }>::new(SECTOR);
+    let mut old = ParamStore::new(REGISTRY);
+    old.set("NAV_ACC_RAD", 31.0).unwrap();
+    save_params(&mut base, &REGION, &mut old, &mut scratch).unwrap();
+    // A newer copy, intact but in a format this firmware does not read (an empty record).
+    save(&mut base, &REGION, &(), &mut scratch).unwrap();
+    assert_eq!(value(&mut base), Some(31.0), "the older copy loads");
+    let mut new = ParamStore::new(REGISTRY);
+    new.set("NAV_ACC_RAD", 42.0).unwrap();
+    let mut probe = base.clone();
+    let before = probe.ops();
+    save_params(&mut probe, &REGION, &mut new.clone(), &mut scratch).unwrap();
+    let total = probe.ops() - before;
+    for cut in 0..=total {
+        let mut f = base.clone();
+        f.cut_after(Some(cut));
+        let _ = save_params(&mut f, &REGION, &mut new.clone(), &mut scratch);
+        f.cut_after(None);
+        let got = value(&mut f);
+        assert!(
+            got == Some(31.0) || got == Some(42.0),
+            "cut at operation {cut} of {total}: {got:?}"
+        );
+    }
+}
