@@ -62,7 +62,8 @@ impl X25 {
         for &b in bytes {
             let mut t = b ^ (self.0 & 0xFF) as u8;
             t ^= t << 4;
-            self.0 = (self.0 >> 8) ^ (u16::from(t) << 8) ^ (u16::from(t) << 3) ^ (u16::from(t) >> 4);
+            self.0 =
+                (self.0 >> 8) ^ (u16::from(t) << 8) ^ (u16::from(t) << 3) ^ (u16::from(t) >> 4);
         }
     }
     fn get(&self) -> u16 {
@@ -145,11 +146,17 @@ impl Default for Simulator {
 impl Simulator {
     /// `HIL_SENSOR` of `f`.
     pub fn sensors(&mut self, f: &SensorFrame) -> Vec<u8> {
-        frame(&mut self.tx, &MavMessage::HIL_SENSOR(encode_hil_sensor(f, 0.0)))
+        frame(
+            &mut self.tx,
+            &MavMessage::HIL_SENSOR(encode_hil_sensor(f, 0.0)),
+        )
     }
 
     /// `HIL_GPS` of `fix` at `time_us`.
     pub fn gps(&mut self, time_us: u64, fix: &GpsFix) -> Vec<u8> {
-        frame(&mut self.tx, &MavMessage::HIL_GPS(encode_hil_gps(time_us, fix)))
+        frame(
+            &mut self.tx,
+            &MavMessage::HIL_GPS(encode_hil_gps(time_us, fix)),
+        )
     }
 }

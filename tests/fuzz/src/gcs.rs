@@ -5,6 +5,7 @@
 
 use arbitrary::Arbitrary;
 use common::gcs::FORCE_ARM_MAGIC;
+use common::navigation::plan::MissionItem;
 use common::params::ParamStore;
 use common::vehicle::modes::FlightMode;
 use mavlink::dialects::common::*;
@@ -169,9 +170,8 @@ const COMMANDS: [u16; 17] = [
 ];
 
 impl Item {
-    /// The item as sent, `None` when its command or frame number is not in the dialect (a
-    /// station cannot send it as a typed message; [`GcsMsg::Raw`] covers that).
-    pub fn data(self, seq: u16, kind: MavMissionType) -> Option<MISSION_ITEM_INT_DATA> {
+    /// The item as stored: command and frame numbers as they are, whatever they name.
+    pub fn raw(self) -> MissionItem {
         let (command, frame, x, y, z, p) = match self {
             Item::Near {
                 command,
@@ -182,7 +182,7 @@ impl Item {
                 p,
             } => (
                 COMMANDS[usize::from(command) % COMMANDS.len()],
-                FRAMES[usize::from(frame) % FRAMES.len()],
+                FRAMES[usize::from(frame) % FRAMES.len()] as u8,
                 HOME.lat_e7 + i32::from(north) * 90,
                 HOME.lon_e7 + i32::from(east) * 130,
                 f32::from(alt) / 10.0,
@@ -195,21 +195,36 @@ impl Item {
                 y,
                 z,
                 p,
-            } => (command, MavFrame::from_u8(frame)?, x, y, z.get(), p),
+            } => (command, frame, x, y, z.get(), p),
         };
-        Some(MISSION_ITEM_INT_DATA {
-            param1: p[0].get(),
-            param2: p[1].get(),
-            param3: p[2].get(),
-            param4: p[3].get(),
+        MissionItem {
+            params: p.map(|f| f.get().to_bits()),
             x,
             y,
-            z,
+            z: z.to_bits(),
+            command,
+            frame,
+            autocontinue: true,
+        }
+    }
+
+    /// The item as sent, `None` when its command or frame number is not in the dialect (a
+    /// station cannot send it as a typed message; [`GcsMsg::Raw`] covers that).
+    pub fn data(self, seq: u16, kind: MavMissionType) -> Option<MISSION_ITEM_INT_DATA> {
+        let it = self.raw();
+        Some(MISSION_ITEM_INT_DATA {
+            param1: it.param(0),
+            param2: it.param(1),
+            param3: it.param(2),
+            param4: it.param(3),
+            x: it.x,
+            y: it.y,
+            z: it.z_m(),
             seq,
-            command: MavCmd::from_u16(command)?,
+            command: MavCmd::from_u16(it.command)?,
             target_system: 1,
             target_component: 1,
-            frame,
+            frame: MavFrame::from_u8(it.frame)?,
             current: 0,
             autocontinue: 1,
             mission_type: kind,
@@ -473,12 +488,10 @@ impl GcsMsg {
                     param_id: name.id(store).into(),
                 }))
             }
-            GcsMsg::ParamList => Typed(MavMessage::PARAM_REQUEST_LIST(
-                PARAM_REQUEST_LIST_DATA {
-                    target_system: 1,
-                    target_component: 1,
-                },
-            )),
+            GcsMsg::ParamList => Typed(MavMessage::PARAM_REQUEST_LIST(PARAM_REQUEST_LIST_DATA {
+                target_system: 1,
+                target_component: 1,
+            })),
             GcsMsg::MissionCount { kind, count } => {
                 Typed(MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
                     count: *count % 200,
@@ -525,25 +538,28 @@ impl GcsMsg {
                     }))
                 }
             }
-            GcsMsg::MissionAck { kind, cancel } => Typed(MavMessage::MISSION_ACK(MISSION_ACK_DATA {
-                target_system: 1,
-                target_component: 1,
-                mavtype: if *cancel {
-                    MavMissionResult::MAV_MISSION_OPERATION_CANCELLED
-                } else {
-                    MavMissionResult::MAV_MISSION_ACCEPTED
-                },
-                mission_type: kind.get(),
-                opaque_id: 0,
-            })),
-            GcsMsg::MissionClear { kind } => Typed(MavMessage::MISSION_CLEAR_ALL(
-                MISSION_CLEAR_ALL_DATA {
+            GcsMsg::MissionAck { kind, cancel } => {
+                Typed(MavMessage::MISSION_ACK(MISSION_ACK_DATA {
+                    target_system: 1,
+                    target_component: 1,
+                    mavtype: if *cancel {
+                        MavMissionResult::MAV_MISSION_OPERATION_CANCELLED
+                    } else {
+                        MavMissionResult::MAV_MISSION_ACCEPTED
+                    },
+                    mission_type: kind.get(),
+                    opaque_id: 0,
+                }))
+            }
+            GcsMsg::MissionClear { kind } => {
+                Typed(MavMessage::MISSION_CLEAR_ALL(MISSION_CLEAR_ALL_DATA {
                     target_system: 1,
                     target_component: 1,
                     mission_type: kind.get(),
-                },
-            )),
-            GcsMsg::MissionSetCurrent { seq } => {
+                }))
+            }
+            GcsMsg::MissionSetCurrent { seq } =>
+            {
                 #[allow(deprecated)]
                 Typed(MavMessage::MISSION_SET_CURRENT(MISSION_SET_CURRENT_DATA {
                     seq: *seq,

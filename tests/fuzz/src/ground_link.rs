@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use arbitrary::{Arbitrary, Unstructured};
+use arbitrary::Arbitrary;
 use common::gcs::Dest;
 use common::link::framing::Sender;
 use firmware::app::App;
@@ -20,13 +20,19 @@ use mavlink::Message;
 
 use crate::frames::{calm_fix, calm_sensors, frame, raw_frame, Simulator, Wobble};
 use crate::gcs::{Built, GcsMsg};
-use crate::watch::{check_controls, check_param_value, check_store, drain, sim_answers, Heartbeat};
+use crate::watch::{after_ground, check_controls, sim_answers, Heartbeat};
 
 /// Who sends: one of a few stations (two share an address on different channels).
 #[derive(Arbitrary, Clone, Copy, Debug)]
 pub struct Station(u8);
 
-const STATIONS: [(u8, u8, u8); 5] = [(255, 190, 1), (255, 190, 2), (254, 1, 3), (1, 1, 4), (0, 0, 5)];
+const STATIONS: [(u8, u8, u8); 5] = [
+    (255, 190, 1),
+    (255, 190, 2),
+    (254, 1, 3),
+    (1, 1, 4),
+    (0, 0, 5),
+];
 
 impl Station {
     fn get(self) -> (u8, u8, u8) {
@@ -43,7 +49,12 @@ pub enum GroundAction {
     Stream { msgs: Vec<GcsMsg>, cuts: Vec<u8> },
     /// A datagram of bytes that are no frame, or a frame with one byte changed.
     Garbage { channel: u8, bytes: Vec<u8> },
-    Corrupt { from: Station, msg: GcsMsg, at: u16, xor: u8 },
+    Corrupt {
+        from: Station,
+        msg: GcsMsg,
+        at: u16,
+        xor: u8,
+    },
     /// Sensor frames of an aircraft at rest: the clock moves on, the link polls.
     Time { frames: u8, wobble: Wobble },
 }
@@ -70,15 +81,7 @@ impl Harness {
 
     /// After a call that ran the ground link.
     fn check(&mut self) -> Vec<crate::watch::Sent> {
-        let sent = drain(&mut self.app);
-        let now = self.app.vehicle().time_us().unwrap_or(0);
-        self.heartbeat.after_poll(now, &sent);
-        let store = self.app.vehicle().params();
-        for s in &sent {
-            check_param_value(&s.message, store);
-        }
-        check_store(store);
-        sent
+        after_ground(&mut self.app, &mut self.heartbeat)
     }
 
     fn step(&mut self, a: &GroundAction) {
@@ -164,7 +167,8 @@ impl Harness {
                     }
                     bytes.extend(self.sim.sensors(&calm_sensors(self.raw_us, wobble)));
                     let mut out = Vec::new();
-                    self.app.on_sim_bytes(&bytes, &mut |b| out.extend_from_slice(b));
+                    self.app
+                        .on_sim_bytes(&bytes, &mut |b| out.extend_from_slice(b));
                     let answers = sim_answers(&out);
                     assert_eq!(answers.len(), 1, "one answer per sensor frame");
                     for a in &answers {
@@ -196,7 +200,6 @@ fn command_for_us(m: &MavMessage, from: (u8, u8)) -> Option<u32> {
 
 /// Runs one input.
 pub fn run(data: &[u8]) {
-    let mut u = Unstructured::new(data);
     let mut h = Harness {
         app: App::new(),
         sim: Simulator::default(),
@@ -204,15 +207,5 @@ pub fn run(data: &[u8]) {
         raw_us: 0,
         heartbeat: Heartbeat::default(),
     };
-    let mut steps = 0;
-    while let Ok(a) = GroundAction::arbitrary(&mut u) {
-        if crate::trace() {
-            eprintln!("{a:?}");
-        }
-        h.step(&a);
-        steps += 1;
-        if steps > 200 || u.is_empty() {
-            break;
-        }
-    }
+    crate::each_action(data, 200, |a: &GroundAction| h.step(a));
 }

@@ -34,8 +34,9 @@ impl Num {
             Num::Int(v) => json!(v),
             Num::Deg(v) => json!(f64::from(v) * 1e-7),
             Num::Huge(e) => json!(10f64.powi(i32::from(e % 400))),
-            Num::Bits(b) => serde_json::Number::from_f64(f64::from_bits(b))
-                .map_or(Value::Null, Value::Number),
+            Num::Bits(b) => {
+                serde_json::Number::from_f64(f64::from_bits(b)).map_or(Value::Null, Value::Number)
+            }
             Num::Null => Value::Null,
         }
     }
@@ -182,14 +183,20 @@ fn check_list(items: &[MISSION_ITEM_INT_DATA], kind: MavMissionType, plan: bool,
     for (i, it) in items.iter().enumerate() {
         assert_eq!(usize::from(it.seq), i, "items numbered 0..");
         assert_eq!(it.mission_type, kind);
-        assert_eq!((it.target_system, it.target_component, it.current), (1, 1, 0));
+        assert_eq!(
+            (it.target_system, it.target_component, it.current),
+            (1, 1, 0)
+        );
         if global(it.frame) {
             assert!(it.x.unsigned_abs() <= 900_000_000, "latitude {}", it.x);
             assert!(it.y.unsigned_abs() <= 1_800_000_000, "longitude {}", it.y);
         }
         if plan {
             for v in [it.param1, it.param2, it.param3, it.param4, it.z] {
-                assert!(!v.is_infinite(), "item {i}: an infinite value from a .plan: {it:?}");
+                assert!(
+                    !v.is_infinite(),
+                    "item {i}: an infinite value from a .plan: {it:?}"
+                );
             }
         }
         if it.command == MavCmd::MAV_CMD_DO_JUMP && kind == MavMissionType::MAV_MISSION_TYPE_MISSION
@@ -205,7 +212,12 @@ fn check_list(items: &[MISSION_ITEM_INT_DATA], kind: MavMissionType, plan: bool,
 
 fn check(f: &MissionFile, plan: bool) {
     let len = f.mission.len();
-    check_list(&f.mission, MavMissionType::MAV_MISSION_TYPE_MISSION, plan, len);
+    check_list(
+        &f.mission,
+        MavMissionType::MAV_MISSION_TYPE_MISSION,
+        plan,
+        len,
+    );
     check_list(&f.fence, MavMissionType::MAV_MISSION_TYPE_FENCE, plan, len);
     check_list(&f.rally, MavMissionType::MAV_MISSION_TYPE_RALLY, plan, len);
     if let Some((lat, lon, alt)) = f.home {

@@ -14,7 +14,7 @@
 
 use std::collections::BTreeMap;
 
-use arbitrary::{Arbitrary, Unstructured};
+use arbitrary::Arbitrary;
 use common::estimator::Home;
 use common::gcs::mission::{item_from_mav, mission_type, plan_kind};
 use common::gcs::{GroundLink, Outgoing, Peer, Stores};
@@ -52,21 +52,58 @@ const PEERS: [Peer; 3] = [
 /// A message of the mission protocol, or time passing.
 #[derive(Arbitrary, Clone, Debug)]
 pub enum MissionAction {
-    Count { peer: u8, kind: Kind, count: u8 },
+    Count {
+        peer: u8,
+        kind: Kind,
+        count: u8,
+    },
     /// Items `seq`.. of an upload, as a station sends them on request.
-    Items { peer: u8, kind: Kind, seq: u8, items: Vec<Item> },
-    RequestList { peer: u8, kind: Kind },
-    Request { peer: u8, kind: Kind, seq: u8 },
-    Ack { peer: u8, kind: Kind, cancel: bool },
-    Clear { peer: u8, kind: Kind },
-    Float { peer: u8, kind: Kind },
-    SetCurrent { peer: u8, seq: u16 },
+    Items {
+        peer: u8,
+        kind: Kind,
+        seq: u8,
+        items: Vec<Item>,
+    },
+    RequestList {
+        peer: u8,
+        kind: Kind,
+    },
+    Request {
+        peer: u8,
+        kind: Kind,
+        seq: u8,
+    },
+    Ack {
+        peer: u8,
+        kind: Kind,
+        cancel: bool,
+    },
+    Clear {
+        peer: u8,
+        kind: Kind,
+    },
+    Float {
+        peer: u8,
+        kind: Kind,
+    },
+    SetCurrent {
+        peer: u8,
+        seq: u16,
+    },
     /// Time passes (timeouts, retries).
-    Wait { ms: u16 },
+    Wait {
+        ms: u16,
+    },
     /// Home is set (or moves), or is not known yet.
-    Home { set: bool, north: i8, alt: i8 },
+    Home {
+        set: bool,
+        north: i8,
+        alt: i8,
+    },
     /// A mission altitude limit changes.
-    Limit { max: Float },
+    Limit {
+        max: Float,
+    },
 }
 
 /// What one station has uploaded since its last count.
@@ -132,15 +169,17 @@ impl Harness {
         }
         let sent = self.poll();
         for (dest, m) in &sent {
-            let to_p =
-                *dest == peer.dest() && m.target_system_id() == Some(peer.system)
-                    && m.target_component_id() == Some(peer.component);
+            let to_p = *dest == peer.dest()
+                && m.target_system_id() == Some(peer.system)
+                && m.target_component_id() == Some(peer.component);
             if !to_p {
                 continue;
             }
             match (m, msg) {
                 // The station's upload starts (or restarts) when the link asks for item 0.
-                (MavMessage::MISSION_REQUEST_INT(r), MavMessage::MISSION_COUNT(c)) if r.seq == 0 => {
+                (MavMessage::MISSION_REQUEST_INT(r), MavMessage::MISSION_COUNT(c))
+                    if r.seq == 0 =>
+                {
                     if let Some(kind) = plan_kind(c.mission_type) {
                         self.uploads.insert(
                             p,
@@ -213,16 +252,31 @@ impl Harness {
             .uploads
             .get(&p)
             .unwrap_or_else(|| panic!("the {kind:?} changed with no upload from station {p}"));
-        assert_eq!(up.kind, kind, "the {kind:?} replaced by a {:?} upload", up.kind);
+        assert_eq!(
+            up.kind, kind,
+            "the {kind:?} replaced by a {:?} upload",
+            up.kind
+        );
         assert_eq!(up.items.len(), up.count, "an incomplete upload stored");
-        assert_eq!(now, &up.items[..], "the {kind:?} stored is not what station {p} sent");
+        assert_eq!(
+            now,
+            &up.items[..],
+            "the {kind:?} stored is not what station {p} sent"
+        );
         match kind {
             PlanKind::Mission => {
                 let v = validate_mission(now, rules.home.as_ref(), &rules.limits, &rules.nav);
-                assert!(v.result.is_ok(), "a mission stored that fails its checks: {v:?}");
+                assert!(
+                    v.result.is_ok(),
+                    "a mission stored that fails its checks: {v:?}"
+                );
             }
             PlanKind::Fence => {
-                assert_eq!(validate_fence(now), Ok(()), "a fence stored that fails its checks")
+                assert_eq!(
+                    validate_fence(now),
+                    Ok(()),
+                    "a fence stored that fails its checks"
+                )
             }
             PlanKind::Rally => {}
         }
@@ -272,7 +326,11 @@ impl Harness {
         let peer = |p: u8| usize::from(p) % PEERS.len();
         let to = |kind: Kind| kind.get();
         match a {
-            MissionAction::Count { peer: p, kind, count } => {
+            MissionAction::Count {
+                peer: p,
+                kind,
+                count,
+            } => {
                 let m = MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
                     count: u16::from(*count),
                     target_system: 1,
@@ -312,7 +370,11 @@ impl Harness {
                 });
                 self.send(peer(*p), &m);
             }
-            MissionAction::Ack { peer: p, kind, cancel } => {
+            MissionAction::Ack {
+                peer: p,
+                kind,
+                cancel,
+            } => {
                 let m = MavMessage::MISSION_ACK(MISSION_ACK_DATA {
                     target_system: 1,
                     target_component: 1,
@@ -375,7 +437,6 @@ impl Harness {
 
 /// Runs one input.
 pub fn run(data: &[u8]) {
-    let mut u = Unstructured::new(data);
     let mut h = Harness {
         link: GroundLink::default(),
         params: ParamStore::new(REGISTRY),
@@ -385,15 +446,5 @@ pub fn run(data: &[u8]) {
         now_us: 0,
         uploads: BTreeMap::new(),
     };
-    let mut steps = 0;
-    while let Ok(a) = MissionAction::arbitrary(&mut u) {
-        if crate::trace() {
-            eprintln!("{a:?}");
-        }
-        h.step(&a);
-        steps += 1;
-        if steps > 300 || u.is_empty() {
-            break;
-        }
-    }
+    crate::each_action(data, 300, |a: &MissionAction| h.step(a));
 }

@@ -12,7 +12,7 @@
 //!   for when the definition and the stage's rule accept it, the old value otherwise;
 //! - after a sensor frame the navigator flies the settings the store holds.
 
-use arbitrary::{Arbitrary, Unstructured};
+use arbitrary::Arbitrary;
 use common::control::{autopilot, lateral, longitudinal, GainSet};
 use common::link::framing::Sender;
 use common::navigation::{fence, navigator, path_manager, validate};
@@ -24,18 +24,29 @@ use mavlink::dialects::common::*;
 
 use crate::frames::{calm_fix, calm_sensors, frame, Simulator, Wobble};
 use crate::gcs::{GcsMsg, Name, ParamValue};
-use crate::watch::{check_param_value, check_store, drain, sim_answers, Heartbeat};
+use crate::watch::{after_ground, sim_answers, Heartbeat};
 
 /// What the ground station (or time) does next.
 #[derive(Arbitrary, Clone, Debug)]
 pub enum ParamAction {
-    Set { name: Name, value: ParamValue, ty: u8 },
-    Read { index: i16, name: Name },
+    Set {
+        name: Name,
+        value: ParamValue,
+        ty: u8,
+    },
+    Read {
+        index: i16,
+        name: Name,
+    },
     List,
     /// `PREFLIGHT_STORAGE`: 1 save, 2 restore the defaults.
-    Storage { restore: bool },
+    Storage {
+        restore: bool,
+    },
     /// Sensor frames: the vehicle ticks and loads changed parameters.
-    Frames { n: u8 },
+    Frames {
+        n: u8,
+    },
     /// Any other ground-station message (arming, modes: a reset is refused while armed).
     Other(GcsMsg),
 }
@@ -52,7 +63,12 @@ struct Harness {
 fn check_stages(store: &ParamStore) {
     fn one<C>(store: &ParamStore, g: &Group<C>) {
         let c = store.load(g);
-        assert_eq!(g.validate(&c), Ok(()), "group {} refuses what the store holds", g.name);
+        assert_eq!(
+            g.validate(&c),
+            Ok(()),
+            "group {} refuses what the store holds",
+            g.name
+        );
     }
     one(store, &lateral::PARAMS);
     one(store, &longitudinal::PARAMS);
@@ -80,15 +96,8 @@ impl Harness {
     }
 
     fn check(&mut self) -> Vec<crate::watch::Sent> {
-        let sent = drain(&mut self.app);
-        let now = self.app.vehicle().time_us().unwrap_or(0);
-        self.heartbeat.after_poll(now, &sent);
-        let store = self.app.vehicle().params();
-        for s in &sent {
-            check_param_value(&s.message, store);
-        }
-        check_store(store);
-        check_stages(store);
+        let sent = after_ground(&mut self.app, &mut self.heartbeat);
+        check_stages(self.app.vehicle().params());
         sent
     }
 
@@ -149,7 +158,8 @@ impl Harness {
                     .sensors(&calm_sensors(self.raw_us, &Wobble::default())),
             );
             let mut out = Vec::new();
-            self.app.on_sim_bytes(&bytes, &mut |b| out.extend_from_slice(b));
+            self.app
+                .on_sim_bytes(&bytes, &mut |b| out.extend_from_slice(b));
             assert_eq!(sim_answers(&out).len(), 1);
             self.check();
             let v = self.app.vehicle();
@@ -239,7 +249,6 @@ fn candidate(store: &ParamStore, index: usize, d: &PARAM_SET_DATA) -> Option<f32
 
 /// Runs one input.
 pub fn run(data: &[u8]) {
-    let mut u = Unstructured::new(data);
     let mut h = Harness {
         app: App::new(),
         sim: Simulator::default(),
@@ -249,15 +258,5 @@ pub fn run(data: &[u8]) {
     };
     // The first frame starts the clock, so the heartbeat check runs from a known time.
     h.frames(1);
-    let mut steps = 0;
-    while let Ok(a) = ParamAction::arbitrary(&mut u) {
-        if crate::trace() {
-            eprintln!("{a:?}");
-        }
-        h.step(&a);
-        steps += 1;
-        if steps > 300 || u.is_empty() {
-            break;
-        }
-    }
+    crate::each_action(data, 300, |a: &ParamAction| h.step(a));
 }

@@ -7,7 +7,7 @@
 //! (throttle zero while disarmed); the heartbeat comes at least once a second of vehicle time;
 //! the vehicle's clock never goes back.
 
-use arbitrary::{Arbitrary, Unstructured};
+use arbitrary::Arbitrary;
 use common::link::framing::{FrameParser, Sender};
 use common::link::simlink::BITS_IMU;
 use common::sensors::SensorFrame;
@@ -55,7 +55,13 @@ pub enum SimAction {
     /// The radio.
     Rc { chan: [u16; 4], count: u8, rssi: u8 },
     /// The simulator's truth.
-    Truth { q: [Float; 4], rates: [Float; 3], v: [i16; 3], tas: u16, alt: i32 },
+    Truth {
+        q: [Float; 4],
+        rates: [Float; 3],
+        v: [i16; 3],
+        tas: u16,
+        alt: i32,
+    },
     /// A frame of any id the dialect knows, any payload.
     Raw { id: u16, payload: Vec<u8> },
     /// A sensor frame from another system.
@@ -121,7 +127,11 @@ impl Harness {
         }
         if let Some(last) = answers.last() {
             let flag = last.mode.contains(MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED);
-            assert_eq!(flag, self.app.armed(), "the answer says armed as the vehicle is");
+            assert_eq!(
+                flag,
+                self.app.armed(),
+                "the answer says armed as the vehicle is"
+            );
         }
         let sent = drain(&mut self.app);
         if !expected.is_empty() {
@@ -207,7 +217,9 @@ impl Harness {
                 self.feed(&[&bytes]);
             }
             SimAction::Fix { north, east, speed } => {
-                let bytes = self.sim.gps(self.raw_us, &calm_fix((*north, *east), *speed));
+                let bytes = self
+                    .sim
+                    .gps(self.raw_us, &calm_fix((*north, *east), *speed));
                 self.feed(&[&bytes]);
             }
             SimAction::Rc { chan, count, rssi } => {
@@ -313,7 +325,6 @@ impl Harness {
 
 /// Runs one input.
 pub fn run(data: &[u8]) {
-    let mut u = Unstructured::new(data);
     let mut h = Harness {
         app: App::new(),
         sim: Simulator::default(),
@@ -321,15 +332,5 @@ pub fn run(data: &[u8]) {
         raw_us: 0,
         heartbeat: Heartbeat::default(),
     };
-    let mut steps = 0;
-    while let Ok(a) = SimAction::arbitrary(&mut u) {
-        if crate::trace() {
-            eprintln!("{a:?}");
-        }
-        h.step(&a);
-        steps += 1;
-        if steps > 400 || u.is_empty() {
-            break;
-        }
-    }
+    crate::each_action(data, 400, |a: &SimAction| h.step(a));
 }

@@ -14,8 +14,8 @@ use common::navigation::plan::{MissionItem, MissionStore};
 use common::params::store::{ParamImage, ParamRecord};
 use common::params::ParamStore;
 use common::storage::{
-    load, load_missions, load_params, save_missions, save_params, AbRegion, RamFlash,
-    StorageError, MISSION_MAGIC, PARAMS_MAGIC,
+    load, load_missions, load_params, save_missions, save_params, AbRegion, RamFlash, StorageError,
+    MISSION_MAGIC, PARAMS_MAGIC,
 };
 use common::vehicle::params::REGISTRY;
 
@@ -71,9 +71,18 @@ pub struct MissionItemIn {
 /// What happens after the first load.
 #[derive(Arbitrary, Debug)]
 pub enum Then {
-    SaveParams { set: Vec<(u16, ParamValue)>, cut: Option<u16> },
-    SaveMissions { items: Vec<(u8, MissionItemIn)>, cut: Option<u16> },
-    Flip { at: u16, xor: u8 },
+    SaveParams {
+        set: Vec<(u16, ParamValue)>,
+        cut: Option<u16>,
+    },
+    SaveMissions {
+        items: Vec<(u8, MissionItemIn)>,
+        cut: Option<u16>,
+    },
+    Flip {
+        at: u16,
+        xor: u8,
+    },
 }
 
 #[derive(Arbitrary, Debug)]
@@ -116,7 +125,8 @@ fn payload(p: &Payload, store: &ParamStore) -> Vec<u8> {
                     Some(bytes) => String::from_utf8_lossy(bytes).into_owned(),
                     None => store.def(index).map_or("", |d| d.name).to_string(),
                 };
-                let Ok(name) = heapless::String::try_from(name.get(..name.len().min(16)).unwrap_or(""))
+                let Ok(name) =
+                    heapless::String::try_from(name.get(..name.len().min(16)).unwrap_or(""))
                 else {
                     continue;
                 };
@@ -166,9 +176,18 @@ fn load_params_bits(flash: &mut Dev) -> Params {
     if let Some(r) = report {
         let image = load::<_, ParamImage>(flash, &PARAMS, &mut scratch)?.expect("loaded twice");
         let counted = usize::from(r.loaded) + usize::from(r.unknown) + usize::from(r.rejected);
-        assert_eq!(counted, image.value.len(), "each record counted once: {r:?}");
+        assert_eq!(
+            counted,
+            image.value.len(),
+            "each record counted once: {r:?}"
+        );
     }
-    Ok(report.map(|_| (0..store.len()).filter_map(|i| store.value(i)).map(f32::to_bits).collect()))
+    Ok(report.map(|_| {
+        (0..store.len())
+            .filter_map(|i| store.value(i))
+            .map(f32::to_bits)
+            .collect()
+    }))
 }
 
 type Missions = Result<Option<MissionStore>, StorageError<common::storage::RamFlashError>>;
@@ -204,9 +223,17 @@ pub fn run(data: &[u8]) {
     let mut flash = Dev::from_image(&image, SECTOR);
 
     let mut params = load_params_bits(&mut flash);
-    assert_eq!(load_params_bits(&mut flash), params, "the same flash loads the same");
+    assert_eq!(
+        load_params_bits(&mut flash),
+        params,
+        "the same flash loads the same"
+    );
     let mut plan = load_missions_now(&mut flash);
-    assert_eq!(load_missions_now(&mut flash), plan, "the same flash loads the same");
+    assert_eq!(
+        load_missions_now(&mut flash),
+        plan,
+        "the same flash loads the same"
+    );
 
     for t in input.then.iter().take(8) {
         match t {
@@ -217,7 +244,10 @@ pub fn run(data: &[u8]) {
                     let value = v.get(&s, i);
                     let _ = s.set_index(i, value);
                 }
-                let new: Vec<u32> = (0..s.len()).filter_map(|i| s.value(i)).map(f32::to_bits).collect();
+                let new: Vec<u32> = (0..s.len())
+                    .filter_map(|i| s.value(i))
+                    .map(f32::to_bits)
+                    .collect();
                 let mut scratch = vec![0u8; SECTOR as usize];
                 let mut torn = flash.clone();
                 torn.cut_after(cut.map(usize::from));

@@ -39,7 +39,10 @@ pub fn drain(app: &mut App) -> Vec<Sent> {
             },
             |raw| {
                 n.set(n.get() + 1);
-                assert_eq!(raw.id, 77, "only a COMMAND_ACK may carry a number unknown to the dialect");
+                assert_eq!(
+                    raw.id, 77,
+                    "only a COMMAND_ACK may carry a number unknown to the dialect"
+                );
                 assert_eq!((raw.header.system_id, raw.header.component_id), (1, 1));
             },
         );
@@ -47,7 +50,10 @@ pub fn drain(app: &mut App) -> Vec<Sent> {
             bad += 1;
         }
     });
-    assert_eq!(bad, 0, "a frame to the ground station is not one valid frame");
+    assert_eq!(
+        bad, 0,
+        "a frame to the ground station is not one valid frame"
+    );
     for s in &out {
         assert_eq!(
             (s.header.system_id, s.header.component_id),
@@ -86,7 +92,10 @@ pub fn check_controls(d: &HIL_ACTUATOR_CONTROLS_DATA, armed: bool) {
             3 => (0.0..=1.0).contains(c) && (armed || *c == 0.0),
             _ => *c == 0.0,
         };
-        assert!(ok, "control {i} = {c} out of its range (armed {armed}): {d:?}");
+        assert!(
+            ok,
+            "control {i} = {c} out of its range (armed {armed}): {d:?}"
+        );
     }
 }
 
@@ -147,7 +156,10 @@ impl Heartbeat {
         // The first run of the link sends one at once.
         let due = match self.last_us {
             Some(last) => {
-                assert!(now_us >= last, "the vehicle's clock went back: {last} -> {now_us}");
+                assert!(
+                    now_us >= last,
+                    "the vehicle's clock went back: {last} -> {now_us}"
+                );
                 last.checked_add(common::gcs::HEARTBEAT_INTERVAL_US)
             }
             None => Some(0),
@@ -161,4 +173,18 @@ impl Heartbeat {
             self.last_us = Some(now_us);
         }
     }
+}
+
+/// After a call that ran the ground link: what it sent, checked (the heartbeat, every
+/// `PARAM_VALUE` against the store, every stored value against its checks).
+pub fn after_ground(app: &mut App, heartbeat: &mut Heartbeat) -> Vec<Sent> {
+    let sent = drain(app);
+    let now = app.vehicle().time_us().unwrap_or(0);
+    heartbeat.after_poll(now, &sent);
+    let store = app.vehicle().params();
+    for s in &sent {
+        check_param_value(&s.message, store);
+    }
+    check_store(store);
+    sent
 }
