@@ -177,3 +177,27 @@ fn a_power_cut_during_a_save_keeps_the_copy_that_loads_when_the_newest_one_does_
         );
     }
 }
+
+#[test]
+fn a_saved_parameter_refused_twice_is_counted_once() {
+    use common::params::store::{ImportReport, ParamImage, ParamRecord};
+    let record = |name: &str, value: f32| ParamRecord {
+        name: name.try_into().unwrap(),
+        value,
+    };
+    let mut image = ParamImage::new();
+    // A throttle limit below the trim: the longitudinal stage refuses its records...
+    image.push(record("THR_MAX", 0.3)).unwrap();
+    // ...among them this one, which its definition refused already.
+    image.push(record("ALT_KP", f32::NAN)).unwrap();
+    image.push(record("NO_SUCH_PARAM", 1.0)).unwrap();
+    let report = ParamStore::new(REGISTRY).import(&image);
+    assert_eq!(
+        report,
+        ImportReport {
+            loaded: 0,
+            unknown: 1,
+            rejected: 2,
+        }
+    );
+}
