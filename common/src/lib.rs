@@ -37,6 +37,11 @@
 //! step: no globals, no I/O, no clock reads.
 #![no_std]
 #![forbid(unsafe_code)]
+// Nothing from outside may stop the autopilot: no unwrap, no expect, no unchecked index.
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)
+)]
 
 pub mod actuators;
 pub mod control;

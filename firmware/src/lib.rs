@@ -5,6 +5,11 @@
 //! ([`sitl`]) uses sockets, a pty or an in-process pipe, so `sim-host` can run this very loop
 //! inside its own process.
 #![cfg_attr(target_os = "none", no_std)]
+// Nothing from outside may stop the autopilot: no unwrap, no expect, no unchecked index.
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)
+)]
 
 pub mod app;
 #[cfg(not(target_os = "none"))]

@@ -4,8 +4,8 @@
 use crate::app::App;
 use common::gcs::Dest;
 use common::storage::{
-    load_missions, load_params, save_missions, save_params, AbRegion, RamFlash, MISSION_MAGIC,
-    PARAMS_MAGIC,
+    load, load_missions, load_params, save, save_missions, save_params, AbRegion, RamFlash,
+    SigningRecord, MISSION_MAGIC, PARAMS_MAGIC, SIGNING_MAGIC,
 };
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs, UdpSocket};
@@ -242,7 +242,9 @@ pub fn run_with(
         }
         last_rx = Instant::now();
         let mut out = Vec::new();
-        app.on_sim_bytes(&buf[..n], &mut |b| out.extend_from_slice(b));
+        app.on_sim_bytes(buf.get(..n).unwrap_or(&[]), &mut |b| {
+            out.extend_from_slice(b)
+        });
         if !out.is_empty() {
             link.write_all_bytes(&out)?;
         }
@@ -259,10 +261,13 @@ pub struct FileStorage {
     path: Option<PathBuf>,
     flash: RamFlash<STORAGE_BYTES>,
     missions_seen: Option<u32>,
+    signing_seen: Option<u32>,
+    /// Boot without the saved signing key (the bench recovery of a lost key).
+    forget_key: bool,
 }
 
 const SECTOR: u32 = 16 * 1024;
-const STORAGE_BYTES: usize = 4 * SECTOR as usize;
+const STORAGE_BYTES: usize = 6 * SECTOR as usize;
 const PARAMS_REGION: AbRegion = AbRegion {
     magic: PARAMS_MAGIC,
     slot_a: 0,
@@ -273,6 +278,12 @@ const MISSIONS_REGION: AbRegion = AbRegion {
     magic: MISSION_MAGIC,
     slot_a: 2 * SECTOR,
     slot_b: 3 * SECTOR,
+    slot_len: SECTOR,
+};
+const SIGNING_REGION: AbRegion = AbRegion {
+    magic: SIGNING_MAGIC,
+    slot_a: 4 * SECTOR,
+    slot_b: 5 * SECTOR,
     slot_len: SECTOR,
 };
 
@@ -287,7 +298,16 @@ impl FileStorage {
             path,
             flash: RamFlash::from_image(&image, SECTOR),
             missions_seen: None,
+            signing_seen: None,
+            forget_key: false,
         }
+    }
+
+    /// Boots without the saved MAVLink signing key, and saves that at the next change: the
+    /// bench recovery of a lost key (`firmware --signing-reset`).
+    pub fn forget_signing_key(mut self) -> Self {
+        self.forget_key = true;
+        self
     }
 
     /// Loads saved parameters and missions into the autopilot.
@@ -312,7 +332,25 @@ impl FileStorage {
             Ok(None) => {}
             Err(e) => notes.push(format!("saved missions unreadable: {e:?}")),
         }
+        match load::<_, SigningRecord>(&mut self.flash, &SIGNING_REGION, &mut scratch) {
+            Ok(Some(r)) if self.forget_key => {
+                app.signing_mut().load(None, r.value.timestamp);
+                notes.push("signing key forgotten (--signing-reset)".into());
+            }
+            Ok(Some(r)) => {
+                app.signing_mut().load(r.value.key, r.value.timestamp);
+                if r.value.key.is_some() {
+                    notes.push("signing key loaded: unsigned writes are refused".into());
+                }
+            }
+            Ok(None) => {}
+            Err(e) => notes.push(format!("saved signing key unreadable: {e:?}")),
+        }
         self.missions_seen = Some(app.vehicle().plan().change_count());
+        self.signing_seen = Some(app.signing_mut().change_count());
+        if self.forget_key {
+            self.signing_seen = None;
+        }
         app.vehicle_mut().params_mut().mark_saved();
         notes
     }
@@ -329,6 +367,17 @@ impl FileStorage {
                 &mut scratch,
             )
             .map_err(|e| io::Error::other(format!("parameter save: {e:?}")))?;
+            changed = true;
+        }
+        let signing = app.signing_mut();
+        if Some(signing.change_count()) != self.signing_seen {
+            let record = SigningRecord {
+                key: signing.key().copied(),
+                timestamp: signing.timestamp(),
+            };
+            self.signing_seen = Some(signing.change_count());
+            save(&mut self.flash, &SIGNING_REGION, &record, &mut scratch)
+                .map_err(|e| io::Error::other(format!("signing key save: {e:?}")))?;
             changed = true;
         }
         let plan = app.vehicle().plan();
@@ -405,10 +454,12 @@ impl GcsUdp {
                 })
             })
             .unwrap_or_else(|| {
-                let heard = |i: &usize| self.peers[*i].map(|(_, h)| h);
+                let heard = |i: &usize| self.peers.get(*i).copied().flatten().map(|(_, h)| h);
                 (0..MAX_GCS_PEERS).min_by_key(heard).unwrap_or(0)
             });
-        self.peers[slot] = Some((from, now));
+        if let Some(p) = self.peers.get_mut(slot) {
+            *p = Some((from, now));
+        }
         slot as u8 + 1
     }
 
@@ -419,7 +470,7 @@ impl GcsUdp {
             match self.socket.recv_from(&mut buf) {
                 Ok((n, from)) => {
                     let channel = self.channel_of(from, Instant::now());
-                    app.on_gcs_datagram(channel, &buf[..n]);
+                    app.on_gcs_datagram(channel, buf.get(..n).unwrap_or(&[]));
                 }
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => break,
                 // A peer that went away makes the next recv report it (ICMP); keep going.
@@ -492,6 +543,10 @@ struct Args {
     /// File holding the saved parameters and missions (the SITL flash); `none` for none.
     #[arg(long, default_value = "sitl-storage.bin")]
     storage: String,
+    /// Boot without the saved MAVLink signing key (the bench recovery of a lost key): the
+    /// ground link accepts unsigned frames again until a new key is set.
+    #[arg(long)]
+    signing_reset: bool,
 }
 
 /// Entry point of the SITL build.
@@ -511,6 +566,9 @@ pub fn main() -> std::process::ExitCode {
     let mut app = App::new();
     let mut storage =
         FileStorage::open((args.storage != "none").then(|| PathBuf::from(&args.storage)));
+    if args.signing_reset {
+        storage = storage.forget_signing_key();
+    }
     for note in storage.load_into(&mut app) {
         eprintln!("firmware: {note}");
     }
@@ -549,5 +607,41 @@ pub fn main() -> std::process::ExitCode {
                 std::process::ExitCode::FAILURE
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mavlink::dialects::common::SETUP_SIGNING_DATA;
+
+    #[test]
+    fn a_signing_key_survives_a_reboot_and_the_bench_reset_forgets_it() {
+        let path = std::env::temp_dir().join(format!("sitl-signing-{}.bin", std::process::id()));
+        let _ = std::fs::remove_file(&path);
+        let mut app = App::new();
+        let mut storage = FileStorage::open(Some(path.clone()));
+        storage.load_into(&mut app);
+        let setup = SETUP_SIGNING_DATA {
+            initial_timestamp: 1_000_000,
+            target_system: 1,
+            target_component: 1,
+            secret_key: [42; 32],
+        };
+        assert!(app.signing_mut().setup(&setup, false));
+        storage.save_changes(&mut app).expect("saved");
+
+        let mut rebooted = App::new();
+        FileStorage::open(Some(path.clone())).load_into(&mut rebooted);
+        assert_eq!(rebooted.signing_mut().key(), Some(&[42; 32]));
+        // The signing clock carries on from where it was saved, never older.
+        assert!(rebooted.signing_mut().timestamp() >= 1_000_000);
+
+        let mut reset = App::new();
+        FileStorage::open(Some(path.clone()))
+            .forget_signing_key()
+            .load_into(&mut reset);
+        assert_eq!(reset.signing_mut().key(), None);
+        let _ = std::fs::remove_file(&path);
     }
 }

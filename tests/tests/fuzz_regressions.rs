@@ -1,7 +1,7 @@
 //! The cases the fuzz targets in `tests/fuzz/` found, each kept as a plain test so it stays
 //! fixed without the fuzzer (`docs/RELIABILITY.md` tells each story).
 
-use common::gcs::{Dest, GroundLink, Outgoing, Stores};
+use common::gcs::{Dest, GroundLink, Origin, Outgoing, Stores};
 use common::navigation::plan::{MissionStore, PlanKind};
 use common::navigation::validate::PlanRules;
 use common::params::ParamStore;
@@ -44,7 +44,7 @@ impl Station {
             },
         };
         self.link
-            .handle(&header, &msg, 0, &snapshot, &mut stores, 0);
+            .handle(&header, &msg, 0, &snapshot, &mut stores, Origin::default());
         let mut acks = Vec::new();
         self.link.poll(0, &snapshot, &stores, |_: Dest, out| {
             if let Outgoing::Message(MavMessage::MISSION_ACK(a)) = out {

@@ -558,3 +558,50 @@ fn a_request_behind_a_corrupt_length_in_its_datagram_is_answered_at_once() {
     });
     assert_eq!(value, Some(17.0), "answered within a second, not held");
 }
+
+/// Runs one of `tests/interop/`'s pymavlink scripts against a fresh SITL vehicle; false when
+/// pymavlink is missing outside CI (skipped), a failed assertion when a check fails.
+fn pymavlink_script(name: &str) -> bool {
+    if !system_tests::tool_available("python3") {
+        return false;
+    }
+    let have_pymavlink = std::process::Command::new("python3")
+        .args(["-c", "import pymavlink"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have_pymavlink {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "pymavlink is required under CI (.ci/run installs it)"
+        );
+        eprintln!("SKIPPED: pymavlink is not installed (pip install pymavlink)");
+        return false;
+    }
+    let gps = Arc::new(AtomicBool::new(true));
+    let sitl = Sitl::start(None, gps);
+    let script = system_tests::workspace_root()
+        .join("tests/interop")
+        .join(name);
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .arg(sitl.gcs_addr.port().to_string())
+        .output()
+        .expect("python3 runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "pymavlink checks of {name}:\n{text}");
+    true
+}
+
+#[test]
+fn signing_interoperates_with_pymavlink_and_refuses_unsigned_and_replayed_writes() {
+    // pymavlink signs and verifies on its own (its signing is independent of this project's).
+    pymavlink_script("pymavlink_signing.py");
+}
+
+#[test]
+fn pymavlink_gets_protocol_version_chunked_texts_param_errors_and_metadata_over_ftp() {
+    // What QGroundControl asks at connection, asked by pymavlink (its FTP client and its
+    // decoding are independent of this project's): see the script's docstring for the checks.
+    pymavlink_script("pymavlink_parity.py");
+}

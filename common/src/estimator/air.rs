@@ -115,7 +115,7 @@ impl WindFilter {
 
     /// 1-sigma uncertainty of the larger component, m/s.
     pub fn sigma(&self) -> f32 {
-        libm::sqrtf(self.p[(0, 0)].max(self.p[(1, 1)]))
+        libm::sqrtf(self.p.m11.max(self.p.m22))
     }
 
     /// Grows the uncertainty over `dt`.

@@ -27,6 +27,10 @@
 //!   (before the first fix, or GPS lost), with the centripetal acceleration of turns removed.
 //! - Air-data velocity while GPS is lost keeps the horizontal velocity bounded.
 
+// The filter's matrices are fixed-size (nalgebra's SMatrix) and indexed with the state
+// layout's constants and loop indices below their dimension: no index comes from outside.
+#![allow(clippy::indexing_slicing)]
+
 use super::kalman::{condition, scalar_update, Fused, Refused};
 use crate::math::frames::Euler;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};

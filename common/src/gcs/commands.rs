@@ -170,6 +170,12 @@ impl GroundLink {
                 after = p;
                 r
             }
+            // QGroundControl 4 asks for it after AUTOPILOT_VERSION and falls back to MAVLink 1
+            // without an answer.
+            MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION => {
+                let _ = after.push(Pending::ProtocolVersion);
+                MavResult::MAV_RESULT_ACCEPTED
+            }
             MavCmd::MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES => {
                 let _ = after.push(Pending::AutopilotVersion);
                 MavResult::MAV_RESULT_ACCEPTED
@@ -196,6 +202,8 @@ impl GroundLink {
     }
 
     /// `MAV_CMD_REQUEST_MESSAGE`: the result and, when accepted, what to send after the ACK.
+    // PROTOCOL_VERSION is deprecated in the dialect, yet QGroundControl 4 asks for it.
+    #[allow(deprecated)]
     fn request_message(&mut self, c: &Command, v: &VehicleSnapshot) -> (MavResult, After) {
         let mut after = After::new();
         let Some(id) = message_id(c.p[0]) else {
@@ -205,6 +213,10 @@ impl GroundLink {
             HEARTBEAT_DATA::ID => Some(Pending::Heartbeat),
             AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
             CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
+            PROTOCOL_VERSION_DATA::ID => Some(Pending::ProtocolVersion),
+            COMPONENT_METADATA_DATA::ID if self.ftp.general().is_some() => {
+                Some(Pending::ComponentMetadata)
+            }
             AVAILABLE_MODES_DATA::ID => {
                 let n = FlightMode::ALL.len();
                 let index = c.p[1];
@@ -215,7 +227,7 @@ impl GroundLink {
                     }
                     return (MavResult::MAV_RESULT_ACCEPTED, after);
                 } else if index >= 1.0 && index <= n as f32 && libm::truncf(index) == index {
-                    Some(Pending::AvailableMode(index as u8 - 1))
+                    Some(Pending::AvailableMode((index as u8).saturating_sub(1)))
                 } else {
                     return (MavResult::MAV_RESULT_DENIED, after);
                 }
@@ -346,13 +358,16 @@ impl GroundLink {
                          // the design names it and older ground stations look for it.
     pub(super) fn autopilot_version(&self) -> MavMessage {
         type C = MavProtocolCapability;
-        let capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        let mut capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
             | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
             | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
             | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
             | C::MAV_PROTOCOL_CAPABILITY_MISSION_RALLY;
+        if !self.ftp.files().is_empty() {
+            capabilities |= C::MAV_PROTOCOL_CAPABILITY_FTP;
+        }
         MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
             capabilities,
             uid: self.cfg.uid,
@@ -379,6 +394,8 @@ fn message_id(p: f32) -> Option<u32> {
     }
 }
 
+// Runs at compile time only, on the crate's own version numbers.
+#[allow(clippy::indexing_slicing, clippy::arithmetic_side_effects)]
 const fn parse_u8(s: &str) -> u32 {
     let b = s.as_bytes();
     let mut v = 0u32;

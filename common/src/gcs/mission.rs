@@ -297,7 +297,7 @@ impl MissionManager {
                 MavMissionResult::MAV_MISSION_NO_SPACE,
             ));
         }
-        let next = next + 1;
+        let next = next.saturating_add(1);
         if next >= count {
             let result = if let Err(r) = self.check(kind, rules) {
                 r
@@ -477,7 +477,7 @@ impl MissionManager {
                         partner,
                     ));
                 }
-                *retries += 1;
+                *retries = retries.saturating_add(1);
                 *last_us = now_us;
                 Some((MissionReply::Request(kind, next), partner))
             }

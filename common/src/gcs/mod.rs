@@ -17,13 +17,18 @@
 //! PX4's `custom_mode` encoding (see [`modes`]). `docs/GROUND-STATION.md` describes the
 //! behaviour a ground station sees.
 
+// Counts, lengths and offsets here come from outside: every operation on them is checked.
+#![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
+
 pub mod client;
 pub mod commands;
+pub mod ftp;
 pub mod mission;
 pub mod modes;
 pub mod outbox;
 pub mod params;
 pub mod peer;
+pub mod signing;
 pub mod streams;
 pub mod telemetry;
 
@@ -45,12 +50,13 @@ use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::VehicleRequests;
 use crate::vehicle::snapshot::VehicleSnapshot;
 use mission::{mission_message, MissionManager, MissionReply};
-use outbox::{Command, Pending, Text};
+use outbox::{Command, Pending, Text, TEXT_MAX};
 
 pub use outbox::{CommandAck, Outgoing};
-pub use peer::{Dest, Peer};
+pub use peer::{Dest, Origin, Peer};
 
 pub use outbox::STATUSTEXT_LEN;
+use signing::Signing;
 use streams::{Scheduler, Stream};
 
 /// Our MAVLink system id.
@@ -77,6 +83,9 @@ pub struct LinkConfig {
     pub params_per_poll: u8,
     /// Hardware unique id reported in `AUTOPILOT_VERSION` (0 when unknown).
     pub uid: u64,
+    /// The files served over MAVLink FTP; with a `general.json` among them, the link answers
+    /// requests for `COMPONENT_METADATA` with its URI.
+    pub files: &'static [ftp::File],
 }
 
 impl Default for LinkConfig {
@@ -86,6 +95,7 @@ impl Default for LinkConfig {
             component_id: COMPONENT_ID,
             params_per_poll: 4,
             uid: 0,
+            files: &[],
         }
     }
 }
@@ -117,6 +127,10 @@ pub struct GroundLink {
     last_mode: Option<FlightMode>,
     dropped: u32,
     rx_errors: u16,
+    signing: Signing,
+    /// The `id` of the last status text sent in chunks.
+    text_id: u16,
+    ftp: ftp::Ftp,
 }
 
 impl Default for GroundLink {
@@ -141,7 +155,20 @@ impl GroundLink {
             last_mode: None,
             dropped: 0,
             rx_errors: 0,
+            signing: Signing::default(),
+            text_id: 0,
+            ftp: ftp::Ftp::new(cfg.files),
         }
+    }
+
+    /// MAVLink 2 signing: the key and its policy.
+    pub fn signing(&self) -> &Signing {
+        &self.signing
+    }
+
+    /// MAVLink 2 signing, writable (loading a persisted key at start-up).
+    pub fn signing_mut(&mut self) -> &mut Signing {
+        &mut self.signing
     }
 
     /// The mission protocol's state (a transfer in progress).
@@ -174,9 +201,10 @@ impl GroundLink {
         self.rx_errors = self.rx_errors.saturating_add(1);
     }
 
-    /// Queues a STATUSTEXT (event messages from the vehicle: failsafes, mode changes, ...).
-    /// Text longer than 50 bytes is cut; when the queue is full the message is dropped and
-    /// counted in [`GroundLink::dropped`].
+    /// Queues a status text (event messages from the vehicle: failsafes, mode changes, ...).
+    /// Text longer than 50 bytes goes out as STATUSTEXT chunks (MAVLink 2's `id` and
+    /// `chunk_seq`), up to 150 bytes; when the queue is full the text is dropped and counted in
+    /// [`GroundLink::dropped`].
     pub fn send_statustext(&mut self, severity: MavSeverity, text: &str) {
         let mut s = String::new();
         for c in text.chars() {
@@ -187,7 +215,7 @@ impl GroundLink {
         self.queue_text(severity, s);
     }
 
-    fn queue_text(&mut self, severity: MavSeverity, text: String<STATUSTEXT_LEN>) {
+    fn queue_text(&mut self, severity: MavSeverity, text: String<TEXT_MAX>) {
         if self.texts.push_back(Text { severity, text }).is_err() {
             self.dropped = self.dropped.wrapping_add(1);
         }
@@ -199,7 +227,7 @@ impl GroundLink {
     }
 
     fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
-        let mut s: String<STATUSTEXT_LEN> = String::new();
+        let mut s: String<TEXT_MAX> = String::new();
         // A text that does not fit is cut, never refused.
         let _ = s.write_fmt(args);
         self.queue_text(severity, s);
@@ -216,8 +244,10 @@ impl GroundLink {
         }
     }
 
-    /// Consumes one message from a ground station, received on the board's `channel`.
-    /// Messages addressed to another system or component, and our own echoes, are ignored.
+    /// Consumes one message from a ground station, received on the board's `channel` (with
+    /// its signature block, when it was signed and a key is installed). Messages addressed to
+    /// another system or component, our own echoes, and whatever the signing policy refuses
+    /// are ignored.
     // SET_MODE, MISSION_REQUEST, MISSION_SET_CURRENT and MISSION_ITEM are deprecated but still
     // sent by pymavlink and older ground stations; answering them is part of compatibility.
     #[allow(deprecated)]
@@ -228,8 +258,9 @@ impl GroundLink {
         now_us: u64,
         vehicle: &VehicleSnapshot,
         stores: &mut Stores,
-        channel: u8,
+        origin: Origin,
     ) {
+        let Origin { channel, signed } = origin;
         let Ok(sys) = u8::try_from(header.system_id) else {
             return;
         };
@@ -246,12 +277,33 @@ impl GroundLink {
                 return;
             }
         }
+        if self
+            .signing
+            .admit(sys, header.component_id, msg, signed)
+            .is_err()
+        {
+            return;
+        }
         let from = Peer {
             system: sys,
             component: header.component_id,
             channel,
         };
         match msg {
+            MavMessage::SETUP_SIGNING(d) => {
+                let with_key = signed.is_some_and(|s| s.valid);
+                let text = if !self.signing.setup(d, with_key) {
+                    "Signing setup refused: not signed with the key"
+                } else if self.signing.key().is_some() {
+                    "Signing on: unsigned writes are refused"
+                } else {
+                    "Signing off"
+                };
+                self.send_statustext(MavSeverity::MAV_SEVERITY_INFO, text);
+            }
+            MavMessage::FILE_TRANSFER_PROTOCOL(d) if d.target_network == 0 => {
+                self.ftp.handle(d, from, now_us);
+            }
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
                 self.gcs_last_seen_us = Some(now_us);
             }
@@ -263,7 +315,7 @@ impl GroundLink {
             MavMessage::PARAM_REQUEST_READ(d) => {
                 self.on_param_read(d, stores.params, from);
             }
-            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params),
+            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params, from),
             MavMessage::MANUAL_CONTROL(d) => {
                 // Axes are -1000..1000 (throttle 0..1000); INT16_MAX marks an axis as unused.
                 let axis = |v: i16| {
@@ -379,6 +431,10 @@ impl GroundLink {
     /// command with an id this autopilot does not know gets `MAV_RESULT_UNSUPPORTED`, as the
     /// command protocol asks, when it is addressed to us.
     pub fn handle_undecoded(&mut self, header: &MavHeader, id: u32, payload: &[u8], channel: u8) {
+        // Whether it was signed cannot be told here: with signing on, no answer.
+        if self.signing.key().is_some() {
+            return;
+        }
         let Some((command, ts, tc)) = outbox::undecoded_command(id, payload) else {
             return;
         };
@@ -431,6 +487,7 @@ impl GroundLink {
         stores: &Stores,
         mut out_raw: F,
     ) {
+        self.signing.tick(now_us);
         while let Some((p, dest)) = self.pending.pop_front() {
             if let Pending::Unsupported { command, to } = p {
                 let ack = CommandAck {
@@ -447,6 +504,10 @@ impl GroundLink {
         }
         let mut out_msg = |d, m| out_raw(d, Outgoing::Message(m));
         let out = &mut out_msg;
+        let mut budget = ftp::BURST_PER_POLL;
+        while let Some((m, to)) = self.ftp.next(&mut budget) {
+            out(to.dest(), m);
+        }
         if now_us >= self.next_heartbeat_us {
             out(Dest::All, telemetry::heartbeat(v));
             self.next_heartbeat_us = self.next_heartbeat_us.saturating_add(HEARTBEAT_INTERVAL_US);
@@ -455,13 +516,36 @@ impl GroundLink {
             }
         }
         while let Some(t) = self.texts.pop_front() {
-            let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
-                severity: t.severity,
-                text: t.text.as_str().into(),
-                id: 0,
-                chunk_seq: 0,
-            });
-            out(Dest::All, text);
+            let bytes = t.text.as_bytes();
+            if bytes.len() <= STATUSTEXT_LEN {
+                let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+                    severity: t.severity,
+                    text: t.text.as_str().into(),
+                    id: 0,
+                    chunk_seq: 0,
+                });
+                out(Dest::All, text);
+                continue;
+            }
+            // Chunks of one text share a non-zero id; the last is shorter than 50 bytes (its
+            // NUL ends the text), an empty one when the text fills its chunks exactly.
+            self.text_id = self.text_id.wrapping_add(1).max(1);
+            let chunks = (bytes.len() / STATUSTEXT_LEN).saturating_add(1);
+            for (seq, start) in (0..chunks).map(|i| (i, i.saturating_mul(STATUSTEXT_LEN))) {
+                let part = bytes.get(start..).unwrap_or(&[]);
+                let part = part.get(..STATUSTEXT_LEN).unwrap_or(part);
+                let mut text = [0u8; STATUSTEXT_LEN];
+                for (d, b) in text.iter_mut().zip(part) {
+                    *d = *b;
+                }
+                let chunk = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+                    severity: t.severity,
+                    text: text.into(),
+                    id: self.text_id,
+                    chunk_seq: seq as u8,
+                });
+                out(Dest::All, chunk);
+            }
         }
         if let Some((reply, to)) = self.missions.poll(now_us) {
             self.emit(
@@ -543,6 +627,37 @@ impl GroundLink {
         match p {
             // Sent as raw data by `poll`.
             Pending::Unsupported { .. } => {}
+            Pending::ParamError {
+                index,
+                name,
+                error,
+                to,
+            } => out(MavMessage::PARAM_ERROR(PARAM_ERROR_DATA {
+                param_index: index,
+                target_system: to.system,
+                target_component: to.component,
+                param_id: name.into(),
+                error,
+            })),
+            // Deprecated in the dialect since 2025, but QGroundControl 4 still asks for it.
+            #[allow(deprecated)]
+            Pending::ProtocolVersion => out(MavMessage::PROTOCOL_VERSION(PROTOCOL_VERSION_DATA {
+                // MAVLink 2 spoken (and sent); MAVLink 1 frames still read.
+                version: 200,
+                min_version: 100,
+                max_version: 200,
+                spec_version_hash: [0; 8],
+                library_version_hash: [0; 8],
+            })),
+            Pending::ComponentMetadata => {
+                if let Some(f) = self.ftp.general() {
+                    out(MavMessage::COMPONENT_METADATA(COMPONENT_METADATA_DATA {
+                        time_boot_ms: (now_us / 1000) as u32,
+                        file_crc: ftp::file_crc(f.bytes),
+                        uri: ftp::uri(f).as_str().into(),
+                    }));
+                }
+            }
             Pending::Ack {
                 command,
                 result,

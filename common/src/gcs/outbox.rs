@@ -6,19 +6,21 @@ use super::streams::Stream;
 use crate::vehicle::modes::FlightMode;
 use heapless::String;
 use mavlink::dialects::common::{
-    MavCmd, MavMessage, MavResult, MavSeverity, COMMAND_ACK_DATA, COMMAND_INT_DATA,
+    MavCmd, MavMessage, MavParamError, MavResult, MavSeverity, COMMAND_ACK_DATA, COMMAND_INT_DATA,
     COMMAND_LONG_DATA,
 };
 use mavlink::{MavlinkVersion, MessageData};
 
-/// Longest STATUSTEXT text.
+/// Longest text one STATUSTEXT carries; a longer one goes out in chunks.
 pub const STATUSTEXT_LEN: usize = 50;
+/// Longest status text the link keeps (three chunks).
+pub const TEXT_MAX: usize = 3 * STATUSTEXT_LEN;
 
 /// A STATUSTEXT waiting to be sent.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Text {
     pub severity: MavSeverity,
-    pub text: String<STATUSTEXT_LEN>,
+    pub text: String<TEXT_MAX>,
 }
 
 /// Something to send at the next poll.
@@ -35,6 +37,16 @@ pub(crate) enum Pending {
         to: Peer,
     },
     ParamValue(u16),
+    /// `PARAM_ERROR` for a name or an index, to the asker.
+    ParamError {
+        index: i16,
+        name: [u8; 16],
+        error: MavParamError,
+        to: Peer,
+    },
+    ProtocolVersion,
+    /// `COMPONENT_METADATA`: where the general metadata file is.
+    ComponentMetadata,
     Mission(MissionReply, Peer),
     MissionCurrent(Option<u16>),
     ItemReached(u16),
@@ -110,10 +122,12 @@ impl MessageData for CommandAck {
 
     fn deser(version: MavlinkVersion, payload: &[u8]) -> Result<Self, mavlink::error::ParserError> {
         let mut full = [0u8; COMMAND_ACK_DATA::ENCODED_LEN];
-        let n = payload.len().min(full.len());
-        full[..n].copy_from_slice(&payload[..n]);
+        for (d, s) in full.iter_mut().zip(payload) {
+            *d = *s;
+        }
         let command = u16::from_le_bytes([full[0], full[1]]);
-        full[..2].copy_from_slice(&(MavCmd::MAV_CMD_NAV_WAYPOINT as u16).to_le_bytes());
+        let placeholder = (MavCmd::MAV_CMD_NAV_WAYPOINT as u16).to_le_bytes();
+        (full[0], full[1]) = (placeholder[0], placeholder[1]);
         let d = COMMAND_ACK_DATA::deser(version, &full)?;
         Ok(Self {
             command,

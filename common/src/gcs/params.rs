@@ -21,9 +21,31 @@ impl GroundLink {
         } else {
             Some(d.param_index as usize).filter(|&i| i < params.len())
         };
-        if let Some(i) = index {
-            self.push_to(Pending::ParamValue(i as u16), from.dest());
+        match index {
+            Some(i) => self.push_to(Pending::ParamValue(i as u16), from.dest()),
+            None => self.param_error(
+                &d.param_id[..],
+                d.param_index,
+                MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST,
+                from,
+            ),
         }
+    }
+
+    /// `PARAM_ERROR` to the station that asked (the parameter protocol's answer to an unknown
+    /// name and to a refused value; QGroundControl counts it as the end of its retries).
+    fn param_error(&mut self, id: &[u8], index: i16, error: MavParamError, to: Peer) {
+        let mut name = [0u8; 16];
+        for (d, b) in name.iter_mut().zip(id) {
+            *d = *b;
+        }
+        let p = Pending::ParamError {
+            index,
+            name,
+            error,
+            to,
+        };
+        self.push_to(p, to.dest());
     }
 
     /// The next `params_per_poll` values of a list download, if one runs, to the channel that
@@ -45,7 +67,7 @@ impl GroundLink {
             if let Some(m) = param_value(params, i) {
                 out(Dest::Channel(channel), m);
             }
-            i += 1;
+            i = i.saturating_add(1);
         }
         self.param_next = if i >= n {
             None
@@ -55,7 +77,7 @@ impl GroundLink {
     }
 
     /// `PARAM_SET`: the store checks the value; the echo carries the value it now holds.
-    pub(super) fn on_param_set(&mut self, d: &PARAM_SET_DATA, params: &mut ParamStore) {
+    pub(super) fn on_param_set(&mut self, d: &PARAM_SET_DATA, params: &mut ParamStore, from: Peer) {
         let Some(name) = param_id_str(&d.param_id[..]) else {
             return;
         };
@@ -63,6 +85,12 @@ impl GroundLink {
             self.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Param {}: unknown", name),
+            );
+            self.param_error(
+                &d.param_id[..],
+                -1,
+                MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST,
+                from,
             );
             return;
         };
@@ -85,18 +113,19 @@ impl GroundLink {
             // Tools that send every value as REAL32 (pymavlink's default) may set an
             // integer parameter with a whole number.
             (k, true) if k.is_integer() => Ok(d.param_value),
-            _ => Err("wrong type"),
+            _ => Err(("wrong type", MavParamError::MAV_PARAM_ERROR_TYPE_MISMATCH)),
         };
         let result = candidate.and_then(|v| {
             params
                 .set_index(index, v)
-                .map_err(crate::params::ParamError::text)
+                .map_err(|e| (e.text(), MavParamError::MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE))
         });
-        if let Err(why) = result {
+        if let Err((why, error)) = result {
             self.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Param {} refused: {} [{}, {}]", name, why, def.min, def.max),
             );
+            self.param_error(&d.param_id[..], index as i16, error, from);
         }
         // The echo carries the value now stored, changed or not.
         self.push(Pending::ParamValue(index as u16));

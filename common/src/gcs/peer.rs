@@ -1,5 +1,18 @@
 //! Who a message came from and where an answer goes.
 
+use crate::link::signing::Signed;
+
+/// How a frame came in: the board's channel and, for a signed frame read with a key
+/// installed, its signature block and whether it matched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Origin {
+    /// The board's channel: 0 for a single link.
+    pub channel: u8,
+    /// The signature, when there was one to check.
+    pub signed: Option<Signed>,
+}
+
 /// Where a message came from: the station's MAVLink address and the board's channel it
 /// arrived on (which UART, which UDP peer). Two stations that share a system and component
 /// id are told apart by their channels.

@@ -403,7 +403,7 @@ pub fn available_mode(index: usize, mode: FlightMode) -> MavMessage {
         custom_mode: mode.custom_mode(),
         properties: mode.properties(),
         number_modes: FlightMode::ALL.len() as u8,
-        mode_index: (index + 1) as u8,
+        mode_index: index.saturating_add(1) as u8,
         standard_mode: mode.standard(),
         mode_name: mode.name().into(),
     })

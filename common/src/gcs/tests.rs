@@ -97,7 +97,11 @@ impl Bench {
             plan: &mut self.plan,
             rules: self.rules,
         };
-        self.link.handle(h, msg, now, v, &mut stores, channel);
+        let origin = Origin {
+            channel,
+            signed: None,
+        };
+        self.link.handle(h, msg, now, v, &mut stores, origin);
     }
 
     fn poll(&mut self, now: u64, v: &VehicleSnapshot, mut out: impl FnMut(MavMessage)) {
@@ -2130,4 +2134,227 @@ fn a_nan_message_interval_is_denied_and_the_rate_kept() {
     // ATTITUDE stays at its default 15 Hz, not the 1 kHz a NaN cast to an integer gave.
     let n = count_over(&mut l, &v, 1_000, 10, 30);
     assert!(n.abs_diff(150) <= 1, "default gave {n}");
+}
+
+#[test]
+#[allow(deprecated)] // PROTOCOL_VERSION: deprecated in the dialect, still asked for by QGC 4.
+fn protocol_version_is_answered_both_ways_with_mavlink_2() {
+    let mut l = link();
+    let v = healthy();
+    for msg in [
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION,
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+        cmd_long(
+            MavCmd::MAV_CMD_REQUEST_MESSAGE,
+            [300.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    ] {
+        let out = exchange(&mut l, &v, 0, msg);
+        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+        let pv = out.iter().find_map(|m| match m {
+            MavMessage::PROTOCOL_VERSION(p) => Some(p.clone()),
+            _ => None,
+        });
+        let pv = pv.expect("PROTOCOL_VERSION after the ACK");
+        assert_eq!(
+            (pv.version, pv.min_version, pv.max_version),
+            (200, 100, 200)
+        );
+    }
+}
+
+#[test]
+fn a_long_status_text_goes_out_in_chunks_a_station_can_join() {
+    let mut l = link();
+    let v = healthy();
+    let long: std::string::String = (0..120)
+        .map(|i| char::from(b'a' + (i % 26) as u8))
+        .collect();
+    l.send_statustext(MavSeverity::MAV_SEVERITY_WARNING, &long);
+    let exact: std::string::String = "x".repeat(100);
+    l.send_statustext(MavSeverity::MAV_SEVERITY_INFO, &exact);
+    let chunks: Vec<STATUSTEXT_DATA> = poll(&mut l, &v, 0)
+        .into_iter()
+        .filter_map(|m| match m {
+            MavMessage::STATUSTEXT(t) => Some(t),
+            _ => None,
+        })
+        .collect();
+    // 120 bytes: 50, 50 and 20 (NUL-terminated); 100 bytes: 50, 50 and an empty closing chunk.
+    assert_eq!(chunks.len(), 6);
+    let (a, b) = chunks.split_at(3);
+    assert!(a.iter().all(|c| c.id == a[0].id) && a[0].id != 0);
+    assert!(b.iter().all(|c| c.id == b[0].id) && b[0].id != a[0].id);
+    assert_eq!(a.iter().map(|c| c.chunk_seq).collect::<Vec<_>>(), [0, 1, 2]);
+    // Joined as QGroundControl joins them: up to the first NUL.
+    let join = |cs: &[STATUSTEXT_DATA]| -> std::string::String {
+        let bytes: Vec<u8> = cs.iter().flat_map(|c| c.text.iter().copied()).collect();
+        let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+        std::string::String::from_utf8(bytes[..end].to_vec()).unwrap()
+    };
+    assert_eq!(join(a), long);
+    assert_eq!(join(b), exact);
+    assert_eq!(b[2].text[0], 0);
+}
+
+fn param_errors(out: &[MavMessage]) -> Vec<(i16, MavParamError)> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::PARAM_ERROR(e) => Some((e.param_index, e.error)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn unknown_names_and_refused_values_get_a_param_error() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(
+        &mut l,
+        &v,
+        0,
+        param_set("NO_SUCH", 1.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(-1, MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST)]
+    );
+    let read = MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+        param_index: -1,
+        target_system: 1,
+        target_component: 1,
+        param_id: "NO_SUCH".into(),
+    });
+    let out = exchange(&mut l, &v, 1, read);
+    assert_eq!(
+        param_errors(&out),
+        [(-1, MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST)]
+    );
+    // Out of bounds: PARAM_ERROR with its index, and the echo of the value kept.
+    let out = exchange(
+        &mut l,
+        &v,
+        2,
+        param_set("RLL_KP", 9.0, MavParamType::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(0, MavParamError::MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE)]
+    );
+    assert_eq!(param_values(&out)[0].param_value, 0.8);
+    // The wrong type for a real.
+    let out = exchange(
+        &mut l,
+        &v,
+        3,
+        param_set("RLL_KP", 1.0, MavParamType::MAV_PARAM_TYPE_UINT8),
+    );
+    assert_eq!(
+        param_errors(&out),
+        [(0, MavParamError::MAV_PARAM_ERROR_TYPE_MISMATCH)]
+    );
+}
+
+static GENERAL_JSON: &[u8] = br#"{"version":1,"metadataTypes":[]}"#;
+static FILES: [super::ftp::File; 1] = [super::ftp::File {
+    name: super::ftp::GENERAL,
+    bytes: GENERAL_JSON,
+}];
+
+fn ftp_request(seq: u16, opcode: u8, data: &[u8]) -> MavMessage {
+    let mut payload = [0u8; 251];
+    payload[..2].copy_from_slice(&seq.to_le_bytes());
+    payload[3] = opcode;
+    payload[4] = data.len() as u8;
+    payload[12..12 + data.len()].copy_from_slice(data);
+    MavMessage::FILE_TRANSFER_PROTOCOL(FILE_TRANSFER_PROTOCOL_DATA {
+        target_network: 0,
+        target_system: 1,
+        target_component: 1,
+        payload,
+    })
+}
+
+/// `MAV_CMD_REQUEST_MESSAGE` for message `id`.
+fn request(id: f32) -> MavMessage {
+    cmd_long(
+        MavCmd::MAV_CMD_REQUEST_MESSAGE,
+        [id, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    )
+}
+
+/// The capabilities of the `AUTOPILOT_VERSION` among `out`.
+fn capabilities(out: &[MavMessage]) -> MavProtocolCapability {
+    let caps = out.iter().find_map(|m| match m {
+        MavMessage::AUTOPILOT_VERSION(d) => Some(d.capabilities),
+        _ => None,
+    });
+    caps.expect("AUTOPILOT_VERSION after the ACK")
+}
+
+#[test]
+fn component_metadata_points_to_the_general_file_which_ftp_serves_to_the_asker() {
+    let mut l = link();
+    l.link = GroundLink::new(LinkConfig {
+        files: &FILES,
+        ..LinkConfig::default()
+    });
+    let v = healthy();
+    let out = exchange(&mut l, &v, 2_000_000, request(397.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    let meta = out.iter().find_map(|m| match m {
+        MavMessage::COMPONENT_METADATA(d) => Some(d.clone()),
+        _ => None,
+    });
+    let meta = meta.expect("COMPONENT_METADATA after the ACK");
+    assert_eq!(meta.uri.to_str().unwrap(), "mftp://general.json");
+    assert_eq!(meta.file_crc, super::ftp::file_crc(GENERAL_JSON));
+    assert_eq!(meta.time_boot_ms, 2000);
+    // The deprecated COMPONENT_INFORMATION is not served: QGroundControl moves on at once.
+    let out = exchange(&mut l, &v, 2_000_000, request(395.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    // AUTOPILOT_VERSION says FTP is spoken.
+    let out = exchange(&mut l, &v, 2_000_000, request(148.0));
+    assert!(capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
+    // The file opens for the station on channel 2 and its answer goes there only.
+    l.handle_on(
+        2,
+        &hdr(),
+        &ftp_request(7, 4, b"/general.json"),
+        2_000_000,
+        &v,
+    );
+    let mut answers = Vec::new();
+    l.poll_to(2_000_000, &v, |d, m| {
+        if let MavMessage::FILE_TRANSFER_PROTOCOL(f) = m {
+            answers.push((d, f));
+        }
+    });
+    assert_eq!(answers.len(), 1);
+    let (dest, f) = &answers[0];
+    assert_eq!(*dest, Dest::Channel(2));
+    // Sequence plus one, ACK, four bytes of length.
+    assert_eq!(
+        (
+            u16::from_le_bytes([f.payload[0], f.payload[1]]),
+            f.payload[3]
+        ),
+        (8, 128)
+    );
+    let len = u32::from_le_bytes([f.payload[12], f.payload[13], f.payload[14], f.payload[15]]);
+    assert_eq!(len as usize, GENERAL_JSON.len());
+    assert_eq!((f.target_system, f.target_component), GCS);
+}
+
+#[test]
+fn without_served_files_component_metadata_is_unsupported_and_ftp_not_claimed() {
+    let mut l = link();
+    let v = healthy();
+    let out = exchange(&mut l, &v, 0, request(397.0));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
+    let out = exchange(&mut l, &v, 0, request(148.0));
+    assert!(!capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
 }

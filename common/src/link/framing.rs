@@ -7,6 +7,7 @@
 //! payload. It takes bytes in whatever chunks a UART, a socket or a pipe delivers them, never
 //! allocates and never panics.
 
+use super::signing::{self, Key, Signed};
 use mavlink::dialects::common::MavMessage;
 use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message};
 
@@ -80,6 +81,9 @@ pub struct Frame {
     pub version: MavlinkVersion,
     /// The message.
     pub message: MavMessage,
+    /// For a signed MAVLink 2 frame read with a key installed: its signature block and
+    /// whether it matches the key (`None`: unsigned, or no key to check against).
+    pub signed: Option<Signed>,
 }
 
 /// Incremental MAVLink 1 and 2 frame parser.
@@ -88,6 +92,7 @@ pub struct FrameParser {
     len: usize,
     stats: LinkStats,
     last_seq: Option<(u32, u8)>,
+    key: Option<Key>,
 }
 
 impl Default for FrameParser {
@@ -124,7 +129,18 @@ impl FrameParser {
                 cut_short: 0,
             },
             last_seq: None,
+            key: None,
         }
+    }
+
+    /// The key signed frames are checked against (MAVLink 2 signing); `None`: not checked.
+    pub fn set_key(&mut self, key: Option<Key>) {
+        self.key = key;
+    }
+
+    /// The bytes held, waiting to form a frame.
+    fn held(&self) -> &[u8] {
+        self.buf.get(..self.len).unwrap_or(&[])
     }
 
     /// What the parser has counted so far.
@@ -150,9 +166,9 @@ impl FrameParser {
                 self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(1);
                 continue;
             }
-            if self.len < self.buf.len() {
-                self.buf[self.len] = b;
-                self.len += 1;
+            if let Some(slot) = self.buf.get_mut(self.len) {
+                *slot = b;
+                self.len = self.len.saturating_add(1);
             }
             self.drain(&mut on_frame, &mut on_undecoded);
         }
@@ -216,7 +232,7 @@ impl FrameParser {
     fn consume(&mut self, n: usize) {
         let n = n.min(self.len);
         self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
+        self.len = self.len.saturating_sub(n);
         self.skip_to_marker(0);
     }
 
@@ -225,7 +241,8 @@ impl FrameParser {
     }
 
     fn skip_to_marker(&mut self, from: usize) {
-        let start = self.buf[..self.len]
+        let start = self
+            .held()
             .iter()
             .enumerate()
             .skip(from)
@@ -233,7 +250,7 @@ impl FrameParser {
             .map_or(self.len, |(i, _)| i);
         self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(start as u32);
         self.buf.copy_within(start..self.len, 0);
-        self.len -= start;
+        self.len = self.len.saturating_sub(start);
     }
 
     fn note_sequence(&mut self, h: &MavHeader) {
@@ -269,12 +286,16 @@ impl FrameParser {
             } else {
                 0
             };
+            // At most 1 + 9 + 255 + 2 + 13: no overflow.
+            #[allow(clippy::arithmetic_side_effects)]
             let total = 1 + V2_HEADER + payload_len + CHECKSUM + sig;
             if self.len < total {
                 return Check::NeedMore;
             }
             let mut raw = MAVLinkV2MessageRaw::new();
-            raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
+            if !copy_into(raw.as_mut_slice(), self.held(), total) {
+                return Check::Bad;
+            }
             let id = raw.message_id();
             if !raw.has_valid_crc::<MavMessage>() {
                 return self.classify_failure(id);
@@ -284,15 +305,29 @@ impl FrameParser {
                 component_id: raw.component_id(),
                 sequence: raw.sequence(),
             };
+            let signed = match (&self.key, self.held().get(..total)) {
+                (Some(k), Some(frame)) => signing::check(frame, k),
+                _ => None,
+            };
             let start = 1 + V2_HEADER;
-            self.finish(header, MavlinkVersion::V2, id, raw.payload(), start, total)
+            let check = self.finish(header, MavlinkVersion::V2, id, raw.payload(), start, total);
+            match check {
+                Check::Done(mut f, n) => {
+                    f.signed = signed;
+                    Check::Done(f, n)
+                }
+                other => other,
+            }
         } else {
+            #[allow(clippy::arithmetic_side_effects)]
             let total = 1 + V1_HEADER + payload_len + CHECKSUM;
             if self.len < total {
                 return Check::NeedMore;
             }
             let mut raw = MAVLinkV1MessageRaw::new();
-            raw.as_mut_slice()[..total].copy_from_slice(&self.buf[..total]);
+            if !copy_into(raw.as_mut_slice(), self.held(), total) {
+                return Check::Bad;
+            }
             let id = u32::from(raw.message_id());
             if !raw.has_valid_crc::<MavMessage>() {
                 return self.classify_failure(id);
@@ -335,15 +370,27 @@ impl FrameParser {
                     header,
                     version,
                     message,
+                    signed: None,
                 },
                 total,
             ),
             Err(_) => {
                 self.stats.parse_errors = self.stats.parse_errors.wrapping_add(1);
-                let range = payload_start..payload_start + payload.len();
+                let range = payload_start..payload_start.saturating_add(payload.len());
                 Check::Skip(header, id, range, total)
             }
         }
+    }
+}
+
+/// Copies the first `n` bytes of `src` into `dst`; false when either is shorter.
+fn copy_into(dst: &mut [u8], src: &[u8], n: usize) -> bool {
+    match (dst.get_mut(..n), src.get(..n)) {
+        (Some(d), Some(s)) => {
+            d.copy_from_slice(s);
+            true
+        }
+        _ => false,
     }
 }
 

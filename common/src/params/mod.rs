@@ -9,6 +9,7 @@
 //! Nothing else keeps a second copy of a name, a default or a bound.
 
 pub mod declare;
+pub mod metadata;
 pub mod store;
 
 pub use declare::{

@@ -19,6 +19,9 @@
 //! Parameters are stored by name ([`ParamImage`]), so a firmware whose table is reordered or
 //! extended still loads them; only values that differ from their default are stored.
 
+// Counts, lengths and offsets here come from outside: every operation on them is checked.
+#![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
+
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::navigation::plan::{
@@ -60,6 +63,18 @@ pub struct AbRegion {
 pub const PARAMS_MAGIC: u32 = 0x5052_4d31; // "PRM1"
 /// Magic of the mission record, format 1.
 pub const MISSION_MAGIC: u32 = 0x4d53_4e31; // "MSN1"
+/// Magic of the signing record (MAVLink 2 signing key and timestamp), format 1.
+pub const SIGNING_MAGIC: u32 = 0x5347_4e31; // "SGN1"
+
+/// The MAVLink 2 signing key and the signing clock when it was saved: a new boot carries on
+/// from that timestamp, so its frames are never older than the ones it signed before.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct SigningRecord {
+    /// The secret key; `None`: signing off.
+    pub key: Option<[u8; 32]>,
+    /// Signing clock, 10 us units since 2015-01-01.
+    pub timestamp: u64,
+}
 
 const HEADER_LEN: u32 = 16;
 
@@ -101,13 +116,12 @@ fn crc_of<F: Flash>(
     let mut chunk = [0u8; 64];
     let mut done = 0u32;
     while done < len {
-        let n = (len - done).min(chunk.len() as u32) as usize;
+        let n = len.saturating_sub(done).min(chunk.len() as u32) as usize;
         let buf = chunk.get_mut(..n).ok_or(StorageError::TooLarge)?;
-        flash
-            .read(addr + HEADER_LEN + done, buf)
-            .map_err(StorageError::Flash)?;
+        let at = addr.saturating_add(HEADER_LEN).saturating_add(done);
+        flash.read(at, buf).map_err(StorageError::Flash)?;
         crc.digest(buf);
-        done += n as u32;
+        done = done.saturating_add(n as u32);
     }
     Ok(crc.get_crc())
 }
@@ -120,8 +134,12 @@ fn check_slot<F: Flash>(
 ) -> Result<Option<Header>, StorageError<F::Error>> {
     let mut h = [0u8; HEADER_LEN as usize];
     flash.read(addr, &mut h).map_err(StorageError::Flash)?;
-    let word = |i: usize| u32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]);
-    let (magic, seq, len, crc) = (word(0), word(4), word(8), word(12));
+    let mut words = h
+        .chunks_exact(4)
+        .filter_map(|w| <[u8; 4]>::try_from(w).ok())
+        .map(u32::from_le_bytes);
+    let mut word = || words.next().unwrap_or(0);
+    let (magic, seq, len, crc) = (word(), word(), word(), word());
     if magic != region.magic || len > region.slot_len.saturating_sub(HEADER_LEN) {
         return Ok(None);
     }
@@ -203,14 +221,15 @@ fn save_keeping<F: Flash, T: Serialize>(
     crc.digest(&len.to_le_bytes());
     crc.digest(payload);
     let mut header = [0u8; HEADER_LEN as usize];
-    for (i, w) in [region.magic, seq, len, crc.get_crc()].iter().enumerate() {
-        if let Some(dst) = header.get_mut(i * 4..i * 4 + 4) {
-            dst.copy_from_slice(&w.to_le_bytes());
-        }
+    for (dst, w) in header
+        .chunks_exact_mut(4)
+        .zip([region.magic, seq, len, crc.get_crc()])
+    {
+        dst.copy_from_slice(&w.to_le_bytes());
     }
     flash.erase_sector(target).map_err(StorageError::Flash)?;
     flash
-        .write(target + HEADER_LEN, payload)
+        .write(target.saturating_add(HEADER_LEN), payload)
         .map_err(StorageError::Flash)?;
     // The header last: until it is complete the slot is not valid.
     flash.write(target, &header).map_err(StorageError::Flash)?;
@@ -231,7 +250,7 @@ pub fn load<F: Flash, T: DeserializeOwned>(
             continue;
         };
         flash
-            .read(addr + HEADER_LEN, buf)
+            .read(addr.saturating_add(HEADER_LEN), buf)
             .map_err(StorageError::Flash)?;
         if let Ok(value) = postcard::from_bytes::<T>(buf) {
             return Ok(Some(Loaded { value, seq: h.seq }));
@@ -362,8 +381,9 @@ impl<const N: usize> RamFlash<N> {
     /// erased, extra ones are ignored. SITL keeps its "flash" in a file this way.
     pub fn from_image(image: &[u8], sector: u32) -> Self {
         let mut f = Self::new(sector);
-        let n = image.len().min(N);
-        f.mem[..n].copy_from_slice(&image[..n]);
+        for (m, b) in f.mem.iter_mut().zip(image) {
+            *m = *b;
+        }
         f
     }
 
@@ -399,7 +419,7 @@ impl<const N: usize> Flash for RamFlash<N> {
         let (start, len) = (addr as usize, self.sector as usize);
         let range = self
             .mem
-            .get_mut(start..start + len)
+            .get_mut(start..start.saturating_add(len))
             .ok_or(RamFlashError::Address)?;
         let whole = self_spend(&mut self.budget, &mut self.ops)?;
         let end = if whole { len } else { len / 2 };
@@ -413,12 +433,16 @@ impl<const N: usize> Flash for RamFlash<N> {
 
     fn write(&mut self, addr: u32, data: &[u8]) -> Result<(), RamFlashError> {
         let start = addr as usize;
-        if self.mem.get(start..start + data.len()).is_none() {
+        if self
+            .mem
+            .get(start..start.saturating_add(data.len()))
+            .is_none()
+        {
             return Err(RamFlashError::Address);
         }
         for (i, d) in data.iter().enumerate() {
             let whole = self.spend()?;
-            if let Some(b) = self.mem.get_mut(start + i) {
+            if let Some(b) = self.mem.get_mut(start.saturating_add(i)) {
                 // A torn byte gets only its upper nibble programmed.
                 *b &= if whole { *d } else { *d | 0x0f };
             }
@@ -433,7 +457,7 @@ impl<const N: usize> Flash for RamFlash<N> {
         let start = addr as usize;
         let src = self
             .mem
-            .get(start..start + buf.len())
+            .get(start..start.saturating_add(buf.len()))
             .ok_or(RamFlashError::Address)?;
         buf.copy_from_slice(src);
         Ok(())
@@ -446,16 +470,16 @@ fn self_spend(budget: &mut Option<usize>, ops: &mut usize) -> Result<bool, RamFl
         Some(0) => Err(RamFlashError::PowerLost),
         Some(1) => {
             *budget = Some(0);
-            *ops += 1;
+            *ops = ops.saturating_add(1);
             Ok(false)
         }
         Some(n) => {
-            *budget = Some(n - 1);
-            *ops += 1;
+            *budget = Some(n.saturating_sub(1));
+            *ops = ops.saturating_add(1);
             Ok(true)
         }
         None => {
-            *ops += 1;
+            *ops = ops.saturating_add(1);
             Ok(true)
         }
     }

@@ -11,6 +11,9 @@
 //! once. The clock itself starts at the first frame's time when that is plausible (under a
 //! day), otherwise at zero; after that only bounded steps are ever added.
 
+// Timestamps come from outside: no operation on them may wrap or panic.
+#![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
+
 /// Largest step between two frames taken as time passing, us (sensor frames come every 10 ms;
 /// a scheduling hiccup of a few hundred milliseconds is still a step).
 pub const MAX_STEP_US: u64 = 500_000;
@@ -89,7 +92,7 @@ impl Clock {
                 Step::Advanced(dt)
             }
             Some(0) => self.stale(),
-            None if self.last_raw - raw <= MAX_STEP_US => self.stale(),
+            None if self.last_raw.saturating_sub(raw) <= MAX_STEP_US => self.stale(),
             _ => self.jump(raw),
         }
     }

@@ -224,6 +224,7 @@ impl Vehicle {
 
     /// One sensor frame: the samples to the estimator, then, with what the ground link
     /// handed over, requests, parameters and (every [`CONTROL_PERIOD_US`]) the control tick.
+    #[deny(clippy::arithmetic_side_effects)]
     pub fn on_sensors(&mut self, f: &SensorFrame, ground: &FromGround) {
         let step = self.clock.on_frame(f.time_us, f.reset);
         let t = self.clock.now_us().unwrap_or(0);
@@ -251,7 +252,8 @@ impl Vehicle {
         // rejected sample does not lose its share of the rotation.
         if let Some(imu) = f.imu {
             if let Some(last) = self.last_imu_us.filter(|&l| t > l) {
-                self.estimator.update_imu(&imu, (t - last) as f32 * 1e-6);
+                self.estimator
+                    .update_imu(&imu, t.saturating_sub(last) as f32 * 1e-6);
             }
             self.last_imu_us = Some(t);
         }
@@ -292,6 +294,7 @@ impl Vehicle {
     }
 
     /// Everything after the sensors: requests, parameters, control at 50 Hz.
+    #[deny(clippy::arithmetic_side_effects)]
     fn tick(&mut self, now_us: u64, ground: &FromGround) {
         self.apply(&ground.requests);
         self.apply_params();

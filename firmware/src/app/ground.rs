@@ -3,8 +3,12 @@
 //! snapshot and stores; the link's answers, telemetry and the vehicle's notices encoded into
 //! one outgoing buffer, each frame tagged with where it goes.
 
-use common::gcs::{Dest, GroundLink, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID};
+use common::gcs::ftp::{self, File};
+use common::gcs::{
+    Dest, GroundLink, LinkConfig, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID,
+};
 use common::link::framing::{FrameParser, LinkStats, Sender};
+use common::link::signing;
 use common::vehicle::commander::Severity;
 use common::vehicle::{FromGround, Notice, Vehicle};
 use mavlink::dialects::common::MavSeverity;
@@ -20,6 +24,19 @@ pub const CHANNELS: usize = 1;
 /// to eight more that spoke first (see `sitl::GcsUdp`).
 #[cfg(not(target_os = "none"))]
 pub const CHANNELS: usize = 9;
+
+/// The files served over MAVLink FTP: the component metadata the build script generated from
+/// the parameter registry (`build.rs`).
+pub static FILES: [File; 2] = [
+    File {
+        name: ftp::GENERAL,
+        bytes: include_bytes!(concat!(env!("OUT_DIR"), "/general.json")),
+    },
+    File {
+        name: "parameters.json.xz",
+        bytes: include_bytes!(concat!(env!("OUT_DIR"), "/parameters.json.xz")),
+    },
+];
 
 /// Tag of a frame for every channel in the output buffer.
 const TO_ALL: u8 = 0xFF;
@@ -54,7 +71,10 @@ impl GroundPort {
         Self {
             parsers: core::array::from_fn(|_| FrameParser::new()),
             tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
-            link: GroundLink::default(),
+            link: GroundLink::new(LinkConfig {
+                files: &FILES,
+                ..LinkConfig::default()
+            }),
             out: heapless::Vec::new(),
             bytes_dropped: 0,
         }
@@ -63,6 +83,11 @@ impl GroundPort {
     /// The ground link's protocol state.
     pub fn link(&self) -> &GroundLink {
         &self.link
+    }
+
+    /// MAVLink 2 signing of the link.
+    pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
+        self.link.signing_mut()
     }
 
     /// Framing counters, every channel together.
@@ -102,18 +127,17 @@ impl GroundPort {
             plan,
             rules,
         };
+        // Signed frames are checked against the key in force when they arrive.
+        parser.set_key(self.link.signing().key().copied());
         // Both callbacks answer through the link, one frame at a time, in order.
         let link = core::cell::RefCell::new(&mut self.link);
-        let mut on_frame = |frame: common::link::framing::Frame| {
+        let mut on_frame = |f: common::link::framing::Frame| {
             let mut link = link.borrow_mut();
-            link.handle(
-                &frame.header,
-                &frame.message,
-                now,
-                &snapshot,
-                &mut stores,
+            let origin = Origin {
                 channel,
-            )
+                signed: f.signed,
+            };
+            link.handle(&f.header, &f.message, now, &snapshot, &mut stores, origin)
         };
         let mut on_undecoded = |raw: common::link::framing::Undecoded<'_>| {
             let mut link = link.borrow_mut();
@@ -151,12 +175,30 @@ impl GroundPort {
             rules,
         };
         let (tx, buf, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
+        let mut outgoing = heapless::Vec::<(Dest, Outgoing), 64>::new();
         self.link.poll(now_us, &snapshot, &stores, |dest, msg| {
+            if outgoing.push((dest, msg)).is_err() {
+                *dropped = dropped.saturating_add(1);
+            }
+        });
+        for (dest, msg) in outgoing {
             let raw = match msg {
                 Outgoing::Message(m) => tx.encode(&m),
                 Outgoing::Ack(a) => tx.encode_data(&a),
             };
-            let frame = raw.raw_bytes();
+            // With signing on, every frame is signed; the link id says which channel.
+            let link_id = match dest {
+                Dest::All => 0,
+                Dest::Channel(c) => c,
+            };
+            let signed = match self.link.signing().key().copied() {
+                Some(key) => {
+                    let t = self.link.signing_mut().next_timestamp();
+                    signing::sign(raw.raw_bytes(), &key, link_id, t)
+                }
+                None => None,
+            };
+            let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
             let tag = match dest {
                 Dest::All => TO_ALL,
                 Dest::Channel(c) => c,
@@ -169,7 +211,7 @@ impl GroundPort {
             {
                 *dropped = dropped.saturating_add(frame.len() as u32);
             }
-        });
+        }
     }
 
     /// Hands out the frames waiting, one call per frame with where it goes, and empties the

@@ -141,6 +141,11 @@ impl App {
         self.ground.link()
     }
 
+    /// MAVLink 2 signing of the ground link (loading a persisted key at start-up).
+    pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
+        self.ground.signing_mut()
+    }
+
     /// What the ground link reports and checks.
     pub fn snapshot(&self) -> VehicleSnapshot {
         self.vehicle.snapshot()

@@ -10,7 +10,7 @@
 
 use crate::report::table::Table;
 use common::params::{ParamDef, ParamKind, Registry};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 /// One stage of the registry and its definitions.
 pub fn stages(registry: Registry) -> Vec<(&'static str, Vec<&'static ParamDef>)> {
@@ -101,59 +101,14 @@ pub fn markdown(registry: Registry) -> String {
     md
 }
 
-/// Decimal places that show a value as declared (1 to 6).
-fn decimal_places(d: &ParamDef) -> usize {
-    [d.default, d.min, d.max]
-        .iter()
-        .map(|x| {
-            let s = format!("{x}");
-            match s.split_once('.') {
-                Some((_, frac)) if !s.contains('e') => frac.len(),
-                _ if s.contains('e') => 6,
-                _ => 0,
-            }
-        })
-        .max()
-        .unwrap_or(0)
-        .clamp(1, 6)
-}
-
 /// The parameter metadata in the format QGroundControl reads (component metadata, type
-/// PARAMETER, `version` 1).
+/// PARAMETER, `version` 1): `common::params::metadata` writes it, the same bytes the firmware
+/// serves over MAVLink FTP.
 pub fn metadata_json(registry: Registry) -> Value {
-    let mut params = Vec::new();
-    for (stage, defs) in stages(registry) {
-        for d in defs {
-            let integer = d.kind.is_integer();
-            // f32 to f64 through its shortest decimal, so 0.1 reads 0.1 and not 0.100000001.
-            let exact = |x: f32| number(x).parse::<f64>().unwrap_or(f64::from(x));
-            let mut p = json!({
-                "name": d.name,
-                "type": if integer { "Int32" } else { "Float" },
-                "shortDesc": d.description,
-                "default": if integer { json!(d.default as i64) } else { json!(exact(d.default)) },
-                "min": if integer { json!(d.min as i64) } else { json!(exact(d.min)) },
-                "max": if integer { json!(d.max as i64) } else { json!(exact(d.max)) },
-                "group": stage,
-                "category": "Standard",
-            });
-            if !d.unit.is_empty() {
-                p["units"] = json!(d.unit);
-            }
-            if !integer {
-                p["decimalPlaces"] = json!(decimal_places(d));
-            }
-            let l = labels(d);
-            if !l.is_empty() {
-                p["values"] = l
-                    .iter()
-                    .map(|(v, n)| json!({ "value": v, "description": n }))
-                    .collect();
-            }
-            params.push(p);
-        }
-    }
-    json!({ "version": 1, "parameters": params })
+    let mut text = String::new();
+    // Writing into a String cannot fail.
+    let _ = common::params::metadata::write_json(registry, &mut text);
+    serde_json::from_str(&text).unwrap_or(Value::Null)
 }
 
 #[cfg(test)]
@@ -189,17 +144,6 @@ mod tests {
                 p["name"]
             );
         }
-    }
-
-    #[test]
-    fn decimal_places_show_the_declared_values() {
-        // The lower bound 1e-5 needs five places.
-        let d = ParamDef::real("X", 0.0015, 1e-5, 0.1, "", "");
-        assert_eq!(decimal_places(&d), 5);
-        let d = ParamDef::real("Y", 17.0, 8.0, 30.0, "m/s", "");
-        assert_eq!(decimal_places(&d), 1);
-        let d = ParamDef::real("Z", 0.25, 0.0, 1.0, "", "");
-        assert_eq!(decimal_places(&d), 2);
     }
 
     #[test]

@@ -155,7 +155,10 @@ impl Harness {
             self.now_us,
             &self.snapshot,
             &mut stores,
-            peer.channel,
+            common::gcs::Origin {
+                channel: peer.channel,
+                signed: None,
+            },
         );
         self.model_item(p, msg);
         // A list replaced by an equal one (or an empty one cleared) changes nothing to check.
