@@ -200,7 +200,7 @@ fn save_keeping<F: Flash, T: Serialize>(
             .get_mut(..h.len as usize)
             .ok_or(StorageError::TooLarge)?;
         flash
-            .read(addr + HEADER_LEN, buf)
+            .read(addr.saturating_add(HEADER_LEN), buf)
             .map_err(StorageError::Flash)?;
         if !decodes(buf) {
             keep = older;
@@ -323,7 +323,7 @@ impl<'de, E: serde::Deserialize<'de>, const N: usize> serde::de::Visitor<'de> fo
         }
         match s.next_element::<E>()? {
             None => Ok(self),
-            Some(_) => Err(serde::de::Error::invalid_length(N + 1, &self)),
+            Some(_) => Err(serde::de::Error::invalid_length(N.saturating_add(1), &self)),
         }
     }
 }
