@@ -9,6 +9,7 @@ use common::navigation::plan::MissionItem;
 use common::params::ParamStore;
 use common::vehicle::modes::FlightMode;
 use mavlink::dialects::common::*;
+use mavlink::MessageData;
 use num_traits::FromPrimitive;
 
 use crate::frames::HOME;
@@ -233,7 +234,7 @@ impl Item {
 }
 
 /// Commands this autopilot answers, and a few it does not.
-const CMDS: [MavCmd; 20] = [
+const CMDS: [MavCmd; 21] = [
     MavCmd::MAV_CMD_COMPONENT_ARM_DISARM,
     MavCmd::MAV_CMD_DO_SET_MODE,
     MavCmd::MAV_CMD_DO_SET_STANDARD_MODE,
@@ -254,12 +255,94 @@ const CMDS: [MavCmd; 20] = [
     MavCmd::MAV_CMD_DO_FLIGHTTERMINATION,
     MavCmd::MAV_CMD_PREFLIGHT_CALIBRATION,
     MavCmd::MAV_CMD_DO_MOTOR_TEST,
+    MavCmd::MAV_CMD_REQUEST_PROTOCOL_VERSION,
 ];
 
 /// Message ids a ground station sends this autopilot, for [`GcsMsg::Raw`].
-const IDS: [u32; 20] = [
-    0, 11, 20, 21, 23, 39, 40, 41, 43, 44, 45, 47, 51, 69, 73, 75, 76, 110, 300, 66,
+const IDS: [u32; 21] = [
+    0, 11, 20, 21, 23, 39, 40, 41, 43, 44, 45, 47, 51, 69, 73, 75, 76, 110, 300, 66, 256,
 ];
+
+/// Messages a ground station asks for with `MAV_CMD_REQUEST_MESSAGE`, and one nobody serves.
+const REQUESTED: [u32; 7] = [
+    HEARTBEAT_DATA::ID,
+    AUTOPILOT_VERSION_DATA::ID,
+    CURRENT_MODE_DATA::ID,
+    PROTOCOL_VERSION_DATA::ID,
+    COMPONENT_METADATA_DATA::ID,
+    AVAILABLE_MODES_DATA::ID,
+    12345,
+];
+
+/// MAVLink FTP opcodes: those the server answers, some it refuses, and any.
+const FTP_OPS: [u8; 9] = [0, 1, 2, 4, 5, 15, 3, 6, 9];
+
+/// Paths an FTP `OpenFileRO` names: the served files, written as QGroundControl and
+/// pymavlink write them, and names that are not served.
+const FTP_PATHS: [&[u8]; 7] = [
+    b"general.json",
+    b"/general.json",
+    b"parameters.json.xz",
+    b"//parameters.json.xz\0junk",
+    b"@MAV_PARAMS/general.json",
+    b"",
+    b"/",
+];
+
+/// Secret keys a station sets up (all zero turns signing off).
+pub const KEYS: [[u8; 32]; 3] = [[0; 32], [0x5A; 32], [0xC3; 32]];
+
+/// A `SETUP_SIGNING`'s initial timestamp (10 us units since 2015).
+const SIGNING_TIMES: [u64; 5] = [0, 1, 35_000_000_000_000, 0xFFFF_FFFF_FFFF, u64::MAX];
+
+/// A MAVLink FTP request: a header as a client writes it, with any values where they vary.
+#[derive(Arbitrary, Clone, Debug)]
+pub struct FtpRequest {
+    op: u8,
+    seq: u16,
+    session: u8,
+    size: u8,
+    /// Most offsets fall inside or just past the served files.
+    offset: u32,
+    far: bool,
+    path: u8,
+    /// Not 0: meant for another network, ignored.
+    network: u8,
+}
+
+impl FtpRequest {
+    fn data(&self) -> FILE_TRANSFER_PROTOCOL_DATA {
+        let op = if self.op >= 200 {
+            self.op
+        } else {
+            FTP_OPS[usize::from(self.op) % FTP_OPS.len()]
+        };
+        let offset = if self.far {
+            self.offset
+        } else {
+            self.offset % 20_000
+        };
+        let mut payload = [0u8; 251];
+        payload[..2].copy_from_slice(&self.seq.to_le_bytes());
+        payload[2] = self.session % 4;
+        payload[3] = op;
+        payload[4] = self.size;
+        payload[8..12].copy_from_slice(&offset.to_le_bytes());
+        if op == 4 {
+            let path = FTP_PATHS[usize::from(self.path) % FTP_PATHS.len()];
+            payload[12..12 + path.len()].copy_from_slice(path);
+            if self.size == 0 {
+                payload[4] = path.len() as u8;
+            }
+        }
+        FILE_TRANSFER_PROTOCOL_DATA {
+            target_network: if self.network < 240 { 0 } else { self.network },
+            target_system: 1,
+            target_component: 1,
+            payload,
+        }
+    }
+}
 
 /// A target: the autopilot, broadcast, or someone else.
 #[derive(Arbitrary, Clone, Copy, Debug)]
@@ -344,6 +427,17 @@ pub enum GcsMsg {
     },
     MissionSetCurrent {
         seq: u16,
+    },
+    /// `MAV_CMD_REQUEST_MESSAGE` for one of [`REQUESTED`].
+    Request {
+        which: u8,
+    },
+    /// A MAVLink FTP request.
+    Ftp(FtpRequest),
+    /// `SETUP_SIGNING` with one of [`KEYS`].
+    SetupSigning {
+        key: u8,
+        time: u8,
     },
     /// Any payload for an id the link reads (the dialect may refuse it: unknown enum values,
     /// command ids it has no name for).
@@ -565,6 +659,27 @@ impl GcsMsg {
                     seq: *seq,
                     target_system: 1,
                     target_component: 1,
+                }))
+            }
+            GcsMsg::Request { which } => Typed(command(
+                MavCmd::MAV_CMD_REQUEST_MESSAGE,
+                [
+                    REQUESTED[usize::from(*which) % REQUESTED.len()] as f32,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                ],
+            )),
+            GcsMsg::Ftp(r) => Typed(MavMessage::FILE_TRANSFER_PROTOCOL(r.data())),
+            GcsMsg::SetupSigning { key, time } => {
+                Typed(MavMessage::SETUP_SIGNING(SETUP_SIGNING_DATA {
+                    initial_timestamp: SIGNING_TIMES[usize::from(*time) % SIGNING_TIMES.len()],
+                    target_system: 1,
+                    target_component: 1,
+                    secret_key: KEYS[usize::from(*key) % KEYS.len()],
                 }))
             }
             GcsMsg::Raw { id, payload } => {

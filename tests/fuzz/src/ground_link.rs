@@ -7,11 +7,16 @@
 //! heartbeat comes at least once a second of vehicle time; every `COMMAND_LONG` and
 //! `COMMAND_INT` addressed to us gets exactly one `COMMAND_ACK`, for its command, addressed
 //! to its sender and on its channel; every `PARAM_VALUE` is the value the store holds and
-//! every stored value passes its checks; the simulator's answers stay in range.
+//! every stored value passes its checks; the simulator's answers stay in range. With a
+//! signing key set (`SETUP_SIGNING` among the messages), a datagram unsigned, signed with
+//! another key or replaying a timestamp is not obeyed (no `COMMAND_ACK`, no parameter or plan
+//! changed) and every frame sent is signed with the key; every FTP reply carrying file data
+//! carries a served file's bytes at its offset.
 
 use std::collections::BTreeMap;
 
 use arbitrary::Arbitrary;
+use common::gcs::signing::MAX_TIMESTAMP;
 use common::gcs::Dest;
 use common::link::framing::Sender;
 use firmware::app::App;
@@ -43,8 +48,12 @@ impl Station {
 /// What happens next on the ground side.
 #[derive(Arbitrary, Clone, Debug)]
 pub enum GroundAction {
-    /// One datagram holding these messages from one station.
-    Datagram { from: Station, msgs: Vec<GcsMsg> },
+    /// One datagram holding these messages from one station, signed or not.
+    Datagram {
+        from: Station,
+        msgs: Vec<GcsMsg>,
+        sig: Sig,
+    },
     /// The messages as a byte stream on the single-link channel, in reads cut at `cuts`.
     Stream { msgs: Vec<GcsMsg>, cuts: Vec<u8> },
     /// A datagram of bytes that are no frame, or a frame with one byte changed.
@@ -59,12 +68,28 @@ pub enum GroundAction {
     Time { frames: u8, wobble: Wobble },
 }
 
+/// How a datagram's frames are signed (MAVLink 2 signing, the link id being the channel).
+#[derive(Arbitrary, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sig {
+    Unsigned,
+    /// With the vehicle's key and a fresh timestamp.
+    Good,
+    /// With another key.
+    WrongKey,
+    /// With the key and the last timestamp the vehicle accepted from this stream.
+    Replay,
+}
+
 struct Harness {
     app: App,
     sim: Simulator,
     senders: BTreeMap<(u8, u8), Sender>,
     raw_us: u64,
     heartbeat: Heartbeat,
+    /// The last timestamp signed with `Sig::Good`, per stream (system, component, link id);
+    /// forgotten when the vehicle's key changes.
+    signed: BTreeMap<(u8, u8, u8), u64>,
+    key_changes: u32,
 }
 
 impl Harness {
@@ -79,6 +104,36 @@ impl Harness {
         }
     }
 
+    /// Signs `frame` of stream `stream` as `sig` says; a replay of a stream with no accepted
+    /// timestamp, and any signature while signing is off, leave it unsigned.
+    fn sign(&mut self, frame: Vec<u8>, stream: (u8, u8, u8), sig: Sig) -> Vec<u8> {
+        let signing = self.app.ground_link().signing();
+        if signing.change_count() != self.key_changes {
+            self.key_changes = signing.change_count();
+            self.signed.clear();
+        }
+        let Some(key) = signing.key().copied() else {
+            return frame;
+        };
+        let fresh = signing.timestamp().saturating_add(1);
+        let (key, t) = match sig {
+            Sig::Unsigned => return frame,
+            Sig::Good => {
+                let t = self.signed.get(&stream).map_or(fresh, |t| fresh.max(t + 1));
+                self.signed.insert(stream, t);
+                (key, t)
+            }
+            Sig::WrongKey => (key.map(|b| !b), fresh),
+            Sig::Replay => match self.signed.get(&stream) {
+                Some(t) => (key, *t),
+                None => return frame,
+            },
+        };
+        common::link::signing::sign(&frame, &key, stream.2, t)
+            .expect("a frame of the dialect signs")
+            .to_vec()
+    }
+
     /// After a call that ran the ground link.
     fn check(&mut self) -> Vec<crate::watch::Sent> {
         after_ground(&mut self.app, &mut self.heartbeat)
@@ -86,29 +141,56 @@ impl Harness {
 
     fn step(&mut self, a: &GroundAction) {
         match a {
-            GroundAction::Datagram { from, msgs } => {
+            GroundAction::Datagram { from, msgs, sig } => {
                 let (sys, comp, channel) = from.get();
+                // With a key set, only frames signed with it and fresh are obeyed.
+                let signing = self.app.ground_link().signing();
+                let locked = signing.key().is_some();
+                let obeyed = !locked || *sig == Sig::Good;
+                // Near the end of the 48-bit signing time (a key set up for then), fresh
+                // timestamps run out: whether a frame is obeyed is not told here.
+                let mut predictable = !locked || signing.timestamp() < MAX_TIMESTAMP - 1000;
                 let mut bytes = Vec::new();
                 // Commands owed an answer: (command, count). Only typed ones: a raw payload
                 // may or may not decode.
                 let mut owed: BTreeMap<u32, usize> = BTreeMap::new();
-                let mut predictable = true;
                 for m in msgs.iter().take(24) {
                     let Some((f, typed)) = self.encode((sys, comp), m) else {
                         continue;
                     };
+                    let f = self.sign(f, (sys, comp, channel), *sig);
                     bytes.extend_from_slice(&f);
                     match typed {
+                        // A new key changes what the frames behind it are.
+                        Some(MavMessage::SETUP_SIGNING(_)) => predictable = false,
                         Some(msg) => {
                             if let Some(c) = command_for_us(&msg, (sys, comp)) {
-                                *owed.entry(c).or_default() += 1;
+                                if obeyed {
+                                    *owed.entry(c).or_default() += 1;
+                                }
                             }
                         }
                         None => predictable = false,
                     }
                 }
                 let dropped = self.app.ground_link().dropped();
+                let (params, plan) = (
+                    self.app.vehicle().params().change_count(),
+                    self.app.vehicle().plan().change_count(),
+                );
                 self.app.on_gcs_datagram(channel, &bytes);
+                if !obeyed {
+                    assert_eq!(
+                        self.app.vehicle().params().change_count(),
+                        params,
+                        "with a key set, a parameter changed by a frame not signed with it"
+                    );
+                    assert_eq!(
+                        self.app.vehicle().plan().change_count(),
+                        plan,
+                        "with a key set, a plan changed by a frame not signed with it"
+                    );
+                }
                 let sent = self.check();
                 if predictable && self.app.ground_link().dropped() == dropped {
                     let mut acked: BTreeMap<u32, usize> = BTreeMap::new();
@@ -206,6 +288,8 @@ pub fn run(data: &[u8]) {
         senders: BTreeMap::new(),
         raw_us: 0,
         heartbeat: Heartbeat::default(),
+        signed: BTreeMap::new(),
+        key_changes: 0,
     };
     crate::each_action(data, 200, |a: &GroundAction| h.step(a));
 }

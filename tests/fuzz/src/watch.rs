@@ -7,7 +7,9 @@ use common::link::framing::FrameParser;
 use common::params::store::{encode_wire, param_id_str};
 use common::params::ParamStore;
 use firmware::app::App;
-use mavlink::dialects::common::{MavMessage, MavParamType, HIL_ACTUATOR_CONTROLS_DATA};
+use mavlink::dialects::common::{
+    MavMessage, MavParamType, FILE_TRANSFER_PROTOCOL_DATA, HIL_ACTUATOR_CONTROLS_DATA,
+};
 use mavlink::MavHeader;
 
 /// One frame the autopilot sent to its ground stations.
@@ -24,13 +26,23 @@ pub struct Sent {
 pub fn drain(app: &mut App) -> Vec<Sent> {
     let mut out = Vec::new();
     let mut bad = 0usize;
+    // With signing on, every frame sent is signed with the key.
+    let key = app.ground_link().signing().key().copied();
     app.drain_gcs_to(&mut |dest, bytes| {
         let mut p = FrameParser::new();
+        p.set_key(key);
         let n = core::cell::Cell::new(0);
         p.push_with(
             bytes,
             |f| {
                 n.set(n.get() + 1);
+                if key.is_some() {
+                    assert!(
+                        f.signed.is_some_and(|s| s.valid),
+                        "with a key set, a frame sent unsigned or badly signed: {:?}",
+                        f.message
+                    );
+                }
                 out.push(Sent {
                     dest,
                     header: f.header,
@@ -60,6 +72,9 @@ pub fn drain(app: &mut App) -> Vec<Sent> {
             (1, 1),
             "every frame names the autopilot"
         );
+        if let MavMessage::FILE_TRANSFER_PROTOCOL(d) = &s.message {
+            check_ftp_data(d);
+        }
         if let Dest::Channel(c) = s.dest {
             assert!(
                 usize::from(c) < firmware::app::ground::CHANNELS,
@@ -68,6 +83,28 @@ pub fn drain(app: &mut App) -> Vec<Sent> {
         }
     }
     out
+}
+
+/// An FTP reply carrying file data (an `ACK` of `ReadFile` or `BurstReadFile`) carries the
+/// bytes of a served file at its offset, at least one.
+fn check_ftp_data(d: &FILE_TRANSFER_PROTOCOL_DATA) {
+    let p = &d.payload;
+    let (opcode, size, req) = (p[3], usize::from(p[4]), p[5]);
+    if opcode != 128 || !(req == 5 || req == 15) {
+        return;
+    }
+    let offset = u32::from_le_bytes([p[8], p[9], p[10], p[11]]) as usize;
+    assert!(
+        size > 0 && size <= 239,
+        "an FTP read answered with {size} bytes"
+    );
+    let data = &p[12..12 + size];
+    assert!(
+        firmware::app::ground::FILES
+            .iter()
+            .any(|f| f.bytes.get(offset..offset + size) == Some(data)),
+        "FTP data at {offset} that no served file holds there"
+    );
 }
 
 /// The answers on the simulator link, decoded.
