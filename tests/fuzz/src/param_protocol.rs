@@ -117,7 +117,26 @@ impl Harness {
         let index = param_id_str(&d.param_id[..]).and_then(|n| store.index_of(n));
         let old = index.and_then(|i| store.value(i));
         let wanted = index.and_then(|i| candidate(store, i, d));
+        // With a signing key set (a `SETUP_SIGNING` among the other messages), this unsigned
+        // write is refused: no echo, nothing changed.
+        let locked = self.app.ground_link().signing().key().is_some();
+        let changes = store.change_count();
         let sent = self.ground(&msg);
+        if locked {
+            assert!(
+                !sent
+                    .iter()
+                    .any(|s| matches!(s.message, MavMessage::PARAM_VALUE(_))
+                        && s.dest == common::gcs::Dest::All),
+                "an unsigned PARAM_SET answered while signing is on"
+            );
+            assert_eq!(
+                self.app.vehicle().params().change_count(),
+                changes,
+                "an unsigned PARAM_SET changed a parameter while signing is on"
+            );
+            return;
+        }
         let Some(i) = index else {
             return;
         };
