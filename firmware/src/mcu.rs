@@ -85,12 +85,12 @@ fn main() -> ! {
     loop {
         // Gather what has arrived on each UART, then hand it over in one piece.
         let n = sim.read_into(&mut chunk);
-        if n > 0 {
-            app.on_sim_bytes(&chunk[..n], &mut |out| sim.write(out));
+        if let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) {
+            app.on_sim_bytes(bytes, &mut |out| sim.write(out));
         }
         let n = gcs.read_into(&mut chunk);
-        if n > 0 {
-            app.on_gcs_bytes(&chunk[..n]);
+        if let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) {
+            app.on_gcs_bytes(bytes);
         }
         // Telemetry and answers for the ground, produced by both calls above.
         app.drain_gcs(&mut |out| gcs.write(out));

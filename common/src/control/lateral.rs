@@ -17,7 +17,7 @@ use super::filters::Washout;
 use super::inputs::{InputFlags, Measurements};
 use super::pid::{Bumpless, Derivative, Pid, PidGains};
 use crate::actuators::SURFACE_LIMIT_RAD;
-use crate::math::{wrap_pi, DEG, RAD2DEG};
+use crate::math::{clamp, wrap_pi, DEG, RAD2DEG};
 use crate::param;
 use crate::params::{Group, ParamDef};
 use serde::{Deserialize, Serialize};
@@ -490,7 +490,7 @@ impl Lateral {
             }
             _ => {
                 self.course.reset();
-                setpoint.clamp(-g.roll_max, g.roll_max)
+                clamp(setpoint, -g.roll_max, g.roll_max)
             }
         };
         let e = wrap_pi(phi_c - m.roll);
@@ -533,7 +533,7 @@ impl Lateral {
                 self.yaw_resume = false;
                 self.slip.reset();
                 self.washout.reset();
-                self.rudder = d.clamp(-g.rudder_max, g.rudder_max);
+                self.rudder = clamp(d, -g.rudder_max, g.rudder_max);
                 return false;
             }
         };

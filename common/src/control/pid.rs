@@ -34,6 +34,8 @@
 //! - The integral term is stored in output units (`I`, not `integral of e`), so a change of `ki`
 //!   does not make the output jump.
 
+use crate::math::clamp;
+
 /// Gains and output limits of one PID loop.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -236,11 +238,11 @@ impl Pid {
 
         if let Some((target, how)) = self.pending.take() {
             // Solve ff + p + I + d + T = target for I (and T).
-            let target = target.clamp(g.out_min, g.out_max);
+            let target = clamp(target, g.out_min, g.out_max);
             let need = target - ff - p - d;
             if how == Bumpless::Integrator && g.ki != 0.0 {
                 let span = g.out_max - g.out_min;
-                self.integ = (need + p).clamp(-span, span);
+                self.integ = clamp(need + p, -span, span);
                 self.transfer = need - self.integ;
             } else {
                 self.integ = 0.0;
@@ -259,11 +261,11 @@ impl Pid {
                 self.integ = self.integ.min(candidate.max(room));
             }
             let span = g.out_max - g.out_min;
-            self.integ = self.integ.clamp(-span, span);
+            self.integ = clamp(self.integ, -span, span);
         }
 
         let raw = ff + p + self.integ + d + self.transfer;
-        let output = raw.clamp(g.out_min, g.out_max);
+        let output = clamp(raw, g.out_min, g.out_max);
         let output = if output.is_finite() {
             output
         } else {

@@ -3,6 +3,7 @@
 //! Every measurement is fused one component at a time: no matrix inverse (nothing to be
 //! singular), and each component can be gated on its own.
 
+use crate::math::clamp;
 use nalgebra::{SMatrix, SVector};
 
 /// Why a measurement component was not fused.
@@ -63,7 +64,7 @@ pub fn condition<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_v
     *p = (*p + p.transpose()) * 0.5;
     for i in 0..N {
         let d = p[(i, i)];
-        p[(i, i)] = d.clamp(min_var, max_var);
+        p[(i, i)] = clamp(d, min_var, max_var);
     }
     true
 }

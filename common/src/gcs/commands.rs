@@ -195,7 +195,8 @@ impl GroundLink {
             _ => MavResult::MAV_RESULT_UNSUPPORTED,
         };
         self.ack(c.cmd, result, from);
-        for p in after {
+        // By reference: a heapless vector's by-value iterator checks a slice bound on drop.
+        for p in after.iter().copied() {
             self.push_to(p, from.dest());
         }
     }

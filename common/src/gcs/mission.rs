@@ -223,6 +223,8 @@ impl MissionManager {
         self.staging.clear();
         if count == 0 {
             self.transfer = Transfer::Idle;
+            // The list uploaded last is gone: a repeat of its last item is no longer accepted.
+            self.last_done = None;
             store.clear(kind);
             return MissionReply::Ack(mtype, MavMissionResult::MAV_MISSION_ACCEPTED);
         }
@@ -436,6 +438,7 @@ impl MissionManager {
         if self.busy() {
             return MissionReply::Ack(mtype, MavMissionResult::MAV_MISSION_DENIED);
         }
+        self.last_done = None;
         match mtype {
             MavMissionType::MAV_MISSION_TYPE_ALL => {
                 store.clear(PlanKind::Mission);

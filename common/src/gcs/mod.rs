@@ -381,7 +381,7 @@ impl GroundLink {
                 if let Some(r) = self.missions.on_item(plan, &stores.rules, d, from, now_us) {
                     self.push_to(Pending::Mission(r, from), from.dest());
                 }
-                for w in self.missions.take_warnings() {
+                for w in self.missions.take_warnings().iter().copied() {
                     self.mission_warning(w);
                 }
             }

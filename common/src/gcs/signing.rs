@@ -19,6 +19,8 @@ use mavlink::dialects::common::{MavMessage, SETUP_SIGNING_DATA};
 /// How far behind the signing clock a new stream's first timestamp may be, in 10 us units
 /// (one minute, as the MAVLink guide asks).
 pub const NEW_STREAM_WINDOW: u64 = 6_000_000;
+/// The largest timestamp a signature can carry (48 bits, 10 us units: 2104).
+pub const MAX_TIMESTAMP: u64 = 0xFFFF_FFFF_FFFF;
 /// Streams whose last timestamp is remembered; the oldest is forgotten for a new one.
 pub const STREAMS: usize = 8;
 
@@ -87,16 +89,21 @@ impl Signing {
         self.changes
     }
 
-    /// The signing clock now, 10 us units since 2015-01-01.
+    /// The signing clock now, 10 us units since 2015-01-01 (never beyond what a signature
+    /// can carry).
     pub fn timestamp(&self) -> u64 {
         self.base
             .saturating_add(self.now_us.saturating_sub(self.at_us) / 10)
+            .min(MAX_TIMESTAMP)
     }
 
-    /// Loads a persisted key and the timestamp it was saved at (at start-up).
+    /// Loads a persisted key and the timestamp it was saved at (at start-up); a timestamp
+    /// beyond 48 bits is not taken.
     pub fn load(&mut self, key: Option<Key>, timestamp: u64) {
         self.key = key.filter(|k| k.iter().any(|&b| b != 0));
-        self.set_clock(timestamp);
+        if timestamp <= MAX_TIMESTAMP {
+            self.set_clock(timestamp);
+        }
         self.streams.clear();
     }
 
@@ -112,9 +119,13 @@ impl Signing {
         }
     }
 
-    /// The timestamp of the next frame sent: the clock, and always newer than the last.
+    /// The timestamp of the next frame sent: the clock, and always newer than the last (until
+    /// the 48 bits run out, in 2104).
     pub fn next_timestamp(&mut self) -> u64 {
-        let t = self.timestamp().max(self.last_sent.saturating_add(1));
+        let t = self
+            .timestamp()
+            .max(self.last_sent.saturating_add(1))
+            .min(MAX_TIMESTAMP);
         self.last_sent = t;
         t
     }
@@ -173,9 +184,11 @@ impl Signing {
 
     /// `SETUP_SIGNING`: takes the key (all zero with a zero timestamp turns signing off). With
     /// signing on, only a correctly signed setup is taken (`signed_ok`), so nobody without the
-    /// key can replace it. Returns whether it was taken.
+    /// key can replace it. An initial timestamp no signature can carry (beyond 48 bits) is
+    /// refused: the clock would pass every timestamp a station can send, and every signed
+    /// frame, a new setup included, would be refused as a replay. Returns whether it was taken.
     pub fn setup(&mut self, d: &SETUP_SIGNING_DATA, signed_ok: bool) -> bool {
-        if self.key.is_some() && !signed_ok {
+        if (self.key.is_some() && !signed_ok) || d.initial_timestamp > MAX_TIMESTAMP {
             return false;
         }
         let off = d.secret_key.iter().all(|&b| b == 0) && d.initial_timestamp == 0;
@@ -295,5 +308,30 @@ mod tests {
         };
         assert!(s.setup(&off, true));
         assert_eq!(s.key(), None);
+    }
+
+    #[test]
+    fn a_setup_time_no_signature_can_carry_is_refused() {
+        // Taken, the clock would pass every 48-bit timestamp: each signed frame, a new
+        // setup included, would then be refused as a replay.
+        let mut s = Signing::default();
+        let far = SETUP_SIGNING_DATA {
+            initial_timestamp: MAX_TIMESTAMP + 1,
+            target_system: 1,
+            target_component: 1,
+            secret_key: [7; 32],
+        };
+        assert!(!s.setup(&far, false));
+        assert_eq!(s.key(), None);
+        let mut s = on(7, 1_000);
+        assert!(!s.setup(&far, true));
+        s.load(Some([7; 32]), u64::MAX);
+        assert!(s.timestamp() <= MAX_TIMESTAMP);
+        assert_eq!(s.admit(255, 190, &write(), signed(0, 2_000)), Ok(()));
+        // At the end of the 48 bits, the clock stops there instead of wrapping to 0.
+        let mut s = on(7, MAX_TIMESTAMP);
+        s.tick(10_000_000);
+        assert_eq!(s.timestamp(), MAX_TIMESTAMP);
+        assert_eq!(s.next_timestamp(), MAX_TIMESTAMP);
     }
 }

@@ -230,10 +230,18 @@ impl FrameParser {
     }
 
     fn consume(&mut self, n: usize) {
-        let n = n.min(self.len);
-        self.buf.copy_within(n..self.len, 0);
-        self.len = self.len.saturating_sub(n);
+        self.drop_front(n);
         self.skip_to_marker(0);
+    }
+
+    /// Forgets the first `n` bytes held (all of them when fewer are held).
+    fn drop_front(&mut self, n: usize) {
+        let len = self.len.min(self.buf.len());
+        let n = n.min(len);
+        if let Some(held) = self.buf.get_mut(..len) {
+            held.copy_within(n.., 0);
+        }
+        self.len = len.saturating_sub(n);
     }
 
     fn resync(&mut self) {
@@ -249,8 +257,7 @@ impl FrameParser {
             .find(|(_, &b)| b == STX_V1 || b == STX_V2)
             .map_or(self.len, |(i, _)| i);
         self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(start as u32);
-        self.buf.copy_within(start..self.len, 0);
-        self.len = self.len.saturating_sub(start);
+        self.drop_front(start);
     }
 
     fn note_sequence(&mut self, h: &MavHeader) {

@@ -24,3 +24,44 @@ pub const STANDARD_GRAVITY: f64 = 9.80665;
 pub const GRAVITY: f32 = STANDARD_GRAVITY as f32;
 /// Degrees per radian, in the board's float.
 pub const RAD2DEG: f32 = 180.0 / core::f32::consts::PI;
+
+/// `x` limited to `[lo, hi]`, as `f32::clamp`, without its panic: with bounds from parameters
+/// (inverted or NaN only if a check failed) the autopilot keeps flying. A NaN `x` stays NaN;
+/// with inverted bounds the result is `lo` below `lo`, else `hi` above `hi`; a NaN bound
+/// limits nothing.
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x < lo {
+        lo
+    } else if x > hi {
+        hi
+    } else {
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::clamp;
+
+    #[test]
+    fn clamp_is_f32_clamp_for_ordered_bounds_and_never_panics() {
+        for x in [
+            -3.0,
+            -1.0,
+            -0.5,
+            0.0,
+            0.5,
+            1.0,
+            3.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ] {
+            assert_eq!(clamp(x, -1.0, 1.0), x.clamp(-1.0, 1.0));
+        }
+        assert!(clamp(f32::NAN, -1.0, 1.0).is_nan());
+        assert_eq!(clamp(5.0, 1.0, -1.0), -1.0);
+        assert_eq!(clamp(-5.0, 1.0, -1.0), 1.0);
+        assert_eq!(clamp(5.0, f32::NAN, f32::NAN), 5.0);
+    }
+}

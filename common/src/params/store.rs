@@ -325,15 +325,14 @@ impl ParamStore {
             if stage.check(values).is_ok() {
                 continue;
             }
-            let names = || {
+            // The stage's records that were loaded (those its definitions refused are counted
+            // already).
+            let loaded = |r: &ParamRecord| {
                 (0..stage.len())
                     .filter_map(|i| stage.def(i))
-                    .map(|d| d.name)
+                    .any(|d| d.name == r.name.as_str() && d.check(r.value).is_ok())
             };
-            let refused = image
-                .iter()
-                .filter(|r| names().any(|n| n == r.name.as_str()))
-                .count() as u16;
+            let refused = image.iter().filter(|r| loaded(r)).count() as u16;
             report.loaded = report.loaded.saturating_sub(refused);
             report.rejected = report.rejected.saturating_add(refused);
             if let (Some(now), Some(was)) = (self.values.get_mut(range.clone()), before.get(range))

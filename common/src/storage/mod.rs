@@ -24,8 +24,12 @@
 
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::navigation::plan::MissionStore;
-use crate::params::store::{ImportReport, ParamExport, ParamImage, ParamStore};
+use crate::navigation::plan::{
+    MissionItem, MissionStore, FENCE_CAPACITY, MISSION_CAPACITY, RALLY_CAPACITY,
+};
+use crate::params::store::{
+    ImportReport, ParamExport, ParamImage, ParamRecord, ParamStore, MAX_PARAMS,
+};
 
 /// A flash device (or a model of one). Erased bytes read 0xFF; a write can only clear bits.
 pub trait Flash {
@@ -175,16 +179,42 @@ pub fn save<F: Flash, T: Serialize>(
     value: &T,
     scratch: &mut [u8],
 ) -> Result<u32, StorageError<F::Error>> {
+    save_keeping(flash, region, value, scratch, |_| true)
+}
+
+/// As [`save`], keeping the copy that loads: `decodes` says whether a payload loads as the
+/// record. When the newest intact copy does not (a format the firmware no longer reads) and
+/// the older one does, the save goes over the newest, so a power cut during it still leaves
+/// the copy [`load`] returns.
+fn save_keeping<F: Flash, T: Serialize>(
+    flash: &mut F,
+    region: &AbRegion,
+    value: &T,
+    scratch: &mut [u8],
+    decodes: impl Fn(&[u8]) -> bool,
+) -> Result<u32, StorageError<F::Error>> {
+    let [newest, older] = candidates(flash, region)?;
+    let mut keep = newest;
+    if let (Some((addr, h)), Some(_)) = (newest, older) {
+        let buf = scratch
+            .get_mut(..h.len as usize)
+            .ok_or(StorageError::TooLarge)?;
+        flash
+            .read(addr.saturating_add(HEADER_LEN), buf)
+            .map_err(StorageError::Flash)?;
+        if !decodes(buf) {
+            keep = older;
+        }
+    }
     let payload = postcard::to_slice(value, scratch).map_err(|_| StorageError::TooLarge)?;
     let len = payload.len() as u32;
     if len > region.slot_len.saturating_sub(HEADER_LEN) {
         return Err(StorageError::TooLarge);
     }
-    let [newest, _] = candidates(flash, region)?;
-    let (target, seq) = match newest {
-        Some((addr, h)) if addr == region.slot_a => (region.slot_b, h.seq.wrapping_add(1)),
-        Some((_, h)) => (region.slot_a, h.seq.wrapping_add(1)),
-        None => (region.slot_a, 1),
+    let seq = newest.map_or(1, |(_, h)| h.seq.wrapping_add(1));
+    let target = match keep {
+        Some((addr, _)) if addr == region.slot_a => region.slot_b,
+        _ => region.slot_a,
     };
     let mut crc = crc_any::CRCu32::crc32();
     crc.digest(&seq.to_le_bytes());
@@ -241,7 +271,8 @@ pub fn save_params<F: Flash>(
     store: &mut ParamStore,
     scratch: &mut [u8],
 ) -> Result<u32, StorageError<F::Error>> {
-    let seq = save(flash, region, &ParamExport(store), scratch)?;
+    let decodes = |b: &[u8]| postcard::from_bytes::<Walk<ParamRecord, MAX_PARAMS>>(b).is_ok();
+    let seq = save_keeping(flash, region, &ParamExport(store), scratch, decodes)?;
     store.mark_saved();
     Ok(seq)
 }
@@ -265,7 +296,44 @@ pub fn save_missions<F: Flash>(
     store: &MissionStore,
     scratch: &mut [u8],
 ) -> Result<u32, StorageError<F::Error>> {
-    save(flash, region, store, scratch)
+    let decodes = |b: &[u8]| postcard::from_bytes::<PlanWalk>(b).is_ok();
+    save_keeping(flash, region, store, scratch, decodes)
+}
+
+/// Decodes a sequence of at most `N` `E`s without keeping them: whether a record loads, in
+/// the stack of one element.
+struct Walk<E, const N: usize>(core::marker::PhantomData<E>);
+
+impl<'de, E: serde::Deserialize<'de>, const N: usize> serde::Deserialize<'de> for Walk<E, N> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_seq(Walk(core::marker::PhantomData))
+    }
+}
+
+impl<'de, E: serde::Deserialize<'de>, const N: usize> serde::de::Visitor<'de> for Walk<E, N> {
+    type Value = Self;
+    fn expecting(&self, f: &mut core::fmt::Formatter) -> core::fmt::Result {
+        write!(f, "at most {N} elements")
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut s: A) -> Result<Self, A::Error> {
+        for _ in 0..N {
+            if s.next_element::<E>()?.is_none() {
+                return Ok(self);
+            }
+        }
+        match s.next_element::<E>()? {
+            None => Ok(self),
+            Some(_) => Err(serde::de::Error::invalid_length(N.saturating_add(1), &self)),
+        }
+    }
+}
+
+/// [`MissionStore`]'s encoding, walked.
+#[derive(serde::Deserialize)]
+struct PlanWalk {
+    _mission: Walk<MissionItem, MISSION_CAPACITY>,
+    _fence: Walk<MissionItem, FENCE_CAPACITY>,
+    _rally: Walk<MissionItem, RALLY_CAPACITY>,
 }
 
 /// Loads the mission, fence and rally lists; `None` when nothing is saved.

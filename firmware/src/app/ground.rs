@@ -181,10 +181,11 @@ impl GroundPort {
                 *dropped = dropped.saturating_add(1);
             }
         });
-        for (dest, msg) in outgoing {
+        // By reference: a heapless vector's by-value iterator checks a slice bound on drop.
+        for &(dest, ref msg) in &outgoing {
             let raw = match msg {
-                Outgoing::Message(m) => tx.encode(&m),
-                Outgoing::Ack(a) => tx.encode_data(&a),
+                Outgoing::Message(m) => tx.encode(m),
+                Outgoing::Ack(a) => tx.encode_data(a),
             };
             // With signing on, every frame is signed; the link id says which channel.
             let link_id = match dest {
@@ -204,7 +205,7 @@ impl GroundPort {
                 Dest::Channel(c) => c,
             };
             let [lo, hi] = (frame.len() as u16).to_le_bytes();
-            let fits = buf.len() + 3 + frame.len() <= buf.capacity();
+            let fits = buf.len().saturating_add(3).saturating_add(frame.len()) <= buf.capacity();
             if !fits
                 || buf.extend_from_slice(&[tag, lo, hi]).is_err()
                 || buf.extend_from_slice(frame).is_err()

@@ -182,6 +182,10 @@ pub fn parse_plan(text: &str, file: &Path) -> Result<MissionFile, MissionFileErr
         let mut p = [None; 7];
         for (k, v) in params.iter().enumerate() {
             p[k] = cx.nullable(v, &format!("{ppath}[{k}]"))?;
+            // The item's fields are 32-bit floats: a larger number would become an infinity.
+            if let Some(x) = p[k].filter(|x| x.abs() > f64::from(f32::MAX)) {
+                return Err(cx.bad(&format!("{ppath}[{k}]"), x, "too large for a 32-bit float"));
+            }
         }
         let f32_or_nan = |v: Option<f64>| v.map_or(f32::NAN, |x| x as f32);
         let x = cx.coord(p[4], frame, Coord::Latitude, &format!("{ppath}[4]"))?;
@@ -291,7 +295,7 @@ pub fn parse_plan(text: &str, file: &Path) -> Result<MissionFile, MissionFileErr
                 )?;
                 let rkey = join(&cpath, "radius");
                 let radius = cx.number(cx.field(circle, "radius", &cpath)?, &rkey)?;
-                if !(radius > 0.0 && radius.is_finite()) {
+                if !(radius > 0.0 && radius <= f64::from(f32::MAX)) {
                     return Err(cx.bad(&rkey, radius, "must be a positive distance in m"));
                 }
                 let command = if inclusion {
@@ -317,6 +321,10 @@ pub fn parse_plan(text: &str, file: &Path) -> Result<MissionFile, MissionFileErr
         if let Some(points) = rp.get("points") {
             for (i, v) in cx.array(points, "rallyPoints.points")?.iter().enumerate() {
                 let p = cx.position(v, &format!("rallyPoints.points[{i}]"), 3)?;
+                if p[2].abs() > f64::from(f32::MAX) {
+                    let key = format!("rallyPoints.points[{i}][2]");
+                    return Err(cx.bad(&key, p[2], "too large for a 32-bit float"));
+                }
                 let g = GeoPoint::from_deg(p[0], p[1]);
                 rally.push(item(
                     rally.len(),

@@ -62,6 +62,10 @@ pub fn parse_wpl(text: &str, file: &Path) -> Result<MissionFile, MissionFileErro
             v[c] = s
                 .parse::<f64>()
                 .map_err(|_| cx.bad(&key(c), format!("{s:?}"), "not a number"))?;
+            // The item's fields are 32-bit floats: a larger number would become an infinity.
+            if v[c].is_finite() && v[c].abs() > f64::from(f32::MAX) {
+                return Err(cx.bad(&key(c), s, "too large for a 32-bit float"));
+            }
         }
         if v[0] != expected_index as f64 {
             return Err(cx.bad(

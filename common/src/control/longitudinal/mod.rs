@@ -26,7 +26,7 @@ use super::filters::LowPass;
 use super::inputs::{InputFlags, Measurements};
 use super::pid::{Bumpless, Derivative, Pid, PidGains};
 use crate::actuators::SURFACE_LIMIT_RAD;
-use crate::math::wrap_pi;
+use crate::math::{clamp, wrap_pi};
 
 pub use gains::{LongitudinalGains, PARAMS, THESIS};
 pub use regime::{Regime, RegimeMachine};
@@ -317,7 +317,11 @@ impl Longitudinal {
                 // the altitude command.
                 let ratio = climb_rate / airspeed;
                 if ratio.is_finite() {
-                    pitch_ff = libm::asinf(ratio.clamp(-1.0, 1.0)).clamp(-g.pitch_max, g.pitch_max);
+                    pitch_ff = clamp(
+                        libm::asinf(ratio.clamp(-1.0, 1.0)),
+                        -g.pitch_max,
+                        g.pitch_max,
+                    );
                 }
                 (altitude, airspeed, None)
             }
@@ -453,7 +457,7 @@ impl Longitudinal {
             }
         }
         let theta_c = match src {
-            PitchSource::Fixed(v) => v.clamp(-g.pitch_max, g.pitch_max),
+            PitchSource::Fixed(v) => clamp(v, -g.pitch_max, g.pitch_max),
             // Both outer loops were designed about the trim: their output is added to it.
             PitchSource::Airspeed(v) => {
                 self.aspd_pitch
@@ -505,7 +509,7 @@ impl Longitudinal {
         self.throttle = match src {
             ThrottleSource::Fixed(v) => {
                 self.aspd_thr.reset();
-                v.clamp(g.throttle_min, g.throttle_max)
+                clamp(v, g.throttle_min, g.throttle_max)
             }
             ThrottleSource::Airspeed(v) => {
                 if self.thr_src != kind || self.thr_resume {

@@ -20,7 +20,7 @@ use crate::control::autopilot::Commands;
 use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::guidance::Path;
-use crate::math::DEG;
+use crate::math::{clamp, DEG};
 use nalgebra::Vector3;
 
 /// Largest height the approach's integral may add to or take off the glide slope, m, and the
@@ -238,7 +238,7 @@ impl Landing {
                 let pitch = if self.touched {
                     0.0
                 } else if sink.is_finite() {
-                    (p.flare_pitch + p.flare_k * (sink - aim)).clamp(floor, 15.0 * DEG)
+                    clamp(p.flare_pitch + p.flare_k * (sink - aim), floor, 15.0 * DEG)
                 } else {
                     p.flare_pitch
                 };
