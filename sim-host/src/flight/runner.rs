@@ -10,13 +10,16 @@ use crate::analysis::trim::{trim_with, TrimTarget};
 use crate::environment::wind::Wind;
 use crate::link::lockstep::{LinkError, Lockstep};
 use crate::link::transport::Transport;
+use crate::plant::battery::Battery;
 use crate::plant::inputs::{Controls, Environment};
 use crate::plant::params::ModelParams;
 use crate::plant::propulsion::motor_power_w;
 use crate::plant::servo::ServoBank;
 use crate::plant::Plant;
 use crate::sensors::models::{SensorSuite, Truth};
-use common::link::simlink::{encode_hil_gps, encode_hil_sensor, encode_rc_channels};
+use common::link::simlink::{
+    encode_battery_status, encode_hil_gps, encode_hil_sensor, encode_rc_channels,
+};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
 use common::math::ned_to_body;
@@ -125,6 +128,8 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         }
     };
     let mut servos = ServoBank::new(&aircraft.actuators, &trim_controls);
+    // Powered up with the avionics; the motor draws what the plant's throttle asks.
+    let mut battery = Battery::new(&aircraft.battery);
     let mut wind = Wind::new(Vector3::from(cfg.wind_ned), cfg.turbulence, cfg.seed);
     let q0 = plant.attitude();
     let env0 = Environment {
@@ -182,6 +187,10 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         if let Some(f) = fix {
             msgs.push(MavMessage::HIL_GPS(encode_hil_gps(time_us, &f)));
         }
+        let pack = battery.output();
+        if let Some(b) = sensors.sample_battery(time_us, pack.voltage_v, pack.current_a) {
+            msgs.push(MavMessage::BATTERY_STATUS(encode_battery_status(&b)));
+        }
         if k % 2 == 0 {
             if let Some(r) = cfg.rc_sticks.iter().rev().find(|r| r.from_s <= t_s) {
                 msgs.push(MavMessage::RC_CHANNELS(encode_rc_channels(
@@ -220,25 +229,32 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             // The safety pilot holds the trim until the autopilot is armed.
             trim_controls
         };
-        let view = onboard.with_app(link, |app| {
+        let (view, monitor) = onboard.with_app(link, |app| {
             let e = app.estimate();
             let nav = NavView::of(app.navigation(), app.mode().needs_navigator(), &e.pos_ned);
-            (app.estimate(), app.setpoints(), app.mode(), nav)
+            let monitor = app.vehicle().battery();
+            (
+                (app.estimate(), app.setpoints(), app.mode(), nav),
+                monitor.present.then_some(monitor.remaining),
+            )
         });
-        samples.push(Sample::new(
-            t_s,
-            &truth,
-            alt_amsl,
-            &env.wind_ned,
-            &Vector3::from(cfg.wind_ned),
-            &view.0,
-            ned_offset::<f64>(home, view.0.position),
-            &view.1,
-            view.2,
-            answer.armed,
-            &answer.surfaces,
-            &view.3,
-        ));
+        samples.push(
+            Sample::new(
+                t_s,
+                &truth,
+                alt_amsl,
+                &env.wind_ned,
+                &Vector3::from(cfg.wind_ned),
+                &view.0,
+                ned_offset::<f64>(home, view.0.position),
+                &view.1,
+                view.2,
+                answer.armed,
+                &answer.surfaces,
+                &view.3,
+            )
+            .with_battery(&battery, monitor),
+        );
         if landed {
             // The frame that disarmed is logged; the stations read what came with it.
             gcs.poll(t_s, link, onboard);
@@ -253,6 +269,8 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         for _ in 0..substeps {
             let seen = servos.step(&command, dt);
             plant.step(&seen, &env, dt);
+            let shaft_w = motor_power_w(&params, seen.throttle);
+            battery.step(battery.electrical_power_w(shaft_w), dt);
         }
         let q = plant.attitude();
         env.wind_ned = wind.step(frame_s, plant.air_data().va, -plant.position_ned().z, &q);

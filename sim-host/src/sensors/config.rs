@@ -38,6 +38,31 @@ impl Default for GpsConfig {
     }
 }
 
+/// The flight battery's power monitor (voltage and current), sent as `BATTERY_STATUS`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BatteryMonitorConfig {
+    /// Rate, Hz.
+    pub rate_hz: f64,
+    /// Voltage noise (1 sigma), V.
+    #[serde(rename = "voltage_sigma_V")]
+    pub voltage_sigma_v: f64,
+    /// Current noise (1 sigma), A.
+    #[serde(rename = "current_sigma_A")]
+    pub current_sigma_a: f64,
+}
+
+impl Default for BatteryMonitorConfig {
+    fn default() -> Self {
+        // Not in the UMN sensor library: a typical analog power module's noise.
+        Self {
+            rate_hz: 10.0,
+            voltage_sigma_v: 0.02,
+            current_sigma_a: 0.1,
+        }
+    }
+}
+
 /// Every sensor's rate and noise.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -73,6 +98,8 @@ pub struct SensorConfig {
     pub pd_noise_power_kpa: f64,
     /// GPS receiver.
     pub gps: GpsConfig,
+    /// The battery's power monitor.
+    pub battery: BatteryMonitorConfig,
 }
 
 impl Default for SensorConfig {
@@ -93,6 +120,7 @@ impl Default for SensorConfig {
             pitot_rate_hz: 50.0,
             pd_noise_power_kpa: 1.5e-7,
             gps: GpsConfig::default(),
+            battery: BatteryMonitorConfig::default(),
         }
     }
 }
@@ -113,6 +141,7 @@ impl SensorConfig {
             ("baro_rate_hz", self.baro_rate_hz),
             ("pitot_rate_hz", self.pitot_rate_hz),
             ("gps.rate_hz", self.gps.rate_hz),
+            ("battery.rate_hz", self.battery.rate_hz),
         ];
         for (k, v) in rates {
             if !v.is_finite() || v <= 0.0 || v > self.imu_rate_hz {
@@ -132,6 +161,8 @@ impl SensorConfig {
             ("gps.vel_mps", self.gps.vel_mps),
             ("gps.latency_s", self.gps.latency_s),
             ("gps.hdop", self.gps.hdop),
+            ("battery.voltage_sigma_V", self.battery.voltage_sigma_v),
+            ("battery.current_sigma_A", self.battery.current_sigma_a),
         ];
         for (k, v) in scalars {
             if !v.is_finite() || v < 0.0 {
