@@ -132,6 +132,10 @@ pub(crate) enum Command {
         #[command(flatten)]
         out: Output,
     },
+    /// A Monte Carlo campaign: N flights of a mission, each with its own draw of the
+    /// aircraft's model, its sensors, the wind and the runway, judged by named criteria;
+    /// `--shard I/N` flies a part of it, `merge` joins the parts.
+    Campaign(crate::cli_campaign::CampaignCli),
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.

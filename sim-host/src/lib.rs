@@ -7,6 +7,7 @@
 //! - [`flight`]: firmware in the loop: the plant flown by the autopilot over the link, a
 //!   scripted ground station, the flight log and its figures;
 //! - [`link`]: the simulator end of PX4's simulator MAVLink interface, in lock-step;
+//! - [`campaign`]: Monte Carlo campaigns of dispersed flights, their verdicts and report;
 //! - [`analysis`]: trim, linearisation, transfer functions, the linear-versus-nonlinear
 //!   doublet check of the thesis, and linear-systems tools;
 //! - [`mission_file`]: QGroundControl `.plan` and `QGC WPL 110` mission files, read into
@@ -17,6 +18,7 @@
 
 pub mod aircraft;
 pub mod analysis;
+pub mod campaign;
 pub mod commands;
 pub mod environment;
 pub mod flight;

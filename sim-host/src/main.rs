@@ -1,6 +1,7 @@
 //! `sim-host`: the Ultra Stick 25e simulator and the thesis's analysis commands.
 
 mod cli;
+mod cli_campaign;
 
 use anyhow::Context;
 use clap::Parser;
@@ -151,6 +152,9 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Fly(args)) => fly_command(&aircraft, args),
+        Some(Command::Campaign(c)) => {
+            cli_campaign::campaign_command(&aircraft, cli.aircraft.as_deref(), c, emit)
+        }
         Some(Command::Navigation { out, img, results }) => {
             let existing = std::fs::read_to_string(&out).ok();
             let command = format!(

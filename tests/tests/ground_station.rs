@@ -605,3 +605,28 @@ fn pymavlink_gets_protocol_version_chunked_texts_param_errors_and_metadata_over_
     // decoding are independent of this project's): see the script's docstring for the checks.
     pymavlink_script("pymavlink_parity.py");
 }
+
+#[test]
+fn the_shipped_pymavlink_mode_map_names_every_mode_by_its_word() {
+    // docs/pymavlink/custom_mode_map.json is what a pymavlink or MAVProxy user copies to
+    // ~/.pymavlink/: MAV_TYPE 1 (fixed wing), each heartbeat word to the mode's name.
+    let path = system_tests::workspace_root().join("docs/pymavlink/custom_mode_map.json");
+    let text = std::fs::read_to_string(&path).expect("the map is in the repository");
+    let map: std::collections::BTreeMap<String, std::collections::BTreeMap<String, String>> =
+        serde_json::from_str(&text).expect("the map is JSON of pymavlink's shape");
+    let fixed_wing = &map["1"];
+    assert_eq!(fixed_wing.len(), common::gcs::modes::FlightMode::ALL.len());
+    for m in common::gcs::modes::FlightMode::ALL {
+        assert_eq!(
+            fixed_wing.get(&m.custom_mode().to_string()),
+            Some(&m.name().to_uppercase()),
+            "{m:?}"
+        );
+    }
+}
+
+#[test]
+fn pymavlink_names_and_sets_every_mode_with_the_shipped_mode_map() {
+    // pymavlink's own heartbeat decoding and set_mode (see the script's docstring).
+    pymavlink_script("pymavlink_modes.py");
+}

@@ -37,10 +37,9 @@ impl GroundLink {
                     );
                     MavResult::MAV_RESULT_DENIED
                 } else {
-                    let (main, sub) = (c.p[1] as u8, c.p[2] as u8);
-                    match FlightMode::from_px4(main, sub) {
-                        Some(m) => self.request_mode(m, v, stores.plan),
-                        None => self.unknown_mode((u32::from(main) << 16) | (u32::from(sub) << 24)),
+                    match FlightMode::from_set_mode_params(c.p[1], c.p[2]) {
+                        Ok(m) => self.request_mode(m, v, stores.plan),
+                        Err(word) => self.unknown_mode(word),
                     }
                 }
             }

@@ -964,7 +964,11 @@ fn available_and_current_modes() {
         })
         .unwrap();
     assert_eq!(cm.custom_mode, px4(4, 3));
-    assert_eq!(cm.standard_mode, MavStandardMode::MAV_STANDARD_MODE_ORBIT);
+    // Loiter is no standard ORBIT (a manual orbit the standard defines), as on PX4.
+    assert_eq!(
+        cm.standard_mode,
+        MavStandardMode::MAV_STANDARD_MODE_NON_STANDARD
+    );
 }
 
 // ---------------------------------------------------------------- telemetry scheduler

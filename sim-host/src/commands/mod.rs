@@ -1,6 +1,7 @@
 //! The analysis commands as library functions: each returns its results (for `--json` and for
 //! tests) and the tables it prints, so the CLI only chooses the output form.
 
+pub mod campaign;
 pub mod design;
 pub mod doublet;
 pub mod fly;

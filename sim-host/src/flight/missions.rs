@@ -59,6 +59,20 @@ impl MissionBuilder {
         )
     }
 
+    /// A landing at `(north_m, east_m)` on the ground at home's height, along the line from
+    /// the item before.
+    pub fn land(self, north_m: f64, east_m: f64) -> Self {
+        self.item(
+            MavCmd::MAV_CMD_NAV_LAND,
+            [0.0, 0.0, 0.0, f32::NAN],
+            Some(Spot {
+                north_m,
+                east_m,
+                height_m: 0.0,
+            }),
+        )
+    }
+
     /// The items.
     pub fn build(self) -> Vec<MISSION_ITEM_INT_DATA> {
         self.items
@@ -163,15 +177,7 @@ pub fn default_mission(home: GeoPoint) -> Vec<MISSION_ITEM_INT_DATA> {
         .waypoint(300.0, -150.0, 40.0)
         .waypoint(-450.0, -150.0, 40.0)
         .waypoint(-450.0, 0.0, 40.0)
-        .item(
-            MavCmd::MAV_CMD_NAV_LAND,
-            [0.0, 0.0, 0.0, f32::NAN],
-            Some(Spot {
-                north_m: 0.0,
-                east_m: 0.0,
-                height_m: 0.0,
-            }),
-        )
+        .land(0.0, 0.0)
         .build()
 }
 

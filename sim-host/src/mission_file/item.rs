@@ -93,7 +93,7 @@ pub(super) fn item(
 
 /// Whether `frame` carries latitude/longitude in x/y.
 #[allow(deprecated)]
-fn is_global(frame: MavFrame) -> bool {
+pub fn is_global(frame: MavFrame) -> bool {
     matches!(
         frame,
         MavFrame::MAV_FRAME_GLOBAL

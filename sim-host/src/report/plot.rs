@@ -7,11 +7,13 @@ use plotters::style::{register_font, FontStyle};
 use std::path::Path;
 use std::sync::Once;
 
-const FONT: &str = "sans-serif";
+/// The family name the bundled font is registered under.
+pub(crate) const FONT: &str = "sans-serif";
 static FONT_BYTES: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
-fn ensure_font() {
+/// Registers the bundled font once, before any text is drawn.
+pub(crate) fn ensure_font() {
     REGISTER.call_once(|| {
         // The font is compiled in and known to be valid; a failure would only cost the labels.
         let _ = register_font(FONT, FontStyle::Normal, FONT_BYTES);

@@ -20,6 +20,29 @@ pub struct GpsConfig {
     pub satellites: u8,
     /// Horizontal dilution of precision reported.
     pub hdop: f64,
+    /// Position error of the first fixes after power-up, NED, m: a receiver's solution
+    /// converges over a minute or two after a cold start, so the autopilot's home and
+    /// initial position are off by about this much. Decays with `startup_tau_s`.
+    #[serde(default, skip_serializing_if = "is_zero3")]
+    pub startup_offset_m: [f64; 3],
+    /// Time constant of that convergence, s.
+    #[serde(
+        default = "default_startup_tau",
+        skip_serializing_if = "is_default_tau"
+    )]
+    pub startup_tau_s: f64,
+}
+
+fn default_startup_tau() -> f64 {
+    60.0
+}
+
+fn is_default_tau(v: &f64) -> bool {
+    *v == default_startup_tau()
+}
+
+fn is_zero3(v: &[f64; 3]) -> bool {
+    *v == [0.0; 3]
 }
 
 impl Default for GpsConfig {
@@ -34,6 +57,8 @@ impl Default for GpsConfig {
             latency_s: 0.12,
             satellites: 12,
             hdop: 0.8,
+            startup_offset_m: [0.0; 3],
+            startup_tau_s: default_startup_tau(),
         }
     }
 }
@@ -100,6 +125,47 @@ pub struct SensorConfig {
     pub gps: GpsConfig,
     /// The battery's power monitor.
     pub battery: BatteryMonitorConfig,
+    /// Calibration errors (scale factors, hard iron, pitot offset): none unless the file
+    /// has a `[sensors.calibration]` table. Monte Carlo campaigns draw them per flight.
+    #[serde(default, skip_serializing_if = "Calibration::is_ideal")]
+    pub calibration: Calibration,
+}
+
+/// What a sensor's calibration leaves: each reading is `scale * truth + offset` before noise
+/// and bias. The default is a perfect calibration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Calibration {
+    /// Gyro scale factor per axis (1: exact).
+    pub gyro_scale: [f64; 3],
+    /// Accelerometer scale factor per axis (1: exact).
+    pub accel_scale: [f64; 3],
+    /// Magnetometer hard-iron offset, body axes, gauss.
+    pub mag_offset_gauss: [f64; 3],
+    /// Differential-pressure scale factor (pitot position error and sensor gain; 1: exact).
+    pub pitot_scale: f64,
+    /// Differential-pressure zero offset, Pa.
+    #[serde(rename = "pitot_offset_Pa")]
+    pub pitot_offset_pa: f64,
+}
+
+impl Default for Calibration {
+    fn default() -> Self {
+        Self {
+            gyro_scale: [1.0; 3],
+            accel_scale: [1.0; 3],
+            mag_offset_gauss: [0.0; 3],
+            pitot_scale: 1.0,
+            pitot_offset_pa: 0.0,
+        }
+    }
+}
+
+impl Calibration {
+    /// True for a perfect calibration (what an aircraft file without the table means).
+    pub fn is_ideal(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 impl Default for SensorConfig {
@@ -121,6 +187,7 @@ impl Default for SensorConfig {
             pd_noise_power_kpa: 1.5e-7,
             gps: GpsConfig::default(),
             battery: BatteryMonitorConfig::default(),
+            calibration: Calibration::default(),
         }
     }
 }
@@ -163,6 +230,8 @@ impl SensorConfig {
             ("gps.hdop", self.gps.hdop),
             ("battery.voltage_sigma_V", self.battery.voltage_sigma_v),
             ("battery.current_sigma_A", self.battery.current_sigma_a),
+            ("gps.startup_tau_s", self.gps.startup_tau_s),
+            ("calibration.pitot_scale", self.calibration.pitot_scale),
         ];
         for (k, v) in scalars {
             if !v.is_finite() || v < 0.0 {
@@ -191,11 +260,25 @@ impl SensorConfig {
             ("gyro_bias_radps", self.gyro_bias_radps),
             ("accel_bias_mps2", self.accel_bias_mps2),
             ("mag_field_ned_gauss", self.mag_field_ned_gauss),
+            ("gps.startup_offset_m", self.gps.startup_offset_m),
+            ("calibration.gyro_scale", self.calibration.gyro_scale),
+            ("calibration.accel_scale", self.calibration.accel_scale),
+            (
+                "calibration.mag_offset_gauss",
+                self.calibration.mag_offset_gauss,
+            ),
         ];
         for (k, v) in finite {
             if v.iter().any(|x| !x.is_finite()) {
                 return Err((format!("sensors.{k}"), format!("{v:?}"), "must be finite"));
             }
+        }
+        if !self.calibration.pitot_offset_pa.is_finite() {
+            return Err((
+                "sensors.calibration.pitot_offset_Pa".into(),
+                self.calibration.pitot_offset_pa.to_string(),
+                "must be finite",
+            ));
         }
         Ok(())
     }

@@ -158,8 +158,13 @@ impl SensorSuite {
         self.gyro_bias += gauss3(&mut self.rng_imu, [walk; 3]);
         let gyro_sigma = cfg.gyro_noise_power.map(|p| sigma(p, ts));
         let accel_sigma = cfg.accel_noise_power.map(|p| sigma(p, ts));
-        let gyro = t.omega_body + self.gyro_bias + gauss3(&mut self.rng_imu, gyro_sigma);
-        let accel = t.specific_force_body
+        let cal = &cfg.calibration;
+        let gyro = t.omega_body.component_mul(&Vector3::from(cal.gyro_scale))
+            + self.gyro_bias
+            + gauss3(&mut self.rng_imu, gyro_sigma);
+        let accel = t
+            .specific_force_body
+            .component_mul(&Vector3::from(cal.accel_scale))
             + Vector3::from(cfg.accel_bias_mps2)
             + gauss3(&mut self.rng_imu, accel_sigma);
         let mut out = SensorFrame {
@@ -179,6 +184,7 @@ impl SensorSuite {
             let ts = n as f64 / fr;
             let s = cfg.mag_noise_power_nt.map(|p| sigma(p, ts) * 1e-5);
             let field = ned_to_body(&t.attitude, &Vector3::from(cfg.mag_field_ned_gauss))
+                + Vector3::from(cfg.calibration.mag_offset_gauss)
                 + gauss3(&mut self.rng_mag, s);
             out.mag = Some(MagSample {
                 field: field.cast(),
@@ -198,8 +204,9 @@ impl SensorSuite {
             let ts = n as f64 / fr;
             let noise_pa = sigma(cfg.pd_noise_power_kpa, ts) * 1e3 * gauss(&mut self.rng_pitot);
             let q = 0.5 * air.density * t.airspeed_mps * t.airspeed_mps;
+            let cal = &cfg.calibration;
             out.pitot = Some(PitotSample {
-                diff_pressure_pa: (q + noise_pa) as f32,
+                diff_pressure_pa: (cal.pitot_scale * q + cal.pitot_offset_pa + noise_pa) as f32,
             });
         }
 
@@ -207,7 +214,15 @@ impl SensorSuite {
         let g = &cfg.gps;
         let n = decimation(fr, g.rate_hz);
         if frame.is_multiple_of(n) {
-            let p = t.pos_ned + gauss3(&mut self.rng_gps, [g.horiz_m, g.horiz_m, g.vert_m]);
+            // The receiver's start-up error fades as its solution converges.
+            let startup = if g.startup_tau_s > 0.0 {
+                Vector3::from(g.startup_offset_m)
+                    * (-(time_us as f64 * 1e-6) / g.startup_tau_s).exp()
+            } else {
+                Vector3::zeros()
+            };
+            let p =
+                t.pos_ned + startup + gauss3(&mut self.rng_gps, [g.horiz_m, g.horiz_m, g.vert_m]);
             let v = t.vel_ned + gauss3(&mut self.rng_gps, [g.vel_mps; 3]);
             let fix = GpsFix {
                 position: offset_point(self.home, p.x, p.y),
@@ -233,6 +248,7 @@ impl SensorSuite {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use common::math::geodetic::ned_offset;
 
     fn level_truth() -> Truth {
         Truth {
@@ -299,6 +315,52 @@ mod tests {
         assert!(times.len() >= 24);
         let mean = alts.iter().sum::<f32>() / alts.len() as f32;
         assert!((mean - 350.0).abs() < 3.0, "GPS altitude {mean}");
+    }
+
+    #[test]
+    fn calibration_errors_scale_and_offset_the_readings_and_the_gps_start_up_offset_fades() {
+        // Noise and bias off, to read the calibration alone.
+        let mut cfg = SensorConfig {
+            gyro_noise_power: [0.0; 3],
+            accel_noise_power: [0.0; 3],
+            gyro_bias_radps: [0.0; 3],
+            gyro_bias_walk: 0.0,
+            accel_bias_mps2: [0.0; 3],
+            pd_noise_power_kpa: 0.0,
+            ..SensorConfig::default()
+        };
+        cfg.gps.horiz_m = 0.0;
+        cfg.gps.vert_m = 0.0;
+        cfg.gps.latency_s = 0.0;
+        cfg.calibration.accel_scale = [1.0, 1.0, 1.02];
+        cfg.calibration.gyro_scale = [1.1, 1.0, 1.0];
+        cfg.calibration.pitot_scale = 0.9;
+        cfg.calibration.pitot_offset_pa = 2.0;
+        cfg.gps.startup_offset_m = [4.0, 0.0, 0.0];
+        cfg.gps.startup_tau_s = 10.0;
+        let mut s = SensorSuite::new(cfg, GeoPoint::from_deg(44.7, -93.0), 0.0, 3);
+        let t = Truth {
+            omega_body: Vector3::new(0.1, 0.0, 0.0),
+            ..level_truth()
+        };
+        let (f, fix) = s.sample(&t);
+        let imu = f.imu.unwrap();
+        assert!((f64::from(imu.accel.z) + 9.8056 * 1.02).abs() < 1e-4);
+        assert!((f64::from(imu.gyro.x) - 0.11).abs() < 1e-6);
+        // 0.9 * 175.32 Pa + 2 Pa.
+        let dp = f64::from(f.pitot.unwrap().diff_pressure_pa);
+        assert!((dp - (0.9 * 175.32 + 2.0)).abs() < 0.05, "{dp}");
+        let north =
+            |fix: GpsFix| ned_offset::<f64>(GeoPoint::from_deg(44.7, -93.0), fix.position).0;
+        assert!((north(fix.unwrap()) - 4.0).abs() < 0.02);
+        // 10 s later, one time constant: 4/e.
+        let mut last = None;
+        for _ in 0..1000 {
+            if let (_, Some(x)) = s.sample(&t) {
+                last = Some(x);
+            }
+        }
+        assert!((north(last.unwrap()) - 4.0 / std::f64::consts::E).abs() < 0.05);
     }
 
     #[test]

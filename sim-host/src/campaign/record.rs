@@ -1,0 +1,531 @@
+//! One flight of a campaign: flown in-process, its figures and facts read from the log, the
+//! summary and the autopilot's own state at the end, judged, and written as one JSON line.
+
+use super::draws::Quantities;
+use super::mission::Landing;
+use super::verdict::{judge, Facts, Verdict};
+use crate::aircraft::Aircraft;
+use crate::flight::config::FlightConfig;
+use crate::flight::onboard::InprocOnboard;
+use crate::flight::record::Sample;
+use crate::flight::runner::{fly, FlightOutcome};
+use crate::link::lockstep::Lockstep;
+use crate::link::transport::Inproc;
+use common::math::{wrap_pi, Euler};
+use common::vehicle::snapshot::LandedState;
+use firmware::app::App;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// The figures of one flight. `None` (JSON `null`): not measured, e.g. no touchdown.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Figures {
+    /// Simulated time, s.
+    pub sim_s: Option<f64>,
+    /// Armed time, s.
+    pub flight_time_s: Option<f64>,
+    /// Motor energy, Wh.
+    pub energy_wh: Option<f64>,
+    /// Charge drawn from the flight pack, mAh.
+    pub battery_mah: Option<f64>,
+    /// Lowest voltage of the flight pack, V.
+    pub battery_min_v: Option<f64>,
+    /// Charge left in the flight pack at the end, %.
+    pub battery_left_pct: Option<f64>,
+    /// Navigation items reached.
+    pub items_reached: Option<f64>,
+    /// Navigation items of the mission.
+    pub items: Option<f64>,
+    /// Cross-track error on straight legs, RMS, m.
+    pub xtrack_rms_m: Option<f64>,
+    /// Largest cross-track error on straight legs, m.
+    pub xtrack_max_m: Option<f64>,
+    /// Cross-track error on loiter circles, RMS, m.
+    pub orbit_xtrack_rms_m: Option<f64>,
+    /// Altitude error, RMS, m.
+    pub alt_rms_m: Option<f64>,
+    /// Airspeed error, RMS, m/s.
+    pub airspeed_rms_mps: Option<f64>,
+    /// Touchdown distance from the landing point, m.
+    pub touchdown_m: Option<f64>,
+    /// Touchdown along the approach from the landing point (positive: past it), m.
+    pub touchdown_along_m: Option<f64>,
+    /// Touchdown across the approach (positive: right of it), m.
+    pub touchdown_cross_m: Option<f64>,
+    /// Sink rate at touchdown, m/s.
+    pub sink_mps: Option<f64>,
+    /// Ground speed at touchdown, m/s.
+    pub touchdown_ground_speed_mps: Option<f64>,
+    /// Bounces after the first contact.
+    pub bounces: Option<f64>,
+    /// Largest |bank| while armed, deg.
+    pub max_bank_deg: Option<f64>,
+    /// Largest |pitch| while armed, deg.
+    pub max_pitch_deg: Option<f64>,
+    /// Smallest clearance of a non-wheel point while armed, m.
+    pub min_clearance_m: Option<f64>,
+    /// Which point that was.
+    pub min_clearance_point: Option<String>,
+    /// When, s of simulated time.
+    pub min_clearance_t_s: Option<f64>,
+    /// The navigator's phase then.
+    pub min_clearance_phase: Option<String>,
+    /// When bank or pitch first went beyond the loss-of-control limits, s.
+    pub loss_of_control_t_s: Option<f64>,
+    /// The navigator's phase then.
+    pub loss_of_control_phase: Option<String>,
+    /// Time of the landing's first contact, s.
+    pub touchdown_t_s: Option<f64>,
+    /// Horizontal position error of the estimate at arming, m.
+    pub est_position_error_at_arm_m: Option<f64>,
+    /// Altitude error of the estimate at arming, m.
+    pub est_alt_error_at_arm_m: Option<f64>,
+    /// Heading error of the estimate at arming, deg.
+    pub est_heading_error_at_arm_deg: Option<f64>,
+    /// Heading error of the estimate 30 s after convergence to the end, RMS, deg.
+    pub est_heading_rms_deg: Option<f64>,
+    /// The autopilot's landed state at the end.
+    pub landed_state: Option<String>,
+    /// The autopilot armed at the end.
+    pub armed_at_end: Option<bool>,
+    /// Failsafes raised (their STATUSTEXT).
+    pub failsafes: Vec<String>,
+    /// Why the flight did not run to its end.
+    pub error: Option<String>,
+}
+
+/// One line of a campaign's `flights.jsonl`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FlightRecord {
+    /// Index of the flight in the campaign.
+    pub index: u64,
+    /// Seed of its sensor noise and turbulence.
+    pub flight_seed: u64,
+    /// Every dispersed quantity as drawn (factors for spreads, values otherwise), then the
+    /// quantities that follow from them (`derived.*`).
+    pub draws: Quantities,
+    /// What the flight did.
+    pub figures: Figures,
+    /// The criteria.
+    pub verdict: Verdict,
+    /// The command that flies it again, with its log and plots.
+    pub reproduce: String,
+}
+
+/// A JSON number for a figure: `None` unless finite (JSON has no NaN).
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// A non-wheel point of the airframe, from the CG in body axes, named for the report.
+#[derive(Clone, Debug, PartialEq)]
+struct Point {
+    name: String,
+    body: Vector3<f64>,
+    /// Extra reach below the point whatever the attitude's roll (the propeller disc's radius,
+    /// in the body y-z plane).
+    disc_radius: f64,
+}
+
+/// The points that must never touch: every belly point of the aircraft file and the lowest
+/// point of the propeller disc, whose hub is at `propeller_hub_m` from the CG.
+fn strike_points(a: &Aircraft, propeller_hub_m: [f64; 3]) -> Vec<Point> {
+    let half_span = 0.5 * a.geometry.b_m;
+    let mut v: Vec<Point> = a
+        .ground
+        .belly_points_m
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let what = if p[1].abs() > 0.5 * half_span {
+                if p[1] < 0.0 {
+                    "left wing tip"
+                } else {
+                    "right wing tip"
+                }
+            } else if p[0] > 0.15 {
+                "nose"
+            } else if p[0] < -0.2 {
+                "tail"
+            } else {
+                "fuselage"
+            };
+            Point {
+                name: format!("{what} (belly_points_m[{i}])"),
+                body: Vector3::from(*p),
+                disc_radius: 0.0,
+            }
+        })
+        .collect();
+    v.push(Point {
+        name: "propeller".into(),
+        body: Vector3::from(propeller_hub_m),
+        disc_radius: a.propulsion.prop_radius_m,
+    });
+    v
+}
+
+/// Where the propeller's hub is, from the CG in body axes, m. The aircraft file's
+/// `prop_arm_from_cg_m` is the UMN model's: only its z acts (the thrust is along x), and its x
+/// is the difference of the UMN station coordinates, which grow aft. The Ultra Stick is a
+/// tractor, so the hub is that far ahead of the CG; a shift `cg_shift_m` of the CG moves it
+/// back by as much.
+pub fn propeller_hub_m(nominal: &Aircraft, cg_shift_m: [f64; 3]) -> [f64; 3] {
+    let p = nominal.geometry.prop_arm_from_cg_m;
+    [
+        p[0].abs() - cg_shift_m[0],
+        p[1] - cg_shift_m[1],
+        p[2] - cg_shift_m[2],
+    ]
+}
+
+/// Height of a point above the ground at a sample (the ground is home's altitude).
+fn clearance(s: &Sample, home_alt: f64, p: &Point) -> f64 {
+    let r = Euler::new(s.roll, s.pitch, s.yaw).body_to_ned();
+    let down = (r * p.body).z;
+    // The disc spans the body y-z plane: its lowest point reaches R * sqrt(r_zy^2 + r_zz^2)
+    // further down.
+    let disc = p.disc_radius * r[(2, 1)].hypot(r[(2, 2)]);
+    (s.alt - home_alt) - down - disc
+}
+
+/// The navigator's phase by its index in the log, in words.
+fn phase_name(index: u8) -> String {
+    use common::navigation::Phase as P;
+    let known = [
+        (P::Idle, "idle (armed, mission not started)"),
+        (P::TakeoffRoll, "take-off roll"),
+        (P::TakeoffClimb, "take-off climb"),
+        (P::Waypoint, "waypoint"),
+        (P::Loiter, "loiter"),
+        (P::Return, "return"),
+        (P::ReturnLoiter, "return loiter"),
+        (P::Approach, "approach"),
+        (P::Flare, "flare"),
+        (P::Landed, "roll-out"),
+        (P::Hold, "hold"),
+        (P::Complete, "complete"),
+    ];
+    known
+        .iter()
+        .find(|(p, _)| *p as u8 == index)
+        .map_or_else(|| format!("phase {index}"), |(_, n)| n.to_string())
+}
+
+/// What the log shows while armed: the largest bank and pitch, when control was first lost,
+/// and the closest call of a non-wheel point.
+#[derive(Clone, Debug, Default)]
+struct Excursions {
+    bank_deg: Option<f64>,
+    pitch_deg: Option<f64>,
+    loss_of_control: Option<(f64, String)>,
+    /// Clearance, point, time, phase.
+    closest: Option<(f64, String, f64, String)>,
+}
+
+fn excursions(samples: &[Sample], points: &[Point], home_alt: f64) -> Excursions {
+    use super::verdict::{LOC_BANK_DEG, LOC_PITCH_DEG};
+    let mut x = Excursions::default();
+    let mut low: Option<(f64, usize, &Sample)> = None;
+    for s in samples.iter().filter(|s| s.armed) {
+        let (bank, pitch) = (s.roll.abs().to_degrees(), s.pitch.abs().to_degrees());
+        x.bank_deg = Some(x.bank_deg.unwrap_or(0.0).max(bank));
+        x.pitch_deg = Some(x.pitch_deg.unwrap_or(0.0).max(pitch));
+        if x.loss_of_control.is_none() && (bank > LOC_BANK_DEG || pitch > LOC_PITCH_DEG) {
+            x.loss_of_control = Some((s.t, phase_name(s.nav_phase)));
+        }
+        for (i, p) in points.iter().enumerate() {
+            let c = clearance(s, home_alt, p);
+            if low.is_none_or(|(m, _, _)| c < m) {
+                low = Some((c, i, s));
+            }
+        }
+    }
+    x.closest = low.map(|(c, i, s)| (c, points[i].name.clone(), s.t, phase_name(s.nav_phase)));
+    x
+}
+
+/// The truth is on the ground: some point of the airframe, wheel or not, within 5 cm of it
+/// (the main legs compress 1.4 cm at rest; an aircraft on its back is on the ground too).
+fn on_ground(s: &Sample, a: &Aircraft, points: &[Point], home_alt: f64) -> bool {
+    let g = &a.ground;
+    let wheels = [g.main_wheel_left_m, g.main_wheel_right_m, g.tail_wheel_m].map(|w| Point {
+        name: String::new(),
+        body: Vector3::from(w),
+        disc_radius: 0.0,
+    });
+    wheels
+        .iter()
+        .chain(points)
+        .any(|p| clearance(s, home_alt, p) < 0.05)
+}
+
+/// What the autopilot says of itself once the flight has stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AutopilotEnd {
+    /// Its landed state.
+    pub landed: LandedState,
+    /// Armed.
+    pub armed: bool,
+}
+
+/// Flies `cfg` with the firmware in-process and reads the autopilot's state at the end.
+pub fn fly_inproc(
+    aircraft: &Aircraft,
+    cfg: &FlightConfig,
+) -> Result<(FlightOutcome, AutopilotEnd), String> {
+    let mut link = Lockstep::new(Inproc::new(App::new()), cfg.link_timeout);
+    let outcome = fly(aircraft, cfg, &mut link, &mut InprocOnboard).map_err(|e| e.to_string())?;
+    let snap = link.transport_mut().app_mut().snapshot();
+    Ok((
+        outcome,
+        AutopilotEnd {
+            landed: snap.landed,
+            armed: snap.armed,
+        },
+    ))
+}
+
+/// The failsafe texts the autopilot raised (not those clearing one).
+fn failsafes_raised(texts: &[(f64, String)]) -> Vec<String> {
+    use common::failsafe::Event;
+    let raising: Vec<&str> = Event::ALL
+        .iter()
+        .filter(|e| e.raises())
+        .map(|e| e.text())
+        .collect();
+    texts
+        .iter()
+        .filter(|(_, t)| raising.contains(&t.as_str()))
+        .map(|(t, text)| format!("{t:.1} s: {text}"))
+        .collect()
+}
+
+/// The figures and the facts of a flown flight (or of one that could not be flown).
+pub fn figures_and_facts(
+    plan: &Plan,
+    flown: &Result<(FlightOutcome, AutopilotEnd), String>,
+) -> (Figures, Facts) {
+    let (aircraft, landing) = (&plan.aircraft, plan.landing);
+    let (outcome, end) = match flown {
+        Ok(x) => x,
+        Err(e) => {
+            let figures = Figures {
+                error: Some(e.clone()),
+                ..Figures::default()
+            };
+            let facts = Facts {
+                error: Some(e.clone()),
+                ..Facts::default()
+            };
+            return (figures, facts);
+        }
+    };
+    let home_alt = aircraft.environment.home_alt_msl_m;
+    let s = &outcome.summary;
+    let samples = &outcome.samples;
+    let points = strike_points(aircraft, plan.propeller_hub_m);
+    let x = excursions(samples, &points, home_alt);
+    let mut f = Figures {
+        sim_s: finite(s.sim_s),
+        max_bank_deg: x.bank_deg,
+        max_pitch_deg: x.pitch_deg,
+        loss_of_control_t_s: x.loss_of_control.as_ref().map(|l| l.0),
+        loss_of_control_phase: x.loss_of_control.as_ref().map(|l| l.1.clone()),
+        min_clearance_m: x.closest.as_ref().map(|c| c.0),
+        min_clearance_point: x.closest.as_ref().map(|c| c.1.clone()),
+        min_clearance_t_s: x.closest.as_ref().map(|c| c.2),
+        min_clearance_phase: x.closest.as_ref().map(|c| c.3.clone()),
+        est_heading_rms_deg: s
+            .estimator_settled
+            .as_ref()
+            .and_then(|e| finite(e.heading_rms_deg)),
+        landed_state: Some(format!("{:?}", end.landed)),
+        armed_at_end: Some(end.armed),
+        failsafes: failsafes_raised(&s.texts),
+        ..Figures::default()
+    };
+    if let Some(a) = samples.iter().find(|x| x.armed) {
+        f.est_position_error_at_arm_m = finite((a.est_north - a.north).hypot(a.est_east - a.east));
+        f.est_alt_error_at_arm_m = finite(a.est_alt - a.alt);
+        f.est_heading_error_at_arm_deg = finite(wrap_pi(a.est_yaw - a.yaw).to_degrees());
+    }
+    if let Some(b) = &s.battery {
+        f.battery_mah = finite(b.charge_mah);
+        f.battery_min_v = finite(b.min_voltage_v);
+        f.battery_left_pct = finite(b.final_remaining_pct);
+    }
+    if let Some(m) = &s.mission {
+        f.flight_time_s = finite(m.flight_time_s);
+        f.energy_wh = finite(m.energy_wh);
+        f.items = Some(m.nav_items.len() as f64);
+        f.items_reached = Some(m.nav_items.iter().filter(|i| m.reached.contains(i)).count() as f64);
+        f.xtrack_rms_m = finite(m.xtrack_rms_m);
+        f.xtrack_max_m = finite(m.xtrack_max_m);
+        f.orbit_xtrack_rms_m = finite(m.orbit_xtrack_rms_m);
+        f.alt_rms_m = finite(m.alt_rms_m);
+        f.airspeed_rms_mps = finite(m.airspeed_rms_mps);
+        if let Some(t) = &m.touchdown {
+            f.sink_mps = finite(t.sink_rate_mps);
+            f.touchdown_ground_speed_mps = finite(t.ground_speed_mps);
+            f.bounces = Some(f64::from(t.bounces));
+            f.touchdown_t_s = finite(t.time_s);
+            if let Some(l) = landing {
+                let (dn, de) = (t.north_m - l.point_ne.0, t.east_m - l.point_ne.1);
+                let (sin, cos) = l.direction_rad.sin_cos();
+                f.touchdown_m = finite(dn.hypot(de));
+                f.touchdown_along_m = finite(dn * cos + de * sin);
+                f.touchdown_cross_m = finite(-dn * sin + de * cos);
+            }
+        }
+    }
+    let truth_on_ground = samples
+        .last()
+        .is_some_and(|x| on_ground(x, aircraft, &points, home_alt));
+    let says_on_ground = end.landed == LandedState::OnGround;
+    let facts = Facts {
+        error: None,
+        max_bank_deg: f.max_bank_deg,
+        max_pitch_deg: f.max_pitch_deg,
+        all_items_reached: s.mission.as_ref().is_some_and(|m| m.all_reached),
+        touchdown_m: f.touchdown_m,
+        sink_mps: f.sink_mps,
+        min_clearance_m: f.min_clearance_m,
+        landed_state_agrees: says_on_ground == truth_on_ground,
+        disarmed_on_ground: truth_on_ground && !end.armed,
+        on_ground: truth_on_ground,
+        failsafes: f.failsafes.clone(),
+        loss_of_control: x.loss_of_control,
+        closest_call: x.closest.map(|c| (c.2, c.1, c.3)),
+        touchdown_at: f.touchdown_t_s.zip(f.touchdown_along_m),
+        items: (
+            f.items_reached.unwrap_or(0.0) as u32,
+            f.items.unwrap_or(0.0) as u32,
+        ),
+    };
+    (f, facts)
+}
+
+/// One flight, planned: its draws applied.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// Index in the campaign.
+    pub index: u64,
+    /// Seed of its sensor noise and turbulence.
+    pub flight_seed: u64,
+    /// The dispersed quantities, as drawn.
+    pub draws: Quantities,
+    /// The dispersed aircraft.
+    pub aircraft: Aircraft,
+    /// Where its propeller's hub is, from the CG, body axes, m ([`propeller_hub_m`]).
+    pub propeller_hub_m: [f64; 3],
+    /// The flight.
+    pub config: FlightConfig,
+    /// Where it lands.
+    pub landing: Option<Landing>,
+}
+
+/// Flies a planned flight and builds its record; a panic inside the flight is caught and
+/// recorded as an error, so one flight cannot end a campaign.
+pub fn fly_record(plan: &Plan, reproduce: String) -> (FlightRecord, Option<FlightOutcome>) {
+    let flown = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        fly_inproc(&plan.aircraft, &plan.config)
+    }))
+    .unwrap_or_else(|p| {
+        let what = p
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(format!("panicked: {what}"))
+    });
+    let (figures, facts) = figures_and_facts(plan, &flown);
+    let record = FlightRecord {
+        index: plan.index,
+        flight_seed: plan.flight_seed,
+        draws: plan.draws.clone(),
+        figures,
+        verdict: judge(&facts),
+        reproduce,
+    };
+    (record, flown.ok().map(|f| f.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plant::ground::rest_state;
+    use crate::plant::ModelParams;
+
+    fn at_rest(a: &Aircraft) -> Sample {
+        let (state, _) = rest_state(&ModelParams::new(a), 0.0, 0.0, 0.0);
+        let e = Euler::from_quaternion(&state.attitude);
+        Sample {
+            alt: a.environment.home_alt_msl_m - state.pos_ned.z,
+            roll: e.phi,
+            pitch: e.theta,
+            yaw: e.psi,
+            ..Sample::default()
+        }
+    }
+
+    #[test]
+    fn at_rest_every_non_wheel_point_clears_the_runway_and_a_20_degree_roll_puts_a_tip_on_it() {
+        let a = Aircraft::ultrastick25e().unwrap();
+        let points = strike_points(&a, propeller_hub_m(&a, [0.0; 3]));
+        let home = a.environment.home_alt_msl_m;
+        let rest = at_rest(&a);
+        for p in &points {
+            let c = clearance(&rest, home, p);
+            // The tail skid sits 5 cm up in the three-point attitude; the propeller more.
+            assert!(c > 0.04, "{}: {c}", p.name);
+        }
+        // The tips are 0.635 m out and 0.16 m up: the ground is reached at asin(0.16/0.635),
+        // about 14.6 degrees.
+        let rolled = Sample {
+            roll: 20f64.to_radians(),
+            ..rest
+        };
+        let tip = points
+            .iter()
+            .find(|p| p.name.starts_with("right wing tip"))
+            .unwrap();
+        assert!(clearance(&rolled, home, tip) < 0.0);
+        assert!(on_ground(&rest, &a, &points, home));
+        let aloft = Sample {
+            alt: rest.alt + 1.0,
+            ..rest
+        };
+        assert!(!on_ground(&aloft, &a, &points, home));
+        // On its back, wheels up: on the ground all the same.
+        let inverted = Sample {
+            roll: std::f64::consts::PI,
+            alt: home + 0.05,
+            ..rest
+        };
+        assert!(on_ground(&inverted, &a, &points, home));
+    }
+
+    #[test]
+    fn the_propeller_disc_reaches_its_radius_below_the_hub_whatever_the_roll() {
+        let a = Aircraft::ultrastick25e().unwrap();
+        let hub = propeller_hub_m(&a, [0.0; 3]);
+        assert!(
+            hub[0] > 0.25,
+            "a tractor's propeller is ahead of the CG: {hub:?}"
+        );
+        let p = Point {
+            name: "propeller".into(),
+            body: Vector3::from(hub),
+            disc_radius: 0.1524,
+        };
+        let level = Sample {
+            alt: 1.0,
+            ..Sample::default()
+        };
+        let rolled = Sample { roll: 0.7, ..level };
+        let expect = 1.0 - hub[2] - 0.1524;
+        assert!((clearance(&level, 0.0, &p) - expect).abs() < 1e-12);
+        assert!((clearance(&rolled, 0.0, &p) - clearance(&level, 0.0, &p)).abs() < 0.05);
+    }
+}
