@@ -10,8 +10,8 @@
 //!   constant [`CORRECTION_TAU_S`]. The first [`INIT_SAMPLES`] are averaged (gain 1/k for
 //!   the k-th), so the power-up estimate is not one noisy reading.
 //! - Time remaining: the charge left over the current filtered with [`CURRENT_TAU_S`].
-//! - Warning level from `BAT_LOW_THR`, `BAT_CRIT_THR` and `BAT_EMERGEN_THR` (PX4's names and
-//!   defaults). It only rises: after a load the voltage recovers and the estimate may creep
+//! - Warning level from `BAT_LOW_THR`, `BAT_CRIT_THR` and `BAT_EMERGEN_THR` (PX4's names;
+//!   higher defaults than PX4's 15, 7 and 5 %, see below). It only rises: after a load the voltage recovers and the estimate may creep
 //!   up a little, and a warning that came and went would chatter on the ground station.
 //! - No sample for [`PRESENT_TIMEOUT_US`]: the battery is reported absent, all unknown, never
 //!   a warning.
@@ -27,6 +27,15 @@
 //! dt / 300 s per 10 Hz sample), a capacity 10 % too large lags the estimate by about 3 % in
 //! cruise (0.01 %/s for 300 s) instead of 10 % at the end, and ten seconds of full throttle
 //! with a wrong resistance move the estimate by a thirtieth of their bias.
+//!
+//! Why the thresholds are 30, 20 and 15 % and not PX4's 15, 7 and 5 %: a multicopter lands where
+//! it is, a fixed wing flies home and then its landing pattern. Flown in the simulator
+//! (`sim-host/tests/failsafe.rs`), the Land reaction from the circle over home to the stop on
+//! the runway takes about 120 s, 1,300 A s at 11 A: 11 % of the 3200 mAh pack. With PX4's
+//! values the emergency landing of the default mission touched down with the pack 3.6 % beyond
+//! empty. Emergency at 15 % leaves a few % at touchdown; critical at 20 % gives the return
+//! home (the default mission's farthest point is under a minute away, about 5 %) before the
+//! landing begins; low at 30 % warns a couple of minutes before that.
 
 use crate::param;
 use crate::params::{Group, ParamDef};
@@ -197,9 +206,9 @@ pub const PARAMS: Group<BatteryConfig> = Group {
         param!(
             ParamDef::real(
                 "BAT_LOW_THR",
-                0.15,
+                0.3,
                 0.12,
-                0.5,
+                0.6,
                 "",
                 "Charge below which the battery is low (a warning)",
             ),
@@ -208,9 +217,9 @@ pub const PARAMS: Group<BatteryConfig> = Group {
         param!(
             ParamDef::real(
                 "BAT_CRIT_THR",
-                0.07,
+                0.2,
                 0.05,
-                0.25,
+                0.5,
                 "",
                 "Charge below which the battery is critical (FS_BAT_ACT: return)",
             ),
@@ -219,9 +228,9 @@ pub const PARAMS: Group<BatteryConfig> = Group {
         param!(
             ParamDef::real(
                 "BAT_EMERGEN_THR",
-                0.05,
+                0.15,
                 0.03,
-                0.1,
+                0.4,
                 "",
                 "Charge below which the battery is an emergency (FS_BAT_ACT: land)",
             ),
@@ -232,9 +241,9 @@ pub const PARAMS: Group<BatteryConfig> = Group {
         cells: 3,
         capacity_mah: 3200.0,
         r_internal_ohm: 0.0,
-        low: 0.15,
-        critical: 0.07,
-        emergency: 0.05,
+        low: 0.3,
+        critical: 0.2,
+        emergency: 0.15,
     },
     check: thresholds_ordered,
 };
@@ -401,15 +410,18 @@ mod tests {
         crate::params::validate_defs(PARAMS.defs()).unwrap();
         let c = BatteryConfig::default();
         assert_eq!((c.cells, c.capacity_mah), (3, 3200.0));
-        assert_eq!((c.low, c.critical, c.emergency), (0.15, 0.07, 0.05));
+        assert_eq!((c.low, c.critical, c.emergency), (0.3, 0.2, 0.15));
         assert_eq!(PARAMS.validate(&c), Ok(()));
-        let crossed = BatteryConfig { critical: 0.2, ..c };
+        let crossed = BatteryConfig {
+            critical: 0.35,
+            ..c
+        };
         assert_eq!(
             PARAMS.validate(&crossed),
             Err(("BAT_CRIT_THR", crate::params::ParamError::Inconsistent))
         );
         let equal = BatteryConfig {
-            emergency: 0.07,
+            emergency: 0.2,
             ..c
         };
         assert_eq!(
@@ -504,7 +516,7 @@ mod tests {
     #[test]
     fn warnings_rise_through_low_critical_emergency_and_never_fall() {
         let cfg = BatteryConfig::default();
-        let levels = [0.5, 0.14, 0.06, 0.04].map(|s| cfg.level(s));
+        let levels = [0.5, 0.25, 0.17, 0.1].map(|s| cfg.level(s));
         assert_eq!(
             levels,
             [
@@ -514,8 +526,8 @@ mod tests {
                 Warning::Emergency
             ]
         );
-        // A pack resting at 6 %: critical from its first sample.
-        let mut m = fed(0.06, 0.3, 1);
+        // A pack resting at 17 %: critical from its first sample.
+        let mut m = fed(0.17, 0.3, 1);
         assert_eq!(m.report(Some(1_000_000)).warning, Warning::Critical);
         // The voltage rises back above low (a charger on the bench): the warning stays.
         for k in 11..100u64 {

@@ -55,7 +55,9 @@ pub const FIGURES: [FigureDef; 20] = [
     ("battery_mah", "charge drawn from the pack (mAh)", |f| {
         f.battery_mah
     }),
-    ("battery_min_v", "lowest pack voltage (V)", |f| f.battery_min_v),
+    ("battery_min_v", "lowest pack voltage (V)", |f| {
+        f.battery_min_v
+    }),
     ("battery_left_pct", "charge left at the end (%)", |f| {
         f.battery_left_pct
     }),

@@ -147,7 +147,7 @@ mod tests {
         //   = (12.6 - sqrt(149.16)) / 0.048 = (12.6 - 12.21311) / 0.048 = 8.0602 A,
         // V = 12.6 - 8.0602 x 0.024 = 12.4066 V, and V I = 100 W.
         let b = Battery::new(&pack());
-        assert_eq!(b.open_circuit_v(), 12.6);
+        assert!((b.open_circuit_v() - 12.6).abs() < 1e-5);
         let o = b.load(100.0);
         assert!((o.current_a - 8.0602).abs() < 1e-4, "{o:?}");
         assert!((o.voltage_v - 12.4066).abs() < 1e-4, "{o:?}");
@@ -169,7 +169,7 @@ mod tests {
         assert!((b.electrical_power_w(shaft) - (shaft / 0.75 + 4.0)).abs() < 1e-9);
         // Asked for more than E^2 / 4R, it gives its most: half its voltage.
         let o = b.load(1e4);
-        assert!((o.voltage_v - 6.3).abs() < 1e-9, "{o:?}");
+        assert!((o.voltage_v - 6.3).abs() < 1e-5, "{o:?}");
     }
 
     #[test]
