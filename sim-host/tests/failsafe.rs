@@ -122,14 +122,7 @@ fn trace(o: &FlightOutcome, every_s: f64) {
 /// 2.6 m/s and 4 to 25 m over seeds 1, 2 and 7): there the recovery is judged by where it
 /// lands, the landing itself being the mission tests' subject.
 fn lands_on_the_runway(o: &FlightOutcome, calm: bool) {
-    let m = o.summary.mission.clone().expect("a mission was flown");
-    let td = m.touchdown.expect("touched down");
-    eprintln!("touchdown {td:?}");
-    assert!(
-        td.distance_m < 20.0,
-        "touchdown {:.1} m from the land point",
-        td.distance_m
-    );
+    let (m, td) = touchdown_near_the_land_point(o);
     if calm {
         assert!(
             td.sink_rate_mps < 1.5,
@@ -150,6 +143,24 @@ fn lands_on_the_runway(o: &FlightOutcome, calm: bool) {
         !last.armed || last.t + 1.0 < runway_mission(Vec::new()).duration_s,
         "disarmed after the landing: {last:?}"
     );
+}
+
+/// The flight's mission figures and its touchdown, which is within 20 m of the land point.
+fn touchdown_near_the_land_point(
+    o: &FlightOutcome,
+) -> (
+    sim_host::flight::summary::MissionSummary,
+    sim_host::flight::summary::TouchdownSummary,
+) {
+    let m = o.summary.mission.clone().expect("a mission was flown");
+    let td = m.touchdown.expect("touched down");
+    eprintln!("touchdown {td:?}");
+    assert!(
+        td.distance_m < 20.0,
+        "touchdown {:.1} m from the land point",
+        td.distance_m
+    );
+    (m, td)
 }
 
 /// Just after `t_s` the mission flies on from the waypoint `before` was flying.
@@ -757,14 +768,7 @@ fn a_low_battery_during_the_mission_warns_returns_home_and_lands_on_the_runway()
         "returning after the critical warning: {s:?}"
     );
     // Emergency: it lands at home, on the runway, and disarms, with charge left.
-    let m = o.summary.mission.clone().expect("a mission was flown");
-    let td = m.touchdown.expect("touched down");
-    eprintln!("touchdown {td:?}");
-    assert!(
-        td.distance_m < 20.0,
-        "touchdown {:.1} m from the land point",
-        td.distance_m
-    );
+    let (_, td) = touchdown_near_the_land_point(&o);
     assert!(
         td.time_s > emergency,
         "the landing came after the emergency"
