@@ -1,5 +1,5 @@
-//! Failsafes: what the aircraft does on its own when the ground link, GPS, the airspeed sensor
-//! or the geofence fails it. Part of the navigator stage: it watches, decides and reports;
+//! Failsafes: what the aircraft does on its own when the ground link, GPS, the airspeed sensor,
+//! the geofence or the battery fails it. Part of the navigator stage: it watches, decides and reports;
 //! the application turns its [`Reaction`] into the mode it flies.
 //!
 //! - Ground link lost for `FS_GCS_TOUT_S` while flying: return (PX4's data-link-loss RTL).
@@ -10,9 +10,19 @@
 //! - Airspeed sensor failed: the estimator flies on a synthetic airspeed (ground velocity
 //!   minus the last wind estimate); reported, no change of mode.
 //! - Geofence breached (polygon or `GF_MAX_ALT_M`): return.
+//! - Battery (the monitor's warning level, PX4's `COM_LOW_BAT_ACT` in spirit): low, a warning
+//!   only; critical, return (`FS_BAT_ACT` 1; latched until the pilot chooses a mode, like the
+//!   fence's return); emergency, land (`FlightMode::Land`: home, then the landing). The level
+//!   only rises in a flight, each step reported once; a battery nobody monitors (no power
+//!   monitor, or an outside simulator that sends no `BATTERY_STATUS`) triggers nothing.
 //!
-//! Each failsafe is reported once when it is raised and once when its cause clears.
+//! Without GPS there is no home to fly to: the GPS reaction comes before every other. The
+//! emergency landing comes before a return.
+//!
+//! Each failsafe is reported once when it is raised and once when its cause clears (the
+//! battery's never clears in flight).
 
+use crate::battery::Warning;
 use crate::param;
 use crate::params::{independent, Group, ParamDef};
 
@@ -51,6 +61,15 @@ pub const PARAMS: Group<FailsafeConfig> = Group {
             ),
             FailsafeConfig => fence_returns, flag
         ),
+        param!(
+            ParamDef::choice(
+                "FS_BAT_ACT",
+                1,
+                &["Warning only", "Return, then land"],
+                "What a critical (return) or emergency (land) battery does in flight",
+            ),
+            FailsafeConfig => battery_acts, flag
+        ),
     ],
     base: || ZERO,
     check: independent,
@@ -65,12 +84,15 @@ pub struct FailsafeConfig {
     pub gps_wings_level_s: f32,
     /// `GF_ACTION`: return on a geofence breach.
     pub fence_returns: bool,
+    /// `FS_BAT_ACT`: return at a critical battery, land at an emergency.
+    pub battery_acts: bool,
 }
 
 const ZERO: FailsafeConfig = FailsafeConfig {
     gcs_timeout_s: 0.0,
     gps_wings_level_s: 0.0,
     fence_returns: false,
+    battery_acts: false,
 };
 
 impl Default for FailsafeConfig {
@@ -95,6 +117,8 @@ pub struct FailsafeInputs {
     pub airspeed_ok: bool,
     /// Outside the geofence (polygon or altitude).
     pub fence_breached: bool,
+    /// The battery monitor's warning level; `None` when no battery is monitored.
+    pub battery: Option<Warning>,
 }
 
 /// What the aircraft should do instead of its chosen mode.
@@ -110,6 +134,8 @@ pub enum Reaction {
     Loiter,
     /// Fly home.
     Return,
+    /// Fly home and land there.
+    Land,
 }
 
 /// One failsafe being raised or cleared, for the ground station's log.
@@ -134,11 +160,21 @@ pub enum Event {
     FenceBreached,
     /// Back inside the geofence.
     FenceCleared,
+    /// Battery low: a warning.
+    BatteryLow,
+    /// Battery critical, `FS_BAT_ACT` 0: a warning.
+    BatteryCritical,
+    /// Battery critical: returning.
+    BatteryCriticalReturn,
+    /// Battery emergency, `FS_BAT_ACT` 0: a warning.
+    BatteryEmergency,
+    /// Battery emergency: landing.
+    BatteryEmergencyLand,
 }
 
 impl Event {
     /// Every event.
-    pub const ALL: [Event; 9] = [
+    pub const ALL: [Event; 14] = [
         Event::GcsLost,
         Event::GcsRegained,
         Event::GpsLost,
@@ -148,6 +184,11 @@ impl Event {
         Event::AirspeedRegained,
         Event::FenceBreached,
         Event::FenceCleared,
+        Event::BatteryLow,
+        Event::BatteryCritical,
+        Event::BatteryCriticalReturn,
+        Event::BatteryEmergency,
+        Event::BatteryEmergencyLand,
     ];
 
     /// The text the ground station shows.
@@ -162,6 +203,11 @@ impl Event {
             Event::AirspeedRegained => "Airspeed sensor regained",
             Event::FenceBreached => "Failsafe: geofence breached",
             Event::FenceCleared => "Back inside the geofence",
+            Event::BatteryLow => "Battery low, return advised",
+            Event::BatteryCritical => "Battery critical, land as soon as possible",
+            Event::BatteryCriticalReturn => "Failsafe: battery critical, returning home",
+            Event::BatteryEmergency => "Battery emergency, land immediately",
+            Event::BatteryEmergencyLand => "Failsafe: battery emergency, landing",
         }
     }
 
@@ -174,12 +220,22 @@ impl Event {
                 | Event::GpsLoiter
                 | Event::AirspeedFailed
                 | Event::FenceBreached
+                | Event::BatteryLow
+                | Event::BatteryCritical
+                | Event::BatteryCriticalReturn
+                | Event::BatteryEmergency
+                | Event::BatteryEmergencyLand
         )
+    }
+
+    /// True for the events that only advise (a warning, not a critical message).
+    pub fn advisory(self) -> bool {
+        self == Event::BatteryLow
     }
 }
 
 /// Events of one tick (at most one per failsafe).
-pub type Events = heapless::Vec<Event, 4>;
+pub type Events = heapless::Vec<Event, 5>;
 
 /// The failsafe monitor.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -191,6 +247,10 @@ pub struct Failsafes {
     airspeed_failed: bool,
     fence_breached: bool,
     fence_return: bool,
+    /// The highest battery warning reported this flight.
+    battery_level: Warning,
+    battery_return: bool,
+    battery_land: bool,
 }
 
 impl Failsafes {
@@ -205,12 +265,22 @@ impl Failsafes {
             || self.gps_lost_since.is_some()
             || self.airspeed_failed
             || self.fence_breached
+            || self.battery_level >= Warning::Critical
     }
 
-    /// Forgets the latched returns: the pilot has chosen a mode, or the aircraft has landed.
+    /// Forgets the latched returns and landing: the pilot has chosen a mode, or the aircraft
+    /// has landed. The battery's level stays, so the same warning is not raised again.
     pub fn acknowledge(&mut self) {
         self.gcs_return = false;
         self.fence_return = false;
+        self.battery_return = false;
+        self.battery_land = false;
+    }
+
+    /// A new flight (arming): the battery's warnings will be reported again as it flies.
+    pub fn new_flight(&mut self) {
+        self.acknowledge();
+        self.battery_level = Warning::None;
     }
 
     /// Evaluates one tick; returns the reaction and the events raised or cleared.
@@ -268,6 +338,21 @@ impl Failsafes {
             self.fence_breached = false;
             push(Event::FenceCleared);
         }
+        // Battery: only a monitored one, only in flight, each level once.
+        if let Some(level) = i.battery.filter(|&l| i.flying && l > self.battery_level) {
+            self.battery_level = level;
+            let act = cfg.battery_acts;
+            match (level, act) {
+                (Warning::None, _) => {}
+                (Warning::Low, _) => push(Event::BatteryLow),
+                (Warning::Critical, false) => push(Event::BatteryCritical),
+                (Warning::Critical, true) => push(Event::BatteryCriticalReturn),
+                (Warning::Emergency, false) => push(Event::BatteryEmergency),
+                (Warning::Emergency, true) => push(Event::BatteryEmergencyLand),
+            }
+            self.battery_return |= act && level == Warning::Critical;
+            self.battery_land |= act && level == Warning::Emergency;
+        }
         // Without GPS there is no home to fly to: the GPS reaction comes first.
         let reaction = if self.gps_lost_since.is_some() {
             if self.gps_loiter {
@@ -275,7 +360,9 @@ impl Failsafes {
             } else {
                 Reaction::WingsLevel
             }
-        } else if self.fence_return || self.gcs_return {
+        } else if self.battery_land {
+            Reaction::Land
+        } else if self.fence_return || self.gcs_return || self.battery_return {
             Reaction::Return
         } else {
             Reaction::None
@@ -296,6 +383,7 @@ mod tests {
             gps_ok: true,
             airspeed_ok: true,
             fence_breached: false,
+            battery: None,
         }
     }
 
@@ -317,6 +405,8 @@ mod tests {
         let cfg = FailsafeConfig::default();
         assert_eq!((cfg.gcs_timeout_s, cfg.fence_returns), (5.0, true));
         assert_eq!(cfg.gps_wings_level_s, 10.0);
+        // COM_LOW_BAT_ACT's spirit: return at critical, land at emergency.
+        assert!(cfg.battery_acts);
     }
 
     #[test]
@@ -433,6 +523,112 @@ mod tests {
         assert_eq!(
             (r, ev.as_slice()),
             (Reaction::Return, &[Event::FenceCleared][..])
+        );
+    }
+
+    #[test]
+    fn a_low_battery_only_warns_a_critical_one_returns_until_the_pilot_chooses_a_mode() {
+        let cfg = FailsafeConfig::default();
+        let mut f = Failsafes::new();
+        let mut i = flying(0.0);
+        i.battery = Some(Warning::None);
+        assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
+        i.battery = Some(Warning::Low);
+        let (r, ev) = f.update(&cfg, &i);
+        assert_eq!(
+            (r, ev.as_slice()),
+            (Reaction::None, &[Event::BatteryLow][..])
+        );
+        assert!(!f.active(), "a warning, not a failsafe");
+        assert!(Event::BatteryLow.advisory());
+        i.battery = Some(Warning::Critical);
+        let (r, ev) = f.update(&cfg, &i);
+        assert_eq!(
+            (r, ev.as_slice()),
+            (Reaction::Return, &[Event::BatteryCriticalReturn][..])
+        );
+        assert!(f.active());
+        // Said once; the return holds.
+        assert_eq!(f.update(&cfg, &i), (Reaction::Return, Events::new()));
+        // The pilot takes over: the same level does not return again.
+        f.acknowledge();
+        assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
+    }
+
+    #[test]
+    fn an_emergency_battery_lands_before_any_return_but_after_a_gps_loss() {
+        let cfg = FailsafeConfig::default();
+        let mut f = Failsafes::new();
+        let mut i = flying(0.0);
+        i.fence_breached = true;
+        i.battery = Some(Warning::Critical);
+        assert_eq!(f.update(&cfg, &i).0, Reaction::Return);
+        i.battery = Some(Warning::Emergency);
+        let (r, ev) = f.update(&cfg, &i);
+        assert_eq!(
+            (r, ev.as_slice()),
+            (Reaction::Land, &[Event::BatteryEmergencyLand][..])
+        );
+        // No home without GPS: wings level first, the landing once GPS is back.
+        i.gps_ok = false;
+        assert_eq!(f.update(&cfg, &i).0, Reaction::WingsLevel);
+        i.gps_ok = true;
+        assert_eq!(f.update(&cfg, &i).0, Reaction::Land);
+        // Straight from no warning to emergency: one event, the landing.
+        let mut g = Failsafes::new();
+        let (r, ev) = g.update(&cfg, &i);
+        assert_eq!(r, Reaction::Land);
+        assert!(ev.contains(&Event::BatteryEmergencyLand), "{ev:?}");
+    }
+
+    #[test]
+    fn no_monitored_battery_and_no_flight_trigger_nothing() {
+        let cfg = FailsafeConfig::default();
+        let mut f = Failsafes::new();
+        let mut i = flying(0.0);
+        // An outside simulator that sends no BATTERY_STATUS.
+        i.battery = None;
+        for t in 0..100 {
+            i.t_s = f64::from(t);
+            i.gcs_heard_s = Some(i.t_s);
+            assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
+        }
+        // An empty pack on the ground: the pre-arm check's business, not a failsafe.
+        i.flying = false;
+        i.battery = Some(Warning::Emergency);
+        assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
+        assert!(!f.active());
+        // Once off the ground, it is.
+        i.flying = true;
+        assert_eq!(f.update(&cfg, &i).0, Reaction::Land);
+    }
+
+    #[test]
+    fn warning_only_says_critical_and_emergency_without_a_change_of_mode() {
+        let cfg = FailsafeConfig {
+            battery_acts: false,
+            ..FailsafeConfig::default()
+        };
+        let mut f = Failsafes::new();
+        let mut i = flying(0.0);
+        i.battery = Some(Warning::Critical);
+        let (r, ev) = f.update(&cfg, &i);
+        assert_eq!(
+            (r, ev.as_slice()),
+            (Reaction::None, &[Event::BatteryCritical][..])
+        );
+        i.battery = Some(Warning::Emergency);
+        let (r, ev) = f.update(&cfg, &i);
+        assert_eq!(
+            (r, ev.as_slice()),
+            (Reaction::None, &[Event::BatteryEmergency][..])
+        );
+        // A new flight reports the pack again.
+        f.new_flight();
+        let (r, ev) = f.update(&cfg, &i);
+        assert_eq!(
+            (r, ev.as_slice()),
+            (Reaction::None, &[Event::BatteryEmergency][..])
         );
     }
 }

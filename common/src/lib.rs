@@ -12,8 +12,10 @@
 //! - [`vehicle`]: the stages wired together: flight modes, requests, the commander (arming,
 //!   mode entry, failsafe reactions, the navigator hand-off), the one parameter registry, the
 //!   clock that follows the sensor frames, and the snapshot the vehicle reports.
+//! - [`battery`]: the battery monitor: charge used, state of charge, time remaining and the
+//!   warning level, from the power monitor's voltage and current.
 //! - [`failsafe`]: what the aircraft does on its own when the ground link, GPS, the airspeed
-//!   sensor or the geofence fails it.
+//!   sensor, the geofence or the battery fails it.
 //! - [`navigation`]: the plan (stored mission, fence, rally points), the navigator and its
 //!   behaviours (mission, take-off, loiter, landing, return), the path manager (fillets),
 //!   mission checks and the geofence.
@@ -44,6 +46,7 @@
 )]
 
 pub mod actuators;
+pub mod battery;
 pub mod control;
 pub mod estimator;
 pub mod failsafe;

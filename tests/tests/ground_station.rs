@@ -5,12 +5,15 @@
 //! The simulated airplane sits on the ground at home, at rest: the estimator converges there
 //! (as before a real flight), which is what the pre-arm checks wait for.
 
+use common::battery::cell_ocv;
 use common::gcs::client::{command_long, gcs_heartbeat};
 use common::link::framing::{Frame, FrameParser, Sender};
-use common::link::simlink::{encode_hil_gps, encode_hil_sensor, SensorFrame};
+use common::link::simlink::{
+    encode_battery_status, encode_hil_gps, encode_hil_sensor, SensorFrame,
+};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::GeoPoint;
-use common::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use common::sensors::{BaroSample, BatterySample, GpsFix, ImuSample, MagSample, PitotSample};
 use firmware::app::App;
 use firmware::sitl::{self, FileStorage, GcsUdp, SimEndpoint};
 use mavlink::dialects::common::*;
@@ -28,7 +31,20 @@ const HOME_ALT_M: f32 = 250.0;
 /// Simulated seconds per wall second.
 const SPEEDUP: u64 = 1;
 
-/// Sensor frames of an airplane at rest on the ground at home, heading north.
+/// The flight pack on the ground: a 3S LiPo at 80 % (3 x 4.02 V at rest), the avionics
+/// drawing 0.35 A through the pack's 24 mOhm (`BAT_R_INTERNAL`), read at 10 Hz.
+const PACK_SOC: f32 = 0.8;
+const PACK_CURRENT_A: f32 = 0.35;
+
+fn pack() -> BatterySample {
+    BatterySample {
+        voltage_v: 3.0 * cell_ocv(PACK_SOC) - PACK_CURRENT_A * 0.024,
+        current_a: PACK_CURRENT_A,
+    }
+}
+
+/// Sensor frames of an airplane at rest on the ground at home, heading north, and its power
+/// monitor's BATTERY_STATUS.
 fn at_rest(k: u64, gps: bool) -> (u64, Vec<MavMessage>) {
     let t = k * 10_000;
     let air = standard_atmosphere(HOME_ALT_M);
@@ -63,6 +79,9 @@ fn at_rest(k: u64, gps: bool) -> (u64, Vec<MavMessage>) {
             hdop: 0.8,
         };
         m.push(MavMessage::HIL_GPS(encode_hil_gps(t, &fix)));
+    }
+    if k.is_multiple_of(10) {
+        m.push(MavMessage::BATTERY_STATUS(encode_battery_status(&pack())));
     }
     (t, m)
 }
@@ -635,4 +654,13 @@ fn pymavlink_names_and_sets_every_mode_with_the_shipped_mode_map() {
 fn home_set_by_arming_on_the_ground_is_held_to_the_millimetre_while_the_estimator_learns() {
     // pymavlink reads HOME_POSITION and GLOBAL_POSITION_INT (see the script's docstring).
     pymavlink_script("pymavlink_home.py");
+}
+
+#[test]
+fn pymavlink_sees_the_pack_s_voltage_current_and_charge_in_sys_status_and_battery_status() {
+    // The simulator sends a 3S pack resting at 80 % (12.05 V, 0.35 A); the script checks
+    // what pymavlink decodes against those figures: see its docstring.
+    let p = pack();
+    assert!((p.voltage_v - 12.0516).abs() < 1e-3, "{p:?}");
+    pymavlink_script("pymavlink_battery.py");
 }

@@ -4,10 +4,9 @@
 use mavlink::dialects::common::*;
 use num_traits::FromPrimitive;
 
+use crate::battery::{Battery, Warning};
 use crate::vehicle::modes::FlightMode;
-use crate::vehicle::snapshot::{
-    LandedState, MissionRunState, VehicleSnapshot, BATTERY_CRITICAL, BATTERY_LOW,
-};
+use crate::vehicle::snapshot::{LandedState, MissionRunState, VehicleSnapshot};
 
 use crate::math::RAD2DEG;
 
@@ -99,10 +98,7 @@ pub fn prearm_failure(v: &VehicleSnapshot) -> Option<&'static str> {
         Some("no 3D GPS fix")
     } else if !h.position_valid {
         Some("position estimate invalid")
-    } else if v.battery.present
-        && v.battery.remaining >= 0.0
-        && v.battery.remaining < BATTERY_CRITICAL
-    {
+    } else if v.battery.present && v.battery.warning >= Warning::Critical {
         Some("battery critical")
     } else {
         None
@@ -147,7 +143,7 @@ pub fn sys_status(v: &VehicleSnapshot, rx_errors: u16) -> MavMessage {
         (h.attitude_converged, S::MAV_SYS_STATUS_AHRS),
         (prearm_failure(v).is_none(), S::MAV_SYS_STATUS_PREARM_CHECK),
         (
-            !(v.battery.present && v.battery.remaining >= 0.0 && v.battery.remaining < BATTERY_LOW),
+            !(v.battery.present && v.battery.warning >= Warning::Low),
             S::MAV_SYS_STATUS_SENSOR_BATTERY,
         ),
     ];
@@ -162,16 +158,8 @@ pub fn sys_status(v: &VehicleSnapshot, rx_errors: u16) -> MavMessage {
         onboard_control_sensors_enabled: present,
         onboard_control_sensors_health: health,
         load: (v.cpu_load * 1000.0) as u16,
-        voltage_battery: if b.present {
-            (b.voltage_v * 1000.0) as u16
-        } else {
-            u16::MAX
-        },
-        current_battery: if b.present && b.current_a >= 0.0 {
-            (b.current_a * 100.0) as i16
-        } else {
-            -1
-        },
+        voltage_battery: battery_mv(b).unwrap_or(u16::MAX),
+        current_battery: battery_ca(b),
         drop_rate_comm: 0,
         errors_comm: rx_errors,
         // Autopilot-specific counters: sensor frames refused for their time, and new time
@@ -180,11 +168,7 @@ pub fn sys_status(v: &VehicleSnapshot, rx_errors: u16) -> MavMessage {
         errors_count2: u16::try_from(v.clock.resyncs).unwrap_or(u16::MAX),
         errors_count3: 0,
         errors_count4: 0,
-        battery_remaining: if b.present && b.remaining >= 0.0 {
-            (b.remaining * 100.0) as i8
-        } else {
-            -1
-        },
+        battery_remaining: battery_percent(b),
         onboard_control_sensors_present_extended: MavSysStatusSensorExtended::empty(),
         onboard_control_sensors_enabled_extended: MavSysStatusSensorExtended::empty(),
         onboard_control_sensors_health_extended: MavSysStatusSensorExtended::empty(),
@@ -312,47 +296,66 @@ pub fn extended_sys_state(v: &VehicleSnapshot) -> MavMessage {
     })
 }
 
-/// `BATTERY_STATUS`.
+/// Pack voltage in mV (UINT16_MAX - 1 at most: UINT16_MAX means unknown); `None` when no
+/// battery is monitored.
+fn battery_mv(b: &Battery) -> Option<u16> {
+    b.present
+        .then(|| libm::roundf(b.voltage_v * 1000.0).clamp(0.0, 65_534.0) as u16)
+}
+
+/// Current in cA, -1 when no battery is monitored.
+fn battery_ca(b: &Battery) -> i16 {
+    if b.present {
+        libm::roundf(b.current_a * 100.0).clamp(-32_768.0, 32_767.0) as i16
+    } else {
+        -1
+    }
+}
+
+/// Charge left in %, -1 when no battery is monitored.
+fn battery_percent(b: &Battery) -> i8 {
+    if b.present {
+        libm::roundf(b.remaining * 100.0).clamp(0.0, 100.0) as i8
+    } else {
+        -1
+    }
+}
+
+/// `BATTERY_STATUS`: the pack voltage in `voltages[0]` (cells are not reported one by one),
+/// the current, the charge (mAh) and energy (hJ) used, the charge left, the time remaining
+/// and the monitor's warning as the charge state; unknown values as MAVLink marks them.
 pub fn battery_status(v: &VehicleSnapshot) -> MavMessage {
     let b = &v.battery;
     let mut voltages = [u16::MAX; 10];
-    voltages[0] = if b.present {
-        (b.voltage_v * 1000.0) as u16
-    } else {
-        u16::MAX
-    };
-    let known = b.present && b.remaining >= 0.0;
+    voltages[0] = battery_mv(b).unwrap_or(u16::MAX);
+    let whole = |x: f32| libm::roundf(x).clamp(0.0, i32::MAX as f32) as i32;
     MavMessage::BATTERY_STATUS(BATTERY_STATUS_DATA {
-        current_consumed: if b.present && b.consumed_mah >= 0.0 {
-            b.consumed_mah as i32
+        current_consumed: if b.present { whole(b.consumed_mah) } else { -1 },
+        // 1 Wh = 3600 J = 36 hJ.
+        energy_consumed: if b.present {
+            whole(b.energy_wh * 36.0)
         } else {
             -1
         },
-        energy_consumed: -1,
         temperature: i16::MAX,
         voltages,
-        current_battery: if b.present && b.current_a >= 0.0 {
-            (b.current_a * 100.0) as i16
-        } else {
-            -1
-        },
+        current_battery: battery_ca(b),
         id: 0,
         battery_function: MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL,
         mavtype: MavBatteryType::MAV_BATTERY_TYPE_LIPO,
-        battery_remaining: if known {
-            (b.remaining * 100.0) as i8
+        battery_remaining: battery_percent(b),
+        // 0: not estimated.
+        time_remaining: if b.present && b.time_remaining_s > 0.0 {
+            whole(b.time_remaining_s).max(1)
         } else {
-            -1
+            0
         },
-        time_remaining: 0,
-        charge_state: if !known {
-            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_UNDEFINED
-        } else if b.remaining < BATTERY_CRITICAL {
-            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_CRITICAL
-        } else if b.remaining < BATTERY_LOW {
-            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_LOW
-        } else {
-            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_OK
+        charge_state: match (b.present, b.warning) {
+            (false, _) => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_UNDEFINED,
+            (true, Warning::None) => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_OK,
+            (true, Warning::Low) => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_LOW,
+            (true, Warning::Critical) => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_CRITICAL,
+            (true, Warning::Emergency) => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_EMERGENCY,
         },
         voltages_ext: [0; 4],
         mode: MavBatteryMode::MAV_BATTERY_MODE_UNKNOWN,

@@ -653,7 +653,7 @@ fn arming_with_and_without_prearm_conditions() {
         (
             |v| {
                 v.battery.present = true;
-                v.battery.remaining = 0.03
+                v.battery.warning = crate::battery::Warning::Critical
             },
             "battery",
         ),
@@ -2361,4 +2361,100 @@ fn without_served_files_component_metadata_is_unsupported_and_ftp_not_claimed() 
     assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_UNSUPPORTED);
     let out = exchange(&mut l, &v, 0, request(148.0));
     assert!(!capabilities(&out).contains(MavProtocolCapability::MAV_PROTOCOL_CAPABILITY_FTP));
+}
+
+#[test]
+fn sys_status_and_battery_status_carry_the_monitor_s_figures_or_say_unknown() {
+    use crate::battery::{Battery, Warning};
+    let mut v = healthy();
+    // No battery monitored: MAVLink's unknowns.
+    let MavMessage::SYS_STATUS(s) = super::telemetry::sys_status(&v, 0) else {
+        panic!("SYS_STATUS")
+    };
+    assert_eq!(
+        (s.voltage_battery, s.current_battery, s.battery_remaining),
+        (u16::MAX, -1, -1)
+    );
+    assert!(!s
+        .onboard_control_sensors_present
+        .contains(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY));
+    let MavMessage::BATTERY_STATUS(b) = super::telemetry::battery_status(&v) else {
+        panic!("BATTERY_STATUS")
+    };
+    assert_eq!(b.voltages, [u16::MAX; 10]);
+    assert_eq!(
+        (b.current_consumed, b.energy_consumed, b.time_remaining),
+        (-1, -1, 0)
+    );
+    assert_eq!(
+        b.charge_state,
+        MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_UNDEFINED
+    );
+    // 11.1 V, 8.25 A, 512.4 mAh and 5.5 Wh used (198 hJ), 84 % left, 20 min to go.
+    v.battery = Battery {
+        present: true,
+        voltage_v: 11.1,
+        current_a: 8.25,
+        consumed_mah: 512.4,
+        energy_wh: 5.5,
+        remaining: 0.84,
+        time_remaining_s: 1200.4,
+        warning: Warning::None,
+    };
+    let MavMessage::SYS_STATUS(s) = super::telemetry::sys_status(&v, 0) else {
+        panic!("SYS_STATUS")
+    };
+    assert_eq!(
+        (s.voltage_battery, s.current_battery, s.battery_remaining),
+        (11_100, 825, 84)
+    );
+    assert!(s
+        .onboard_control_sensors_health
+        .contains(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY));
+    let MavMessage::BATTERY_STATUS(b) = super::telemetry::battery_status(&v) else {
+        panic!("BATTERY_STATUS")
+    };
+    assert_eq!(b.voltages[0], 11_100);
+    assert!(b.voltages[1..].iter().all(|&c| c == u16::MAX));
+    assert_eq!(
+        (
+            b.current_battery,
+            b.current_consumed,
+            b.energy_consumed,
+            b.battery_remaining,
+            b.time_remaining
+        ),
+        (825, 512, 198, 84, 1200)
+    );
+    assert_eq!(
+        b.charge_state,
+        MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_OK
+    );
+    // Each warning level as its charge state; from Low the battery is unhealthy.
+    for (w, state) in [
+        (
+            Warning::Low,
+            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_LOW,
+        ),
+        (
+            Warning::Critical,
+            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_CRITICAL,
+        ),
+        (
+            Warning::Emergency,
+            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_EMERGENCY,
+        ),
+    ] {
+        v.battery.warning = w;
+        let MavMessage::BATTERY_STATUS(b) = super::telemetry::battery_status(&v) else {
+            panic!("BATTERY_STATUS")
+        };
+        assert_eq!(b.charge_state, state);
+        let MavMessage::SYS_STATUS(s) = super::telemetry::sys_status(&v, 0) else {
+            panic!("SYS_STATUS")
+        };
+        assert!(!s
+            .onboard_control_sensors_health
+            .contains(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY));
+    }
 }

@@ -1,11 +1,12 @@
-//! PX4's simulator interface: `HIL_SENSOR` and `HIL_GPS` from the simulator,
+//! PX4's simulator interface: `HIL_SENSOR`, `HIL_GPS` and `BATTERY_STATUS` from the simulator,
 //! `HIL_ACTUATOR_CONTROLS` back.
 //!
 //! Both sides of the link use these functions, so units and flag bits are defined once:
 //! `HIL_SENSOR` carries specific force in m/s^2 (level flight z = -g), rates in rad/s, field in
 //! gauss, pressures in hPa and temperature in deg C, with `fields_updated` bits saying which
 //! groups are new (a barometer update sets bits 9, 11 and 12 together). `HIL_GPS` carries
-//! 1e-7 deg, mm and cm/s. The autopilot answers every sensor frame with
+//! 1e-7 deg, mm and cm/s; `BATTERY_STATUS` the pack voltage in mV (`voltages[0]`, the other
+//! cells UINT16_MAX: not measured one by one) and the current in cA. The autopilot answers every sensor frame with
 //! `HIL_ACTUATOR_CONTROLS`: roll, pitch, yaw in -1..1 and throttle 0..1, `mode` bit 128 when
 //! armed and `flags` bit 0 (lock-step).
 //!
@@ -14,13 +15,16 @@
 
 use crate::actuators::Surfaces;
 use crate::math::geodetic::GeoPoint;
-use crate::sensors::{limits, BaroSample, GpsFix, ImuSample, MagSample, ManualInput, PitotSample};
+use crate::sensors::{
+    limits, BaroSample, BatterySample, GpsFix, ImuSample, MagSample, ManualInput, PitotSample,
+};
 
 /// The frame `HIL_SENSOR` decodes into.
 pub use crate::sensors::SensorFrame;
 use mavlink::dialects::common::{
-    HilActuatorControlsFlags, HilSensorUpdatedFlags, MavModeFlag, HIL_ACTUATOR_CONTROLS_DATA,
-    HIL_GPS_DATA, HIL_SENSOR_DATA, RC_CHANNELS_DATA,
+    HilActuatorControlsFlags, HilSensorUpdatedFlags, MavBatteryFunction, MavBatteryType,
+    MavModeFlag, BATTERY_STATUS_DATA, HIL_ACTUATOR_CONTROLS_DATA, HIL_GPS_DATA, HIL_SENSOR_DATA,
+    RC_CHANNELS_DATA,
 };
 use nalgebra::Vector3;
 
@@ -276,6 +280,53 @@ pub fn decode_hil_gps(d: &HIL_GPS_DATA) -> Option<GpsFix> {
     })
 }
 
+/// `BATTERY_STATUS` of a power monitor (simulator side): the pack voltage in `voltages[0]` in
+/// mV with the other cells UINT16_MAX, as MAVLink asks when cells are not measured one by one;
+/// the current in cA; the charge left -1 (the autopilot estimates it itself).
+pub fn encode_battery_status(s: &BatterySample) -> BATTERY_STATUS_DATA {
+    let mut voltages = [u16::MAX; 10];
+    // UINT16_MAX means "not measured": a pack voltage above 65.534 V would continue in the
+    // second cell, which the 60 V limit never needs.
+    voltages[0] = libm::roundf(s.voltage_v * 1000.0).clamp(0.0, 65_534.0) as u16;
+    BATTERY_STATUS_DATA {
+        voltages,
+        current_battery: libm::roundf(s.current_a * 100.0).clamp(-32_767.0, 32_767.0) as i16,
+        current_consumed: -1,
+        energy_consumed: -1,
+        temperature: i16::MAX,
+        battery_remaining: -1,
+        battery_function: MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL,
+        mavtype: MavBatteryType::MAV_BATTERY_TYPE_LIPO,
+        ..BATTERY_STATUS_DATA::DEFAULT
+    }
+}
+
+/// Decodes a power monitor's `BATTERY_STATUS` (autopilot side): the pack voltage is the sum
+/// of the cells reported (`voltages`, then `voltages_ext`; UINT16_MAX and, in the extension,
+/// 0 mark a cell not reported), the current `current_battery`. `None` without a voltage,
+/// without a current (-1: not measured; the monitor counts charge) or outside the
+/// plausibility limits.
+pub fn decode_battery_status(d: &BATTERY_STATUS_DATA) -> Option<BatterySample> {
+    let cells = d.voltages.iter().filter(|&&mv| mv != u16::MAX);
+    let ext = d
+        .voltages_ext
+        .iter()
+        .filter(|&&mv| mv != 0 && mv != u16::MAX);
+    let (mut mv, mut reported) = (0u32, false);
+    for &c in cells.chain(ext) {
+        mv = mv.saturating_add(u32::from(c));
+        reported = true;
+    }
+    if !reported || d.current_battery == -1 {
+        return None;
+    }
+    let sample = BatterySample {
+        voltage_v: mv as f32 / 1000.0,
+        current_a: f32::from(d.current_battery) / 100.0,
+    };
+    sample.plausible().then_some(sample)
+}
+
 /// What the autopilot commands for one sensor frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ActuatorFrame {
@@ -403,6 +454,35 @@ mod tests {
         let mut bad = d;
         bad.lat = 950_000_000;
         assert!(decode_hil_gps(&bad).is_none());
+    }
+
+    #[test]
+    fn battery_status_round_trips_in_mv_and_ca_and_refuses_what_is_not_measured() {
+        let pack = BatterySample {
+            voltage_v: 11.1,
+            current_a: 8.25,
+        };
+        let d = encode_battery_status(&pack);
+        // 11.1 V is 11099.999 mV in f32: rounded, not truncated.
+        assert_eq!((d.voltages[0], d.current_battery), (11_100, 825));
+        assert!(d.voltages[1..].iter().all(|&v| v == u16::MAX));
+        assert_eq!(d.battery_remaining, -1);
+        assert_eq!(decode_battery_status(&d), Some(pack));
+        // Cells reported one by one add up to the pack.
+        let mut cells = d.clone();
+        cells.voltages[..3].copy_from_slice(&[3700, 3700, 3700]);
+        let v = decode_battery_status(&cells).map(|s| s.voltage_v);
+        assert!(v.is_some_and(|v| (v - 11.1).abs() < 1e-4), "{v:?}");
+        // No voltage, no current, or 65 V: refused.
+        let mut none = d.clone();
+        none.voltages[0] = u16::MAX;
+        assert_eq!(decode_battery_status(&none), None);
+        let mut no_current = d.clone();
+        no_current.current_battery = -1;
+        assert_eq!(decode_battery_status(&no_current), None);
+        let mut high = d.clone();
+        high.voltages[0] = 65_000;
+        assert_eq!(decode_battery_status(&high), None);
     }
 
     #[test]

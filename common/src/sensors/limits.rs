@@ -2,7 +2,7 @@
 //! simulator link's decoder and the estimator check against the same numbers, so a value the
 //! link lets through is one the estimator will not refuse on range alone.
 
-use super::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use super::{BaroSample, BatterySample, GpsFix, ImuSample, MagSample, PitotSample};
 use crate::math::GRAVITY;
 use nalgebra::Vector3;
 
@@ -24,6 +24,12 @@ pub const PITOT_PA: (f32, f32) = (-500.0, 20_000.0);
 pub const GPS_ALT_M: (f32, f32) = (-1_000.0, 20_000.0);
 /// Largest GPS speed, m/s.
 pub const GPS_SPEED_MPS: f32 = 150.0;
+
+/// Pack voltage, V (up to a 14-cell pack, with room).
+pub const BATTERY_V: (f32, f32) = (0.0, 60.0);
+/// Pack current, A (a little charging current, up to what a small aircraft's power module
+/// measures).
+pub const BATTERY_A: (f32, f32) = (-20.0, 300.0);
 
 /// Finite and inside `[lo, hi]`.
 pub fn in_range(x: f32, (lo, hi): (f32, f32)) -> bool {
@@ -60,6 +66,13 @@ impl PitotSample {
     /// Differential pressure inside its range.
     pub fn plausible(&self) -> bool {
         in_range(self.diff_pressure_pa, PITOT_PA)
+    }
+}
+
+impl BatterySample {
+    /// Voltage and current finite and inside their ranges.
+    pub fn plausible(&self) -> bool {
+        in_range(self.voltage_v, BATTERY_V) && in_range(self.current_a, BATTERY_A)
     }
 }
 
@@ -116,5 +129,34 @@ mod tests {
             ..sea
         }
         .plausible());
+    }
+
+    #[test]
+    fn a_loaded_3s_pack_is_plausible_and_a_nan_or_a_100_v_one_is_not() {
+        let pack = BatterySample {
+            voltage_v: 11.1,
+            current_a: 25.0,
+        };
+        assert!(pack.plausible());
+        for bad in [
+            BatterySample {
+                voltage_v: f32::NAN,
+                ..pack
+            },
+            BatterySample {
+                voltage_v: 100.0,
+                ..pack
+            },
+            BatterySample {
+                current_a: -50.0,
+                ..pack
+            },
+            BatterySample {
+                current_a: f32::INFINITY,
+                ..pack
+            },
+        ] {
+            assert!(!bad.plausible(), "{bad:?}");
+        }
     }
 }

@@ -1,8 +1,9 @@
 //! Raw sensor samples, as the estimator consumes them.
 //!
-//! On the MCU they come from drivers; in SITL from the simulator's `HIL_SENSOR` and `HIL_GPS`
-//! frames. Units are SI: specific force in m/s^2 (level flight reads z = -g), rates in rad/s,
-//! magnetic field in gauss, pressures in Pa, temperatures in deg C.
+//! On the MCU they come from drivers; in SITL from the simulator's `HIL_SENSOR`, `HIL_GPS` and
+//! `BATTERY_STATUS` frames. Units are SI: specific force in m/s^2 (level flight reads z = -g),
+//! rates in rad/s, magnetic field in gauss, pressures in Pa, temperatures in deg C, volts and
+//! amperes.
 
 pub mod limits;
 
@@ -56,6 +57,15 @@ pub struct GpsFix {
     pub satellites: u8,
     /// Horizontal dilution of precision.
     pub hdop: f32,
+}
+
+/// One reading of the flight battery's power monitor.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BatterySample {
+    /// Pack voltage at the terminals, V.
+    pub voltage_v: f32,
+    /// Current drawn from the pack, A (negative while charging).
+    pub current_a: f32,
 }
 
 /// Stick positions, normalised: a ground station's `MANUAL_CONTROL` or the radio's

@@ -12,6 +12,7 @@ use super::modes::FlightMode;
 use super::requests::VehicleRequests;
 use super::snapshot::MissionRunState;
 use crate::actuators::Surfaces;
+use crate::battery::Warning;
 use crate::control::autopilot::{Commands, GainSet};
 use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
@@ -185,6 +186,7 @@ impl Commander {
             Reaction::WingsLevel => FlightMode::Altitude,
             Reaction::Loiter => FlightMode::Loiter,
             Reaction::Return => FlightMode::Return,
+            Reaction::Land => FlightMode::Land,
         }
     }
 
@@ -276,7 +278,9 @@ impl Commander {
             }
             if a.arm != self.armed {
                 self.armed = a.arm;
-                if !a.arm {
+                if a.arm {
+                    self.failsafes.new_flight();
+                } else {
                     self.navigator.stop();
                     self.nav_for = None;
                     self.failsafes.acknowledge();
@@ -339,7 +343,8 @@ impl Commander {
         rehome
     }
 
-    /// Watches the failsafes at the control rate and acts on their reaction.
+    /// Watches the failsafes at the control rate and acts on their reaction. `battery` is the
+    /// battery monitor's warning, `None` when no battery is monitored.
     pub fn check_failsafes(
         &mut self,
         now_us: u64,
@@ -347,6 +352,7 @@ impl Commander {
         watch: &Watch,
         plan: &MissionStore,
         gcs_heard_us: Option<u64>,
+        battery: Option<Warning>,
     ) {
         let flying = self.armed && in_air(e);
         let fence_breached = match e.home {
@@ -362,13 +368,14 @@ impl Commander {
             gps_ok: e.health.gps.healthy,
             airspeed_ok: e.health.pitot.healthy,
             fence_breached,
+            battery,
         };
         let (reaction, events) = self.failsafes.update(&watch.failsafe, &inputs);
         for ev in events {
-            let sev = if ev.raises() {
-                Severity::Critical
-            } else {
-                Severity::Info
+            let sev = match (ev.raises(), ev.advisory()) {
+                (false, _) => Severity::Info,
+                (true, true) => Severity::Warning,
+                (true, false) => Severity::Critical,
             };
             self.text(sev, ev.text());
         }

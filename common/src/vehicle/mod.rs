@@ -10,7 +10,8 @@
 //! ```
 //!
 //! [`Vehicle`] is what a board runs: one way in for sensors ([`Vehicle::on_sensors`], fed by
-//! HIL decoding in SITL and by drivers on a board), the ground station's requests handed in
+//! HIL decoding in SITL and by drivers on a board; [`Vehicle::on_gps`] and
+//! [`Vehicle::on_battery`] beside it), the ground station's requests handed in
 //! with them, surfaces out, a [`snapshot::VehicleSnapshot`] for telemetry and [`Notice`]s to
 //! report. It reads no clock: its time is the sensor frames' timestamps.
 //!
@@ -33,6 +34,7 @@ pub mod snapshot;
 mod tests;
 
 use crate::actuators::Surfaces;
+use crate::battery::{self, BatteryMonitor};
 use crate::control::autopilot::{Autopilot, GainSet};
 use crate::control::gains::NAMED;
 use crate::control::inputs::Measurements;
@@ -41,7 +43,7 @@ use crate::navigation::plan::MissionStore;
 use crate::navigation::validate::{MissionLimits, PlanRules};
 use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::params::ParamStore;
-use crate::sensors::{GpsFix, ManualInput, SensorFrame};
+use crate::sensors::{BatterySample, GpsFix, ManualInput, SensorFrame};
 use crate::{failsafe, guidance};
 use clock::{Clock, ClockStats, Step};
 use commander::{trim_surfaces, Commander, Demand, Setpoints, Severity, Watch};
@@ -70,6 +72,7 @@ pub struct Vehicle {
     estimator: Estimator,
     autopilot: Autopilot,
     commander: Commander,
+    battery: BatteryMonitor,
     watch: Watch,
     limits: MissionLimits,
     use_truth: bool,
@@ -100,6 +103,7 @@ impl Vehicle {
             estimator: Estimator::default(),
             autopilot: Autopilot::default(),
             commander: Commander::new(),
+            battery: BatteryMonitor::default(),
             watch: Watch::default(),
             limits: MissionLimits::default(),
             use_truth: false,
@@ -213,6 +217,7 @@ impl Vehicle {
             gps: self.last_gps,
             throttle: self.surfaces.throttle,
             clock: self.clock.stats(),
+            battery: self.battery.report(self.clock.now_us()),
         };
         report::snapshot(&self.estimator.state(), &self.commander, &extras)
     }
@@ -275,6 +280,20 @@ impl Vehicle {
         self.estimator.update_gps(fix);
     }
 
+    /// A reading of the battery's power monitor, taken now (the vehicle's clock: the last
+    /// sensor frame's time). Before the first sensor frame there is no clock to integrate on,
+    /// and the reading is dropped.
+    pub fn on_battery(&mut self, s: &BatterySample) {
+        if let Some(t) = self.clock.now_us() {
+            self.battery.update(t, s);
+        }
+    }
+
+    /// What the battery monitor knows now.
+    pub fn battery(&self) -> battery::Battery {
+        self.battery.report(self.clock.now_us())
+    }
+
     /// The simulator's truth, flown instead of the estimate when `SIM_USE_TRUTH` is set.
     pub fn on_truth(&mut self, m: Measurements) {
         self.truth = Some(m);
@@ -312,8 +331,15 @@ impl Vehicle {
         self.last_control_us = Some(now_us);
         // One estimate for the whole control step.
         let e = self.estimator.state();
-        self.commander
-            .check_failsafes(now_us, &e, &self.watch, &self.plan, ground.heard_us);
+        let b = self.battery.report(Some(now_us));
+        self.commander.check_failsafes(
+            now_us,
+            &e,
+            &self.watch,
+            &self.plan,
+            ground.heard_us,
+            b.present.then_some(b.warning),
+        );
         let m = self.measurements(&e);
         let gains = *self.autopilot.gains();
         let clock = self.clock.now_us().unwrap_or(0);
@@ -388,6 +414,7 @@ impl Vehicle {
             &p.load(&guidance::PARAMS),
         );
         self.limits = p.load(&validate::PARAMS);
+        self.battery.set_config(p.load(&battery::PARAMS));
         self.watch = Watch {
             failsafe: p.load(&failsafe::PARAMS),
             fence: p.load(&fence::PARAMS),

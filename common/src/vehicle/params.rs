@@ -5,7 +5,7 @@ use crate::control::{autopilot, gains, lateral, longitudinal};
 use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::param;
 use crate::params::{independent, Group, ParamDef, Registry};
-use crate::{estimator, failsafe, guidance};
+use crate::{battery, estimator, failsafe, guidance};
 
 /// The vehicle's own settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,7 +48,7 @@ pub const PARAMS: Group<SystemParams> = Group {
 };
 
 /// Every parameter of the vehicle: the control stages, the estimator, guidance and navigation,
-/// the failsafes and the vehicle's own settings.
+/// the battery monitor, the failsafes and the vehicle's own settings.
 pub const REGISTRY: Registry = &[
     &lateral::PARAMS,
     &longitudinal::PARAMS,
@@ -59,6 +59,7 @@ pub const REGISTRY: Registry = &[
     &navigator::params::PARAMS,
     &validate::PARAMS,
     &fence::PARAMS,
+    &battery::PARAMS,
     &failsafe::PARAMS,
     &PARAMS,
 ];

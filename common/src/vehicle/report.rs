@@ -4,8 +4,9 @@
 use super::commander::{in_air, Commander};
 use super::modes::{FlightMode, ModeSet};
 use super::snapshot::{
-    Battery, GpsRaw, Home, LandedState, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot,
+    GpsRaw, Home, LandedState, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot,
 };
+use crate::battery::Battery;
 use crate::estimator::EstimatedState;
 use crate::math::{course_and_speed, wrap_two_pi};
 use crate::sensors::GpsFix;
@@ -21,6 +22,8 @@ pub struct Extras {
     pub throttle: f32,
     /// The clock's counters.
     pub clock: super::clock::ClockStats,
+    /// The battery monitor's report.
+    pub battery: Battery,
 }
 
 /// The modes the vehicle can fly with this estimate: attitude for the altitude hold, a
@@ -112,10 +115,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         throttle: if c.armed() { x.throttle } else { 0.0 },
         home,
         gps,
-        battery: Battery {
-            present: false,
-            ..Battery::default()
-        },
+        battery: x.battery,
         nav: nav_telemetry(e, c),
         mission_seq,
         mission_state,

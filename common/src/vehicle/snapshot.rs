@@ -97,26 +97,8 @@ pub struct GpsRaw {
     pub satellites: u8,
 }
 
-/// Battery state.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Battery {
-    /// Whether a battery monitor is fitted; when not, the battery fields are sent as unknown.
-    pub present: bool,
-    /// Pack voltage, V.
-    pub voltage_v: f32,
-    /// Current drawn, A; negative when not measured.
-    pub current_a: f32,
-    /// Charge used since boot, mAh; negative when not measured.
-    pub consumed_mah: f32,
-    /// Remaining charge as a fraction 0..1; negative when not estimated.
-    pub remaining: f32,
-}
-
-/// Low- and critical-charge thresholds (fractions), PX4's `BAT_LOW_THR` and `BAT_CRIT_THR`.
-pub const BATTERY_LOW: f32 = 0.15;
-/// See [`BATTERY_LOW`].
-pub const BATTERY_CRITICAL: f32 = 0.07;
+/// Battery state: the battery monitor's report.
+pub use crate::battery::Battery;
 
 /// What the navigator and guidance are doing (`NAV_CONTROLLER_OUTPUT`).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]

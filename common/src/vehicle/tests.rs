@@ -189,16 +189,16 @@ fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() 
     let watch = Watch::default();
     let plan = MissionStore::default();
     // Heard at 0 s; FS_GCS_TOUT_S is 5 s by default.
-    c.check_failsafes(4_900_000, &e, &watch, &plan, Some(0));
+    c.check_failsafes(4_900_000, &e, &watch, &plan, Some(0), None);
     assert_eq!(c.flown_mode(), FlightMode::Hold);
-    c.check_failsafes(5_100_000, &e, &watch, &plan, Some(0));
+    c.check_failsafes(5_100_000, &e, &watch, &plan, Some(0), None);
     assert_eq!(c.reaction(), Reaction::Return);
     assert_eq!(c.flown_mode(), FlightMode::Return);
     assert_eq!(c.chosen_mode(), FlightMode::Hold);
     assert!(!texts(&mut c).is_empty(), "the failsafe is reported");
     // Choosing a mode, even the same one, takes over from the return.
     c.apply(&mode(FlightMode::Hold), &e);
-    c.check_failsafes(5_200_000, &e, &watch, &plan, Some(5_150_000));
+    c.check_failsafes(5_200_000, &e, &watch, &plan, Some(5_150_000), None);
     assert_eq!(c.flown_mode(), FlightMode::Hold);
 }
 

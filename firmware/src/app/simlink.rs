@@ -1,5 +1,5 @@
-//! The simulator port: `HIL_SENSOR` and `HIL_GPS` decoded with their plausibility checks into
-//! the vehicle's one way in for sensors, `HIL_ACTUATOR_CONTROLS` back for every sensor frame
+//! The simulator port: `HIL_SENSOR`, `HIL_GPS` and `BATTERY_STATUS` decoded with their
+//! plausibility checks into the vehicle's ways in for sensors, `HIL_ACTUATOR_CONTROLS` back for every sensor frame
 //! (lock-step), the radio's `RC_CHANNELS` to the sticks and the simulator's truth to the
 //! vehicle for the `SIM_USE_TRUTH` comparison.
 
@@ -19,6 +19,8 @@ pub struct SimLinkHealth {
     pub sensor_frames: u32,
     /// GPS frames accepted.
     pub gps_frames: u32,
+    /// Power-monitor frames (BATTERY_STATUS) accepted.
+    pub battery_frames: u32,
     /// Frames from a system other than ours.
     pub foreign_frames: u32,
     /// Frames of a message the sim link does not carry.
@@ -33,6 +35,8 @@ pub struct SimLinkHealth {
     pub rejected_pitot: u32,
     /// GPS frames dropped.
     pub rejected_gps: u32,
+    /// BATTERY_STATUS frames dropped: no voltage or current, or implausible.
+    pub rejected_battery: u32,
     /// Sensor frames whose time did not advance.
     pub stale_frames: u32,
     /// RC_CHANNELS frames without a usable signal.
@@ -126,6 +130,13 @@ impl SimPort {
                     vehicle.on_gps(&fix);
                 }
                 None => self.health.rejected_gps += 1,
+            },
+            MavMessage::BATTERY_STATUS(d) => match simlink::decode_battery_status(d) {
+                Some(s) => {
+                    self.health.battery_frames += 1;
+                    vehicle.on_battery(&s);
+                }
+                None => self.health.rejected_battery += 1,
             },
             MavMessage::HIL_STATE_QUATERNION(d) => {
                 if let Some(m) = truth_measurements(d) {

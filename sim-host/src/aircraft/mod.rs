@@ -243,6 +243,25 @@ pub struct Propulsion {
     pub omega_limits_radps: [f64; 2],
 }
 
+/// The flight battery (not part of the Minnesota model): a LiPo pack as an equivalent circuit,
+/// see [`crate::plant::battery`].
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Battery {
+    /// Cells in series.
+    pub cells: u8,
+    /// Capacity, mAh.
+    pub capacity_mAh: f64,
+    /// Internal resistance of the whole pack, ohm.
+    pub internal_resistance_ohm: f64,
+    /// Shaft power over electrical power of motor and ESC, 0..1.
+    pub motor_esc_efficiency: f64,
+    /// Constant draw of the avionics and servos, W.
+    pub avionics_power_W: f64,
+    /// State of charge at power-up, 0..1.
+    pub initial_soc: f64,
+}
+
 /// Servo model parameters (all surfaces alike).
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -322,6 +341,8 @@ pub struct Aircraft {
     pub aero: Aero,
     /// Propulsion.
     pub propulsion: Propulsion,
+    /// Flight battery.
+    pub battery: Battery,
     /// Servos.
     pub actuators: Actuators,
     /// Sensor rates, noise, biases and the GPS receiver.

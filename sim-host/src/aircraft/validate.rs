@@ -68,6 +68,31 @@ impl Aircraft {
         ordered("propulsion.omega_limits_radps", p.omega_limits_radps)?;
         // Qm = P / Omega: the lower engine-speed limit keeps the division finite.
         positive("propulsion.omega_limits_radps", p.omega_limits_radps[0])?;
+        let b = &self.battery;
+        if !(1..=14).contains(&b.cells) {
+            return Err(bad(
+                "battery.cells",
+                b.cells.to_string(),
+                "must be within 1..14 cells",
+            ));
+        }
+        positive("battery.capacity_mAh", b.capacity_mAh)?;
+        non_negative("battery.internal_resistance_ohm", b.internal_resistance_ohm)?;
+        non_negative("battery.avionics_power_W", b.avionics_power_W)?;
+        if !(b.motor_esc_efficiency > 0.0 && b.motor_esc_efficiency <= 1.0) {
+            return Err(bad(
+                "battery.motor_esc_efficiency",
+                b.motor_esc_efficiency.to_string(),
+                "must be within 0 (excluded) and 1",
+            ));
+        }
+        if !(0.0..=1.0).contains(&b.initial_soc) {
+            return Err(bad(
+                "battery.initial_soc",
+                b.initial_soc.to_string(),
+                "must be within 0..1",
+            ));
+        }
         let a = &self.actuators;
         positive("actuators.bandwidth_Hz", a.bandwidth_Hz)?;
         positive("actuators.rate_limit_radps", a.rate_limit_radps)?;

@@ -26,6 +26,12 @@ pub struct Figures {
     pub flight_time_s: Option<f64>,
     /// Motor energy, Wh.
     pub energy_wh: Option<f64>,
+    /// Charge drawn from the flight pack, mAh.
+    pub battery_mah: Option<f64>,
+    /// Lowest voltage of the flight pack, V.
+    pub battery_min_v: Option<f64>,
+    /// Charge left in the flight pack at the end, %.
+    pub battery_left_pct: Option<f64>,
     /// Navigation items reached.
     pub items_reached: Option<f64>,
     /// Navigation items of the mission.
@@ -343,6 +349,11 @@ pub fn figures_and_facts(
         f.est_position_error_at_arm_m = finite((a.est_north - a.north).hypot(a.est_east - a.east));
         f.est_alt_error_at_arm_m = finite(a.est_alt - a.alt);
         f.est_heading_error_at_arm_deg = finite(wrap_pi(a.est_yaw - a.yaw).to_degrees());
+    }
+    if let Some(b) = &s.battery {
+        f.battery_mah = finite(b.charge_mah);
+        f.battery_min_v = finite(b.min_voltage_v);
+        f.battery_left_pct = finite(b.final_remaining_pct);
     }
     if let Some(m) = &s.mission {
         f.flight_time_s = finite(m.flight_time_s);

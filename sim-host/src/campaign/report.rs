@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 pub type FigureDef = (&'static str, &'static str, fn(&Figures) -> Option<f64>);
 
 /// The figures of a flight that the report summarises and plots.
-pub const FIGURES: [FigureDef; 17] = [
+pub const FIGURES: [FigureDef; 20] = [
     ("touchdown_m", "touchdown from the point (m)", |f| {
         f.touchdown_m
     }),
@@ -52,6 +52,15 @@ pub const FIGURES: [FigureDef; 17] = [
     }),
     ("flight_time_s", "flight time (s)", |f| f.flight_time_s),
     ("energy_wh", "motor energy (Wh)", |f| f.energy_wh),
+    ("battery_mah", "charge drawn from the pack (mAh)", |f| {
+        f.battery_mah
+    }),
+    ("battery_min_v", "lowest pack voltage (V)", |f| {
+        f.battery_min_v
+    }),
+    ("battery_left_pct", "charge left at the end (%)", |f| {
+        f.battery_left_pct
+    }),
     (
         "est_position_error_at_arm_m",
         "estimate's position error at arming (m)",

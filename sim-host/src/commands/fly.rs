@@ -6,7 +6,7 @@ use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
 use crate::flight::onboard::{spawn_firmware, InprocOnboard};
 use crate::flight::runner::FlightOutcome;
-use crate::flight::summary::MissionSummary;
+use crate::flight::summary::{BatterySummary, MissionSummary};
 use crate::link::qemu::QemuConfig;
 use crate::link::transport::{Inproc, PtyServer, TcpServer, UdpServer};
 use crate::report::sig;
@@ -319,6 +319,9 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
     if let Some(m) = &s.mission {
         tables.push(mission_table(m));
     }
+    if let Some(b) = &s.battery {
+        tables.push(battery_table(b));
+    }
     tables
 }
 
@@ -330,6 +333,35 @@ fn known(x: f64, digits: usize) -> String {
     } else {
         sig(x, digits)
     }
+}
+
+/// What the flight took from the battery.
+pub fn battery_table(b: &BatterySummary) -> Table {
+    let mut t = Table::new("Battery", &["quantity", "value"]);
+    t.row([
+        "energy used (Wh)".to_string(),
+        format!("{:.2}", b.energy_wh),
+    ]);
+    t.row([
+        "charge used (mAh)".to_string(),
+        format!("{:.0}", b.charge_mah),
+    ]);
+    t.row([
+        "lowest voltage (V)".to_string(),
+        format!("{:.2}", b.min_voltage_v),
+    ]);
+    t.row([
+        "remaining at the end (%)".to_string(),
+        if b.final_estimate_pct.is_finite() {
+            format!(
+                "{:.1} (the autopilot's estimate: {:.1})",
+                b.final_remaining_pct, b.final_estimate_pct
+            )
+        } else {
+            format!("{:.1}", b.final_remaining_pct)
+        },
+    ]);
+    t
 }
 
 /// The figures of a mission flight.
@@ -535,6 +567,15 @@ pub fn results_markdown(
             d(a.metrics.settling_time_s, b.metrics.settling_time_s),
             a.final_error_max,
             b.final_error_max,
+        );
+    }
+    if let Some(b) = &s.battery {
+        let _ = writeln!(
+            md,
+            "\nBattery (the simulated 3S 3200 mAh pack, from full at power-up): {:.2} Wh and \
+             {:.0} mAh drawn, lowest {:.2} V, {:.1} % left at the end (the autopilot's \
+             estimate: {:.1} %).",
+            b.energy_wh, b.charge_mah, b.min_voltage_v, b.final_remaining_pct, b.final_estimate_pct
         );
     }
     let _ = writeln!(

@@ -99,6 +99,8 @@ pub enum Fault {
     MagFailed,
     /// No barometer.
     BaroFailed,
+    /// No battery power monitor (no BATTERY_STATUS).
+    BatteryMonitorFailed,
 }
 
 impl FlightConfig {
@@ -130,6 +132,7 @@ impl FlightConfig {
                 Fault::PitotFailed => f.pitot_failed = true,
                 Fault::MagFailed => f.mag_failed = true,
                 Fault::BaroFailed => f.baro_failed = true,
+                Fault::BatteryMonitorFailed => f.battery_failed = true,
             }
         }
         f

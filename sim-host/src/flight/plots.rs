@@ -1,4 +1,5 @@
-//! The flight's figures: altitude, course and attitude against time, and the ground track.
+//! The flight's figures: altitude, course, attitude and the battery against time, and the
+//! ground track.
 
 use super::record::{csv_headers, csv_row, Sample, DEG};
 use crate::report::csv_out::write_csv;
@@ -142,6 +143,40 @@ pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec
                         t.clone(),
                         col(&|s| wrap_pi(s.est_yaw - s.yaw) * DEG),
                     )],
+                ),
+            ],
+        ),
+    )?);
+    let known: Vec<&&Sample> = p
+        .iter()
+        .filter(|s| s.est_bat_remaining.is_finite())
+        .collect();
+    files.push(fig(
+        "battery.png",
+        Figure::new(
+            "Battery: the simulated pack and the autopilot's estimate",
+            "t (s)",
+            vec![
+                Panel::new(
+                    "voltage (V)",
+                    vec![Series::new("truth", t.clone(), col(&|s| s.bat_voltage))],
+                ),
+                Panel::new(
+                    "current (A)",
+                    vec![Series::new("truth", t.clone(), col(&|s| s.bat_current))],
+                ),
+                Panel::new(
+                    "charge left (%)",
+                    vec![
+                        Series::new("truth", t.clone(), col(&|s| s.bat_soc * 100.0)),
+                        // Only while the autopilot monitors a battery.
+                        Series::new(
+                            "estimate",
+                            known.iter().map(|s| s.t).collect(),
+                            known.iter().map(|s| s.est_bat_remaining * 100.0).collect(),
+                        )
+                        .dashed(),
+                    ],
                 ),
             ],
         ),

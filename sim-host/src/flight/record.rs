@@ -1,6 +1,7 @@
 //! The flight log: one sample per frame of the truth beside what the autopilot holds, and
 //! its CSV form.
 
+use crate::plant::battery::Battery;
 use crate::sensors::models::Truth;
 use common::actuators::Surfaces;
 use common::estimator::EstimatedState;
@@ -88,6 +89,18 @@ pub struct Sample {
     pub mission_seq: i32,
     /// The path followed is a straight leg.
     pub straight: bool,
+    /// Truth: the battery's terminal voltage, V.
+    pub bat_voltage: f64,
+    /// Truth: the battery's current, A.
+    pub bat_current: f64,
+    /// Truth: the charge drawn from the battery since power-up, mAh.
+    pub bat_drawn_mah: f64,
+    /// Truth: the energy drawn from the battery since power-up, Wh.
+    pub bat_energy_wh: f64,
+    /// Truth: the battery's state of charge, 0..1.
+    pub bat_soc: f64,
+    /// The autopilot's estimate of the charge left, 0..1 (NaN: no battery monitored).
+    pub est_bat_remaining: f64,
 }
 
 /// What the navigator was doing at one frame.
@@ -197,6 +210,20 @@ impl Sample {
             sample.hold(truth, v);
         }
         sample
+    }
+
+    /// The sample with the battery's truth and the autopilot's estimate of the charge left.
+    pub fn with_battery(self, b: &Battery, est_remaining: Option<f32>) -> Self {
+        let o = b.output();
+        Self {
+            bat_voltage: o.voltage_v,
+            bat_current: o.current_a,
+            bat_drawn_mah: b.drawn_mah(),
+            bat_energy_wh: b.energy_wh(),
+            bat_soc: b.soc(),
+            est_bat_remaining: est_remaining.map_or(f64::NAN, f64::from),
+            ..self
+        }
     }
 
     /// A sample whose autopilot columns say "not known".
@@ -312,6 +339,12 @@ pub fn csv_headers() -> Vec<String> {
         "nav_phase",
         "mission_seq",
         "straight",
+        "bat_voltage_v",
+        "bat_current_a",
+        "bat_drawn_mah",
+        "bat_energy_wh",
+        "bat_soc",
+        "est_bat_remaining",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -359,5 +392,11 @@ pub fn csv_row(s: &Sample) -> Vec<f64> {
         f64::from(s.nav_phase),
         f64::from(s.mission_seq),
         b(s.straight),
+        s.bat_voltage,
+        s.bat_current,
+        s.bat_drawn_mah,
+        s.bat_energy_wh,
+        s.bat_soc,
+        s.est_bat_remaining,
     ]
 }

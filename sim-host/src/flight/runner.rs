@@ -13,13 +13,16 @@ use crate::environment::wind::Wind;
 use crate::link::lockstep::{LinkError, Lockstep};
 use crate::link::tlog::TlogWriter;
 use crate::link::transport::Transport;
+use crate::plant::battery::Battery;
 use crate::plant::inputs::{Controls, Environment};
 use crate::plant::params::ModelParams;
 use crate::plant::propulsion::motor_power_w;
 use crate::plant::servo::ServoBank;
 use crate::plant::Plant;
 use crate::sensors::models::{SensorSuite, Truth};
-use common::link::simlink::{encode_hil_gps, encode_hil_sensor, encode_rc_channels};
+use common::link::simlink::{
+    encode_battery_status, encode_hil_gps, encode_hil_sensor, encode_rc_channels,
+};
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
 use common::math::ned_to_body;
@@ -181,6 +184,8 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         }
     };
     let mut servos = ServoBank::new(&aircraft.actuators, &trim_controls);
+    // Powered up with the avionics; the motor draws what the plant's throttle asks.
+    let mut battery = Battery::new(&aircraft.battery);
     let mut wind = Wind::new(Vector3::from(cfg.wind_ned), cfg.turbulence, cfg.seed);
     let q0 = plant.attitude();
     let env0 = Environment {
@@ -250,6 +255,10 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         if let Some(f) = fix {
             msgs.push(MavMessage::HIL_GPS(encode_hil_gps(time_us, &f)));
         }
+        let pack = battery.output();
+        if let Some(b) = sensors.sample_battery(time_us, pack.voltage_v, pack.current_a) {
+            msgs.push(MavMessage::BATTERY_STATUS(encode_battery_status(&b)));
+        }
         if k % 2 == 0 {
             if let Some(r) = cfg.rc_sticks.iter().rev().find(|r| r.from_s <= t_s) {
                 msgs.push(MavMessage::RC_CHANNELS(encode_rc_channels(
@@ -293,30 +302,39 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             // The safety pilot holds the trim until the autopilot is armed.
             trim_controls
         };
-        let view = onboard.with_app(link, |app| {
-            let estimate = app.estimate();
-            AutopilotView {
-                est_ne: ned_offset::<f64>(home, estimate.position),
-                nav: NavView::of(
-                    app.navigation(),
-                    app.mode().needs_navigator(),
-                    &estimate.pos_ned,
-                ),
-                estimate,
-                setpoints: app.setpoints(),
-                mode: app.mode(),
-            }
-        });
-        samples.push(Sample::new(
-            t_s,
-            &truth,
-            alt_amsl,
-            &env.wind_ned,
-            &Vector3::from(cfg.wind_ned),
-            view.as_ref(),
-            answer.armed,
-            &answer.surfaces,
-        ));
+        let (view, monitor) = onboard
+            .with_app(link, |app| {
+                let estimate = app.estimate();
+                let monitor = app.vehicle().battery();
+                (
+                    AutopilotView {
+                        est_ne: ned_offset::<f64>(home, estimate.position),
+                        nav: NavView::of(
+                            app.navigation(),
+                            app.mode().needs_navigator(),
+                            &estimate.pos_ned,
+                        ),
+                        estimate,
+                        setpoints: app.setpoints(),
+                        mode: app.mode(),
+                    },
+                    monitor.present.then_some(monitor.remaining),
+                )
+            })
+            .unzip();
+        samples.push(
+            Sample::new(
+                t_s,
+                &truth,
+                alt_amsl,
+                &env.wind_ned,
+                &Vector3::from(cfg.wind_ned),
+                view.as_ref(),
+                answer.armed,
+                &answer.surfaces,
+            )
+            .with_battery(&battery, monitor.flatten()),
+        );
         if landed {
             // The frame that disarmed is logged; the stations read what came with it.
             serve_stations(t_s, gcs.as_mut(), bridge.as_mut(), link, onboard);
@@ -327,6 +345,8 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         for _ in 0..substeps {
             let seen = servos.step(&command, dt);
             plant.step(&seen, &env, dt);
+            let shaft_w = motor_power_w(&params, seen.throttle);
+            battery.step(battery.electrical_power_w(shaft_w), dt);
         }
         let q = plant.attitude();
         env.wind_ned = wind.step(frame_s, plant.air_data().va, -plant.position_ned().z, &q);

@@ -147,6 +147,8 @@ pub struct FlightSummary {
     pub uploads: Vec<(String, f64, String)>,
     /// How the mission went, when one was uploaded.
     pub mission: Option<MissionSummary>,
+    /// What the flight took from the battery.
+    pub battery: Option<BatterySummary>,
 }
 
 impl FlightSummary {
@@ -552,6 +554,7 @@ pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts)
         uploads: f.gcs.map(|g| g.uploads.clone()).unwrap_or_default(),
         mission: None,
         touchdown: None,
+        battery: battery_summary(samples),
         frames: f.frames,
         armed_frames: f.armed_frames,
         sim_s,
@@ -594,4 +597,35 @@ pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts)
             stale_frames: health.stale_frames,
         }),
     }
+}
+
+/// What a flight took from the battery: the simulated pack's truth, and the autopilot's
+/// estimate of the charge left at the end.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct BatterySummary {
+    /// Energy drawn from the pack, Wh.
+    pub energy_wh: f64,
+    /// Charge drawn from the pack, mAh.
+    pub charge_mah: f64,
+    /// Lowest terminal voltage, V.
+    pub min_voltage_v: f64,
+    /// Charge left at the end, %.
+    pub final_remaining_pct: f64,
+    /// The autopilot's estimate of the charge left at the end, % (NaN: no battery monitored).
+    pub final_estimate_pct: f64,
+}
+
+/// The battery's figures of a flight's log (`None` for an empty log).
+pub fn battery_summary(samples: &[Sample]) -> Option<BatterySummary> {
+    let last = samples.last()?;
+    Some(BatterySummary {
+        energy_wh: last.bat_energy_wh,
+        charge_mah: last.bat_drawn_mah,
+        min_voltage_v: samples
+            .iter()
+            .map(|s| s.bat_voltage)
+            .fold(f64::INFINITY, f64::min),
+        final_remaining_pct: last.bat_soc * 100.0,
+        final_estimate_pct: last.est_bat_remaining * 100.0,
+    })
 }

@@ -11,12 +11,14 @@
 //! [`ground`] adds the contact of the landing gear and belly points ([`gear`]) with the runway
 //! (zero in the air). [`state`], [`inputs`] and [`params`] hold what every block reads.
 //! [`servo`] models the surface servos; simulations put it in front of the plant, trim and
-//! linearisation do not.
+//! linearisation do not. [`battery`] is the flight pack, stepped beside the plant by the
+//! flights (not part of the UMN model; it does not feed back into thrust).
 //!
 //! State (13 degrees of freedom, 14 numbers): NED position, body velocity, attitude quaternion
 //! (body to NED), body rates, engine speed Omega.
 
 pub mod aero;
+pub mod battery;
 pub mod dynamics;
 pub mod gear;
 pub mod ground;

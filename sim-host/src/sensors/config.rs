@@ -63,6 +63,31 @@ impl Default for GpsConfig {
     }
 }
 
+/// The flight battery's power monitor (voltage and current), sent as `BATTERY_STATUS`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BatteryMonitorConfig {
+    /// Rate, Hz.
+    pub rate_hz: f64,
+    /// Voltage noise (1 sigma), V.
+    #[serde(rename = "voltage_sigma_V")]
+    pub voltage_sigma_v: f64,
+    /// Current noise (1 sigma), A.
+    #[serde(rename = "current_sigma_A")]
+    pub current_sigma_a: f64,
+}
+
+impl Default for BatteryMonitorConfig {
+    fn default() -> Self {
+        // Not in the UMN sensor library: a typical analog power module's noise.
+        Self {
+            rate_hz: 10.0,
+            voltage_sigma_v: 0.02,
+            current_sigma_a: 0.1,
+        }
+    }
+}
+
 /// Every sensor's rate and noise.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -98,6 +123,8 @@ pub struct SensorConfig {
     pub pd_noise_power_kpa: f64,
     /// GPS receiver.
     pub gps: GpsConfig,
+    /// The battery's power monitor.
+    pub battery: BatteryMonitorConfig,
     /// Calibration errors (scale factors, hard iron, pitot offset): none unless the file
     /// has a `[sensors.calibration]` table. Monte Carlo campaigns draw them per flight.
     #[serde(default, skip_serializing_if = "Calibration::is_ideal")]
@@ -159,6 +186,7 @@ impl Default for SensorConfig {
             pitot_rate_hz: 50.0,
             pd_noise_power_kpa: 1.5e-7,
             gps: GpsConfig::default(),
+            battery: BatteryMonitorConfig::default(),
             calibration: Calibration::default(),
         }
     }
@@ -180,6 +208,7 @@ impl SensorConfig {
             ("baro_rate_hz", self.baro_rate_hz),
             ("pitot_rate_hz", self.pitot_rate_hz),
             ("gps.rate_hz", self.gps.rate_hz),
+            ("battery.rate_hz", self.battery.rate_hz),
         ];
         for (k, v) in rates {
             if !v.is_finite() || v <= 0.0 || v > self.imu_rate_hz {
@@ -199,6 +228,8 @@ impl SensorConfig {
             ("gps.vel_mps", self.gps.vel_mps),
             ("gps.latency_s", self.gps.latency_s),
             ("gps.hdop", self.gps.hdop),
+            ("battery.voltage_sigma_V", self.battery.voltage_sigma_v),
+            ("battery.current_sigma_A", self.battery.current_sigma_a),
             ("gps.startup_tau_s", self.gps.startup_tau_s),
             ("calibration.pitot_scale", self.calibration.pitot_scale),
         ];

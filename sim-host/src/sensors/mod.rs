@@ -5,11 +5,12 @@
 //! its variance is `P / Ts`. That is a fixed power spectral density, so the noise level stays
 //! physically the same whatever rate a sensor is sampled at here. On top of the UMN model the
 //! IMU gets a constant turn-on bias and a random-walk bias drift (the estimator must track
-//! them), and the GPS a latency. Each sensor draws from its own seeded stream, so turning one
+//! them), and the GPS a latency. The battery's power monitor (not in the UMN library) reads the
+//! pack's voltage and current with white noise. Each sensor draws from its own seeded stream, so turning one
 //! sensor off or changing its rate does not change the noise of another.
 
 pub mod config;
 pub mod models;
 
-pub use config::{GpsConfig, SensorConfig};
+pub use config::{BatteryMonitorConfig, GpsConfig, SensorConfig};
 pub use models::{SensorFaults, SensorSuite, Truth};

@@ -5,7 +5,7 @@ use common::link::simlink::SensorFrame;
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::{offset_point, GeoPoint};
 use common::math::ned_to_body;
-use common::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use common::sensors::{BaroSample, BatterySample, GpsFix, ImuSample, MagSample, PitotSample};
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -61,6 +61,8 @@ pub struct SensorFaults {
     pub mag_failed: bool,
     /// No barometer.
     pub baro_failed: bool,
+    /// No battery power monitor (no BATTERY_STATUS).
+    pub battery_failed: bool,
 }
 
 /// Every sensor of the airplane.
@@ -76,6 +78,7 @@ pub struct SensorSuite {
     rng_baro: ChaCha8Rng,
     rng_pitot: ChaCha8Rng,
     rng_gps: ChaCha8Rng,
+    rng_battery: ChaCha8Rng,
     gps_queue: VecDeque<(u64, GpsFix)>,
     /// Injected faults.
     pub faults: SensorFaults,
@@ -99,6 +102,7 @@ impl SensorSuite {
             rng_baro: stream(3),
             rng_pitot: stream(4),
             rng_gps: stream(5),
+            rng_battery: stream(6),
             gps_queue: VecDeque::new(),
             faults: SensorFaults::default(),
         }
@@ -117,6 +121,26 @@ impl SensorSuite {
     /// The next frame's time, us.
     pub fn next_time_us(&self) -> u64 {
         self.frame * self.period_us
+    }
+
+    /// The power monitor's reading of the pack at `voltage_v` and `current_a`, if one is due
+    /// at frame time `time_us` (its own noise stream: the other sensors read the same with or
+    /// without it).
+    pub fn sample_battery(
+        &mut self,
+        time_us: u64,
+        voltage_v: f64,
+        current_a: f64,
+    ) -> Option<BatterySample> {
+        let b = &self.cfg.battery;
+        let n = decimation(self.cfg.imu_rate_hz, b.rate_hz);
+        if !(time_us / self.period_us.max(1)).is_multiple_of(n) || self.faults.battery_failed {
+            return None;
+        }
+        Some(BatterySample {
+            voltage_v: (voltage_v + b.voltage_sigma_v * gauss(&mut self.rng_battery)) as f32,
+            current_a: (current_a + b.current_sigma_a * gauss(&mut self.rng_battery)) as f32,
+        })
     }
 
     /// Samples every sensor due at the next frame time; returns the frame and a GPS fix if one
@@ -354,5 +378,32 @@ mod tests {
             // A fix measured before the loss may still be in flight for one latency.
             assert!(g.is_none() || k < 12, "GPS fix {k} frames after the loss");
         }
+    }
+
+    #[test]
+    fn the_power_monitor_reads_at_10_hz_with_its_noise_until_it_fails() {
+        let mut s = SensorSuite::new(SensorConfig::default(), GeoPoint::default(), 0.0, 3);
+        let mut v = Vec::new();
+        for k in 0..10_000u64 {
+            if let Some(b) = s.sample_battery(k * 10_000, 11.1, 8.0) {
+                v.push(b);
+            }
+        }
+        assert_eq!(v.len(), 1000, "10 Hz of 100 Hz frames");
+        let n = v.len() as f64;
+        let mean = v.iter().map(|b| f64::from(b.voltage_v)).sum::<f64>() / n;
+        let sd = (v
+            .iter()
+            .map(|b| (f64::from(b.voltage_v) - mean).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        let amps = v.iter().map(|b| f64::from(b.current_a)).sum::<f64>() / n;
+        // 20 mV and 0.1 A of noise: the means within 4 standard errors.
+        assert!((mean - 11.1).abs() < 4.0 * 0.02 / n.sqrt(), "{mean}");
+        assert!((sd - 0.02).abs() < 0.002, "{sd}");
+        assert!((amps - 8.0).abs() < 4.0 * 0.1 / n.sqrt(), "{amps}");
+        s.faults.battery_failed = true;
+        assert!((0..100u64).all(|k| s.sample_battery(k * 10_000, 11.1, 8.0).is_none()));
     }
 }
