@@ -38,6 +38,12 @@ pub struct Log {
     pub foreign: usize,
     /// Frames the `mavlink` crate could not parse.
     pub unparsed: usize,
+    /// HOME_POSITION while the last heartbeat said armed: (latitude, longitude, altitude in
+    /// mm), in arrival order.
+    pub armed_homes: Vec<(i32, i32, i32)>,
+    /// GLOBAL_POSITION_INT while armed: altitude above sea level less height above home, mm
+    /// (home's altitude in the aircraft's datum).
+    pub armed_datums: Vec<i32>,
 }
 
 /// The ground station.
@@ -139,6 +145,11 @@ impl Station {
         std::thread::sleep(Duration::from_millis(1));
     }
 
+    /// Whether the autopilot's last heartbeat said armed.
+    fn armed(&self) -> bool {
+        self.log.heartbeats.last().is_some_and(|h| h.0)
+    }
+
     fn take(&mut self, h: MavHeader, m: MavMessage) {
         if (h.system_id, h.component_id) != (u32::from(TARGET.0), TARGET.1) {
             self.log.foreign += 1;
@@ -164,6 +175,14 @@ impl Station {
                     .push((c.seq, c.total, c.mission_state, c.mission_id))
             }
             MavMessage::MISSION_ITEM_REACHED(r) => self.log.reached.push(r.seq),
+            MavMessage::HOME_POSITION(p) if self.armed() => {
+                self.log
+                    .armed_homes
+                    .push((p.latitude, p.longitude, p.altitude))
+            }
+            MavMessage::GLOBAL_POSITION_INT(g) if self.armed() => {
+                self.log.armed_datums.push(g.alt - g.relative_alt)
+            }
             MavMessage::STATUSTEXT(t) => self
                 .log
                 .texts

@@ -578,9 +578,8 @@ fn a_request_behind_a_corrupt_length_in_its_datagram_is_answered_at_once() {
     assert_eq!(value, Some(17.0), "answered within a second, not held");
 }
 
-/// Runs one of `tests/interop/`'s pymavlink scripts against a fresh SITL vehicle; false when
-/// pymavlink is missing outside CI (skipped), a failed assertion when a check fails.
-fn pymavlink_script(name: &str) -> bool {
+/// Whether python3 with pymavlink is here; false (skipped) outside CI, a failure under CI.
+fn have_pymavlink() -> bool {
     if !system_tests::tool_available("python3") {
         return false;
     }
@@ -594,6 +593,15 @@ fn pymavlink_script(name: &str) -> bool {
             "pymavlink is required under CI (.ci/run installs it)"
         );
         eprintln!("SKIPPED: pymavlink is not installed (pip install pymavlink)");
+        return false;
+    }
+    true
+}
+
+/// Runs one of `tests/interop/`'s pymavlink scripts against a fresh SITL vehicle; false when
+/// pymavlink is missing outside CI (skipped), a failed assertion when a check fails.
+fn pymavlink_script(name: &str) -> bool {
+    if !have_pymavlink() {
         return false;
     }
     let gps = Arc::new(AtomicBool::new(true));
@@ -651,7 +659,7 @@ fn pymavlink_names_and_sets_every_mode_with_the_shipped_mode_map() {
 }
 
 #[test]
-fn home_set_by_arming_on_the_ground_is_held_to_the_millimetre_while_the_estimator_learns() {
+fn home_set_by_arming_at_rest_is_reported_and_heights_are_in_its_datum() {
     // pymavlink reads HOME_POSITION and GLOBAL_POSITION_INT (see the script's docstring).
     pymavlink_script("pymavlink_home.py");
 }
@@ -663,4 +671,34 @@ fn pymavlink_sees_the_pack_s_voltage_current_and_charge_in_sys_status_and_batter
     let p = pack();
     assert!((p.voltage_v - 12.0516).abs() < 1e-3, "{p:?}");
     pymavlink_script("pymavlink_battery.py");
+}
+
+#[test]
+fn pymavlink_reads_the_flights_tlog_as_a_ground_stations_log_of_both_directions() {
+    // A short scripted flight writes out/…/flight.tlog; pymavlink's own log reader checks it
+    // (see the script's docstring).
+    if !have_pymavlink() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let cfg = sim_host::flight::FlightConfig {
+        duration_s: 40.0,
+        ..sim_host::flight::FlightConfig::default()
+    };
+    let opts = sim_host::commands::fly::FlyOptions {
+        out: Some(dir.path().to_path_buf()),
+        plots: false,
+        ..sim_host::commands::fly::FlyOptions::default()
+    };
+    let aircraft = sim_host::aircraft::Aircraft::ultrastick25e().expect("built-in aircraft");
+    sim_host::commands::fly::fly_report(&aircraft, &cfg, &opts).expect("flight");
+    let script = system_tests::workspace_root().join("tests/interop/pymavlink_tlog.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .arg(dir.path().join("flight.tlog"))
+        .output()
+        .expect("python3 runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "pymavlink reads the tlog:\n{text}");
 }

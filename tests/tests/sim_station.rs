@@ -139,6 +139,43 @@ fn a_station_flies_the_default_mission_through_sim_host_sim_and_the_host_build()
 
     let log = &gcs.log;
     eprintln!("reached {:?}; texts {:?}", log.reached, log.texts);
+    // Home, set by arming on the runway, is held in the datum it was set in for the whole
+    // flight, and the aircraft's altitude is given in that datum (within a millimetre of
+    // rounding), while the estimator learns its barometer's offset from GPS.
+    let first = log
+        .armed_homes
+        .first()
+        .copied()
+        .expect("HOME_POSITION while armed");
+    let moved = log
+        .armed_homes
+        .iter()
+        .map(|h| (h.2 - first.2).abs())
+        .max()
+        .unwrap_or(0);
+    assert!(
+        log.armed_homes.len() > 50
+            && log
+                .armed_homes
+                .iter()
+                .all(|h| h.0 == first.0 && h.1 == first.1),
+        "{} homes",
+        log.armed_homes.len()
+    );
+    assert_eq!(
+        moved, 0,
+        "home's altitude moved by up to {moved} mm in flight"
+    );
+    let off = log
+        .armed_datums
+        .iter()
+        .map(|d| (d - first.2).abs())
+        .max()
+        .unwrap_or(i32::MAX);
+    assert!(
+        off <= 1,
+        "altitude less height above home is {off} mm off home's"
+    );
     assert_eq!(
         log.reached,
         (0..n).collect::<Vec<_>>(),
