@@ -14,6 +14,7 @@ use std::path::Path;
 use arbitrary::{Arbitrary, Unstructured};
 use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
 use serde_json::{json, Value};
+use sim_host::mission_file::item::is_global;
 use sim_host::mission_file::{parse_mission_text, MissionFile};
 
 /// A number as a file may write it.
@@ -166,19 +167,6 @@ impl Built {
     }
 }
 
-#[allow(deprecated)]
-fn global(frame: MavFrame) -> bool {
-    matches!(
-        frame,
-        MavFrame::MAV_FRAME_GLOBAL
-            | MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT
-            | MavFrame::MAV_FRAME_GLOBAL_INT
-            | MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
-            | MavFrame::MAV_FRAME_GLOBAL_TERRAIN_ALT
-            | MavFrame::MAV_FRAME_GLOBAL_TERRAIN_ALT_INT
-    )
-}
-
 fn check_list(items: &[MISSION_ITEM_INT_DATA], kind: MavMissionType, plan: bool, len: usize) {
     for (i, it) in items.iter().enumerate() {
         assert_eq!(usize::from(it.seq), i, "items numbered 0..");
@@ -187,7 +175,7 @@ fn check_list(items: &[MISSION_ITEM_INT_DATA], kind: MavMissionType, plan: bool,
             (it.target_system, it.target_component, it.current),
             (1, 1, 0)
         );
-        if global(it.frame) {
+        if is_global(it.frame) {
             assert!(it.x.unsigned_abs() <= 900_000_000, "latitude {}", it.x);
             assert!(it.y.unsigned_abs() <= 1_800_000_000, "longitude {}", it.y);
         }
