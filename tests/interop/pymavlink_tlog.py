@@ -8,21 +8,10 @@ through the same format: each frame after its time. Checks:
      vehicle's COMMAND_ACK accepting it;
   4. the vehicle's telemetry a replay draws: ATTITUDE and GLOBAL_POSITION_INT.
 """
-import os
 import sys
 
-os.environ["MAVLINK20"] = "1"
-from pymavlink import mavutil  # noqa: E402
-
-MAV = mavutil.mavlink
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what, flush=True)
-    if not ok:
-        failures.append(what)
-
+from station import MAV, check, finish
+from pymavlink import mavutil
 
 log = mavutil.mavlink_connection(sys.argv[1], dialect="common")
 counts, times, bad = {}, [], 0
@@ -52,4 +41,4 @@ check(counts.get((255, "HEARTBEAT"), 0) >= span - 2, f"station heartbeats: {coun
 check(arm_sent and arm_acked, "the station's arming command and its ACCEPTED")
 check(counts.get((1, "ATTITUDE"), 0) > span and counts.get((1, "GLOBAL_POSITION_INT"), 0) > span / 2,
       f"telemetry: {counts.get((1, 'ATTITUDE'), 0)} ATTITUDE, {counts.get((1, 'GLOBAL_POSITION_INT'), 0)} GLOBAL_POSITION_INT")
-sys.exit(1 if failures else 0)
+finish()

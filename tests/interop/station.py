@@ -1,8 +1,8 @@
 """What the pymavlink scripts of this folder share: a ground station (255/190) on the autopilot's
 UDP ground link, the checks and the verdict.
 
-Each script takes the port of the ground link as its one argument, prints one line per check
-and exits 0 when every check holds.
+Each script takes the port of the ground link (or, for a log, its path) as its one argument,
+prints one line per check and exits 0 when every check holds.
 """
 import os
 import sys
@@ -11,7 +11,6 @@ import time
 os.environ["MAVLINK20"] = "1"
 from pymavlink import mavutil  # noqa: E402
 
-PORT = int(sys.argv[1])
 MAV = mavutil.mavlink
 failures = []
 
@@ -25,7 +24,7 @@ def check(ok, what):
 def connect():
     """A new station (its own UDP port, so its own channel on the vehicle), heard once."""
     m = mavutil.mavlink_connection(
-        f"udpout:127.0.0.1:{PORT}", source_system=255, source_component=190
+        f"udpout:127.0.0.1:{int(sys.argv[1])}", source_system=255, source_component=190
     )
     m.mav.heartbeat_send(MAV.MAV_TYPE_GCS, MAV.MAV_AUTOPILOT_INVALID, 0, 0, 0)
     return m
