@@ -9,6 +9,7 @@ use crate::flight::config::FlightConfig;
 use crate::flight::onboard::InprocOnboard;
 use crate::flight::record::Sample;
 use crate::flight::runner::{fly, FlightOutcome};
+use crate::flight::summary::HomeDatum;
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::Inproc;
 use common::math::{wrap_pi, Euler};
@@ -347,7 +348,8 @@ pub fn figures_and_facts(
     };
     if let Some(a) = samples.iter().find(|x| x.armed) {
         f.est_position_error_at_arm_m = finite((a.est_north - a.north).hypot(a.est_east - a.east));
-        f.est_alt_error_at_arm_m = finite(a.est_alt - a.alt);
+        // Home is set at arming to the altitude estimated then: the error it is held with.
+        f.est_alt_error_at_arm_m = finite(HomeDatum::of(samples).error_m);
         f.est_heading_error_at_arm_deg = finite(wrap_pi(a.est_yaw - a.yaw).to_degrees());
     }
     if let Some(b) = &s.battery {
