@@ -1,0 +1,39 @@
+//! The STM32F405 board layer.
+//!
+//! Clock set-up is skipped: QEMU's netduinoplus2 does not emulate RCC, and polling a ready bit
+//! there hangs (on a real board the reset clock, 16 MHz HSI, runs this loop as well). USART1
+//! carries the simulator link and USART2 the ground link; both are busy-polled, which also
+//! keeps QEMU's instruction-counting mode exact.
+
+use cortex_m_rt::entry;
+use defmt_semihosting as _;
+use firmware::app::App;
+use panic_probe as _;
+
+mod usart;
+use usart::Usart;
+
+#[entry]
+fn main() -> ! {
+    let sim = Usart::USART1;
+    let gcs = Usart::USART2;
+    sim.enable();
+    gcs.enable();
+    defmt::info!("autopilot booted: STM32F405, USART1 sim link, USART2 ground link");
+    let mut app = App::new();
+    sim.write(&firmware::app::heartbeat_frame(&mut app));
+    let mut chunk = [0u8; 64];
+    loop {
+        // Gather what has arrived on each UART, then hand it over in one piece.
+        let n = sim.read_into(&mut chunk);
+        if let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) {
+            app.on_sim_bytes(bytes, &mut |out| sim.write(out));
+        }
+        let n = gcs.read_into(&mut chunk);
+        if let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) {
+            app.on_gcs_bytes(bytes);
+        }
+        // Telemetry and answers for the ground, produced by both calls above.
+        app.drain_gcs(&mut |out| gcs.write(out));
+    }
+}
