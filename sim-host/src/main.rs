@@ -335,13 +335,22 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         None
     };
     if a.json {
-        match &compared {
-            Some(c) => emit(&to_json(&serde_json::json!({
+        match (&compared, &r.mcu) {
+            (Some(c), mcu) => emit(&to_json(&serde_json::json!({
                 "flight": r.outcome.summary,
                 "host": c.host.summary,
                 "answers": c.answers,
+                "mcu": mcu,
             }))?)?,
-            None => emit(&to_json(&r.outcome.summary)?)?,
+            // The MCU image's figures of itself (--link qemu): flash, RAM, instructions.
+            (None, Some(m)) => {
+                let mut doc = serde_json::to_value(&r.outcome.summary)?;
+                if let Some(o) = doc.as_object_mut() {
+                    o.insert("mcu".into(), serde_json::to_value(m)?);
+                }
+                emit(&to_json(&doc)?)?
+            }
+            (None, None) => emit(&to_json(&r.outcome.summary)?)?,
         }
     } else {
         emit(&render(

@@ -11,7 +11,7 @@ use common::link::framing::{FrameParser, LinkStats, Sender};
 use common::link::signing;
 use common::vehicle::commander::Severity;
 use common::vehicle::{FromGround, Notice, Vehicle};
-use mavlink::dialects::common::MavSeverity;
+use mavlink::dialects::common::{MavMessage, MavSeverity};
 
 /// Bytes waiting for the ground station at most (a full parameter burst and telemetry).
 pub const GCS_OUT: usize = 8192;
@@ -174,7 +174,7 @@ impl GroundPort {
             plan,
             rules,
         };
-        let (tx, buf, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
+        let dropped = &mut self.bytes_dropped;
         let mut outgoing = heapless::Vec::<(Dest, Outgoing), 64>::new();
         self.link.poll(now_us, &snapshot, &stores, |dest, msg| {
             if outgoing.push((dest, msg)).is_err() {
@@ -183,35 +183,48 @@ impl GroundPort {
         });
         // By reference: a heapless vector's by-value iterator checks a slice bound on drop.
         for &(dest, ref msg) in &outgoing {
-            let raw = match msg {
-                Outgoing::Message(m) => tx.encode(m),
-                Outgoing::Ack(a) => tx.encode_data(a),
-            };
-            // With signing on, every frame is signed; the link id says which channel.
-            let link_id = match dest {
-                Dest::All => 0,
-                Dest::Channel(c) => c,
-            };
-            let signed = match self.link.signing().key().copied() {
-                Some(key) => {
-                    let t = self.link.signing_mut().next_timestamp();
-                    signing::sign(raw.raw_bytes(), &key, link_id, t)
-                }
-                None => None,
-            };
-            let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
-            let tag = match dest {
-                Dest::All => TO_ALL,
-                Dest::Channel(c) => c,
-            };
-            let [lo, hi] = (frame.len() as u16).to_le_bytes();
-            let fits = buf.len().saturating_add(3).saturating_add(frame.len()) <= buf.capacity();
-            if !fits
-                || buf.extend_from_slice(&[tag, lo, hi]).is_err()
-                || buf.extend_from_slice(frame).is_err()
-            {
-                *dropped = dropped.saturating_add(frame.len() as u32);
+            self.queue(dest, msg);
+        }
+    }
+
+    /// A message of the board's own (its figures of itself) to every station, framed and
+    /// signed as the link's own.
+    pub fn send(&mut self, msg: &MavMessage) {
+        self.queue(Dest::All, &Outgoing::Message(msg.clone()));
+    }
+
+    /// Encodes `msg` (signed when signing is on) into the output buffer, or counts its bytes
+    /// dropped when the buffer is full.
+    fn queue(&mut self, dest: Dest, msg: &Outgoing) {
+        let raw = match msg {
+            Outgoing::Message(m) => self.tx.encode(m),
+            Outgoing::Ack(a) => self.tx.encode_data(a),
+        };
+        // With signing on, every frame is signed; the link id says which channel.
+        let link_id = match dest {
+            Dest::All => 0,
+            Dest::Channel(c) => c,
+        };
+        let signed = match self.link.signing().key().copied() {
+            Some(key) => {
+                let t = self.link.signing_mut().next_timestamp();
+                signing::sign(raw.raw_bytes(), &key, link_id, t)
             }
+            None => None,
+        };
+        let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
+        let tag = match dest {
+            Dest::All => TO_ALL,
+            Dest::Channel(c) => c,
+        };
+        let [lo, hi] = (frame.len() as u16).to_le_bytes();
+        let buf = &mut self.out;
+        let fits = buf.len().saturating_add(3).saturating_add(frame.len()) <= buf.capacity();
+        if !fits
+            || buf.extend_from_slice(&[tag, lo, hi]).is_err()
+            || buf.extend_from_slice(frame).is_err()
+        {
+            self.bytes_dropped = self.bytes_dropped.saturating_add(frame.len() as u32);
         }
     }
 

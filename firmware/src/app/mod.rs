@@ -151,6 +151,19 @@ impl App {
         self.vehicle.snapshot()
     }
 
+    /// A figure the board measures of itself (instructions per control period, stack peak)
+    /// to every ground station as NAMED_VALUE_INT; `name` is cut to its 10 characters.
+    pub fn report_figure(&mut self, name: &str, value: i32) {
+        use mavlink::dialects::common::{MavMessage, NAMED_VALUE_INT_DATA};
+        let time_boot_ms = (self.vehicle.time_us().unwrap_or(0) / 1000) as u32;
+        self.ground
+            .send(&MavMessage::NAMED_VALUE_INT(NAMED_VALUE_INT_DATA {
+                time_boot_ms,
+                name: name.into(),
+                value,
+            }));
+    }
+
     /// Feeds bytes from the simulator link; `out` receives the bytes to send back.
     pub fn on_sim_bytes(&mut self, bytes: &[u8], out: &mut impl FnMut(&[u8])) {
         self.sim

@@ -10,6 +10,7 @@ use defmt_semihosting as _;
 use firmware::app::App;
 use panic_probe as _;
 
+mod budget;
 mod usart;
 use usart::Usart;
 
@@ -20,20 +21,31 @@ fn main() -> ! {
     sim.enable();
     gcs.enable();
     defmt::info!("autopilot booted: STM32F405, USART1 sim link, USART2 ground link");
+    budget::start();
+    let mut budget = budget::Budget::new();
     let mut app = App::new();
     sim.write(&firmware::app::heartbeat_frame(&mut app));
-    let mut chunk = [0u8; 64];
+    let (mut sim_chunk, mut gcs_chunk) = ([0u8; 64], [0u8; 64]);
     loop {
         // Gather what has arrived on each UART, then hand it over in one piece.
-        let n = sim.read_into(&mut chunk);
-        if let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) {
+        let n = sim.read_into(&mut sim_chunk);
+        let sim_bytes = sim_chunk.get(..n).filter(|b| !b.is_empty());
+        let n = gcs.read_into(&mut gcs_chunk);
+        let gcs_bytes = gcs_chunk.get(..n).filter(|b| !b.is_empty());
+        if sim_bytes.is_none() && gcs_bytes.is_none() {
+            continue;
+        }
+        let t0 = budget::now();
+        if let Some(bytes) = sim_bytes {
             app.on_sim_bytes(bytes, &mut |out| sim.write(out));
         }
-        let n = gcs.read_into(&mut chunk);
-        if let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) {
+        if let Some(bytes) = gcs_bytes {
             app.on_gcs_bytes(bytes);
         }
         // Telemetry and answers for the ground, produced by both calls above.
         app.drain_gcs(&mut |out| gcs.write(out));
+        budget.charge(budget::since(t0), app.vehicle().time_us());
+        // Outside the measured work: the report scans the stack (sent with the next frames).
+        budget.report(&mut app);
     }
 }

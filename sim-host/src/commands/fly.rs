@@ -137,6 +137,7 @@ pub fn fly_report(
     let tlog = tlog.as_deref();
     let wait = Duration::from_secs(10);
     let silence = cfg.link_timeout.max(Duration::from_secs(2));
+    let mut mcu = None;
     let flown = match opts.link {
         LinkKind::Inproc => run_on(
             aircraft,
@@ -182,14 +183,20 @@ pub fn fly_report(
             let mut fw = spawn_firmware(SimEndpoint::Serial(path), App::new(), wait, silence);
             run_on(aircraft, &cfg, pty, &mut fw, tlog)?
         }
-        LinkKind::Qemu => fly_qemu(aircraft, &cfg, &opts.qemu, opts.out.as_deref(), tlog)?,
+        LinkKind::Qemu => {
+            let (flown, budget) = fly_qemu(aircraft, &cfg, &opts.qemu, opts.out.as_deref(), tlog)?;
+            mcu = budget;
+            flown
+        }
     };
     let mut files: Vec<PathBuf> = cfg.ground_tlog.iter().cloned().collect();
     files.extend(tlog.map(std::path::Path::to_path_buf));
     if opts.link == LinkKind::Qemu {
         files.extend(opts.out.as_ref().map(|d| d.join(MCU_LOG)));
     }
-    finish_report(flown, opts.out.as_deref(), opts.plots, files)
+    let mut report = finish_report(flown, opts.out.as_deref(), opts.plots, files)?;
+    report.mcu = mcu;
+    Ok(report)
 }
 
 /// The short summary printed after a flight.

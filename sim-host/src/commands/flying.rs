@@ -7,6 +7,7 @@ use crate::flight::config::FlightConfig;
 use crate::flight::onboard::{Onboard, OutsideOnboard};
 use crate::flight::plots::write_log_and_plots;
 use crate::flight::runner::{fly, FlightError, FlightOutcome};
+use crate::link::budget::{image_size, McuBudget};
 use crate::link::lockstep::Lockstep;
 use crate::link::qemu::{boot, QemuConfig};
 use crate::link::tlog::TlogWriter;
@@ -22,6 +23,8 @@ pub struct FlyReport {
     pub outcome: FlightOutcome,
     /// Files written.
     pub files: Vec<PathBuf>,
+    /// The MCU image's budget as it measured itself (`--link qemu` only).
+    pub mcu: Option<McuBudget>,
 }
 
 /// A flight, or why it could not be flown: the outer error is this side's (a file that
@@ -62,14 +65,15 @@ pub(crate) fn run_on_with<T: Transport, O: Onboard<T>>(
 
 /// Boots the MCU image in QEMU and flies `cfg` against it, the scripted station on the UDP
 /// side of its ground bridge. The bridge serves `cfg.ground_link` when one is asked for
-/// (QGroundControl watching), else a free port for the scripted station alone.
+/// (QGroundControl watching), else a free port for the scripted station alone. Also returns
+/// the image's budget: its size and what it measured of itself in flight.
 pub(crate) fn fly_qemu(
     aircraft: &Aircraft,
     cfg: &FlightConfig,
     qemu: &QemuConfig,
     out: Option<&Path>,
     tlog: Option<&Path>,
-) -> Flown {
+) -> anyhow::Result<(Result<FlightOutcome, FlightError>, Option<McuBudget>)> {
     let (bind, remote) = match &cfg.ground_link {
         Some((b, r)) => (b.clone(), Some(r.clone())),
         None => ("127.0.0.1:0".to_string(), None),
@@ -87,7 +91,9 @@ pub(crate) fn fly_qemu(
         truth_frames: uart_truth_frames(cfg),
         ..cfg.clone()
     };
-    run_on(aircraft, &cfg, sim, &mut onboard, tlog)
+    let flown = run_on(aircraft, &cfg, sim, &mut onboard, tlog)?;
+    let size = image_size(&qemu.elf)?;
+    Ok((flown, McuBudget::from_reports(size, &bridge.named_values())))
 }
 
 /// Whether the truth goes to the MCU image: only when it flies on it. Each byte a UART
@@ -132,7 +138,11 @@ pub(crate) fn finish_report(
             if let Some(dir) = out {
                 files.extend(write_flight_files(dir, &outcome, plots)?);
             }
-            Ok(FlyReport { outcome, files })
+            Ok(FlyReport {
+                outcome,
+                files,
+                mcu: None,
+            })
         }
         Err(e) => match (e.partial(), out) {
             (Some(partial), Some(dir)) => {

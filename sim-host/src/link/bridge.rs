@@ -12,7 +12,9 @@
 
 use common::link::framing::{encode_v2, FrameParser, LinkStats};
 use firmware::sitl::{timed_out, MAX_GCS_PEERS};
+use mavlink::dialects::common::MavMessage;
 use mavlink::{MAVLinkV1MessageRaw, MavlinkVersion};
+use std::collections::BTreeMap;
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, UdpSocket};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -47,6 +49,7 @@ pub struct GroundBridge {
     stop: Arc<AtomicBool>,
     counters: Arc<Counters>,
     uart_stats: Arc<Mutex<LinkStats>>,
+    named: Arc<Mutex<BTreeMap<String, i32>>>,
     threads: Vec<JoinHandle<()>>,
 }
 
@@ -63,17 +66,19 @@ impl GroundBridge {
         let counters = Arc::new(Counters::default());
         let uart_stats = Arc::new(Mutex::new(LinkStats::default()));
         let peers = Arc::new(Mutex::new(Vec::<SocketAddr>::new()));
+        let named = Arc::new(Mutex::new(BTreeMap::new()));
         uart.set_read_timeout(Some(POLL))?;
         socket.set_read_timeout(Some(POLL))?;
         let (uart_in, mut uart_out) = (uart.try_clone()?, uart);
         let (sock_in, sock_out) = (socket.try_clone()?, socket);
 
         let down = {
-            let (stop, counters, stats, peers) = (
+            let (stop, counters, stats, peers, named) = (
                 stop.clone(),
                 counters.clone(),
                 uart_stats.clone(),
                 peers.clone(),
+                named.clone(),
             );
             let mut uart = uart_in;
             std::thread::spawn(move || {
@@ -100,6 +105,14 @@ impl GroundBridge {
                         )
                         .collect();
                     parser.push(&buf[..n], |f| {
+                        if let MavMessage::NAMED_VALUE_INT(v) = &f.message {
+                            if let Ok(name) = v.name.to_str() {
+                                named
+                                    .lock()
+                                    .unwrap_or_else(|p| p.into_inner())
+                                    .insert(name.to_string(), v.value);
+                            }
+                        }
                         let frame = match f.version {
                             MavlinkVersion::V2 => {
                                 encode_v2(f.header, &f.message).raw_bytes().to_vec()
@@ -152,6 +165,7 @@ impl GroundBridge {
             stop,
             counters,
             uart_stats,
+            named,
             threads: vec![down, up],
         })
     }
@@ -159,6 +173,12 @@ impl GroundBridge {
     /// Where ground stations send their frames.
     pub fn local_addr(&self) -> SocketAddr {
         self.addr
+    }
+
+    /// The last value of each NAMED_VALUE_INT the image has sent (its figures of itself:
+    /// `firmware`'s `mcu/budget.rs`).
+    pub fn named_values(&self) -> BTreeMap<String, i32> {
+        self.named.lock().unwrap_or_else(|p| p.into_inner()).clone()
     }
 
     /// What the bridge has carried so far.

@@ -5,9 +5,10 @@
 //! before the plant may advance, so a run is deterministic and as fast as the CPU allows;
 //! [`tlog`] records every frame both ways in the `.tlog` format pymavlink and QGroundControl
 //! read; [`qemu`] runs the MCU image on QEMU's emulated STM32F405 with its ground UART
-//! behind the [`bridge`] to UDP.
+//! behind the [`bridge`] to UDP; [`budget`] gives the image's flash, RAM and instructions.
 
 pub mod bridge;
+pub mod budget;
 pub mod lockstep;
 pub mod qemu;
 pub mod tlog;
