@@ -101,6 +101,26 @@ fn the_mcu_image_takes_off_flies_the_first_legs_and_answers_as_the_host_build_to
     assert_eq!(s.frames, (FIRST_LEGS_S * 100.0) as u64);
     assert_eq!(s.sim_rx.crc_errors, 0);
 
+    // The image measured itself: one control period per 20 ms of the flight (each period
+    // closes when the next begins), a stack peak within the 48 KiB stack region of memory.x.
+    let b = pil.mcu.expect("the image's figures of itself");
+    let periods = s.frames / 2;
+    assert!(
+        b.control_periods + 100 >= periods && b.control_periods <= periods,
+        "{} control periods measured in {periods}",
+        b.control_periods
+    );
+    assert!(
+        b.stack_peak_bytes > 1024 && b.stack_peak_bytes < 48 * 1024,
+        "{b:?}"
+    );
+    assert!(
+        b.instr_per_control_period_mean > 0.0
+            && b.instr_per_control_period_max >= b.instr_per_control_period_mean,
+        "{b:?}"
+    );
+    eprintln!("MCU budget: {b:?}");
+
     // Same answers: bit for bit until the first frame whose computation meets an elementary
     // function the two libraries round apart (after arming: until then the answer is the
     // trim, whatever the estimator holds), then within the bound.
@@ -354,4 +374,26 @@ fn a_qemu_that_dies_mid_flight_ends_it_at_once_naming_how_and_the_log_is_kept() 
     let (rows, summary) = kept_log(dir.path());
     assert!(rows > 50, "{rows} rows");
     assert_eq!(summary["ended"], "link_failed");
+}
+
+/// The budget of the MCU image (docs/PERFORMANCE.md, "MCU image budget"): flash at most
+/// 160 KiB; statics and the stack's measured peak at most 48 KiB; per 20 ms control period at
+/// most 100,000 instructions on average and 150,000 at most, over the take-off and first legs.
+#[test]
+#[ignore = "not met yet: measured 2026-12-02 flash 481,084 B, statics 32,436 B + stack peak 38,596 B, 327,836 instructions per control period on average, 5,177,368 at most (docs/PERFORMANCE.md)"]
+fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
+    let Some(qemu) = mcu() else { return };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let pil = fly_report(
+        &aircraft(),
+        &mission(FIRST_LEGS_S),
+        &pil_options(qemu, dir.path()),
+    )
+    .expect("the PIL flight");
+    let b = pil.mcu.expect("the image's figures of itself");
+    eprintln!("MCU budget: {b:?}");
+    assert!(b.flash_bytes <= 160 * 1024, "flash {b:?}");
+    assert!(b.ram_bytes() <= 48 * 1024, "RAM {b:?}");
+    assert!(b.instr_per_control_period_mean <= 100_000.0, "{b:?}");
+    assert!(b.instr_per_control_period_max <= 150_000.0, "{b:?}");
 }

@@ -62,6 +62,22 @@ impl App {
         }
     }
 
+    /// A freshly booted autopilot built in place in `slot` (a static on the MCU), stage by
+    /// stage: `App::new` would build the whole application in its own stack frame first and
+    /// then copy it out, which on the STM32F405 costs more stack than the image has.
+    pub fn init_in(slot: &mut core::mem::MaybeUninit<App>) -> &mut App {
+        let p = slot.as_mut_ptr();
+        // SAFETY: each field of the slot is written exactly once, through a raw pointer that
+        // never reads the uninitialised memory; after the three writes every field holds a
+        // valid value, so the whole `App` is initialised.
+        unsafe {
+            core::ptr::addr_of_mut!((*p).vehicle).write(Vehicle::new());
+            core::ptr::addr_of_mut!((*p).sim).write(SimPort::new());
+            core::ptr::addr_of_mut!((*p).ground).write(GroundPort::new());
+            slot.assume_init_mut()
+        }
+    }
+
     /// The vehicle.
     pub fn vehicle(&self) -> &Vehicle {
         &self.vehicle
@@ -293,6 +309,19 @@ mod tests {
         }
         let c = actuators(&mut app, 80);
         assert!(c[0].abs() < 0.1, "{c:?}");
+    }
+
+    #[test]
+    fn an_application_built_in_place_answers_as_one_built_by_value() {
+        let mut slot = core::mem::MaybeUninit::uninit();
+        let in_place = App::init_in(&mut slot);
+        let mut by_value = App::new();
+        for k in 0..5 {
+            let (a, b) = (actuators(in_place, k), actuators(&mut by_value, k));
+            assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "frame {k}");
+        }
+        assert_eq!(in_place.mode(), FlightMode::Manual);
+        assert!(!in_place.armed());
     }
 
     #[test]

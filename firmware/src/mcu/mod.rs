@@ -5,6 +5,7 @@
 //! carries the simulator link and USART2 the ground link; both are busy-polled, which also
 //! keeps QEMU's instruction-counting mode exact.
 
+use core::mem::MaybeUninit;
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::app::App;
@@ -23,8 +24,11 @@ fn main() -> ! {
     defmt::info!("autopilot booted: STM32F405, USART1 sim link, USART2 ground link");
     budget::start();
     let mut budget = budget::Budget::new();
-    let mut app = App::new();
-    sim.write(&firmware::app::heartbeat_frame(&mut app));
+    // The application lives in a static, built in place (no stack frame holds it).
+    static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
+    // SAFETY: `main` runs once and is the only code that names APP.
+    let app = App::init_in(unsafe { &mut *core::ptr::addr_of_mut!(APP) });
+    sim.write(&firmware::app::heartbeat_frame(app));
     let (mut sim_chunk, mut gcs_chunk) = ([0u8; 64], [0u8; 64]);
     loop {
         // Gather what has arrived on each UART, then hand it over in one piece.
@@ -46,6 +50,6 @@ fn main() -> ! {
         app.drain_gcs(&mut |out| gcs.write(out));
         budget.charge(budget::since(t0), app.vehicle().time_us());
         // Outside the measured work: the report scans the stack (sent with the next frames).
-        budget.report(&mut app);
+        budget.report(app);
     }
 }
