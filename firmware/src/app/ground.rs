@@ -174,58 +174,25 @@ impl GroundPort {
             plan,
             rules,
         };
-        let dropped = &mut self.bytes_dropped;
-        let mut outgoing = heapless::Vec::<(Dest, Outgoing), 64>::new();
+        // Each message is encoded the moment the link hands it over, so no list of whole
+        // messages (64 of them: 18 KB) waits on the stack. The link's poll only advances the
+        // signing clock; the signing state is lent to the encoder meanwhile.
+        let signing = self.link.signing_mut();
+        signing.tick(now_us);
+        let mut signing = core::mem::take(signing);
+        let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
         self.link.poll(now_us, &snapshot, &stores, |dest, msg| {
-            if outgoing.push((dest, msg)).is_err() {
-                *dropped = dropped.saturating_add(1);
-            }
+            queue(tx, out, dropped, &mut signing, dest, &msg)
         });
-        // By reference: a heapless vector's by-value iterator checks a slice bound on drop.
-        for &(dest, ref msg) in &outgoing {
-            self.queue(dest, msg);
-        }
+        *self.link.signing_mut() = signing;
     }
 
     /// A message of the board's own (its figures of itself) to every station, framed and
     /// signed as the link's own.
     pub fn send(&mut self, msg: &MavMessage) {
-        self.queue(Dest::All, &Outgoing::Message(msg.clone()));
-    }
-
-    /// Encodes `msg` (signed when signing is on) into the output buffer, or counts its bytes
-    /// dropped when the buffer is full.
-    fn queue(&mut self, dest: Dest, msg: &Outgoing) {
-        let raw = match msg {
-            Outgoing::Message(m) => self.tx.encode(m),
-            Outgoing::Ack(a) => self.tx.encode_data(a),
-        };
-        // With signing on, every frame is signed; the link id says which channel.
-        let link_id = match dest {
-            Dest::All => 0,
-            Dest::Channel(c) => c,
-        };
-        let signed = match self.link.signing().key().copied() {
-            Some(key) => {
-                let t = self.link.signing_mut().next_timestamp();
-                signing::sign(raw.raw_bytes(), &key, link_id, t)
-            }
-            None => None,
-        };
-        let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
-        let tag = match dest {
-            Dest::All => TO_ALL,
-            Dest::Channel(c) => c,
-        };
-        let [lo, hi] = (frame.len() as u16).to_le_bytes();
-        let buf = &mut self.out;
-        let fits = buf.len().saturating_add(3).saturating_add(frame.len()) <= buf.capacity();
-        if !fits
-            || buf.extend_from_slice(&[tag, lo, hi]).is_err()
-            || buf.extend_from_slice(frame).is_err()
-        {
-            self.bytes_dropped = self.bytes_dropped.saturating_add(frame.len() as u32);
-        }
+        let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
+        let msg = Outgoing::Message(msg.clone());
+        queue(tx, out, dropped, self.link.signing_mut(), Dest::All, &msg);
     }
 
     /// Hands out the frames waiting, one call per frame with where it goes, and empties the
@@ -245,5 +212,46 @@ impl GroundPort {
             rest = tail.get(n..).unwrap_or(&[]);
         }
         self.out.clear();
+    }
+}
+
+/// Encodes `msg` (signed when `signing` has a key) into the output buffer `buf`, or counts its
+/// bytes in `dropped` when the buffer is full.
+fn queue(
+    tx: &mut Sender,
+    buf: &mut heapless::Vec<u8, GCS_OUT>,
+    dropped: &mut u32,
+    signing: &mut common::gcs::signing::Signing,
+    dest: Dest,
+    msg: &Outgoing,
+) {
+    let raw = match msg {
+        Outgoing::Message(m) => tx.encode(m),
+        Outgoing::Ack(a) => tx.encode_data(a),
+    };
+    // With signing on, every frame is signed; the link id says which channel.
+    let link_id = match dest {
+        Dest::All => 0,
+        Dest::Channel(c) => c,
+    };
+    let signed = match signing.key().copied() {
+        Some(key) => {
+            let t = signing.next_timestamp();
+            signing::sign(raw.raw_bytes(), &key, link_id, t)
+        }
+        None => None,
+    };
+    let frame = signed.as_deref().unwrap_or(raw.raw_bytes());
+    let tag = match dest {
+        Dest::All => TO_ALL,
+        Dest::Channel(c) => c,
+    };
+    let [lo, hi] = (frame.len() as u16).to_le_bytes();
+    let fits = buf.len().saturating_add(3).saturating_add(frame.len()) <= buf.capacity();
+    if !fits
+        || buf.extend_from_slice(&[tag, lo, hi]).is_err()
+        || buf.extend_from_slice(frame).is_err()
+    {
+        *dropped = dropped.saturating_add(frame.len() as u32);
     }
 }
