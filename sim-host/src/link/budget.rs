@@ -76,7 +76,7 @@ pub struct McuBudget {
 }
 
 impl McuBudget {
-    /// The budget of the image at `elf` from the NAMED_VALUE_INT figures it sent; `None` when
+    /// The budget of an image of `size` from the NAMED_VALUE_INT figures it sent; `None` when
     /// it sent none (an image that does not measure itself) or no calibration.
     pub fn from_reports(size: ImageSize, named: &BTreeMap<String, i32>) -> Option<Self> {
         let get = |n: &str| named.get(n).copied();
