@@ -15,6 +15,8 @@
 //! sensor timestamps on the MCU; nothing here reads a clock of its own.
 
 pub mod ground;
+pub mod persist;
+pub mod reset;
 pub mod simlink;
 
 use common::actuators::Surfaces;
@@ -139,6 +141,22 @@ impl App {
     /// The ground link's protocol state.
     pub fn ground_link(&self) -> &GroundLink {
         self.ground.link()
+    }
+
+    /// The ground link, writable (the board answers storage and reboot requests).
+    pub fn ground_link_mut(&mut self) -> &mut GroundLink {
+        self.ground.link_mut()
+    }
+
+    /// A STATUSTEXT from the board to every station (why it reset): a warning or information.
+    pub fn announce(&mut self, warning: bool, text: &str) {
+        use mavlink::dialects::common::MavSeverity;
+        let severity = if warning {
+            MavSeverity::MAV_SEVERITY_WARNING
+        } else {
+            MavSeverity::MAV_SEVERITY_INFO
+        };
+        self.ground.link_mut().send_statustext(severity, text);
     }
 
     /// MAVLink 2 signing of the ground link (loading a persisted key at start-up).
