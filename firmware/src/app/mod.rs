@@ -157,6 +157,14 @@ impl App {
             MavSeverity::MAV_SEVERITY_INFO
         };
         self.ground.link_mut().send_statustext(severity, text);
+        self.poll_ground();
+    }
+
+    /// Encodes what the ground link has due now (an answer the board produced between
+    /// frames, such as a finished save), ready for [`App::drain_gcs`].
+    pub fn poll_ground(&mut self) {
+        let now = self.vehicle.time_us().unwrap_or(0);
+        self.ground.poll(now, &mut self.vehicle);
     }
 
     /// MAVLink 2 signing of the ground link (loading a persisted key at start-up).

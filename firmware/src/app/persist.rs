@@ -147,6 +147,7 @@ impl<F: Flash> Persistence<F> {
             done.failed = !ok;
             if let Some(peer) = asked {
                 app.ground_link_mut().storage_done(peer, ok);
+                app.poll_ground();
             }
         }
         done.reboot = app.ground_link_mut().take_reboot_request();

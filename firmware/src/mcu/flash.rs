@@ -79,7 +79,7 @@ impl HostFile {
         let mut cmdline = [0u8; 256];
         let mut block = [cmdline.as_mut_ptr() as usize, cmdline.len()];
         // SAFETY: SYS_GET_CMDLINE writes at most block[1] bytes into the buffer.
-        if unsafe { syscall!(GET_CMDLINE, block.as_mut_ptr()) } != 0 {
+        if unsafe { cortex_m_semihosting::syscall1!(GET_CMDLINE, block.as_mut_ptr()) } != 0 {
             return None;
         }
         let line = cmdline.get(..block.get(1).copied()?.min(cmdline.len()))?;
