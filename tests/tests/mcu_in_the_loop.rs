@@ -276,7 +276,7 @@ fn upload(st: &mut Station, n: u16) -> Option<mavlink::dialects::common::MavMiss
             },
             target_system: 1,
             target_component: 1,
-            frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+            frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
             autocontinue: 1,
             ..Default::default()
         }));

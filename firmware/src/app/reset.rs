@@ -145,7 +145,7 @@ mod tests {
                 .as_str(),
             "Reset cause: power-on"
         );
-        assert_eq!(t(csr::BORRSTF | csr::PINRSTF, None).0, true);
+        assert!(t(csr::BORRSTF | csr::PINRSTF, None).0, "a brown-out warns");
         assert_eq!(t(csr::PINRSTF, None).1.as_str(), "Reset cause: reset pin");
         assert_eq!(t(0, None).1.as_str(), "Reset cause: unknown");
     }
