@@ -1,12 +1,10 @@
 //! The host (SITL) board: the simulator link over TCP, UDP or a serial line (a pty), and the
 //! same [`App`] the MCU runs.
 
+use crate::app::persist::Persistence;
 use crate::app::App;
 use common::gcs::Dest;
-use common::storage::{
-    load, load_missions, load_params, save, save_missions, save_params, AbRegion, RamFlash,
-    SigningRecord, MISSION_MAGIC, PARAMS_MAGIC, SIGNING_MAGIC,
-};
+use common::storage::{AbRegion, RamFlash, BOARD_MAGIC};
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs, UdpSocket};
 use std::os::fd::AsFd;
@@ -254,36 +252,21 @@ pub fn run_with(
     }
 }
 
-/// The SITL "flash": the parameter and mission records of `common::storage`, in a file.
+/// The SITL "flash": the board record of `common::storage` (parameters, plan, signing key)
+/// in a file, through the same [`Persistence`] as the MCU.
 ///
-/// The records are written A/B with a CRC exactly as on the MCU; the file is the flash image.
+/// The record is written A/B with a CRC exactly as on the MCU; the file is the flash image.
 pub struct FileStorage {
     path: Option<PathBuf>,
-    flash: RamFlash<STORAGE_BYTES>,
-    missions_seen: Option<u32>,
-    signing_seen: Option<u32>,
-    /// Boot without the saved signing key (the bench recovery of a lost key).
-    forget_key: bool,
+    store: Persistence<RamFlash<STORAGE_BYTES>>,
 }
 
 const SECTOR: u32 = 16 * 1024;
-const STORAGE_BYTES: usize = 6 * SECTOR as usize;
-const PARAMS_REGION: AbRegion = AbRegion {
-    magic: PARAMS_MAGIC,
+const STORAGE_BYTES: usize = 2 * SECTOR as usize;
+const REGION: AbRegion = AbRegion {
+    magic: BOARD_MAGIC,
     slot_a: 0,
     slot_b: SECTOR,
-    slot_len: SECTOR,
-};
-const MISSIONS_REGION: AbRegion = AbRegion {
-    magic: MISSION_MAGIC,
-    slot_a: 2 * SECTOR,
-    slot_b: 3 * SECTOR,
-    slot_len: SECTOR,
-};
-const SIGNING_REGION: AbRegion = AbRegion {
-    magic: SIGNING_MAGIC,
-    slot_a: 4 * SECTOR,
-    slot_b: 5 * SECTOR,
     slot_len: SECTOR,
 };
 
@@ -296,103 +279,52 @@ impl FileStorage {
             .unwrap_or_default();
         Self {
             path,
-            flash: RamFlash::from_image(&image, SECTOR),
-            missions_seen: None,
-            signing_seen: None,
-            forget_key: false,
+            store: Persistence::new(RamFlash::from_image(&image, SECTOR), REGION),
         }
     }
 
     /// Boots without the saved MAVLink signing key, and saves that at the next change: the
     /// bench recovery of a lost key (`firmware --signing-reset`).
     pub fn forget_signing_key(mut self) -> Self {
-        self.forget_key = true;
+        self.store.forget_signing_key();
         self
     }
 
     /// Loads saved parameters and missions into the autopilot.
     pub fn load_into(&mut self, app: &mut App) -> Vec<String> {
-        let mut notes = Vec::new();
         let mut scratch = vec![0u8; SECTOR as usize];
-        match load_params(
-            &mut self.flash,
-            &PARAMS_REGION,
-            app.vehicle_mut().params_mut(),
-            &mut scratch,
-        ) {
-            Ok(Some(r)) => notes.push(format!("parameters loaded ({r:?})")),
-            Ok(None) => {}
-            Err(e) => notes.push(format!("saved parameters unreadable: {e:?}")),
+        let l = self.store.load_into(app, &mut scratch);
+        let mut notes = Vec::new();
+        if let Some(r) = l.params {
+            notes.push(format!("parameters loaded ({r:?})"));
         }
-        match load_missions(&mut self.flash, &MISSIONS_REGION, &mut scratch) {
-            Ok(Some(m)) => {
-                app.vehicle_mut().plan_mut().load(m);
-                notes.push("missions loaded".into());
-            }
-            Ok(None) => {}
-            Err(e) => notes.push(format!("saved missions unreadable: {e:?}")),
+        if l.mission_items > 0 {
+            notes.push(format!("missions loaded ({} items)", l.mission_items));
         }
-        match load::<_, SigningRecord>(&mut self.flash, &SIGNING_REGION, &mut scratch) {
-            Ok(Some(r)) if self.forget_key => {
-                app.signing_mut().load(None, r.value.timestamp);
-                notes.push("signing key forgotten (--signing-reset)".into());
-            }
-            Ok(Some(r)) => {
-                app.signing_mut().load(r.value.key, r.value.timestamp);
-                if r.value.key.is_some() {
-                    notes.push("signing key loaded: unsigned writes are refused".into());
-                }
-            }
-            Ok(None) => {}
-            Err(e) => notes.push(format!("saved signing key unreadable: {e:?}")),
+        if l.key_forgotten {
+            notes.push("signing key forgotten (--signing-reset)".into());
+        } else if l.signing_key {
+            notes.push("signing key loaded: unsigned writes are refused".into());
         }
-        self.missions_seen = Some(app.vehicle().plan().change_count());
-        self.signing_seen = Some(app.signing_mut().change_count());
-        if self.forget_key {
-            self.signing_seen = None;
+        if l.unreadable {
+            notes.push("saved record unreadable: defaults kept".into());
         }
-        app.vehicle_mut().params_mut().mark_saved();
         notes
     }
 
-    /// Saves what changed since the last save (PX4 saves parameters as they change).
+    /// Saves what changed since the last save while disarmed, and answers a
+    /// `MAV_CMD_PREFLIGHT_STORAGE` once saved (PX4 saves parameters as they change).
     pub fn save_changes(&mut self, app: &mut App) -> io::Result<()> {
-        let mut changed = false;
         let mut scratch = vec![0u8; SECTOR as usize];
-        if app.vehicle().params().is_dirty() {
-            save_params(
-                &mut self.flash,
-                &PARAMS_REGION,
-                app.vehicle_mut().params_mut(),
-                &mut scratch,
-            )
-            .map_err(|e| io::Error::other(format!("parameter save: {e:?}")))?;
-            changed = true;
+        let done = self.store.service(app, &mut scratch);
+        if done.failed {
+            return Err(io::Error::other("save of the board record failed"));
         }
-        let signing = app.signing_mut();
-        if Some(signing.change_count()) != self.signing_seen {
-            let record = SigningRecord {
-                key: signing.key().copied(),
-                timestamp: signing.timestamp(),
-            };
-            self.signing_seen = Some(signing.change_count());
-            save(&mut self.flash, &SIGNING_REGION, &record, &mut scratch)
-                .map_err(|e| io::Error::other(format!("signing key save: {e:?}")))?;
-            changed = true;
-        }
-        let plan = app.vehicle().plan();
-        let busy = app.ground_link().missions().busy();
-        if Some(plan.change_count()) != self.missions_seen && !busy {
-            save_missions(&mut self.flash, &MISSIONS_REGION, plan, &mut scratch)
-                .map_err(|e| io::Error::other(format!("mission save: {e:?}")))?;
-            self.missions_seen = Some(plan.change_count());
-            changed = true;
-        }
-        if changed {
+        if done.saved {
             if let Some(p) = &self.path {
                 // Write-then-rename: the file is never half written.
                 let tmp = p.with_extension("tmp");
-                std::fs::write(&tmp, self.flash.bytes())?;
+                std::fs::write(&tmp, self.store.flash().bytes())?;
                 std::fs::rename(&tmp, p)?;
             }
         }

@@ -190,6 +190,10 @@ pub(crate) struct McuArgs {
     /// The QEMU that runs it (a name on the PATH or a path).
     #[arg(long, value_name = "PROGRAM", default_value = sim_host::link::qemu::DEFAULT_QEMU)]
     pub(crate) qemu: PathBuf,
+    /// File that keeps the image's saved parameters and missions across runs (its two flash
+    /// sectors; created when missing). Without it the image starts from defaults every run.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) mcu_storage: Option<PathBuf>,
 }
 
 impl McuArgs {
@@ -197,6 +201,7 @@ impl McuArgs {
         sim_host::link::qemu::QemuConfig {
             program: self.qemu.clone(),
             elf: self.elf.clone(),
+            storage: self.mcu_storage.clone(),
             ..Default::default()
         }
     }

@@ -179,15 +179,29 @@ impl GroundLink {
                 let _ = after.push(Pending::AutopilotVersion);
                 MavResult::MAV_RESULT_ACCEPTED
             }
+            // The save is the board's: IN_PROGRESS now, ACCEPTED or FAILED once it is done
+            // (GroundLink::storage_done). Erasing flash stalls the processor, so never armed.
             MavCmd::MAV_CMD_PREFLIGHT_STORAGE => match c.p[0] as i32 {
+                1 if v.armed => MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
                 1 => {
-                    self.requests.save_params = true;
-                    MavResult::MAV_RESULT_ACCEPTED
+                    self.storage_request = Some(from);
+                    MavResult::MAV_RESULT_IN_PROGRESS
                 }
                 2 if v.armed => MavResult::MAV_RESULT_DENIED,
                 2 => {
                     stores.params.reset_to_defaults();
-                    self.requests.save_params = true;
+                    self.storage_request = Some(from);
+                    MavResult::MAV_RESULT_IN_PROGRESS
+                }
+                _ => MavResult::MAV_RESULT_UNSUPPORTED,
+            },
+            // param1: 0 nothing for the autopilot, 1 reboot it (the board does, once the
+            // answer is sent); shutdown and the bootloader are not offered.
+            MavCmd::MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN => match c.p[0] as i32 {
+                _ if v.armed => MavResult::MAV_RESULT_DENIED,
+                0 => MavResult::MAV_RESULT_ACCEPTED,
+                1 => {
+                    self.reboot_request = true;
                     MavResult::MAV_RESULT_ACCEPTED
                 }
                 _ => MavResult::MAV_RESULT_UNSUPPORTED,

@@ -120,6 +120,10 @@ pub struct GroundLink {
     pending: Deque<(Pending, Dest), PENDING_CAPACITY>,
     texts: Deque<Text, TEXT_CAPACITY>,
     requests: VehicleRequests,
+    /// A `MAV_CMD_PREFLIGHT_STORAGE` save the board owes, and who asked.
+    storage_request: Option<Peer>,
+    /// A `MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN` reboot the board owes.
+    reboot_request: bool,
     /// The next index of a parameter list download, and the channel that asked for it.
     param_next: Option<(u16, u8)>,
     next_heartbeat_us: u64,
@@ -149,6 +153,8 @@ impl GroundLink {
             pending: Deque::new(),
             texts: Deque::new(),
             requests: VehicleRequests::default(),
+            storage_request: None,
+            reboot_request: false,
             param_next: None,
             next_heartbeat_us: 0,
             gcs_last_seen_us: None,
@@ -184,6 +190,32 @@ impl GroundLink {
     /// Takes the requests accepted since the last call.
     pub fn take_requests(&mut self) -> VehicleRequests {
         core::mem::take(&mut self.requests)
+    }
+
+    /// The station whose `MAV_CMD_PREFLIGHT_STORAGE` waits for the board's save (answered
+    /// `IN_PROGRESS` so far); the board saves and answers with [`GroundLink::storage_done`].
+    pub fn take_storage_request(&mut self) -> Option<Peer> {
+        self.storage_request.take()
+    }
+
+    /// The final answer to a `MAV_CMD_PREFLIGHT_STORAGE`: ACCEPTED once the save is done,
+    /// FAILED (with a status text) when the flash refused it.
+    pub fn storage_done(&mut self, to: Peer, saved: bool) {
+        let result = if saved {
+            MavResult::MAV_RESULT_ACCEPTED
+        } else {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_ERROR,
+                format_args!("Parameters not saved: flash error"),
+            );
+            MavResult::MAV_RESULT_FAILED
+        };
+        self.ack(MavCmd::MAV_CMD_PREFLIGHT_STORAGE, result, to);
+    }
+
+    /// Whether a reboot was asked for (and accepted: disarmed) since the last call.
+    pub fn take_reboot_request(&mut self) -> bool {
+        core::mem::take(&mut self.reboot_request)
     }
 
     /// Time the last ground-station heartbeat arrived, µs (for a link-loss failsafe).

@@ -1907,51 +1907,80 @@ fn heartbeat_reports_truth_not_requests_and_tracks_gcs() {
     );
 }
 
+/// MAVLink's long-running command pattern: IN_PROGRESS at once, then ACCEPTED only when the
+/// board reports the save done (FAILED when the flash refused it); never while armed.
 #[test]
-fn preflight_storage_requests_save_and_resets_defaults() {
+fn preflight_storage_is_accepted_only_once_the_board_has_saved() {
     let mut l = link();
     let mut v = healthy();
+    let store = |p1: f32| {
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
+            [p1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+    };
     exchange(
         &mut l,
         &v,
         0,
         param_set("RLL_KP", 2.0, MavParamType::MAV_PARAM_TYPE_REAL32),
     );
-    let out = exchange(
-        &mut l,
-        &v,
-        1,
-        cmd_long(
-            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
-            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        ),
+    let out = exchange(&mut l, &v, 1, store(1.0));
+    let stored = MavCmd::MAV_CMD_PREFLIGHT_STORAGE;
+    assert_eq!(acks(&out), [(stored, MavResult::MAV_RESULT_IN_PROGRESS)]);
+    let asker = l.take_storage_request().expect("the board owes a save");
+    assert_eq!(l.take_storage_request(), None, "once");
+    l.storage_done(asker, true);
+    assert_eq!(
+        acks(&poll(&mut l, &v, 2)),
+        [(stored, MavResult::MAV_RESULT_ACCEPTED)]
     );
-    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
-    assert!(l.take_requests().save_params);
+    exchange(&mut l, &v, 3, store(1.0));
+    let asker = l.take_storage_request().unwrap();
+    l.storage_done(asker, false);
+    let out = poll(&mut l, &v, 4);
+    assert_eq!(acks(&out), [(stored, MavResult::MAV_RESULT_FAILED)]);
+    assert!(texts(&out).iter().any(|t| t.contains("not saved")));
+
     v.armed = true;
-    let out = exchange(
-        &mut l,
-        &v,
-        2,
-        cmd_long(
-            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
-            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        ),
+    let out = exchange(&mut l, &v, 5, store(1.0));
+    assert_eq!(
+        acks(&out),
+        [(stored, MavResult::MAV_RESULT_TEMPORARILY_REJECTED)]
     );
-    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+    let out = exchange(&mut l, &v, 6, store(2.0));
+    assert_eq!(acks(&out), [(stored, MavResult::MAV_RESULT_DENIED)]);
+    assert_eq!(l.take_storage_request(), None, "nothing saved armed");
     assert_eq!(l.params.get("RLL_KP"), Some(2.0));
     v.armed = false;
-    let out = exchange(
-        &mut l,
-        &v,
-        3,
-        cmd_long(
-            MavCmd::MAV_CMD_PREFLIGHT_STORAGE,
-            [2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        ),
-    );
-    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    let out = exchange(&mut l, &v, 7, store(2.0));
+    assert_eq!(acks(&out), [(stored, MavResult::MAV_RESULT_IN_PROGRESS)]);
     assert_eq!(l.params.get("RLL_KP"), Some(0.8));
+    assert!(l.take_storage_request().is_some());
+}
+
+#[test]
+fn a_reboot_is_asked_of_the_board_only_when_disarmed() {
+    let mut l = link();
+    let mut v = healthy();
+    let reboot = |p1: f32| {
+        cmd_long(
+            MavCmd::MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN,
+            [p1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        )
+    };
+    let cmd = MavCmd::MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN;
+    v.armed = true;
+    let out = exchange(&mut l, &v, 0, reboot(1.0));
+    assert_eq!(acks(&out), [(cmd, MavResult::MAV_RESULT_DENIED)]);
+    assert!(!l.take_reboot_request());
+    v.armed = false;
+    let out = exchange(&mut l, &v, 1, reboot(2.0));
+    assert_eq!(acks(&out), [(cmd, MavResult::MAV_RESULT_UNSUPPORTED)]);
+    let out = exchange(&mut l, &v, 2, reboot(1.0));
+    assert_eq!(acks(&out), [(cmd, MavResult::MAV_RESULT_ACCEPTED)]);
+    assert!(l.take_reboot_request());
+    assert!(!l.take_reboot_request());
 }
 
 /// An upload is checked as the navigator will fly it before it replaces the stored mission:

@@ -345,6 +345,63 @@ pub fn load_missions<F: Flash>(
     Ok(load::<F, MissionStore>(flash, region, scratch)?.map(|l| l.value))
 }
 
+/// Magic of the board record (parameters, plan and signing key in one record), format 1.
+pub const BOARD_MAGIC: u32 = 0x424f_5231; // "BOR1"
+
+/// Everything a board keeps across resets, in one record of one [`AbRegion`]: the
+/// parameters that differ from their defaults (by name), the mission, fence and rally lists,
+/// and the signing key with its clock. One record in two sectors is what a small flash can
+/// spare (the STM32F405's 16 KiB sectors 1 and 2).
+#[derive(Serialize)]
+pub struct BoardRecordRef<'a> {
+    /// The parameters, streamed from the store.
+    pub params: ParamExport<'a>,
+    /// The plan.
+    pub plan: &'a MissionStore,
+    /// The signing key.
+    pub signing: SigningRecord,
+}
+
+/// [`BoardRecordRef`], loaded.
+#[derive(Debug, serde::Deserialize)]
+pub struct BoardRecord {
+    /// The saved parameters, by name.
+    pub params: ParamImage,
+    /// The plan.
+    pub plan: MissionStore,
+    /// The signing key.
+    pub signing: SigningRecord,
+}
+
+/// [`BoardRecord`]'s encoding, walked.
+#[derive(serde::Deserialize)]
+struct BoardWalk {
+    _params: Walk<ParamRecord, MAX_PARAMS>,
+    _plan: PlanWalk,
+    _signing: SigningRecord,
+}
+
+/// Saves the board record and marks the parameters saved; keeps the copy that loads as
+/// [`save`] does.
+pub fn save_board<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    record: &BoardRecordRef,
+    scratch: &mut [u8],
+) -> Result<u32, StorageError<F::Error>> {
+    let decodes = |b: &[u8]| postcard::from_bytes::<BoardWalk>(b).is_ok();
+    save_keeping(flash, region, record, scratch, decodes)
+}
+
+/// Loads the board record; `None` when nothing is saved.
+pub fn load_board<F: Flash>(
+    flash: &mut F,
+    region: &AbRegion,
+    scratch: &mut [u8],
+) -> Result<Option<BoardRecord>, StorageError<F::Error>> {
+    Ok(load::<F, BoardRecord>(flash, region, scratch)?.map(|l| l.value))
+}
+
 /// Error of [`RamFlash`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RamFlashError {
@@ -484,6 +541,8 @@ fn self_spend(budget: &mut Option<usize>, ops: &mut usize) -> Result<bool, RamFl
         }
     }
 }
+
+pub mod f4;
 
 #[cfg(test)]
 mod tests;

@@ -304,3 +304,41 @@ fn full_records_fit_their_sectors() {
     let n = postcard::to_slice(&img, &mut buf).unwrap().len();
     assert!(n + 16 <= 16 * 1024, "params: {n} bytes");
 }
+
+#[test]
+fn the_board_record_keeps_parameters_plan_and_key_together() {
+    use crate::vehicle::params::REGISTRY;
+    let mut store = ParamStore::new(REGISTRY);
+    store.set("RLL_KP", -0.5).unwrap();
+    let mut plan = MissionStore::default();
+    let item = MissionItem {
+        command: 16,
+        x: 449_000_000,
+        ..Default::default()
+    };
+    plan.mission.push(item).unwrap();
+    let signing = SigningRecord {
+        key: Some([7; 32]),
+        timestamp: 99,
+    };
+    let mut f = RamFlash::<{ 2 * 16384 }>::new(16384);
+    let region = AbRegion {
+        magic: BOARD_MAGIC,
+        slot_a: 0,
+        slot_b: 16384,
+        slot_len: 16384,
+    };
+    let mut scratch = std::vec![0u8; 16384];
+    let rec = BoardRecordRef {
+        params: ParamExport(&store),
+        plan: &plan,
+        signing,
+    };
+    save_board(&mut f, &region, &rec, &mut scratch).unwrap();
+    let back = load_board(&mut f, &region, &mut scratch).unwrap().unwrap();
+    assert_eq!(back.plan, plan);
+    assert_eq!(back.signing, signing);
+    let mut fresh = ParamStore::new(REGISTRY);
+    fresh.import(&back.params);
+    assert_eq!(fresh.get("RLL_KP"), Some(-0.5));
+}

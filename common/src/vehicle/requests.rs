@@ -25,8 +25,6 @@ pub struct VehicleRequests {
     pub mode: Option<FlightMode>,
     /// Make this mission item the current one.
     pub mission_seq: Option<u16>,
-    /// Persist the parameters now (`MAV_CMD_PREFLIGHT_STORAGE` write).
-    pub save_params: bool,
     /// New altitude setpoint (`MAV_CMD_DO_CHANGE_ALTITUDE`).
     pub altitude: Option<AltitudeSetpoint>,
     /// New airspeed setpoint, m/s (`MAV_CMD_DO_CHANGE_SPEED`, airspeed type).

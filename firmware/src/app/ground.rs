@@ -85,6 +85,11 @@ impl GroundPort {
         &self.link
     }
 
+    /// The ground link's protocol state, writable.
+    pub fn link_mut(&mut self) -> &mut GroundLink {
+        &mut self.link
+    }
+
     /// MAVLink 2 signing of the link.
     pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
         self.link.signing_mut()

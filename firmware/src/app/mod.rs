@@ -15,6 +15,8 @@
 //! sensor timestamps on the MCU; nothing here reads a clock of its own.
 
 pub mod ground;
+pub mod persist;
+pub mod reset;
 pub mod simlink;
 
 use common::actuators::Surfaces;
@@ -155,6 +157,30 @@ impl App {
     /// The ground link's protocol state.
     pub fn ground_link(&self) -> &GroundLink {
         self.ground.link()
+    }
+
+    /// The ground link, writable (the board answers storage and reboot requests).
+    pub fn ground_link_mut(&mut self) -> &mut GroundLink {
+        self.ground.link_mut()
+    }
+
+    /// A STATUSTEXT from the board to every station (why it reset): a warning or information.
+    pub fn announce(&mut self, warning: bool, text: &str) {
+        use mavlink::dialects::common::MavSeverity;
+        let severity = if warning {
+            MavSeverity::MAV_SEVERITY_WARNING
+        } else {
+            MavSeverity::MAV_SEVERITY_INFO
+        };
+        self.ground.link_mut().send_statustext(severity, text);
+        self.poll_ground();
+    }
+
+    /// Encodes what the ground link has due now (an answer the board produced between
+    /// frames, such as a finished save), ready for [`App::drain_gcs`].
+    pub fn poll_ground(&mut self) {
+        let now = self.vehicle.time_us().unwrap_or(0);
+        self.ground.poll(now, &mut self.vehicle);
     }
 
     /// MAVLink 2 signing of the ground link (loading a persisted key at start-up).

@@ -9,11 +9,17 @@ use core::mem::MaybeUninit;
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::app::App;
-use panic_probe as _;
 
 mod budget;
+mod fault;
+mod flash;
 mod usart;
+mod watchdog;
+use firmware::app::persist::Persistence;
 use usart::Usart;
+
+/// Room for one encoded board record (a slot's size).
+const RECORD_BYTES: usize = 16 * 1024;
 
 #[entry]
 fn main() -> ! {
@@ -22,15 +28,38 @@ fn main() -> ! {
     sim.enable();
     gcs.enable();
     defmt::info!("autopilot booted: STM32F405, USART1 sim link, USART2 ground link");
+    let (warn, boot_text) = firmware::app::reset::boot_text(fault::reset_flags(), fault::take());
+    defmt::info!("{=str}", boot_text.as_str());
+    let mut boot_text = Some(boot_text);
     budget::start();
     let mut budget = budget::Budget::new();
     // The application lives in a static, built in place (no stack frame holds it).
     static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
     // SAFETY: `main` runs once and is the only code that names APP.
     let app = App::init_in(unsafe { &mut *core::ptr::addr_of_mut!(APP) });
+    let scratch = cortex_m::singleton!(: [u8; RECORD_BYTES] = [0; RECORD_BYTES]);
+    let Some(scratch) = scratch else { loop {} };
+    let board_flash = flash::BoardFlash::open();
+    let host_file = board_flash.is_host_file();
+    let mut store = Persistence::new(board_flash, flash::REGION);
+    let loaded = store.load_into(app, scratch);
+    defmt::info!(
+        "storage ({}): parameters {}, {} mission items, unreadable {}",
+        if host_file {
+            "host file"
+        } else {
+            "flash sectors 1-2"
+        },
+        loaded.params.map_or(0, |r| r.loaded),
+        loaded.mission_items,
+        loaded.unreadable
+    );
+    watchdog::start();
     sim.write(&firmware::app::heartbeat_frame(app));
     let (mut sim_chunk, mut gcs_chunk) = ([0u8; 64], [0u8; 64]);
     loop {
+        // Fed on every pass, idle ones included: a pass that never returns starves it.
+        watchdog::feed();
         // Gather what has arrived on each UART, then hand it over in one piece.
         let n = sim.read_into(&mut sim_chunk);
         let sim_bytes = sim_chunk.get(..n).filter(|b| !b.is_empty());
@@ -46,9 +75,21 @@ fn main() -> ! {
         if let Some(bytes) = gcs_bytes {
             app.on_gcs_bytes(bytes);
         }
-        // Telemetry and answers for the ground, produced by both calls above.
+        // Why the board reset, once a ground station is listening.
+        if app.ground_link().gcs_last_seen_us().is_some() {
+            if let Some(text) = boot_text.take() {
+                app.announce(warn, &text);
+            }
+        }
+        let done = store.service(app, scratch);
+        // Telemetry and answers for the ground, produced by the calls above.
         app.drain_gcs(&mut |out| gcs.write(out));
         budget.charge(budget::since(t0), app.vehicle().time_us());
+        if done.reboot {
+            defmt::info!("rebooting on the ground station's request");
+            fault::record(firmware::app::reset::Fault::Requested);
+            cortex_m::peripheral::SCB::sys_reset();
+        }
         // Outside the measured work: the report scans the stack (sent with the next frames).
         budget.report(app);
     }

@@ -58,6 +58,10 @@ pub struct QemuConfig {
     /// File for QEMU's standard output: the image's defmt log over semihosting (read it with
     /// `defmt-print -e ELF < FILE`). `None`: discarded.
     pub log: Option<PathBuf>,
+    /// Host file holding the image's two flash sectors of saved parameters and missions
+    /// (QEMU does not emulate the flash controller; the image reaches the file over
+    /// semihosting). Created erased when missing. `None`: the image keeps nothing.
+    pub storage: Option<PathBuf>,
 }
 
 impl Default for QemuConfig {
@@ -67,6 +71,7 @@ impl Default for QemuConfig {
             elf: default_elf(),
             icount_shift: DEFAULT_ICOUNT_SHIFT,
             log: None,
+            storage: None,
         }
     }
 }
@@ -129,7 +134,8 @@ impl QemuConfig {
         let mut c = Command::new(&self.program);
         c.args(["-machine", "netduinoplus2", "-cpu", "cortex-m4"])
             .args(["-nographic", "-monitor", "none"])
-            .args(["-semihosting-config", "enable=on,target=native"])
+            .arg("-semihosting-config")
+            .arg(semihosting_config(self.storage.as_deref()))
             .arg("-icount")
             .arg(format!("shift={}", self.icount_shift))
             .arg("-serial")
@@ -139,6 +145,19 @@ impl QemuConfig {
             .arg("-kernel")
             .arg(&self.elf);
         c
+    }
+}
+
+/// QEMU's `-semihosting-config` value: semihosting on the host, with the image's storage
+/// file as the argument `storage=PATH` when there is one (a comma in the path is doubled, as
+/// QEMU's option syntax wants).
+pub fn semihosting_config(storage: Option<&Path>) -> String {
+    match storage {
+        Some(p) => format!(
+            "enable=on,target=native,arg=firmware,arg=storage={}",
+            p.display().to_string().replace(',', ",,")
+        ),
+        None => "enable=on,target=native".to_string(),
     }
 }
 
