@@ -65,9 +65,7 @@ fn main() -> ! {
         let sim_bytes = sim_chunk.get(..n).filter(|b| !b.is_empty());
         let n = gcs.read_into(&mut gcs_chunk);
         let gcs_bytes = gcs_chunk.get(..n).filter(|b| !b.is_empty());
-        if sim_bytes.is_none() && gcs_bytes.is_none() {
-            continue;
-        }
+        let idle = sim_bytes.is_none() && gcs_bytes.is_none();
         let t0 = budget::now();
         if let Some(bytes) = sim_bytes {
             app.on_sim_bytes(bytes, &mut |out| sim.write(out));
@@ -84,7 +82,10 @@ fn main() -> ! {
         let done = store.service(app, scratch);
         // Telemetry and answers for the ground, produced by the calls above.
         app.drain_gcs(&mut |out| gcs.write(out));
-        budget.charge(budget::since(t0), app.vehicle().time_us());
+        // Only the passes that had work are the control period's cost.
+        if !idle {
+            budget.charge(budget::since(t0), app.vehicle().time_us());
+        }
         if done.reboot {
             defmt::info!("rebooting on the ground station's request");
             fault::record(firmware::app::reset::Fault::Requested);
