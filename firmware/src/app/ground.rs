@@ -134,19 +134,23 @@ impl GroundPort {
         };
         // Signed frames are checked against the key in force when they arrive.
         parser.set_key(self.link.signing().key().copied());
-        // Both callbacks answer through the link, one frame at a time, in order.
+        // Both callbacks answer through the link, one frame at a time, in order. The parser
+        // never calls one from inside the other, so the borrow is always free: `try_` keeps
+        // the image free of the panic path `borrow_mut` would bring.
         let link = core::cell::RefCell::new(&mut self.link);
         let mut on_frame = |f: common::link::framing::Frame| {
-            let mut link = link.borrow_mut();
-            let origin = Origin {
-                channel,
-                signed: f.signed,
-            };
-            link.handle(&f.header, &f.message, now, &snapshot, &mut stores, origin)
+            if let Ok(mut link) = link.try_borrow_mut() {
+                let origin = Origin {
+                    channel,
+                    signed: f.signed,
+                };
+                link.handle(&f.header, &f.message, now, &snapshot, &mut stores, origin)
+            }
         };
         let mut on_undecoded = |raw: common::link::framing::Undecoded<'_>| {
-            let mut link = link.borrow_mut();
-            link.handle_undecoded(&raw.header, raw.id, raw.payload, channel)
+            if let Ok(mut link) = link.try_borrow_mut() {
+                link.handle_undecoded(&raw.header, raw.id, raw.payload, channel)
+            }
         };
         parser.push_with(bytes, &mut on_frame, &mut on_undecoded);
         if datagram {
