@@ -427,3 +427,32 @@ pub const FLIGHT_SW_VERSION: u32 = (parse_u8(env!("CARGO_PKG_VERSION_MAJOR")) <<
     | (parse_u8(env!("CARGO_PKG_VERSION_MINOR")) << 16)
     | (parse_u8(env!("CARGO_PKG_VERSION_PATCH")) << 8)
     | 255;
+
+/// What the board owes a station after a storage or reboot command.
+impl GroundLink {
+    /// The station whose `MAV_CMD_PREFLIGHT_STORAGE` waits for the board's save (answered
+    /// `IN_PROGRESS` so far); the board saves and answers with [`GroundLink::storage_done`].
+    pub fn take_storage_request(&mut self) -> Option<Peer> {
+        self.storage_request.take()
+    }
+
+    /// The final answer to a `MAV_CMD_PREFLIGHT_STORAGE`: ACCEPTED once the save is done,
+    /// FAILED (with a status text) when the flash refused it.
+    pub fn storage_done(&mut self, to: Peer, saved: bool) {
+        let result = if saved {
+            MavResult::MAV_RESULT_ACCEPTED
+        } else {
+            self.textf(
+                MavSeverity::MAV_SEVERITY_ERROR,
+                format_args!("Parameters not saved: flash error"),
+            );
+            MavResult::MAV_RESULT_FAILED
+        };
+        self.ack(MavCmd::MAV_CMD_PREFLIGHT_STORAGE, result, to);
+    }
+
+    /// Whether a reboot was asked for (and accepted: disarmed) since the last call.
+    pub fn take_reboot_request(&mut self) -> bool {
+        core::mem::take(&mut self.reboot_request)
+    }
+}
