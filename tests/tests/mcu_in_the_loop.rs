@@ -193,23 +193,14 @@ fn boot_with_storage(
 ) {
     let sim = std::net::TcpListener::bind("127.0.0.1:0").expect("sim listener");
     let gcs = std::net::TcpListener::bind("127.0.0.1:0").expect("gcs listener");
-    let child = Command::new("qemu-system-arm")
-        .args([
-            "-cpu",
-            "cortex-m4",
-            "-machine",
-            "netduinoplus2",
-            "-nographic",
-        ])
-        .arg("-semihosting-config")
-        .arg(sim_host::link::qemu::semihosting_config(Some(storage)))
-        .args(["-monitor", "none"])
-        .arg("-serial")
-        .arg(format!("tcp:{},nodelay=on", sim.local_addr().unwrap()))
-        .arg("-serial")
-        .arg(format!("tcp:{},nodelay=on", gcs.local_addr().unwrap()))
-        .arg("-kernel")
-        .arg(elf)
+    // The command line sim-host runs the image with, the storage file as its argument.
+    let cfg = sim_host::link::qemu::QemuConfig {
+        elf: elf.to_path_buf(),
+        storage: Some(storage.to_path_buf()),
+        ..Default::default()
+    };
+    let child = cfg
+        .command(sim.local_addr().unwrap(), gcs.local_addr().unwrap())
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
