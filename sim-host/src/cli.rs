@@ -247,6 +247,11 @@ pub(crate) struct FlyArgs {
     /// autopilots' answers (HIL_ACTUATOR_CONTROLS) frame by frame, and the pace of both.
     #[arg(long)]
     pub(crate) compare_host: bool,
+    /// With --link qemu: profile the MCU image by function over PERIODS whole 20 ms control
+    /// periods (10 by default) from SECONDS of simulated time, from QEMU's instruction trace;
+    /// printed, written to OUT/profile.md and given as `mcu.profile` with --json.
+    #[arg(long, value_name = "SECONDS[:PERIODS]", value_parser = sim_host::link::profile::ProfileWindow::parse)]
+    pub(crate) profile: Option<sim_host::link::profile::ProfileWindow>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub(crate) json: bool,

@@ -326,9 +326,20 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
             _ => None,
         },
         use_truth: a.truth,
-        qemu: a.mcu.config(),
+        qemu: sim_host::link::qemu::QemuConfig {
+            profile: a.profile.map(|w| (w, a.out.clone())),
+            ..a.mcu.config()
+        },
     };
+    if a.profile.is_some() && a.link != commands::fly::LinkKind::Qemu {
+        anyhow::bail!("--profile profiles the MCU image: it needs --link qemu");
+    }
     let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
+    if let Some(p) = &r.mcu_profile {
+        let path = a.out.join("profile.md");
+        std::fs::write(&path, p.markdown(usize::MAX))
+            .with_context(|| format!("cannot write `{}`", path.display()))?;
+    }
     let compared = if a.compare_host {
         Some(commands::compare::compare_with_host(aircraft, &cfg, &opts)?)
     } else {
@@ -346,7 +357,11 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
             (None, Some(m)) => {
                 let mut doc = serde_json::to_value(&r.outcome.summary)?;
                 if let Some(o) = doc.as_object_mut() {
-                    o.insert("mcu".into(), serde_json::to_value(m)?);
+                    let mut mcu = serde_json::to_value(m)?;
+                    if let (Some(p), Some(mo)) = (&r.mcu_profile, mcu.as_object_mut()) {
+                        mo.insert("profile".into(), serde_json::to_value(p)?);
+                    }
+                    o.insert("mcu".into(), mcu);
                 }
                 emit(&to_json(&doc)?)?
             }
@@ -359,6 +374,9 @@ fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
         ))?;
         if let Some(c) = &compared {
             emit(&render(&[c.table(&r.outcome, opts.link)], Format::Text))?;
+        }
+        if let Some(p) = &r.mcu_profile {
+            emit(&p.markdown(25))?;
         }
         for f in &r.files {
             emit(&format!("wrote {}", f.display()))?;

@@ -397,3 +397,38 @@ fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
     assert!(b.instr_per_control_period_mean <= 100_000.0, "{b:?}");
     assert!(b.instr_per_control_period_max <= 150_000.0, "{b:?}");
 }
+
+/// The profile by function (`sim-host fly --link qemu --profile`) counts the image's work from
+/// QEMU's instruction trace; the image counts the same work with SysTick. Two counters that
+/// share nothing but the image agree on the size of a control period, and the profile holds
+/// the stages every period runs.
+#[test]
+fn a_profile_from_qemus_trace_counts_the_work_the_image_counts_with_its_own_clock() {
+    let Some(qemu) = mcu() else { return };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let window = sim_host::link::profile::ProfileWindow::parse("4:10").expect("window");
+    let qemu = QemuConfig {
+        profile: Some((window, dir.path().to_path_buf())),
+        ..qemu
+    };
+    let r = fly_report(&aircraft(), &mission(6.0), &pil_options(qemu, dir.path()))
+        .expect("the PIL flight");
+    let (b, p) = (
+        r.mcu.expect("the image's figures"),
+        r.mcu_profile.expect("the profile"),
+    );
+    eprintln!("{}", p.markdown(15));
+    assert_eq!(p.periods, 10);
+    // On the runway the periods differ (the station's parameter and mission traffic comes
+    // in bursts): the same order of magnitude, not the same number.
+    let ratio = p.instr_per_period / b.instr_per_control_period_mean;
+    assert!((0.3..3.0).contains(&ratio), "{ratio}: {b:?}");
+    let share: f64 = p.functions.iter().map(|f| f.percent).sum();
+    assert!((share - 100.0).abs() < 1e-6, "{share}");
+    for stage in ["Ins::predict", "FrameParser"] {
+        assert!(
+            p.functions.iter().any(|f| f.function.contains(stage)),
+            "{stage} missing from the profile"
+        );
+    }
+}

@@ -65,6 +65,23 @@ pub fn since(then: u32) -> u32 {
     then.wrapping_sub(now()) & SYST_MASK
 }
 
+/// SysTick now, at the start of a pass's work. Never inlined, under a fixed name: its entry
+/// marks the start of the measured work in QEMU's instruction trace, which
+/// `sim-host fly --link qemu --profile` reads to profile the image by function.
+#[inline(never)]
+#[no_mangle]
+pub extern "C" fn budget_work_start() -> u32 {
+    now()
+}
+
+/// Cycles of a pass's work since `t0` (from [`budget_work_start`]); its entry marks the end of
+/// the measured work in the instruction trace.
+#[inline(never)]
+#[no_mangle]
+pub extern "C" fn budget_work_end(t0: u32) -> u32 {
+    since(t0)
+}
+
 /// Cycles of [`CAL_INSTRUCTIONS`] instructions.
 pub fn calibrate() -> u32 {
     let t0 = now();

@@ -66,7 +66,7 @@ fn main() -> ! {
         let n = gcs.read_into(&mut gcs_chunk);
         let gcs_bytes = gcs_chunk.get(..n).filter(|b| !b.is_empty());
         let idle = sim_bytes.is_none() && gcs_bytes.is_none();
-        let t0 = budget::now();
+        let t0 = budget::budget_work_start();
         if let Some(bytes) = sim_bytes {
             app.on_sim_bytes(bytes, &mut |out| sim.write(out));
         }
@@ -84,7 +84,7 @@ fn main() -> ! {
         app.drain_gcs(&mut |out| gcs.write(out));
         // Only the passes that had work are the control period's cost.
         if !idle {
-            budget.charge(budget::since(t0), app.vehicle().time_us());
+            budget.charge(budget::budget_work_end(t0), app.vehicle().time_us());
         }
         if done.reboot {
             defmt::info!("rebooting on the ground station's request");

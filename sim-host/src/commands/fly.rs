@@ -138,6 +138,7 @@ pub fn fly_report(
     let wait = Duration::from_secs(10);
     let silence = cfg.link_timeout.max(Duration::from_secs(2));
     let mut mcu = None;
+    let mut mcu_profile = None;
     let flown = match opts.link {
         LinkKind::Inproc => run_on(
             aircraft,
@@ -184,8 +185,10 @@ pub fn fly_report(
             run_on(aircraft, &cfg, pty, &mut fw, tlog)?
         }
         LinkKind::Qemu => {
-            let (flown, budget) = fly_qemu(aircraft, &cfg, &opts.qemu, opts.out.as_deref(), tlog)?;
+            let (flown, budget, profile) =
+                fly_qemu(aircraft, &cfg, &opts.qemu, opts.out.as_deref(), tlog)?;
             mcu = budget;
+            mcu_profile = profile;
             flown
         }
     };
@@ -196,6 +199,7 @@ pub fn fly_report(
     }
     let mut report = finish_report(flown, opts.out.as_deref(), opts.plots, files)?;
     report.mcu = mcu;
+    report.mcu_profile = mcu_profile;
     Ok(report)
 }
 

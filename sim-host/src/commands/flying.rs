@@ -9,6 +9,7 @@ use crate::flight::plots::write_log_and_plots;
 use crate::flight::runner::{fly, FlightError, FlightOutcome};
 use crate::link::budget::{image_size, McuBudget};
 use crate::link::lockstep::Lockstep;
+use crate::link::profile::{McuProfile, ProfileSlot};
 use crate::link::qemu::{boot, QemuConfig};
 use crate::link::tlog::TlogWriter;
 use crate::link::transport::Transport;
@@ -25,6 +26,9 @@ pub struct FlyReport {
     pub files: Vec<PathBuf>,
     /// The MCU image's budget as it measured itself (`--link qemu` only).
     pub mcu: Option<McuBudget>,
+    /// Where the MCU image's instructions went in the profiled window (`--link qemu` with a
+    /// [`QemuConfig::profile`] window that the flight reached).
+    pub mcu_profile: Option<McuProfile>,
 }
 
 /// A flight, or why it could not be flown: the outer error is this side's (a file that
@@ -63,17 +67,25 @@ pub(crate) fn run_on_with<T: Transport, O: Onboard<T>>(
     Ok(flown)
 }
 
+/// A flight of the MCU image, its figures of itself and its profile (when one was asked for).
+pub(crate) type QemuFlown = (
+    Result<FlightOutcome, FlightError>,
+    Option<McuBudget>,
+    Option<McuProfile>,
+);
+
 /// Boots the MCU image in QEMU and flies `cfg` against it, the scripted station on the UDP
 /// side of its ground bridge. The bridge serves `cfg.ground_link` when one is asked for
 /// (QGroundControl watching), else a free port for the scripted station alone. Also returns
-/// the image's budget: its size and what it measured of itself in flight.
+/// the image's budget: its size and what it measured of itself in flight, and the profile of
+/// its instructions when one was asked for.
 pub(crate) fn fly_qemu(
     aircraft: &Aircraft,
     cfg: &FlightConfig,
     qemu: &QemuConfig,
     out: Option<&Path>,
     tlog: Option<&Path>,
-) -> anyhow::Result<(Result<FlightOutcome, FlightError>, Option<McuBudget>)> {
+) -> anyhow::Result<QemuFlown> {
     let (bind, remote) = match &cfg.ground_link {
         Some((b, r)) => (b.clone(), Some(r.clone())),
         None => ("127.0.0.1:0".to_string(), None),
@@ -82,7 +94,10 @@ pub(crate) fn fly_qemu(
         log: out.map(|d| d.join(MCU_LOG)),
         ..qemu.clone()
     };
-    let (sim, bridge) = boot(&qemu, &bind, remote.as_deref(), || stop_requested(cfg))?;
+    let slot = ProfileSlot::default();
+    let (sim, bridge) = boot(&qemu, &bind, remote.as_deref(), Some(slot.clone()), || {
+        stop_requested(cfg)
+    })?;
     let mut onboard = OutsideOnboard::with_station(bridge.local_addr())
         .context("cannot open the scripted station's socket")?;
     // The bridge is the autopilot's ground link; no port into an application here.
@@ -93,7 +108,18 @@ pub(crate) fn fly_qemu(
     };
     let flown = run_on(aircraft, &cfg, sim, &mut onboard, tlog)?;
     let size = image_size(&qemu.elf)?;
-    Ok((flown, McuBudget::from_reports(size, &bridge.named_values())))
+    let profile = match slot.lock().unwrap_or_else(|p| p.into_inner()).take() {
+        Some(p) => Some(p.map_err(anyhow::Error::msg)?),
+        None if qemu.profile.is_some() => {
+            anyhow::bail!("the flight ended before the profile's window closed")
+        }
+        None => None,
+    };
+    Ok((
+        flown,
+        McuBudget::from_reports(size, &bridge.named_values()),
+        profile,
+    ))
 }
 
 /// Whether the truth goes to the MCU image: only when it flies on it. Each byte a UART
@@ -142,6 +168,7 @@ pub(crate) fn finish_report(
                 outcome,
                 files,
                 mcu: None,
+                mcu_profile: None,
             })
         }
         Err(e) => match (e.partial(), out) {

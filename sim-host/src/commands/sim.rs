@@ -220,6 +220,7 @@ pub fn sim_report(
                 &qemu,
                 &opts.gcs_bind,
                 opts.gcs_remote.as_deref(),
+                None,
                 || stop_requested(&cfg),
             )?;
             ready(&Ready {

@@ -20,6 +20,7 @@
 //! writes its log and then ends QEMU (and any wrapper around it) by that group.
 
 use super::bridge::GroundBridge;
+use super::profile::{ProfileSlot, ProfileWindow, Profiler};
 use super::transport::{TcpServer, Transport};
 use std::io::{self, Read};
 use std::net::{SocketAddr, TcpListener, UdpSocket};
@@ -62,6 +63,9 @@ pub struct QemuConfig {
     /// (QEMU does not emulate the flash controller; the image reaches the file over
     /// semihosting). Created erased when missing. `None`: the image keeps nothing.
     pub storage: Option<PathBuf>,
+    /// A window of control periods to profile by function ([`crate::link::profile`]), and
+    /// the directory for QEMU's monitor socket and its (transient) instruction trace.
+    pub profile: Option<(ProfileWindow, PathBuf)>,
 }
 
 impl Default for QemuConfig {
@@ -72,6 +76,7 @@ impl Default for QemuConfig {
             icount_shift: DEFAULT_ICOUNT_SHIFT,
             log: None,
             storage: None,
+            profile: None,
         }
     }
 }
@@ -133,7 +138,11 @@ impl QemuConfig {
     pub fn command(&self, sim: SocketAddr, gcs: SocketAddr) -> Command {
         let mut c = Command::new(&self.program);
         c.args(["-machine", "netduinoplus2", "-cpu", "cortex-m4"])
-            .args(["-nographic", "-monitor", "none"])
+            .arg("-nographic")
+            .args(self.profiler(None).map_or_else(
+                || vec!["-monitor".to_string(), "none".to_string()],
+                |p| p.qemu_args(),
+            ))
             .arg("-semihosting-config")
             .arg(semihosting_config(self.storage.as_deref()))
             .arg("-icount")
@@ -145,6 +154,20 @@ impl QemuConfig {
             .arg("-kernel")
             .arg(&self.elf);
         c
+    }
+}
+
+impl QemuConfig {
+    /// The profiler of [`QemuConfig::profile`], its result going to `slot` (a slot of its
+    /// own when `None`).
+    pub fn profiler(&self, slot: Option<ProfileSlot>) -> Option<Profiler> {
+        let (window, dir) = self.profile.as_ref()?;
+        Some(Profiler::new(
+            *window,
+            dir,
+            &self.elf,
+            slot.unwrap_or_default(),
+        ))
     }
 }
 
@@ -307,6 +330,7 @@ pub struct QemuLink {
     process: QemuProcess,
     log: Option<PathBuf>,
     elf: PathBuf,
+    profiler: Option<Profiler>,
 }
 
 impl QemuLink {
@@ -326,6 +350,10 @@ impl QemuLink {
 
 impl Transport for QemuLink {
     fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
+        // Each send is one sensor frame (the lock-step link writes a frame's messages at once).
+        if let Some(p) = self.profiler.as_mut() {
+            p.before_frame();
+        }
         self.server.send(bytes).map_err(|e| self.explain(e))
     }
 
@@ -375,11 +403,13 @@ impl Transport for QemuLink {
 
 /// Boots the MCU image: starts QEMU, accepts its two UARTs (within [`CONNECT_WAIT`]) and
 /// starts the ground bridge on `gcs_bind` (telemetry also to `gcs_remote`). `check` runs while
-/// waiting and aborts the boot with its error (Ctrl-C).
+/// waiting and aborts the boot with its error (Ctrl-C). With [`QemuConfig::profile`], the
+/// profile goes to `profile` once its window has been flown.
 pub fn boot(
     cfg: &QemuConfig,
     gcs_bind: &str,
     gcs_remote: Option<&str>,
+    profile: Option<ProfileSlot>,
     mut check: impl FnMut() -> io::Result<()>,
 ) -> Result<(QemuLink, GroundBridge), QemuError> {
     cfg.check()?;
@@ -425,6 +455,7 @@ pub fn boot(
             process,
             log: cfg.log.clone(),
             elf: cfg.elf.clone(),
+            profiler: cfg.profiler(profile),
         },
         bridge,
     ))

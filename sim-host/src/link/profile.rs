@@ -1,0 +1,448 @@
+//! Where the MCU image's instructions go: a profile by function of whole control periods,
+//! from QEMU's own instruction trace.
+//!
+//! For a window of sensor frames, QEMU is switched (over its monitor) to translate one
+//! instruction per block (`singlestep on`) and to log every block it executes
+//! (`log exec,nochain`): each line of the log is then one executed instruction with its
+//! address. The image marks its measured work with two functions that are never inlined
+//! ([`WORK_START`] and [`WORK_END`], `firmware/src/mcu/budget.rs`): only the instructions
+//! between the entry of the first and the entry of the second count, the same work the
+//! image's own SysTick figures (`CYC_MEAN`) charge to its control periods; the idle loop's
+//! polling between frames is left out. Each instruction is charged to the function whose
+//! symbol covers its address (code inlined into a function is that function's).
+//!
+//! The window opens just before its first frame is sent and closes once the last frame's work
+//! is logged (the log has stopped growing), with the image idle at both ends: a window of
+//! `2 N` frames at 100 Hz is `N` whole 20 ms control periods.
+
+use object::{Object, ObjectSymbol, SymbolKind};
+use serde::Serialize;
+use std::collections::HashMap;
+use std::io::{self, BufRead, Read, Write};
+use std::os::unix::net::UnixStream;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Symbol of the function whose entry starts the measured work of a pass.
+pub const WORK_START: &str = "budget_work_start";
+/// Symbol of the function whose entry ends it.
+pub const WORK_END: &str = "budget_work_end";
+
+/// Sensor frames per 20 ms control period (100 Hz frames).
+const FRAMES_PER_PERIOD: u64 = 2;
+
+/// Which control periods to profile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProfileWindow {
+    /// Sensor frame (counted from the first, 100 Hz) before which the window opens.
+    pub start_frame: u64,
+    /// Whole control periods in the window.
+    pub periods: u32,
+}
+
+impl ProfileWindow {
+    /// Parses `SECONDS[:PERIODS]` (simulated seconds from the first sensor frame; 10 periods
+    /// by default).
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let (at, n) = match s.split_once(':') {
+            Some((a, n)) => (a, Some(n)),
+            None => (s, None),
+        };
+        let at: f64 = at
+            .trim()
+            .parse()
+            .map_err(|_| format!("profile `{s}`: `{at}` is not a time in seconds"))?;
+        if !(at.is_finite() && at >= 0.0) {
+            return Err(format!("profile `{s}`: the time must be 0 s or later"));
+        }
+        let periods = match n {
+            Some(n) => n
+                .trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|p| (1..=500).contains(p))
+                .ok_or_else(|| format!("profile `{s}`: `{n}` periods: expected 1 to 500"))?,
+            None => 10,
+        };
+        Ok(Self {
+            start_frame: (at * 100.0).round() as u64,
+            periods,
+        })
+    }
+
+    fn end_frame(&self) -> u64 {
+        self.start_frame + FRAMES_PER_PERIOD * u64::from(self.periods)
+    }
+}
+
+/// The instructions of one function in the window.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FunctionCost {
+    /// The function, demangled, without its hash.
+    pub function: String,
+    /// Instructions per control period, on average over the window.
+    pub instr_per_period: f64,
+    /// Share of the window's measured instructions, percent.
+    pub percent: f64,
+}
+
+/// A profile of whole control periods: the `mcu.profile` object of
+/// `sim-host fly --link qemu --profile ... --json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct McuProfile {
+    /// Sensor frame before which the window opened.
+    pub start_frame: u64,
+    /// Control periods in the window.
+    pub periods: u32,
+    /// Measured instructions per control period, on average over the window.
+    pub instr_per_period: f64,
+    /// Every function that ran, costliest first.
+    pub functions: Vec<FunctionCost>,
+}
+
+impl McuProfile {
+    /// The `n` costliest functions as a Markdown table.
+    pub fn markdown(&self, n: usize) -> String {
+        let mut s = format!(
+            "{} control periods from sensor frame {}: {:.0} instructions per period.\n\n\
+             | function | instructions per period | share |\n|---|---:|---:|\n",
+            self.periods, self.start_frame, self.instr_per_period
+        );
+        for f in self.functions.iter().take(n) {
+            s.push_str(&format!(
+                "| `{}` | {:.0} | {:.1} % |\n",
+                f.function, f.instr_per_period, f.percent
+            ));
+        }
+        let rest: f64 = self.functions.iter().skip(n).map(|f| f.percent).sum();
+        if self.functions.len() > n {
+            s.push_str(&format!(
+                "| {} other functions | {:.0} | {:.1} % |\n",
+                self.functions.len() - n,
+                rest / 100.0 * self.instr_per_period,
+                rest
+            ));
+        }
+        s
+    }
+}
+
+/// The result of a window, shared between the link that records it and the flight's report.
+pub type ProfileSlot = Arc<Mutex<Option<Result<McuProfile, String>>>>;
+
+/// Switches QEMU's trace on and off around the window, then reads the trace.
+pub struct Profiler {
+    window: ProfileWindow,
+    monitor: PathBuf,
+    log: PathBuf,
+    elf: PathBuf,
+    frames_sent: u64,
+    slot: ProfileSlot,
+}
+
+impl Profiler {
+    /// A profiler of `window` for a QEMU started with `-monitor unix:MONITOR,server,nowait
+    /// -D LOG` (see [`Profiler::qemu_args`]) running `elf`.
+    pub fn new(window: ProfileWindow, dir: &Path, elf: &Path, slot: ProfileSlot) -> Self {
+        Self {
+            window,
+            monitor: dir.join("qemu-monitor.sock"),
+            log: dir.join("qemu-trace.log"),
+            elf: elf.to_path_buf(),
+            frames_sent: 0,
+            slot,
+        }
+    }
+
+    /// QEMU's arguments for the monitor socket and the trace file.
+    pub fn qemu_args(&self) -> Vec<String> {
+        vec![
+            "-monitor".into(),
+            format!("unix:{},server,nowait", self.monitor.display()),
+            "-D".into(),
+            self.log.display().to_string(),
+        ]
+    }
+
+    /// Called before each sensor frame is sent: opens or closes the window.
+    pub fn before_frame(&mut self) {
+        let k = self.frames_sent;
+        self.frames_sent += 1;
+        if k == self.window.start_frame {
+            if let Err(e) = self.open() {
+                self.finish(Err(format!("cannot start QEMU's trace: {e}")));
+            }
+        } else if k == self.window.end_frame() {
+            let r = self
+                .close()
+                .map_err(|e| format!("cannot read QEMU's trace: {e}"))
+                .and_then(|()| self.read());
+            self.finish(r);
+        }
+    }
+
+    fn finish(&mut self, r: Result<McuProfile, String>) {
+        *self.slot.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
+        // The trace is hundreds of megabytes: gone once read.
+        let _ = std::fs::remove_file(&self.log);
+    }
+
+    fn monitor(&self, commands: &[&str]) -> io::Result<()> {
+        let mut s = UnixStream::connect(&self.monitor)?;
+        s.set_read_timeout(Some(Duration::from_secs(5)))?;
+        let mut buf = [0u8; 4096];
+        let mut seen = Vec::new();
+        // Each command is answered with the monitor's prompt once it has been carried out.
+        let mut prompts_wanted = 1;
+        for c in std::iter::once(&"").chain(commands.iter()) {
+            if !c.is_empty() {
+                s.write_all(format!("{c}\n").as_bytes())?;
+                prompts_wanted += 1;
+            }
+            while count(&seen, b"(qemu)") < prompts_wanted {
+                let n = s.read(&mut buf)?;
+                if n == 0 {
+                    return Err(io::Error::new(
+                        io::ErrorKind::UnexpectedEof,
+                        "QEMU's monitor closed",
+                    ));
+                }
+                seen.extend_from_slice(&buf[..n]);
+            }
+        }
+        Ok(())
+    }
+
+    fn open(&mut self) -> io::Result<()> {
+        // The image has answered the previous frame; let it finish that frame's work.
+        wait_quiet(&self.log, Duration::from_millis(100));
+        self.monitor(&["singlestep on", "log exec,nochain"])
+    }
+
+    fn close(&mut self) -> io::Result<()> {
+        // The last frame's answer is in; its work goes on after the answer (telemetry):
+        // closed once the trace has stopped growing.
+        wait_quiet(&self.log, Duration::from_millis(500));
+        self.monitor(&["log none", "singlestep off"])
+    }
+
+    fn read(&self) -> Result<McuProfile, String> {
+        let symbols = Symbols::of(&self.elf)?;
+        let f = std::fs::File::open(&self.log)
+            .map_err(|e| format!("cannot open `{}`: {e}", self.log.display()))?;
+        let (start, end) = (
+            symbols.address_of(WORK_START).ok_or_else(|| {
+                format!("the image has no `{WORK_START}`: it does not mark its work")
+            })?,
+            symbols
+                .address_of(WORK_END)
+                .ok_or_else(|| format!("no `{WORK_END}` in the image"))?,
+        );
+        let mut counts = Counts::new(start, end);
+        for line in io::BufReader::new(f).lines() {
+            let line = line.map_err(|e| format!("reading the trace: {e}"))?;
+            counts.line(&line);
+        }
+        Ok(counts.profile(&symbols, self.window))
+    }
+}
+
+fn count(hay: &[u8], needle: &[u8]) -> usize {
+    hay.windows(needle.len()).filter(|w| *w == needle).count()
+}
+
+/// Waits until `path` has not grown for `quiet` (at most a minute).
+fn wait_quiet(path: &Path, quiet: Duration) {
+    let size = || std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut last = size();
+    let mut since = Instant::now();
+    while Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+        let s = size();
+        if s != last {
+            (last, since) = (s, Instant::now());
+        } else if since.elapsed() >= quiet {
+            return;
+        }
+    }
+}
+
+/// The image's functions by address.
+struct Symbols {
+    /// (start, end, name), sorted by start.
+    ranges: Vec<(u64, u64, String)>,
+    by_name: HashMap<String, u64>,
+}
+
+impl Symbols {
+    fn of(elf: &Path) -> Result<Self, String> {
+        let bytes =
+            std::fs::read(elf).map_err(|e| format!("cannot read `{}`: {e}", elf.display()))?;
+        let file = object::File::parse(&*bytes)
+            .map_err(|e| format!("`{}` is not an ELF file: {e}", elf.display()))?;
+        let mut ranges = Vec::new();
+        let mut by_name = HashMap::new();
+        for s in file.symbols() {
+            if s.kind() != SymbolKind::Text || s.size() == 0 {
+                continue;
+            }
+            let Ok(raw) = s.name() else { continue };
+            // Thumb code: bit 0 of a function's address says so; the instructions are at the
+            // even address.
+            let start = s.address() & !1;
+            by_name.insert(raw.to_string(), start);
+            ranges.push((start, start + s.size(), demangle(raw)));
+        }
+        ranges.sort_by_key(|r| r.0);
+        Ok(Self { ranges, by_name })
+    }
+
+    fn address_of(&self, name: &str) -> Option<u64> {
+        self.by_name.get(name).copied()
+    }
+
+    fn function_at(&self, pc: u64) -> Option<&str> {
+        let i = self.ranges.partition_point(|r| r.0 <= pc).checked_sub(1)?;
+        let (s, e, name) = &self.ranges[i];
+        (pc >= *s && pc < *e).then_some(name.as_str())
+    }
+}
+
+/// A Rust symbol's path without the hash suffix.
+fn demangle(raw: &str) -> String {
+    format!("{:#}", rustc_demangle::demangle(raw))
+}
+
+/// Executed instructions by address, inside the marked work only.
+struct Counts {
+    start: u64,
+    end: u64,
+    /// The addresses executed since the last start marker; committed to `by_pc` at the end
+    /// marker. A pass that found nothing to do calls the start marker and never the end one:
+    /// what it ran is dropped at the next start.
+    pass: Option<Vec<u64>>,
+    by_pc: HashMap<u64, u64>,
+    passes: u64,
+}
+
+impl Counts {
+    fn new(start: u64, end: u64) -> Self {
+        Self {
+            start,
+            end,
+            pass: None,
+            by_pc: HashMap::new(),
+            passes: 0,
+        }
+    }
+
+    /// One line of QEMU's log: `Trace 0: 0x... [flags/PC/...] name`, or a note that a block
+    /// was executed again after an I/O access (the instruction logged just before is then
+    /// logged a second time, and counted once).
+    fn line(&mut self, line: &str) {
+        if line.starts_with("cpu_io_recompile") {
+            if let Some(p) = self.pass.as_mut() {
+                p.pop();
+            }
+            return;
+        }
+        let Some(pc) = trace_pc(line) else { return };
+        if pc == self.start {
+            self.pass = Some(Vec::new());
+        } else if pc == self.end {
+            if let Some(p) = self.pass.take() {
+                for a in p {
+                    *self.by_pc.entry(a).or_insert(0) += 1;
+                }
+                self.passes += 1;
+            }
+        }
+        if let Some(p) = self.pass.as_mut() {
+            p.push(pc);
+        }
+    }
+
+    fn profile(self, symbols: &Symbols, window: ProfileWindow) -> McuProfile {
+        let mut by_fn: HashMap<String, u64> = HashMap::new();
+        let mut total = 0u64;
+        for (pc, n) in &self.by_pc {
+            let name = symbols
+                .function_at(*pc)
+                .map_or_else(|| format!("0x{pc:08x}"), str::to_string);
+            *by_fn.entry(name).or_insert(0) += n;
+            total += n;
+        }
+        let periods = f64::from(window.periods.max(1));
+        let mut functions: Vec<FunctionCost> = by_fn
+            .into_iter()
+            .map(|(function, n)| FunctionCost {
+                function,
+                instr_per_period: n as f64 / periods,
+                percent: 100.0 * n as f64 / (total.max(1) as f64),
+            })
+            .collect();
+        functions.sort_by(|a, b| {
+            b.instr_per_period
+                .total_cmp(&a.instr_per_period)
+                .then_with(|| a.function.cmp(&b.function))
+        });
+        McuProfile {
+            start_frame: window.start_frame,
+            periods: window.periods,
+            instr_per_period: total as f64 / periods,
+            functions,
+        }
+    }
+}
+
+/// The guest address of a `Trace` line: the second field of its bracket.
+fn trace_pc(line: &str) -> Option<u64> {
+    let rest = line.strip_prefix("Trace ")?;
+    let inside = rest.split_once('[')?.1.split_once(']')?.0;
+    let pc = inside.split('/').nth(1)?;
+    u64::from_str_radix(pc, 16).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_window_is_given_in_simulated_seconds_and_whole_periods() {
+        let w = ProfileWindow::parse("40").expect("window");
+        assert_eq!((w.start_frame, w.periods, w.end_frame()), (4000, 10, 4020));
+        let w = ProfileWindow::parse("1.5:3").expect("window");
+        assert_eq!((w.start_frame, w.end_frame()), (150, 156));
+        for bad in ["", "x", "-1", "5:0", "5:x", "inf"] {
+            assert!(ProfileWindow::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn only_instructions_between_the_work_markers_count_and_a_rewound_one_counts_once() {
+        let t = |pc: u32| format!("Trace 0: 0x7f00 [00800400/{pc:08x}/00000010/ff020201] f");
+        let mut c = Counts::new(0x100, 0x200);
+        // Idle polling before the work, not counted, nor a pass that found nothing to do.
+        c.line(&t(0x50));
+        c.line(&t(0x52));
+        c.line(&t(0x100));
+        c.line(&t(0x54));
+        // The work: the start marker's entry, three instructions (one executed again after an
+        // I/O access), then the end marker's entry.
+        c.line(&t(0x100));
+        c.line(&t(0x300));
+        c.line(&t(0x302));
+        c.line("cpu_io_recompile: rewound execution of TB to 00000302");
+        c.line(&t(0x302));
+        c.line(&t(0x200));
+        c.line(&t(0x50));
+        c.line(&t(0x100));
+        c.line(&t(0x52));
+        let total: u64 = c.by_pc.values().sum();
+        assert_eq!((total, c.passes), (3, 1));
+        assert_eq!(trace_pc(&t(0x0800_ebd8)), Some(0x0800_ebd8));
+        assert_eq!(trace_pc("cpu_io_recompile: x"), None);
+    }
+}
