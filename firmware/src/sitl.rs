@@ -292,8 +292,7 @@ impl FileStorage {
 
     /// Loads saved parameters and missions into the autopilot.
     pub fn load_into(&mut self, app: &mut App) -> Vec<String> {
-        let mut scratch = vec![0u8; SECTOR as usize];
-        let l = self.store.load_into(app, &mut scratch);
+        let l = self.store.load_into(app);
         let mut notes = Vec::new();
         if let Some(r) = l.params {
             notes.push(format!("parameters loaded ({r:?})"));
@@ -315,8 +314,7 @@ impl FileStorage {
     /// Saves what changed since the last save while disarmed, and answers a
     /// `MAV_CMD_PREFLIGHT_STORAGE` once saved (PX4 saves parameters as they change).
     pub fn save_changes(&mut self, app: &mut App) -> io::Result<()> {
-        let mut scratch = vec![0u8; SECTOR as usize];
-        let done = self.store.service(app, &mut scratch);
+        let done = self.store.service(app);
         if done.failed {
             return Err(io::Error::other("save of the board record failed"));
         }

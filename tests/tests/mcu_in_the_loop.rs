@@ -297,9 +297,6 @@ fn mission_count(st: &mut Station) -> Option<u16> {
 /// file standing for the flash sectors; PREFLIGHT_REBOOT_SHUTDOWN resets the emulated board
 /// (SCB system reset), which boots again with the parameter and the mission it saved.
 #[test]
-#[ignore = "the emulated board does not come back from the SCB reset on every run (QEMU ends \
-            the connection): the saved record is read back by a new QEMU process, not yet \
-            across the in-process reset; docs/PIL.md"]
 fn parameters_and_a_mission_survive_a_reset_of_the_emulated_board() {
     use mavlink::dialects::common::*;
     if !tool_available("qemu-system-arm") {

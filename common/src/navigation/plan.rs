@@ -8,11 +8,14 @@
 use heapless::Vec;
 use serde::{Deserialize, Serialize};
 
-/// Mission items stored (at least 128, QGC plans of a few hundred items are rare on a small
-/// fixed wing).
-pub const MISSION_CAPACITY: usize = 160;
-/// Geofence items stored (polygon vertices, circles, return point).
-pub const FENCE_CAPACITY: usize = 64;
+/// Mission items stored: a QGroundControl survey of a small fixed wing's field (a few dozen
+/// transects, each two waypoints, with its camera items) or a long waypoint route fits; a
+/// plan of a few hundred items does not, and is refused whole (`MAV_MISSION_NO_SPACE`). Each
+/// item costs 64 bytes of the STM32F405's RAM (stored and staged during an upload).
+pub const MISSION_CAPACITY: usize = 140;
+/// Geofence items stored (polygon vertices, circles, return point): a 30-vertex inclusion
+/// polygon with its return point.
+pub const FENCE_CAPACITY: usize = 32;
 /// Rally points stored.
 pub const RALLY_CAPACITY: usize = 16;
 

@@ -302,21 +302,31 @@ impl ParamStore {
     /// values it had (its records count as rejected). Order within the image does not matter.
     /// Does not count as a change to persist.
     pub fn import(&mut self, image: &ParamImage) -> ImportReport {
+        self.import_with(|put| image.iter().for_each(|r| put(r.name.as_str(), r.value)))
+    }
+
+    /// As [`ParamStore::import`], from records that `records` hands to its argument, name and
+    /// value, each time it is called (once, and once more for each stage whose rule refuses
+    /// what was loaded): a record streamed from flash needs no image in RAM.
+    pub fn import_with(
+        &mut self,
+        mut records: impl FnMut(&mut dyn FnMut(&str, f32)),
+    ) -> ImportReport {
         let mut report = ImportReport::default();
         let before = self.values.clone();
-        for rec in image.iter() {
-            let Some(i) = self.index_of(rec.name.as_str()) else {
+        records(&mut |name, value| {
+            let Some(i) = self.index_of(name) else {
                 report.unknown += 1;
-                continue;
+                return;
             };
-            match self.def(i).map(|d| d.check(rec.value)) {
+            match self.def(i).map(|d| d.check(value)) {
                 Some(Ok(v)) => {
                     self.put(i, v);
                     report.loaded += 1;
                 }
                 _ => report.rejected += 1,
             }
-        }
+        });
         let mut start = 0;
         for stage in self.registry.iter() {
             let range = start..start + stage.len();
@@ -327,12 +337,13 @@ impl ParamStore {
             }
             // The stage's records that were loaded (those its definitions refused are counted
             // already).
-            let loaded = |r: &ParamRecord| {
-                (0..stage.len())
+            let mut refused = 0u16;
+            records(&mut |name, value| {
+                let loaded = (0..stage.len())
                     .filter_map(|i| stage.def(i))
-                    .any(|d| d.name == r.name.as_str() && d.check(r.value).is_ok())
-            };
-            let refused = image.iter().filter(|r| loaded(r)).count() as u16;
+                    .any(|d| d.name == name && d.check(value).is_ok());
+                refused += u16::from(loaded);
+            });
             report.loaded = report.loaded.saturating_sub(refused);
             report.rejected = report.rejected.saturating_add(refused);
             if let (Some(now), Some(was)) = (self.values.get_mut(range.clone()), before.get(range))

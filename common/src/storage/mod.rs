@@ -362,45 +362,7 @@ pub struct BoardRecordRef<'a> {
     pub signing: SigningRecord,
 }
 
-/// [`BoardRecordRef`], loaded.
-#[derive(Debug, serde::Deserialize)]
-pub struct BoardRecord {
-    /// The saved parameters, by name.
-    pub params: ParamImage,
-    /// The plan.
-    pub plan: MissionStore,
-    /// The signing key.
-    pub signing: SigningRecord,
-}
-
-/// [`BoardRecord`]'s encoding, walked.
-#[derive(serde::Deserialize)]
-struct BoardWalk {
-    _params: Walk<ParamRecord, MAX_PARAMS>,
-    _plan: PlanWalk,
-    _signing: SigningRecord,
-}
-
-/// Saves the board record and marks the parameters saved; keeps the copy that loads as
-/// [`save`] does.
-pub fn save_board<F: Flash>(
-    flash: &mut F,
-    region: &AbRegion,
-    record: &BoardRecordRef,
-    scratch: &mut [u8],
-) -> Result<u32, StorageError<F::Error>> {
-    let decodes = |b: &[u8]| postcard::from_bytes::<BoardWalk>(b).is_ok();
-    save_keeping(flash, region, record, scratch, decodes)
-}
-
-/// Loads the board record; `None` when nothing is saved.
-pub fn load_board<F: Flash>(
-    flash: &mut F,
-    region: &AbRegion,
-    scratch: &mut [u8],
-) -> Result<Option<BoardRecord>, StorageError<F::Error>> {
-    Ok(load::<F, BoardRecord>(flash, region, scratch)?.map(|l| l.value))
-}
+pub use stream::{load_board_into, save_board, BoardLoaded};
 
 /// Error of [`RamFlash`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -543,6 +505,7 @@ fn self_spend(budget: &mut Option<usize>, ops: &mut usize) -> Result<bool, RamFl
 }
 
 pub mod f4;
+mod stream;
 
 #[cfg(test)]
 mod tests;

@@ -328,17 +328,198 @@ fn the_board_record_keeps_parameters_plan_and_key_together() {
         slot_b: 16384,
         slot_len: 16384,
     };
-    let mut scratch = std::vec![0u8; 16384];
     let rec = BoardRecordRef {
         params: ParamExport(&store),
         plan: &plan,
         signing,
     };
-    save_board(&mut f, &region, &rec, &mut scratch).unwrap();
-    let back = load_board(&mut f, &region, &mut scratch).unwrap().unwrap();
-    assert_eq!(back.plan, plan);
-    assert_eq!(back.signing, signing);
-    let mut fresh = ParamStore::new(REGISTRY);
-    fresh.import(&back.params);
+    assert_eq!(save_board(&mut f, &region, &rec), Ok(1));
+    let (mut fresh, mut back) = (ParamStore::new(REGISTRY), MissionStore::default());
+    back.rally.push(item).unwrap();
+    let loaded = load_board_into(&mut f, &region, &mut fresh, &mut back)
+        .unwrap()
+        .unwrap();
+    assert_eq!(back, plan);
+    assert_eq!(loaded.signing, signing);
+    assert_eq!((loaded.seq, loaded.params.loaded), (1, 1));
     assert_eq!(fresh.get("RLL_KP"), Some(-0.5));
+}
+
+/// A board region of two 16 KiB slots.
+const BOARD: AbRegion = AbRegion {
+    magic: BOARD_MAGIC,
+    slot_a: 0,
+    slot_b: 16384,
+    slot_len: 16384,
+};
+
+/// A plan of `n` mission items, each told apart by its latitude.
+fn plan_of(n: usize) -> MissionStore {
+    let mut plan = MissionStore::default();
+    for k in 0..n {
+        let item = MissionItem {
+            command: 16,
+            x: 449_000_000 + k as i32,
+            params: [0, 0, f32::NAN.to_bits() | k as u32, 0],
+            z: 100f32.to_bits(),
+            ..Default::default()
+        };
+        plan.mission.push(item).unwrap();
+    }
+    plan
+}
+
+#[test]
+fn a_streamed_board_record_is_the_postcard_encoding_of_the_record() {
+    use crate::vehicle::params::REGISTRY;
+    let mut store = ParamStore::new(REGISTRY);
+    store.set("RLL_KP", -0.5).unwrap();
+    let plan = plan_of(MISSION_CAPACITY);
+    let rec = BoardRecordRef {
+        params: ParamExport(&store),
+        plan: &plan,
+        signing: SigningRecord {
+            key: Some([3; 32]),
+            timestamp: 1 << 40,
+        },
+    };
+    let mut f = RamFlash::<{ 2 * 16384 }>::new(16384);
+    save_board(&mut f, &BOARD, &rec).unwrap();
+    // The reference: postcard's own encoding in one buffer, and the slot layout of the
+    // module's docs around it (magic, seq, len, CRC-32 of seq, len and payload).
+    let mut buf = std::vec![0u8; 16384];
+    let payload = postcard::to_slice(&rec, &mut buf).unwrap();
+    let word = |k: usize| u32::from_le_bytes(f.bytes()[4 * k..4 * k + 4].try_into().unwrap());
+    assert_eq!(
+        (word(0), word(1), word(2)),
+        (BOARD_MAGIC, 1, payload.len() as u32)
+    );
+    let mut crc = crc_any::CRCu32::crc32();
+    crc.digest(&1u32.to_le_bytes());
+    crc.digest(&(payload.len() as u32).to_le_bytes());
+    crc.digest(payload);
+    assert_eq!(word(3), crc.get_crc());
+    assert_eq!(&f.bytes()[16..16 + payload.len()], &*payload);
+}
+
+#[test]
+fn a_full_plan_loads_back_bit_for_bit_over_the_one_flown_before() {
+    use crate::vehicle::params::REGISTRY;
+    let store = ParamStore::new(REGISTRY);
+    let plan = plan_of(MISSION_CAPACITY);
+    let rec = BoardRecordRef {
+        params: ParamExport(&store),
+        plan: &plan,
+        signing: SigningRecord::default(),
+    };
+    let mut f = RamFlash::<{ 2 * 16384 }>::new(16384);
+    save_board(&mut f, &BOARD, &rec).unwrap();
+    let mut flown = plan_of(3);
+    flown.fence.push(MissionItem::default()).unwrap();
+    let changes = flown.change_count();
+    let mut params = ParamStore::new(REGISTRY);
+    load_board_into(&mut f, &BOARD, &mut params, &mut flown)
+        .unwrap()
+        .unwrap();
+    assert_eq!(flown, plan);
+    assert_ne!(
+        flown.change_count(),
+        changes,
+        "the navigator must see a new plan"
+    );
+}
+
+#[test]
+fn a_board_copy_that_does_not_decode_changes_nothing_and_the_older_one_loads() {
+    use crate::vehicle::params::REGISTRY;
+    let mut store = ParamStore::new(REGISTRY);
+    store.set("RLL_KP", -0.25).unwrap();
+    let old_plan = plan_of(2);
+    let mut f = RamFlash::<{ 2 * 16384 }>::new(16384);
+    let rec = |store, plan| BoardRecordRef {
+        params: ParamExport(store),
+        plan,
+        signing: SigningRecord::default(),
+    };
+    save_board(&mut f, &BOARD, &rec(&store, &old_plan)).unwrap();
+    // A newer copy, intact (its CRC holds) but of another format: a mission count beyond the
+    // capacity.
+    let mut bytes = std::vec![0xffu8; 16384];
+    let payload = [0u8, 0xff, 0x7f, 0, 0];
+    let mut crc = crc_any::CRCu32::crc32();
+    crc.digest(&2u32.to_le_bytes());
+    crc.digest(&(payload.len() as u32).to_le_bytes());
+    crc.digest(&payload);
+    for (k, w) in [BOARD_MAGIC, 2, payload.len() as u32, crc.get_crc()]
+        .iter()
+        .enumerate()
+    {
+        bytes[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+    }
+    bytes[16..16 + payload.len()].copy_from_slice(&payload);
+    let mut image = f.bytes().to_vec();
+    image[16384..].copy_from_slice(&bytes);
+    let mut f = RamFlash::<{ 2 * 16384 }>::from_image(&image, 16384);
+    let (mut params, mut plan) = (ParamStore::new(REGISTRY), plan_of(5));
+    let loaded = load_board_into(&mut f, &BOARD, &mut params, &mut plan)
+        .unwrap()
+        .unwrap();
+    assert_eq!((loaded.seq, plan.mission.len()), (1, 2));
+    assert_eq!(params.get("RLL_KP"), Some(-0.25));
+    // A save keeps the copy that loads: it goes over the newer one that does not.
+    save_board(&mut f, &BOARD, &rec(&store, &plan_of(7))).unwrap();
+    assert_eq!(&f.bytes()[..16384], &image[..16384]);
+    // Only the undecodable copy left: an error, and nothing changed.
+    let mut only_bad = RamFlash::<{ 2 * 16384 }>::from_image(&bytes, 16384);
+    let (mut params, mut plan) = (ParamStore::new(REGISTRY), plan_of(5));
+    assert_eq!(
+        load_board_into(&mut only_bad, &BOARD, &mut params, &mut plan),
+        Err(StorageError::Decode)
+    );
+    assert_eq!(plan, plan_of(5));
+    assert_eq!(
+        params.get("RLL_KP"),
+        ParamStore::new(REGISTRY).get("RLL_KP")
+    );
+}
+
+#[test]
+fn a_power_cut_anywhere_in_a_streamed_board_save_loads_the_old_record_or_the_new() {
+    use crate::vehicle::params::REGISTRY;
+    let mut old_params = ParamStore::new(REGISTRY);
+    old_params.set("RLL_KP", -0.25).unwrap();
+    let mut new_params = old_params.clone();
+    new_params.set("RLL_KP", -0.75).unwrap();
+    let (old_plan, new_plan) = (plan_of(4), plan_of(9));
+    let rec = |store, plan| BoardRecordRef {
+        params: ParamExport(store),
+        plan,
+        signing: SigningRecord::default(),
+    };
+    let mut base = RamFlash::<{ 2 * 16384 }>::new(16384);
+    save_board(&mut base, &BOARD, &rec(&old_params, &old_plan)).unwrap();
+    let mut cuts = 0;
+    for cut in 1.. {
+        let mut f = base.clone();
+        f.cut_after(Some(cut));
+        let done = save_board(&mut f, &BOARD, &rec(&new_params, &new_plan)).is_ok();
+        f.cut_after(None);
+        let (mut params, mut plan) = (ParamStore::new(REGISTRY), MissionStore::default());
+        load_board_into(&mut f, &BOARD, &mut params, &mut plan)
+            .unwrap()
+            .unwrap();
+        let kp = params.get("RLL_KP");
+        if plan == new_plan {
+            assert_eq!(kp, Some(-0.75), "cut {cut}");
+        } else {
+            assert_eq!((&plan, kp), (&old_plan, Some(-0.25)), "cut {cut}");
+            assert!(!done, "cut {cut}: a save that returned Ok must load");
+        }
+        if done {
+            break;
+        }
+        cuts += 1;
+    }
+    // An erase and every payload and header byte.
+    assert!(cuts > 9 * 20, "{cuts}");
 }

@@ -97,7 +97,33 @@ impl Default for Vehicle {
 impl Vehicle {
     /// A freshly booted vehicle with default parameters: disarmed, in Manual.
     pub fn new() -> Self {
-        let mut v = Self {
+        let mut v = Self::fresh();
+        v.apply_params();
+        v
+    }
+
+    /// [`Vehicle::new`] written into `slot` (a static on the MCU): one copy of the vehicle on
+    /// the stack while it is built (`new` takes one more for its return), in a frame of its own
+    /// that is gone before the caller builds anything else.
+    pub fn init_in(slot: &mut core::mem::MaybeUninit<Vehicle>) -> &mut Vehicle {
+        let v = Self::write_fresh(slot);
+        v.apply_params();
+        v
+    }
+
+    /// [`Vehicle::fresh`] into `slot`, in a frame of its own: the copy it takes on the stack is
+    /// gone before the parameters are applied.
+    #[inline(never)]
+    fn write_fresh(slot: &mut core::mem::MaybeUninit<Vehicle>) -> &mut Vehicle {
+        slot.write(Self::fresh())
+    }
+
+    /// The vehicle's state before the parameters are applied to its stages. Not inlined: a
+    /// call builds its result in the caller's destination, where an inlined literal is built
+    /// on the stack and copied.
+    #[inline(never)]
+    fn fresh() -> Self {
+        Self {
             params: ParamStore::new(params::REGISTRY),
             plan: MissionStore::default(),
             estimator: Estimator::default(),
@@ -116,9 +142,7 @@ impl Vehicle {
             truth: None,
             surfaces: trim_surfaces(&GainSet::default()),
             refusing: false,
-        };
-        v.apply_params();
-        v
+        }
     }
 
     /// The parameters.

@@ -13,7 +13,13 @@ use common::vehicle::commander::Severity;
 use common::vehicle::{FromGround, Notice, Vehicle};
 use mavlink::dialects::common::{MavMessage, MavSeverity};
 
+/// Bytes waiting for the ground station at most (a full parameter burst and telemetry). The
+/// MCU hands them to its USART's ring on every pass of its loop, so a pass's answers and
+/// telemetry are all it holds (a burst of four FTP frames is 1 KiB).
+#[cfg(target_os = "none")]
+pub const GCS_OUT: usize = 4096;
 /// Bytes waiting for the ground station at most (a full parameter burst and telemetry).
+#[cfg(not(target_os = "none"))]
 pub const GCS_OUT: usize = 8192;
 
 /// Channels a board may have: one UART on the MCU; on the host a fixed ground station and up

@@ -69,13 +69,14 @@ impl App {
     /// then copy it out, which on the STM32F405 costs more stack than the image has.
     pub fn init_in(slot: &mut core::mem::MaybeUninit<App>) -> &mut App {
         let p = slot.as_mut_ptr();
-        // SAFETY: each field of the slot is written exactly once, through a raw pointer that
-        // never reads the uninitialised memory; after the three writes every field holds a
+        // SAFETY: each field of the slot is written exactly once, through a raw pointer (or a
+        // `MaybeUninit` of the same layout) that never reads the uninitialised memory; after the three writes every field holds a
         // valid value, so the whole `App` is initialised.
         unsafe {
-            core::ptr::addr_of_mut!((*p).vehicle).write(Vehicle::new());
+            let vehicle = core::ptr::addr_of_mut!((*p).vehicle);
+            Vehicle::init_in(&mut *vehicle.cast::<core::mem::MaybeUninit<Vehicle>>());
             core::ptr::addr_of_mut!((*p).sim).write(SimPort::new());
-            core::ptr::addr_of_mut!((*p).ground).write(GroundPort::new());
+            write_ground(&mut *core::ptr::addr_of_mut!((*p).ground).cast());
             slot.assume_init_mut()
         }
     }
@@ -240,6 +241,13 @@ impl App {
     pub fn drain_gcs_to(&mut self, out: &mut impl FnMut(Dest, &[u8])) {
         self.ground.drain(out);
     }
+}
+
+/// Writes a new ground port into `slot`, in a frame of its own: the port is built on the stack
+/// and copied, and that copy must not sit under the vehicle's while the vehicle is built.
+#[inline(never)]
+fn write_ground(slot: &mut core::mem::MaybeUninit<GroundPort>) {
+    slot.write(GroundPort::new());
 }
 
 /// A heartbeat frame of the autopilot on its simulator link (the ground link's heartbeat, so

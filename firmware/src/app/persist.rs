@@ -8,7 +8,9 @@
 
 use common::params::store::ImportReport;
 use common::storage::StorageError;
-use common::storage::{load_board, save_board, AbRegion, BoardRecordRef, Flash, SigningRecord};
+use common::storage::{
+    load_board_into, save_board, AbRegion, BoardRecordRef, Flash, SigningRecord,
+};
 
 use super::App;
 
@@ -73,15 +75,15 @@ impl<F: Flash> Persistence<F> {
         self.forget_key = true;
     }
 
-    /// Loads the saved record into the autopilot (at start-up). `scratch` holds the encoded
-    /// record (a slot's size is always enough).
-    pub fn load_into(&mut self, app: &mut App, scratch: &mut [u8]) -> Loaded {
+    /// Loads the saved record into the autopilot (at start-up), streamed from the flash
+    /// straight into its stores: no copy of the record, encoded or decoded, is held.
+    pub fn load_into(&mut self, app: &mut App) -> Loaded {
         let mut loaded = Loaded::default();
-        match load_board(&mut self.flash, &self.region, scratch) {
+        let (params, plan, _) = app.vehicle_mut().stores();
+        match load_board_into(&mut self.flash, &self.region, params, plan) {
             Ok(Some(r)) => {
-                loaded.params = Some(app.vehicle_mut().params_mut().import(&r.params));
-                loaded.mission_items = r.plan.mission.len();
-                app.vehicle_mut().plan_mut().load(r.plan);
+                loaded.params = Some(r.params);
+                loaded.mission_items = app.vehicle().plan().mission.len();
                 let key = if self.forget_key {
                     loaded.key_forgotten = true;
                     None
@@ -108,12 +110,8 @@ impl<F: Flash> Persistence<F> {
         app.vehicle().params().is_dirty() || missions || signing
     }
 
-    /// Saves the record now.
-    pub fn save(
-        &mut self,
-        app: &mut App,
-        scratch: &mut [u8],
-    ) -> Result<u32, StorageError<F::Error>> {
+    /// Saves the record now, encoded straight into the flash.
+    pub fn save(&mut self, app: &mut App) -> Result<u32, StorageError<F::Error>> {
         let signing = app.signing_mut();
         let record_signing = SigningRecord {
             key: signing.key().copied(),
@@ -127,7 +125,7 @@ impl<F: Flash> Persistence<F> {
             plan: &*plan,
             signing: record_signing,
         };
-        let seq = save_board(&mut self.flash, &self.region, &record, scratch)?;
+        let seq = save_board(&mut self.flash, &self.region, &record)?;
         params.mark_saved();
         self.signing_seen = Some(signing_seen);
         self.missions_seen = Some(missions_seen);
@@ -136,12 +134,12 @@ impl<F: Flash> Persistence<F> {
 
     /// Called by the board's loop: answers a `MAV_CMD_PREFLIGHT_STORAGE` once its save is
     /// done, saves other changes while disarmed, and passes on a reboot request.
-    pub fn service(&mut self, app: &mut App, scratch: &mut [u8]) -> Serviced {
+    pub fn service(&mut self, app: &mut App) -> Serviced {
         let mut done = Serviced::default();
         let asked = app.ground_link_mut().take_storage_request();
         let auto = !app.armed() && !self.gave_up && self.changed(app);
         if asked.is_some() || auto {
-            let ok = self.save(app, scratch).is_ok();
+            let ok = self.save(app).is_ok();
             self.gave_up = !ok;
             done.saved = ok;
             done.failed = !ok;

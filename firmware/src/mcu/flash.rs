@@ -133,7 +133,7 @@ impl HostFile {
     }
 
     fn erase(&mut self, addr: u32) -> Result<(), HostError> {
-        if (addr - START.min(addr)) % SECTOR != 0 {
+        if !(addr - START.min(addr)).is_multiple_of(SECTOR) {
             return Err(HostError::Address);
         }
         let ones = [0xffu8; 256];

@@ -2,11 +2,12 @@
 //!
 //! Clock set-up is skipped: QEMU's netduinoplus2 does not emulate RCC, and polling a ready bit
 //! there hangs (on a real board the reset clock, 16 MHz HSI, runs this loop as well). USART1
-//! carries the simulator link and USART2 the ground link; both are busy-polled, which also
-//! keeps QEMU's instruction-counting mode exact.
+//! carries the simulator link and USART2 the ground link; their interrupts fill and drain ring
+//! buffers ([`usart`]) while the main loop keeps polling those rings (no WFI: under `-icount`
+//! it stalls QEMU 7.2 when UART interrupts are on).
 
 use core::mem::MaybeUninit;
-use cortex_m_rt::entry;
+use cortex_m_rt::{entry, exception};
 use defmt_semihosting as _;
 use firmware::app::App;
 
@@ -16,17 +17,28 @@ mod flash;
 mod usart;
 mod watchdog;
 use firmware::app::persist::Persistence;
-use usart::Usart;
+use usart::{Id, Usart};
 
-/// Room for one encoded board record (a slot's size).
-const RECORD_BYTES: usize = 16 * 1024;
+/// Every interrupt without a handler of its own comes here (cortex-m-rt's vector table): the
+/// USARTs' are served, anything else spins as cortex-m-rt's default does, until the watchdog
+/// resets the board.
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    match Id::of_irq(irqn) {
+        Some(id) => usart::on_interrupt(id),
+        None => loop {
+            cortex_m::asm::nop();
+        },
+    }
+}
 
 #[entry]
 fn main() -> ! {
-    let sim = Usart::USART1;
-    let gcs = Usart::USART2;
-    sim.enable();
-    gcs.enable();
+    let (Some(mut sim), Some(mut gcs)) = (Usart::open(Id::Usart1), Usart::open(Id::Usart2)) else {
+        loop {
+            cortex_m::asm::nop();
+        }
+    };
     defmt::info!("autopilot booted: STM32F405, USART1 sim link, USART2 ground link");
     let (warn, boot_text) = firmware::app::reset::boot_text(fault::reset_flags(), fault::take());
     defmt::info!("{=str}", boot_text.as_str());
@@ -37,12 +49,10 @@ fn main() -> ! {
     static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
     // SAFETY: `main` runs once and is the only code that names APP.
     let app = App::init_in(unsafe { &mut *core::ptr::addr_of_mut!(APP) });
-    let scratch = cortex_m::singleton!(: [u8; RECORD_BYTES] = [0; RECORD_BYTES]);
-    let Some(scratch) = scratch else { loop {} };
     let board_flash = flash::BoardFlash::open();
     let host_file = board_flash.is_host_file();
     let mut store = Persistence::new(board_flash, flash::REGION);
-    let loaded = store.load_into(app, scratch);
+    let loaded = store.load_into(app);
     defmt::info!(
         "storage ({}): parameters {}, {} mission items, unreadable {}",
         if host_file {
@@ -79,7 +89,7 @@ fn main() -> ! {
                 app.announce(warn, &text);
             }
         }
-        let done = store.service(app, scratch);
+        let done = store.service(app);
         // Telemetry and answers for the ground, produced by the calls above.
         app.drain_gcs(&mut |out| gcs.write(out));
         // Only the passes that had work are the control period's cost.
@@ -89,6 +99,8 @@ fn main() -> ! {
         if done.reboot {
             defmt::info!("rebooting on the ground station's request");
             fault::record(firmware::app::reset::Fault::Requested);
+            gcs.flush();
+            sim.flush();
             cortex_m::peripheral::SCB::sys_reset();
         }
         // Outside the measured work: the report scans the stack (sent with the next frames).
