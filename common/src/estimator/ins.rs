@@ -150,6 +150,10 @@ pub struct Ins {
     history: [Snapshot; HISTORY],
     head: usize,
     len: usize,
+    /// Corrections of the fusions in progress, to be carried into the stored states once the
+    /// measurement's components are all fused: from time `t` on, rotated by `q`, velocity
+    /// moved by `v` and position by `p`.
+    pending: Option<Snapshot>,
     attitude_ok: bool,
     nav_ok: bool,
 }
@@ -173,6 +177,7 @@ impl Ins {
             history: [Snapshot::default(); HISTORY],
             head: 0,
             len: 0,
+            pending: None,
             attitude_ok: false,
             nav_ok: false,
         }
@@ -381,33 +386,35 @@ impl Ins {
         } else {
             (self.v, self.p)
         };
-        let mut phi = Mat::identity();
-        phi.fixed_view_mut::<3, 3>(ITH, IBG).copy_from(&(-r * dt));
-        if self.nav_ok {
-            let fx = f_ned.cross_matrix();
-            phi.fixed_view_mut::<3, 3>(IV, ITH).copy_from(&(-fx * dt));
-            phi.fixed_view_mut::<3, 3>(IP, ITH)
-                .copy_from(&(-fx * (0.5 * dt * dt)));
-            phi.fixed_view_mut::<3, 3>(IP, IV)
-                .copy_from(&(Matrix3::identity() * dt));
-        }
-        let mut qd = Mat::zeros();
+        // The transition is the identity plus four 3x3 blocks; with the position and velocity
+        // blocks only once navigation runs.
+        let rdt = -r * dt;
+        let fx = f_ned.cross_matrix();
+        let (fdt, fdt2) = (-fx * dt, -fx * (0.5 * dt * dt));
+        let idt = Matrix3::identity() * dt;
+        let all = [
+            (ITH, IBG, &rdt),
+            (IV, ITH, &fdt),
+            (IP, ITH, &fdt2),
+            (IP, IV, &idt),
+        ];
+        let blocks = if self.nav_ok { &all[..] } else { &all[..1] };
+        let mut cov = propagate(&self.cov, blocks);
         let g = noise.gyro * noise.gyro * dt;
         let qa = noise.accel * noise.accel * dt;
         let b = noise.gyro_bias * noise.gyro_bias * dt;
         for k in 0..3 {
-            qd[(ITH + k, ITH + k)] = g;
-            qd[(IBG + k, IBG + k)] = b;
+            cov[(ITH + k, ITH + k)] += g;
+            cov[(IBG + k, IBG + k)] += b;
             if self.nav_ok {
                 // Integrated white acceleration: the exact discrete covariance of (p, v).
-                qd[(IV + k, IV + k)] = qa;
-                qd[(IP + k, IP + k)] = qa * dt * dt / 3.0;
-                qd[(IP + k, IV + k)] = qa * dt / 2.0;
-                qd[(IV + k, IP + k)] = qa * dt / 2.0;
+                cov[(IV + k, IV + k)] += qa;
+                cov[(IP + k, IP + k)] += qa * dt * dt / 3.0;
+                cov[(IP + k, IV + k)] += qa * dt / 2.0;
+                cov[(IV + k, IP + k)] += qa * dt / 2.0;
             }
         }
-        qd[(IBO, IBO)] = noise.baro_offset * noise.baro_offset * dt;
-        let cov = phi * self.cov * phi.transpose() + qd;
+        cov[(IBO, IBO)] += noise.baro_offset * noise.baro_offset * dt;
         self.commit(q, v, p, self.bias, self.baro_offset, cov);
         if self.nav_ok {
             self.remember(t);
@@ -415,6 +422,12 @@ impl Ins {
     }
 
     fn remember(&mut self, t: f64) {
+        // The stored states are kept in time order (searches stop early on it): a clock that
+        // went back starts the history again.
+        let newest = self.history.get(self.head).map(|s| s.t);
+        if self.len > 0 && newest.is_some_and(|n| t <= n) {
+            self.len = 0;
+        }
         self.head = (self.head + 1) % HISTORY;
         if let Some(s) = self.history.get_mut(self.head) {
             *s = Snapshot {
@@ -436,6 +449,7 @@ impl Ins {
             p: self.p,
         };
         let mut best_err = f64::INFINITY;
+        // Newest first, in time order: once the distance grows it only grows.
         for k in 0..self.len {
             let i = (self.head + HISTORY - k) % HISTORY;
             if let Some(s) = self.history.get(i) {
@@ -443,6 +457,8 @@ impl Ins {
                 if e < best_err {
                     best_err = e;
                     best = *s;
+                } else if e > best_err {
+                    break;
                 }
             }
         }
@@ -461,11 +477,13 @@ impl Ins {
         for k in 0..self.len {
             let i = (self.head + HISTORY - k) % HISTORY;
             if let Some(s) = self.history.get_mut(i) {
-                if s.t >= after {
-                    s.q = rot * s.q;
-                    s.v += dv;
-                    s.p += dp;
+                // Newest first, in time order: the rest are older still.
+                if s.t < after {
+                    break;
                 }
+                s.q = rot * s.q;
+                s.v += dv;
+                s.p += dp;
             }
         }
     }
@@ -488,9 +506,36 @@ impl Ins {
             cov,
         );
         if ok {
-            self.shift_stored(t_meas - 1e-4, &rot, &dv, &dp);
+            // One pass over the stored states per measurement, not per component: the
+            // corrections compose.
+            let after = t_meas - 1e-4;
+            let sum = match self.pending {
+                Some(s) if s.t == after => Snapshot {
+                    t: after,
+                    q: rot * s.q,
+                    v: s.v + dv,
+                    p: s.p + dp,
+                },
+                _ => {
+                    self.flush_shift();
+                    Snapshot {
+                        t: after,
+                        q: rot,
+                        v: dv,
+                        p: dp,
+                    }
+                }
+            };
+            self.pending = Some(sum);
         }
         ok
+    }
+
+    /// Carries the pending corrections into the stored states.
+    fn flush_shift(&mut self) {
+        if let Some(s) = self.pending.take() {
+            self.shift_stored(s.t, &s.q, &s.v, &s.p);
+        }
     }
 
     /// Fuses one scalar component: `innov` against the error-state row `h`.
@@ -548,6 +593,7 @@ impl Ins {
             let innov = pos[i] - (past.p[i] + (self.p[i] - p0[i]));
             self.fuse_scalar(&h, innov, r, gate_sigma, t_meas, &mut pos_out);
         }
+        self.flush_shift();
         (pos_out, vel_out)
     }
 
@@ -562,6 +608,7 @@ impl Ins {
         h[IBO] = -1.0;
         let innov = home_minus_baro - (self.p.z - self.baro_offset);
         self.fuse_scalar(&h, innov, noise * noise, gate, t, &mut out);
+        self.flush_shift();
         out
     }
 
@@ -578,6 +625,7 @@ impl Ins {
             let innov = z - self.v[i];
             self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t, &mut out);
         }
+        self.flush_shift();
         out
     }
 
@@ -615,6 +663,7 @@ impl Ins {
         h[ITH + 2] = 1.0;
         let sigma = noise / libm::sqrtf(bh2);
         self.fuse_scalar(&h, innov, sigma * sigma, gate_sigma, t, &mut out);
+        self.flush_shift();
         out
     }
 
@@ -656,6 +705,7 @@ impl Ins {
             let innov = accel[axis] - predicted[axis];
             self.fuse_scalar(&h, innov, noise * noise, gate_sigma, t, &mut out);
         }
+        self.flush_shift();
         Some(out)
     }
 
@@ -746,6 +796,40 @@ impl Ins {
         self.cov = cov;
         true
     }
+}
+
+/// `phi P phi'` for `phi = I + A`, where `A` is zero but for the 3x3 `blocks`
+/// `(row, column, block)`, none of which sits on the diagonal. `phi P` touches only the rows of
+/// the blocks (27 products a block and column instead of a dense 13x13x13 product); the second
+/// product is formed for the upper triangle only and mirrored, so the result is exactly
+/// symmetric.
+fn propagate(p: &Mat, blocks: &[(usize, usize, &Matrix3<f32>)]) -> Mat {
+    // m = phi P: each block adds B times the rows of P its column names.
+    let mut m = *p;
+    for &(row, col, b) in blocks {
+        let rows = b * p.fixed_rows::<3>(col);
+        let mut target = m.fixed_rows_mut::<3>(row);
+        target += rows;
+    }
+    // out = m phi': out[i][j] = m[i][j] + sum over the blocks whose rows hold j of
+    // B[j - row] . m[i][col..col + 3].
+    let mut out = m;
+    for j in 0..N {
+        for i in 0..=j {
+            let mut v = m[(i, j)];
+            for &(row, col, b) in blocks {
+                if (row..row + 3).contains(&j) {
+                    let k = j - row;
+                    v += b[(k, 0)] * m[(i, col)]
+                        + b[(k, 1)] * m[(i, col + 1)]
+                        + b[(k, 2)] * m[(i, col + 2)];
+                }
+            }
+            out[(i, j)] = v;
+            out[(j, i)] = v;
+        }
+    }
+    out
 }
 
 /// Heading from a magnetometer sample levelled with roll `phi` and pitch `theta`, against the
@@ -874,5 +958,43 @@ mod tests {
         }
         let e = Euler::from_quaternion(&f.attitude());
         assert!(e.phi.abs() < 0.005, "roll {}", e.phi);
+    }
+
+    #[test]
+    fn the_structured_propagation_equals_the_dense_product() {
+        // A full covariance and the transition of a flight with navigation on: the dense
+        // textbook product, in f64, is the reference.
+        let a = SMatrix::<f64, N, N>::from_fn(|i, j| ((i * 5 + j * 11) % 7) as f64 * 0.2 - 0.6);
+        let p64 = a * a.transpose() + SMatrix::<f64, N, N>::identity();
+        let dt = 0.01_f32;
+        let r = UnitQuaternion::from_euler_angles(0.3_f32, -0.2, 1.1)
+            .to_rotation_matrix()
+            .into_inner();
+        let fx = Vector3::new(1.5_f32, -0.7, -9.9).cross_matrix();
+        let (rdt, fdt, fdt2) = (-r * dt, -fx * dt, -fx * (0.5 * dt * dt));
+        let idt = Matrix3::identity() * dt;
+        let blocks = [
+            (ITH, IBG, &rdt),
+            (IV, ITH, &fdt),
+            (IP, ITH, &fdt2),
+            (IP, IV, &idt),
+        ];
+        let mut phi = SMatrix::<f64, N, N>::identity();
+        for &(row, col, b) in &blocks {
+            phi.fixed_view_mut::<3, 3>(row, col)
+                .copy_from(&b.cast::<f64>());
+        }
+        let dense = phi * p64 * phi.transpose();
+        let got = propagate(&p64.cast::<f32>(), &blocks);
+        for i in 0..N {
+            for j in 0..N {
+                let tol = 1e-5 * dense[(i, j)].abs().max(1.0);
+                assert!(
+                    (f64::from(got[(i, j)]) - dense[(i, j)]).abs() < tol,
+                    "({i}, {j})"
+                );
+                assert_eq!(got[(i, j)], got[(j, i)]);
+            }
+        }
     }
 }
