@@ -31,7 +31,7 @@
 // layout's constants and loop indices below their dimension: no index comes from outside.
 #![allow(clippy::indexing_slicing)]
 
-use super::kalman::{condition, scalar_update, Fused, Refused};
+use super::kalman::{condition, downdate, gain, Refused};
 use crate::math::frames::Euler;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
@@ -380,7 +380,7 @@ impl Ins {
         let f_ned = r * accel;
         let a = f_ned + Vector3::new(0.0, 0.0, GRAVITY);
         let omega = gyro - self.bias;
-        let q = self.q * UnitQuaternion::from_scaled_axis(omega * dt);
+        let q = self.q * crate::math::rotation_from_vector(&(omega * dt));
         let (v, p) = if self.nav_ok {
             (self.v + a * dt, self.p + self.v * dt + a * (0.5 * dt * dt))
         } else {
@@ -491,20 +491,30 @@ impl Ins {
     /// Applies an error-state correction to the present state and to the stored states after
     /// `t_meas` (so the next delayed fix compares like with like). Returns whether the
     /// present state accepted it.
-    fn apply(&mut self, dx: &Vecn, cov: Mat, t_meas: f64) -> bool {
+    fn apply(&mut self, g: &Gain, t_meas: f64) -> bool {
+        let dx = &g.fused.dx;
         let dtheta = Vector3::new(dx[ITH], dx[ITH + 1], dx[ITH + 2]);
         let dv = Vector3::new(dx[IV], dx[IV + 1], dx[IV + 2]);
         let dp = Vector3::new(dx[IP], dx[IP + 1], dx[IP + 2]);
         let db = Vector3::new(dx[IBG], dx[IBG + 1], dx[IBG + 2]);
-        let rot = UnitQuaternion::from_scaled_axis(dtheta);
-        let ok = self.commit(
+        let rot = crate::math::rotation_from_vector(&dtheta);
+        // The state is checked before the covariance changes, and the covariance is changed
+        // in place: on refusal both are as they were, and no copy of the matrix is made.
+        let state = self.checked_state(
             rot * self.q,
             self.v + dv,
             self.p + dp,
             self.bias + db,
             self.baro_offset + dx[IBO],
-            cov,
         );
+        let ok = match state {
+            Some(state) if downdate(&mut self.cov, g) => {
+                condition(&mut self.cov, MIN_VAR, MAX_VAR);
+                self.set_state(state);
+                true
+            }
+            _ => false,
+        };
         if ok {
             // One pass over the stored states per measurement, not per component: the
             // corrections compose.
@@ -548,12 +558,11 @@ impl Ins {
         t_meas: f64,
         out: &mut Fusion,
     ) {
-        let mut cov = self.cov;
-        match scalar_update(&mut cov, h, innov, r, gate_sigma) {
-            Ok(Fused { dx, nis }) => {
-                if self.apply(&dx, cov, t_meas) {
+        match gain(&self.cov, h, innov, r, gate_sigma) {
+            Ok(g) => {
+                if self.apply(&g, t_meas) {
                     out.fused += 1;
-                    out.nis_sum += nis;
+                    out.nis_sum += g.fused.nis;
                 }
             }
             Err(Refused::Gated) => out.gated += 1,
@@ -779,24 +788,64 @@ impl Ins {
         baro_offset: f32,
         mut cov: Mat,
     ) -> bool {
+        let Some(state) = self.checked_state(q, v, p, bias, baro_offset) else {
+            return false;
+        };
+        if !condition(&mut cov, MIN_VAR, MAX_VAR) {
+            return false;
+        }
+        self.set_state(state);
+        self.cov = cov;
+        true
+    }
+
+    /// The state with its quaternion normalised, if everything in it is finite.
+    fn checked_state(
+        &self,
+        q: UnitQuaternion<f32>,
+        v: Vector3<f32>,
+        p: Vector3<f32>,
+        bias: Vector3<f32>,
+        baro_offset: f32,
+    ) -> Option<State> {
         let q = UnitQuaternion::new_normalize(q.into_inner());
         let finite = q.coords.iter().all(|c| c.is_finite())
             && v.iter().all(|c| c.is_finite())
             && p.iter().all(|c| c.is_finite())
             && bias.iter().all(|c| c.is_finite())
             && baro_offset.is_finite();
-        if !finite || !condition(&mut cov, 1e-12, 1e8) {
-            return false;
-        }
-        self.q = q;
-        self.v = v;
-        self.p = p;
-        self.bias = bias;
-        self.baro_offset = baro_offset;
-        self.cov = cov;
-        true
+        finite.then_some(State {
+            q,
+            v,
+            p,
+            bias,
+            baro_offset,
+        })
+    }
+
+    fn set_state(&mut self, s: State) {
+        self.q = s.q;
+        self.v = s.v;
+        self.p = s.p;
+        self.bias = s.bias;
+        self.baro_offset = s.baro_offset;
     }
 }
+
+/// A whole state, checked finite (see `Ins::checked_state`).
+struct State {
+    q: UnitQuaternion<f32>,
+    v: Vector3<f32>,
+    p: Vector3<f32>,
+    bias: Vector3<f32>,
+    baro_offset: f32,
+}
+
+/// Bounds of the covariance's diagonal, kept by every commit.
+const MIN_VAR: f32 = 1e-12;
+const MAX_VAR: f32 = 1e8;
+
+type Gain = super::kalman::Gain<N>;
 
 /// `phi P phi'` for `phi = I + A`, where `A` is zero but for the 3x3 `blocks`
 /// `(row, column, block)`, none of which sits on the diagonal. `phi P` touches only the rows of

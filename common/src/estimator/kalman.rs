@@ -24,23 +24,26 @@ pub struct Fused<const N: usize> {
     pub nis: f32,
 }
 
-/// Fuses one scalar measurement `z = h . x + noise(r)` given its innovation `z - h . x_pred`.
-///
-/// With the optimal gain `k = P h / s`, the Joseph form `(I - k h') P (I - k h')' + k r k'`
-/// equals `P - (P h)(P h)' / s`: a symmetric rank-one downdate. Only its upper triangle is
-/// computed (91 products for 13 states instead of two dense 13x13x13 products) and mirrored,
-/// so `p` stays exactly symmetric; the caller's conditioning keeps its diagonal positive.
-/// `P h` reads only the columns where `h` is non-zero (one to six of them in the estimator).
-///
-/// Returns the correction to add to the state, or why the measurement was refused (then `p`
-/// is untouched).
-pub fn scalar_update<const N: usize>(
-    p: &mut SMatrix<f32, N, N>,
+/// The gain of one scalar measurement: `P h`, the innovation variance and what the state moves
+/// by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gain<const N: usize> {
+    ph: SVector<f32, N>,
+    s: f32,
+    /// The outcome: the state correction and the normalised innovation.
+    pub fused: Fused<N>,
+}
+
+/// The gain of one scalar measurement `z = h . x + noise(r)` given its innovation
+/// `z - h . x_pred`, or why it is refused. `P h` reads only the columns where `h` is non-zero
+/// (one to six of them in the estimator). `p` is not changed: see [`downdate`].
+pub fn gain<const N: usize>(
+    p: &SMatrix<f32, N, N>,
     h: &SVector<f32, N>,
     innov: f32,
     r: f32,
     gate_sigma: f32,
-) -> Result<Fused<N>, Refused> {
+) -> Result<Gain<N>, Refused> {
     let mut ph = SVector::<f32, N>::zeros();
     for (j, &hj) in h.iter().enumerate() {
         if hj != 0.0 {
@@ -55,35 +58,77 @@ pub fn scalar_update<const N: usize>(
     if nis > gate_sigma * gate_sigma {
         return Err(Refused::Gated);
     }
-    let k = ph / s;
-    let mut new_p = *p;
+    Ok(Gain {
+        ph,
+        s,
+        fused: Fused {
+            dx: ph * (innov / s),
+            nis,
+        },
+    })
+}
+
+/// The covariance after the measurement of `g`. With the optimal gain `k = P h / s`, the
+/// Joseph form `(I - k h') P (I - k h')' + k r k'` equals `P - (P h)(P h)' / s`: a symmetric
+/// rank-one downdate. Only its upper triangle is computed (91 products for 13 states instead
+/// of two dense 13x13x13 products) and mirrored, so `p` stays exactly symmetric; the caller's
+/// conditioning keeps its diagonal positive. Returns false, with `p` untouched, when the
+/// result would hold a non-finite entry.
+pub fn downdate<const N: usize>(p: &mut SMatrix<f32, N, N>, g: &Gain<N>) -> bool {
+    let k = g.ph / g.s;
+    // Checked before anything is written: no copy of `p` is needed to keep it on refusal.
     let mut finite = true;
     for j in 0..N {
         for i in 0..=j {
-            let v = p[(i, j)] - k[i] * ph[j];
-            finite &= v.is_finite();
-            new_p[(i, j)] = v;
-            new_p[(j, i)] = v;
+            finite &= (p[(i, j)] - k[i] * g.ph[j]).is_finite();
         }
     }
     if !finite {
-        return Err(Refused::Degenerate);
+        return false;
     }
-    *p = new_p;
-    Ok(Fused { dx: k * innov, nis })
+    for j in 0..N {
+        for i in 0..=j {
+            let v = p[(i, j)] - k[i] * g.ph[j];
+            p[(i, j)] = v;
+            p[(j, i)] = v;
+        }
+    }
+    true
 }
 
-/// Makes `p` exactly symmetric and keeps its diagonal between `min_var` and `max_var`.
+/// Fuses one scalar measurement: [`gain`] then [`downdate`]. Returns the correction to add to
+/// the state, or why the measurement was refused (then `p` is untouched).
+pub fn scalar_update<const N: usize>(
+    p: &mut SMatrix<f32, N, N>,
+    h: &SVector<f32, N>,
+    innov: f32,
+    r: f32,
+    gate_sigma: f32,
+) -> Result<Fused<N>, Refused> {
+    let g = gain(p, h, innov, r, gate_sigma)?;
+    if !downdate(p, &g) {
+        return Err(Refused::Degenerate);
+    }
+    Ok(g.fused)
+}
+
+/// Makes `p` exactly symmetric and keeps its diagonal between `min_var` and `max_var`, in
+/// place (no temporary matrix).
 ///
-/// Returns false when `p` holds a non-finite entry (the caller then resets the filter).
+/// Returns false when `p` holds a non-finite entry (the caller then resets the filter); `p`
+/// is then left as it was.
 pub fn condition<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) -> bool {
     if !p.iter().all(|x| x.is_finite()) {
         return false;
     }
-    *p = (*p + p.transpose()) * 0.5;
-    for i in 0..N {
-        let d = p[(i, i)];
-        p[(i, i)] = clamp(d, min_var, max_var);
+    for j in 0..N {
+        for i in 0..j {
+            let v = 0.5 * (p[(i, j)] + p[(j, i)]);
+            p[(i, j)] = v;
+            p[(j, i)] = v;
+        }
+        let d = p[(j, j)];
+        p[(j, j)] = clamp(d, min_var, max_var);
     }
     true
 }
