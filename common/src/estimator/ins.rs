@@ -31,7 +31,7 @@
 // layout's constants and loop indices below their dimension: no index comes from outside.
 #![allow(clippy::indexing_slicing)]
 
-use super::kalman::{condition, downdate, gain, Refused};
+use super::kalman::{clamp_diagonal, condition, downdate, gain, Refused};
 use crate::math::frames::Euler;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
@@ -399,7 +399,8 @@ impl Ins {
             (IP, IV, &idt),
         ];
         let blocks = if self.nav_ok { &all[..] } else { &all[..1] };
-        let mut cov = propagate(&self.cov, blocks);
+        let mut cov = self.cov;
+        propagate(&mut cov, blocks);
         let g = noise.gyro * noise.gyro * dt;
         let qa = noise.accel * noise.accel * dt;
         let b = noise.gyro_bias * noise.gyro_bias * dt;
@@ -509,7 +510,8 @@ impl Ins {
         );
         let ok = match state {
             Some(state) if downdate(&mut self.cov, g) => {
-                condition(&mut self.cov, MIN_VAR, MAX_VAR);
+                // Finite and exactly symmetric already: only the diagonal's bounds to keep.
+                clamp_diagonal(&mut self.cov, MIN_VAR, MAX_VAR);
                 self.set_state(state);
                 true
             }
@@ -847,38 +849,32 @@ const MAX_VAR: f32 = 1e8;
 
 type Gain = super::kalman::Gain<N>;
 
-/// `phi P phi'` for `phi = I + A`, where `A` is zero but for the 3x3 `blocks`
-/// `(row, column, block)`, none of which sits on the diagonal. `phi P` touches only the rows of
-/// the blocks (27 products a block and column instead of a dense 13x13x13 product); the second
-/// product is formed for the upper triangle only and mirrored, so the result is exactly
-/// symmetric.
-fn propagate(p: &Mat, blocks: &[(usize, usize, &Matrix3<f32>)]) -> Mat {
-    // m = phi P: each block adds B times the rows of P its column names.
-    let mut m = *p;
-    for &(row, col, b) in blocks {
-        let rows = b * p.fixed_rows::<3>(col);
-        let mut target = m.fixed_rows_mut::<3>(row);
-        target += rows;
-    }
-    // out = m phi': out[i][j] = m[i][j] + sum over the blocks whose rows hold j of
-    // B[j - row] . m[i][col..col + 3].
-    let mut out = m;
-    for j in 0..N {
-        for i in 0..=j {
-            let mut v = m[(i, j)];
-            for &(row, col, b) in blocks {
-                if (row..row + 3).contains(&j) {
-                    let k = j - row;
-                    v += b[(k, 0)] * m[(i, col)]
-                        + b[(k, 1)] * m[(i, col + 1)]
-                        + b[(k, 2)] * m[(i, col + 2)];
-                }
+/// `P <- phi P phi'` in place, for `phi = I + A` where `A` is zero but for the 3x3 `blocks`
+/// `(row, column, block)`, none on the diagonal, listed so that no block's column range is
+/// the row range of a block listed after it. `phi P` changes only the rows of the blocks
+/// (27 products per block and column instead of a dense 13x13x13 product), `(phi P) phi'`
+/// only their columns; the blocks are taken last first, so each reads rows (then columns)
+/// not yet changed and no copy of the matrix is made. The caller's conditioning makes the
+/// result exactly symmetric.
+fn propagate(p: &mut Mat, blocks: &[(usize, usize, &Matrix3<f32>)]) {
+    for &(row, col, b) in blocks.iter().rev() {
+        for c in 0..N {
+            let x = Vector3::new(p[(col, c)], p[(col + 1, c)], p[(col + 2, c)]);
+            let y = b * x;
+            for k in 0..3 {
+                p[(row + k, c)] += y[k];
             }
-            out[(i, j)] = v;
-            out[(j, i)] = v;
         }
     }
-    out
+    for &(row, col, b) in blocks.iter().rev() {
+        for r in 0..N {
+            let x = Vector3::new(p[(r, col)], p[(r, col + 1)], p[(r, col + 2)]);
+            let y = b * x;
+            for k in 0..3 {
+                p[(r, row + k)] += y[k];
+            }
+        }
+    }
 }
 
 /// Heading from a magnetometer sample levelled with roll `phi` and pitch `theta`, against the
@@ -1034,7 +1030,9 @@ mod tests {
                 .copy_from(&b.cast::<f64>());
         }
         let dense = phi * p64 * phi.transpose();
-        let got = propagate(&p64.cast::<f32>(), &blocks);
+        let mut got = p64.cast::<f32>();
+        propagate(&mut got, &blocks);
+        assert!(condition(&mut got, 0.0, f32::INFINITY));
         for i in 0..N {
             for j in 0..N {
                 let tol = 1e-5 * dense[(i, j)].abs().max(1.0);

@@ -112,6 +112,15 @@ pub fn scalar_update<const N: usize>(
     Ok(g.fused)
 }
 
+/// Keeps the diagonal of `p` between `min_var` and `max_var`: the conditioning of a
+/// covariance already exactly symmetric and finite (as [`downdate`] leaves it).
+pub fn clamp_diagonal<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) {
+    for i in 0..N {
+        let d = p[(i, i)];
+        p[(i, i)] = clamp(d, min_var, max_var);
+    }
+}
+
 /// Makes `p` exactly symmetric and keeps its diagonal between `min_var` and `max_var`, in
 /// place (no temporary matrix).
 ///

@@ -164,7 +164,7 @@ impl GroundPort {
         if datagram {
             parser.end_of_datagram_with(&mut on_frame, &mut on_undecoded);
         }
-        drop(shared);
+        let (_, _, snapshot) = shared.into_inner();
         let after = parser.stats();
         let bad = after.crc_errors.wrapping_sub(before.crc_errors)
             + after.parse_errors.wrapping_sub(before.parse_errors);
@@ -175,12 +175,25 @@ impl GroundPort {
         if frames.get() == 0 {
             return;
         }
-        vehicle.apply(&self.link.take_requests());
-        self.poll(now, vehicle);
+        let requests = self.link.take_requests();
+        vehicle.apply(&requests);
+        // Nothing the vehicle acted on: the snapshot the frames saw still describes it.
+        let unchanged = requests == common::vehicle::requests::VehicleRequests::default();
+        self.poll_with(now, vehicle, snapshot.filter(|_| unchanged));
     }
 
     /// The vehicle's notices to the link, then everything due at `now_us` into the buffer.
     pub fn poll(&mut self, now_us: u64, vehicle: &mut Vehicle) {
+        self.poll_with(now_us, vehicle, None);
+    }
+
+    /// [`GroundPort::poll`] with the vehicle's snapshot when one was just taken.
+    fn poll_with(
+        &mut self,
+        now_us: u64,
+        vehicle: &mut Vehicle,
+        snapshot: Option<common::vehicle::snapshot::VehicleSnapshot>,
+    ) {
         while let Some(n) = vehicle.next_notice() {
             match n {
                 Notice::Text(s, text) => self.link.send_statustext(severity(s), text),
@@ -189,7 +202,7 @@ impl GroundPort {
                 }
             }
         }
-        let snapshot = vehicle.snapshot();
+        let snapshot = snapshot.unwrap_or_else(|| vehicle.snapshot());
         let (params, plan, rules) = vehicle.stores();
         let stores = Stores {
             params,
