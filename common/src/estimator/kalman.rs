@@ -3,6 +3,10 @@
 //! Every measurement is fused one component at a time: no matrix inverse (nothing to be
 //! singular), and each component can be gated on its own.
 
+// The matrices and vectors are fixed-size and indexed with loop indices below their
+// dimension: no index comes from outside.
+#![allow(clippy::indexing_slicing)]
+
 use crate::math::clamp;
 use nalgebra::{SMatrix, SVector};
 
