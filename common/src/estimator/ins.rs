@@ -31,7 +31,7 @@
 // layout's constants and loop indices below their dimension: no index comes from outside.
 #![allow(clippy::indexing_slicing)]
 
-use super::kalman::{condition, scalar_update, Fused, Refused};
+use super::kalman::{clamp_diagonal, condition, downdate, gain, Refused};
 use crate::math::frames::Euler;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
@@ -150,6 +150,10 @@ pub struct Ins {
     history: [Snapshot; HISTORY],
     head: usize,
     len: usize,
+    /// Corrections of the fusions in progress, to be carried into the stored states once the
+    /// measurement's components are all fused: from time `t` on, rotated by `q`, velocity
+    /// moved by `v` and position by `p`.
+    pending: Option<Snapshot>,
     attitude_ok: bool,
     nav_ok: bool,
 }
@@ -173,6 +177,7 @@ impl Ins {
             history: [Snapshot::default(); HISTORY],
             head: 0,
             len: 0,
+            pending: None,
             attitude_ok: false,
             nav_ok: false,
         }
@@ -375,39 +380,42 @@ impl Ins {
         let f_ned = r * accel;
         let a = f_ned + Vector3::new(0.0, 0.0, GRAVITY);
         let omega = gyro - self.bias;
-        let q = self.q * UnitQuaternion::from_scaled_axis(omega * dt);
+        let q = self.q * crate::math::rotation_from_vector(&(omega * dt));
         let (v, p) = if self.nav_ok {
             (self.v + a * dt, self.p + self.v * dt + a * (0.5 * dt * dt))
         } else {
             (self.v, self.p)
         };
-        let mut phi = Mat::identity();
-        phi.fixed_view_mut::<3, 3>(ITH, IBG).copy_from(&(-r * dt));
-        if self.nav_ok {
-            let fx = f_ned.cross_matrix();
-            phi.fixed_view_mut::<3, 3>(IV, ITH).copy_from(&(-fx * dt));
-            phi.fixed_view_mut::<3, 3>(IP, ITH)
-                .copy_from(&(-fx * (0.5 * dt * dt)));
-            phi.fixed_view_mut::<3, 3>(IP, IV)
-                .copy_from(&(Matrix3::identity() * dt));
-        }
-        let mut qd = Mat::zeros();
+        // The transition is the identity plus four 3x3 blocks; with the position and velocity
+        // blocks only once navigation runs.
+        let rdt = -r * dt;
+        let fx = f_ned.cross_matrix();
+        let (fdt, fdt2) = (-fx * dt, -fx * (0.5 * dt * dt));
+        let idt = Matrix3::identity() * dt;
+        let all = [
+            (ITH, IBG, &rdt),
+            (IV, ITH, &fdt),
+            (IP, ITH, &fdt2),
+            (IP, IV, &idt),
+        ];
+        let blocks = if self.nav_ok { &all[..] } else { &all[..1] };
+        let mut cov = self.cov;
+        propagate(&mut cov, blocks);
         let g = noise.gyro * noise.gyro * dt;
         let qa = noise.accel * noise.accel * dt;
         let b = noise.gyro_bias * noise.gyro_bias * dt;
         for k in 0..3 {
-            qd[(ITH + k, ITH + k)] = g;
-            qd[(IBG + k, IBG + k)] = b;
+            cov[(ITH + k, ITH + k)] += g;
+            cov[(IBG + k, IBG + k)] += b;
             if self.nav_ok {
                 // Integrated white acceleration: the exact discrete covariance of (p, v).
-                qd[(IV + k, IV + k)] = qa;
-                qd[(IP + k, IP + k)] = qa * dt * dt / 3.0;
-                qd[(IP + k, IV + k)] = qa * dt / 2.0;
-                qd[(IV + k, IP + k)] = qa * dt / 2.0;
+                cov[(IV + k, IV + k)] += qa;
+                cov[(IP + k, IP + k)] += qa * dt * dt / 3.0;
+                cov[(IP + k, IV + k)] += qa * dt / 2.0;
+                cov[(IV + k, IP + k)] += qa * dt / 2.0;
             }
         }
-        qd[(IBO, IBO)] = noise.baro_offset * noise.baro_offset * dt;
-        let cov = phi * self.cov * phi.transpose() + qd;
+        cov[(IBO, IBO)] += noise.baro_offset * noise.baro_offset * dt;
         self.commit(q, v, p, self.bias, self.baro_offset, cov);
         if self.nav_ok {
             self.remember(t);
@@ -415,6 +423,12 @@ impl Ins {
     }
 
     fn remember(&mut self, t: f64) {
+        // The stored states are kept in time order (searches stop early on it): a clock that
+        // went back starts the history again.
+        let newest = self.history.get(self.head).map(|s| s.t);
+        if self.len > 0 && newest.is_some_and(|n| t <= n) {
+            self.len = 0;
+        }
         self.head = (self.head + 1) % HISTORY;
         if let Some(s) = self.history.get_mut(self.head) {
             *s = Snapshot {
@@ -436,6 +450,7 @@ impl Ins {
             p: self.p,
         };
         let mut best_err = f64::INFINITY;
+        // Newest first, in time order: once the distance grows it only grows.
         for k in 0..self.len {
             let i = (self.head + HISTORY - k) % HISTORY;
             if let Some(s) = self.history.get(i) {
@@ -443,6 +458,8 @@ impl Ins {
                 if e < best_err {
                     best_err = e;
                     best = *s;
+                } else if e > best_err {
+                    break;
                 }
             }
         }
@@ -461,11 +478,13 @@ impl Ins {
         for k in 0..self.len {
             let i = (self.head + HISTORY - k) % HISTORY;
             if let Some(s) = self.history.get_mut(i) {
-                if s.t >= after {
-                    s.q = rot * s.q;
-                    s.v += dv;
-                    s.p += dp;
+                // Newest first, in time order: the rest are older still.
+                if s.t < after {
+                    break;
                 }
+                s.q = rot * s.q;
+                s.v += dv;
+                s.p += dp;
             }
         }
     }
@@ -473,24 +492,62 @@ impl Ins {
     /// Applies an error-state correction to the present state and to the stored states after
     /// `t_meas` (so the next delayed fix compares like with like). Returns whether the
     /// present state accepted it.
-    fn apply(&mut self, dx: &Vecn, cov: Mat, t_meas: f64) -> bool {
+    fn apply(&mut self, g: &Gain, t_meas: f64) -> bool {
+        let dx = &g.fused.dx;
         let dtheta = Vector3::new(dx[ITH], dx[ITH + 1], dx[ITH + 2]);
         let dv = Vector3::new(dx[IV], dx[IV + 1], dx[IV + 2]);
         let dp = Vector3::new(dx[IP], dx[IP + 1], dx[IP + 2]);
         let db = Vector3::new(dx[IBG], dx[IBG + 1], dx[IBG + 2]);
-        let rot = UnitQuaternion::from_scaled_axis(dtheta);
-        let ok = self.commit(
+        let rot = crate::math::rotation_from_vector(&dtheta);
+        // The state is checked before the covariance changes, and the covariance is changed
+        // in place: on refusal both are as they were, and no copy of the matrix is made.
+        let state = self.checked_state(
             rot * self.q,
             self.v + dv,
             self.p + dp,
             self.bias + db,
             self.baro_offset + dx[IBO],
-            cov,
         );
+        let ok = match state {
+            Some(state) if downdate(&mut self.cov, g) => {
+                // Finite and exactly symmetric already: only the diagonal's bounds to keep.
+                clamp_diagonal(&mut self.cov, MIN_VAR, MAX_VAR);
+                self.set_state(state);
+                true
+            }
+            _ => false,
+        };
         if ok {
-            self.shift_stored(t_meas - 1e-4, &rot, &dv, &dp);
+            // One pass over the stored states per measurement, not per component: the
+            // corrections compose.
+            let after = t_meas - 1e-4;
+            let sum = match self.pending {
+                Some(s) if s.t == after => Snapshot {
+                    t: after,
+                    q: rot * s.q,
+                    v: s.v + dv,
+                    p: s.p + dp,
+                },
+                _ => {
+                    self.flush_shift();
+                    Snapshot {
+                        t: after,
+                        q: rot,
+                        v: dv,
+                        p: dp,
+                    }
+                }
+            };
+            self.pending = Some(sum);
         }
         ok
+    }
+
+    /// Carries the pending corrections into the stored states.
+    fn flush_shift(&mut self) {
+        if let Some(s) = self.pending.take() {
+            self.shift_stored(s.t, &s.q, &s.v, &s.p);
+        }
     }
 
     /// Fuses one scalar component: `innov` against the error-state row `h`.
@@ -503,12 +560,11 @@ impl Ins {
         t_meas: f64,
         out: &mut Fusion,
     ) {
-        let mut cov = self.cov;
-        match scalar_update(&mut cov, h, innov, r, gate_sigma) {
-            Ok(Fused { dx, nis }) => {
-                if self.apply(&dx, cov, t_meas) {
+        match gain(&self.cov, h, innov, r, gate_sigma) {
+            Ok(g) => {
+                if self.apply(&g, t_meas) {
                     out.fused += 1;
-                    out.nis_sum += nis;
+                    out.nis_sum += g.fused.nis;
                 }
             }
             Err(Refused::Gated) => out.gated += 1,
@@ -548,6 +604,7 @@ impl Ins {
             let innov = pos[i] - (past.p[i] + (self.p[i] - p0[i]));
             self.fuse_scalar(&h, innov, r, gate_sigma, t_meas, &mut pos_out);
         }
+        self.flush_shift();
         (pos_out, vel_out)
     }
 
@@ -562,6 +619,7 @@ impl Ins {
         h[IBO] = -1.0;
         let innov = home_minus_baro - (self.p.z - self.baro_offset);
         self.fuse_scalar(&h, innov, noise * noise, gate, t, &mut out);
+        self.flush_shift();
         out
     }
 
@@ -578,6 +636,7 @@ impl Ins {
             let innov = z - self.v[i];
             self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t, &mut out);
         }
+        self.flush_shift();
         out
     }
 
@@ -615,6 +674,7 @@ impl Ins {
         h[ITH + 2] = 1.0;
         let sigma = noise / libm::sqrtf(bh2);
         self.fuse_scalar(&h, innov, sigma * sigma, gate_sigma, t, &mut out);
+        self.flush_shift();
         out
     }
 
@@ -656,6 +716,7 @@ impl Ins {
             let innov = accel[axis] - predicted[axis];
             self.fuse_scalar(&h, innov, noise * noise, gate_sigma, t, &mut out);
         }
+        self.flush_shift();
         Some(out)
     }
 
@@ -729,22 +790,90 @@ impl Ins {
         baro_offset: f32,
         mut cov: Mat,
     ) -> bool {
+        let Some(state) = self.checked_state(q, v, p, bias, baro_offset) else {
+            return false;
+        };
+        if !condition(&mut cov, MIN_VAR, MAX_VAR) {
+            return false;
+        }
+        self.set_state(state);
+        self.cov = cov;
+        true
+    }
+
+    /// The state with its quaternion normalised, if everything in it is finite.
+    fn checked_state(
+        &self,
+        q: UnitQuaternion<f32>,
+        v: Vector3<f32>,
+        p: Vector3<f32>,
+        bias: Vector3<f32>,
+        baro_offset: f32,
+    ) -> Option<State> {
         let q = UnitQuaternion::new_normalize(q.into_inner());
         let finite = q.coords.iter().all(|c| c.is_finite())
             && v.iter().all(|c| c.is_finite())
             && p.iter().all(|c| c.is_finite())
             && bias.iter().all(|c| c.is_finite())
             && baro_offset.is_finite();
-        if !finite || !condition(&mut cov, 1e-12, 1e8) {
-            return false;
+        finite.then_some(State {
+            q,
+            v,
+            p,
+            bias,
+            baro_offset,
+        })
+    }
+
+    fn set_state(&mut self, s: State) {
+        self.q = s.q;
+        self.v = s.v;
+        self.p = s.p;
+        self.bias = s.bias;
+        self.baro_offset = s.baro_offset;
+    }
+}
+
+/// A whole state, checked finite (see `Ins::checked_state`).
+struct State {
+    q: UnitQuaternion<f32>,
+    v: Vector3<f32>,
+    p: Vector3<f32>,
+    bias: Vector3<f32>,
+    baro_offset: f32,
+}
+
+/// Bounds of the covariance's diagonal, kept by every commit.
+const MIN_VAR: f32 = 1e-12;
+const MAX_VAR: f32 = 1e8;
+
+type Gain = super::kalman::Gain<N>;
+
+/// `P <- phi P phi'` in place, for `phi = I + A` where `A` is zero but for the 3x3 `blocks`
+/// `(row, column, block)`, none on the diagonal, listed so that no block's column range is
+/// the row range of a block listed after it. `phi P` changes only the rows of the blocks
+/// (27 products per block and column instead of a dense 13x13x13 product), `(phi P) phi'`
+/// only their columns; the blocks are taken last first, so each reads rows (then columns)
+/// not yet changed and no copy of the matrix is made. The caller's conditioning makes the
+/// result exactly symmetric.
+fn propagate(p: &mut Mat, blocks: &[(usize, usize, &Matrix3<f32>)]) {
+    for &(row, col, b) in blocks.iter().rev() {
+        for c in 0..N {
+            let x = Vector3::new(p[(col, c)], p[(col + 1, c)], p[(col + 2, c)]);
+            let y = b * x;
+            for k in 0..3 {
+                p[(row + k, c)] += y[k];
+            }
         }
-        self.q = q;
-        self.v = v;
-        self.p = p;
-        self.bias = bias;
-        self.baro_offset = baro_offset;
-        self.cov = cov;
-        true
+    }
+    for &(row, col, b) in blocks.iter().rev() {
+        for r in 0..N {
+            let x = Vector3::new(p[(r, col)], p[(r, col + 1)], p[(r, col + 2)]);
+            let y = b * x;
+            for k in 0..3 {
+                p[(r, row + k)] += y[k];
+            }
+        }
     }
 }
 
@@ -874,5 +1003,45 @@ mod tests {
         }
         let e = Euler::from_quaternion(&f.attitude());
         assert!(e.phi.abs() < 0.005, "roll {}", e.phi);
+    }
+
+    #[test]
+    fn the_structured_propagation_equals_the_dense_product() {
+        // A full covariance and the transition of a flight with navigation on: the dense
+        // textbook product, in f64, is the reference.
+        let a = SMatrix::<f64, N, N>::from_fn(|i, j| ((i * 5 + j * 11) % 7) as f64 * 0.2 - 0.6);
+        let p64 = a * a.transpose() + SMatrix::<f64, N, N>::identity();
+        let dt = 0.01_f32;
+        let r = UnitQuaternion::from_euler_angles(0.3_f32, -0.2, 1.1)
+            .to_rotation_matrix()
+            .into_inner();
+        let fx = Vector3::new(1.5_f32, -0.7, -9.9).cross_matrix();
+        let (rdt, fdt, fdt2) = (-r * dt, -fx * dt, -fx * (0.5 * dt * dt));
+        let idt = Matrix3::identity() * dt;
+        let blocks = [
+            (ITH, IBG, &rdt),
+            (IV, ITH, &fdt),
+            (IP, ITH, &fdt2),
+            (IP, IV, &idt),
+        ];
+        let mut phi = SMatrix::<f64, N, N>::identity();
+        for &(row, col, b) in &blocks {
+            phi.fixed_view_mut::<3, 3>(row, col)
+                .copy_from(&b.cast::<f64>());
+        }
+        let dense = phi * p64 * phi.transpose();
+        let mut got = p64.cast::<f32>();
+        propagate(&mut got, &blocks);
+        assert!(condition(&mut got, 0.0, f32::INFINITY));
+        for i in 0..N {
+            for j in 0..N {
+                let tol = 1e-5 * dense[(i, j)].abs().max(1.0);
+                assert!(
+                    (f64::from(got[(i, j)]) - dense[(i, j)]).abs() < tol,
+                    "({i}, {j})"
+                );
+                assert_eq!(got[(i, j)], got[(j, i)]);
+            }
+        }
     }
 }

@@ -3,6 +3,10 @@
 //! Every measurement is fused one component at a time: no matrix inverse (nothing to be
 //! singular), and each component can be gated on its own.
 
+// The matrices and vectors are fixed-size and indexed with loop indices below their
+// dimension: no index comes from outside.
+#![allow(clippy::indexing_slicing)]
+
 use crate::math::clamp;
 use nalgebra::{SMatrix, SVector};
 
@@ -24,18 +28,32 @@ pub struct Fused<const N: usize> {
     pub nis: f32,
 }
 
-/// Fuses one scalar measurement `z = h . x + noise(r)` given its innovation `z - h . x_pred`.
-///
-/// Updates `p` in Joseph form (keeps it symmetric and positive in `f32`) and returns the
-/// correction to add to the state, or why the measurement was refused (then `p` is untouched).
-pub fn scalar_update<const N: usize>(
-    p: &mut SMatrix<f32, N, N>,
+/// The gain of one scalar measurement: `P h`, the innovation variance and what the state moves
+/// by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gain<const N: usize> {
+    ph: SVector<f32, N>,
+    s: f32,
+    /// The outcome: the state correction and the normalised innovation.
+    pub fused: Fused<N>,
+}
+
+/// The gain of one scalar measurement `z = h . x + noise(r)` given its innovation
+/// `z - h . x_pred`, or why it is refused. `P h` reads only the columns where `h` is non-zero
+/// (one to six of them in the estimator). `p` is not changed: see [`downdate`].
+pub fn gain<const N: usize>(
+    p: &SMatrix<f32, N, N>,
     h: &SVector<f32, N>,
     innov: f32,
     r: f32,
     gate_sigma: f32,
-) -> Result<Fused<N>, Refused> {
-    let ph = *p * h;
+) -> Result<Gain<N>, Refused> {
+    let mut ph = SVector::<f32, N>::zeros();
+    for (j, &hj) in h.iter().enumerate() {
+        if hj != 0.0 {
+            ph += p.column(j) * hj;
+        }
+    }
     let s = h.dot(&ph) + r;
     if !(s.is_finite() && s > 0.0 && innov.is_finite()) {
         return Err(Refused::Degenerate);
@@ -44,27 +62,86 @@ pub fn scalar_update<const N: usize>(
     if nis > gate_sigma * gate_sigma {
         return Err(Refused::Gated);
     }
-    let k = ph / s;
-    let ikh = SMatrix::<f32, N, N>::identity() - k * h.transpose();
-    let new_p = ikh * *p * ikh.transpose() + k * k.transpose() * r;
-    if !new_p.iter().all(|x| x.is_finite()) {
-        return Err(Refused::Degenerate);
-    }
-    *p = new_p;
-    Ok(Fused { dx: k * innov, nis })
+    Ok(Gain {
+        ph,
+        s,
+        fused: Fused {
+            dx: ph * (innov / s),
+            nis,
+        },
+    })
 }
 
-/// Makes `p` exactly symmetric and keeps its diagonal between `min_var` and `max_var`.
+/// The covariance after the measurement of `g`. With the optimal gain `k = P h / s`, the
+/// Joseph form `(I - k h') P (I - k h')' + k r k'` equals `P - (P h)(P h)' / s`: a symmetric
+/// rank-one downdate. Only its upper triangle is computed (91 products for 13 states instead
+/// of two dense 13x13x13 products) and mirrored, so `p` stays exactly symmetric; the caller's
+/// conditioning keeps its diagonal positive. Returns false, with `p` untouched, when the
+/// result would hold a non-finite entry.
+pub fn downdate<const N: usize>(p: &mut SMatrix<f32, N, N>, g: &Gain<N>) -> bool {
+    let k = g.ph / g.s;
+    // Checked before anything is written: no copy of `p` is needed to keep it on refusal.
+    let mut finite = true;
+    for j in 0..N {
+        for i in 0..=j {
+            finite &= (p[(i, j)] - k[i] * g.ph[j]).is_finite();
+        }
+    }
+    if !finite {
+        return false;
+    }
+    for j in 0..N {
+        for i in 0..=j {
+            let v = p[(i, j)] - k[i] * g.ph[j];
+            p[(i, j)] = v;
+            p[(j, i)] = v;
+        }
+    }
+    true
+}
+
+/// Fuses one scalar measurement: [`gain`] then [`downdate`]. Returns the correction to add to
+/// the state, or why the measurement was refused (then `p` is untouched).
+pub fn scalar_update<const N: usize>(
+    p: &mut SMatrix<f32, N, N>,
+    h: &SVector<f32, N>,
+    innov: f32,
+    r: f32,
+    gate_sigma: f32,
+) -> Result<Fused<N>, Refused> {
+    let g = gain(p, h, innov, r, gate_sigma)?;
+    if !downdate(p, &g) {
+        return Err(Refused::Degenerate);
+    }
+    Ok(g.fused)
+}
+
+/// Keeps the diagonal of `p` between `min_var` and `max_var`: the conditioning of a
+/// covariance already exactly symmetric and finite (as [`downdate`] leaves it).
+pub fn clamp_diagonal<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) {
+    for i in 0..N {
+        let d = p[(i, i)];
+        p[(i, i)] = clamp(d, min_var, max_var);
+    }
+}
+
+/// Makes `p` exactly symmetric and keeps its diagonal between `min_var` and `max_var`, in
+/// place (no temporary matrix).
 ///
-/// Returns false when `p` holds a non-finite entry (the caller then resets the filter).
+/// Returns false when `p` holds a non-finite entry (the caller then resets the filter); `p`
+/// is then left as it was.
 pub fn condition<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) -> bool {
     if !p.iter().all(|x| x.is_finite()) {
         return false;
     }
-    *p = (*p + p.transpose()) * 0.5;
-    for i in 0..N {
-        let d = p[(i, i)];
-        p[(i, i)] = clamp(d, min_var, max_var);
+    for j in 0..N {
+        for i in 0..j {
+            let v = 0.5 * (p[(i, j)] + p[(j, i)]);
+            p[(i, j)] = v;
+            p[(j, i)] = v;
+        }
+        let d = p[(j, j)];
+        p[(j, j)] = clamp(d, min_var, max_var);
     }
     true
 }
@@ -103,5 +180,32 @@ mod tests {
         assert_eq!(p, Matrix2::identity());
         let mut bad = Matrix2::new(f32::NAN, 0.0, 0.0, 1.0);
         assert!(!condition(&mut bad, 1e-9, 1e9));
+    }
+
+    #[test]
+    fn the_symmetric_downdate_equals_the_joseph_form() {
+        // A full, positive definite 5x5 covariance and a measurement of two states at once:
+        // the textbook Joseph form, in f64, is the reference.
+        let a = SMatrix::<f64, 5, 5>::from_fn(|i, j| ((i * 7 + j * 3) % 5) as f64 * 0.3 - 0.5);
+        let p64 = a * a.transpose() + SMatrix::<f64, 5, 5>::identity() * 0.7;
+        let h64 = SVector::<f64, 5>::new(0.0, 1.0, 0.0, -1.0, 0.0);
+        let r = 0.25;
+        let ph = p64 * h64;
+        let s = h64.dot(&ph) + r;
+        let k = ph / s;
+        let ikh = SMatrix::<f64, 5, 5>::identity() - k * h64.transpose();
+        let joseph = ikh * p64 * ikh.transpose() + k * k.transpose() * r;
+        let mut p = p64.cast::<f32>();
+        let f = scalar_update(&mut p, &h64.cast::<f32>(), 0.5, r as f32, 100.0).unwrap();
+        for i in 0..5 {
+            assert!((f.dx[i] as f64 - k[i] * 0.5).abs() < 1e-6, "{i}");
+            for j in 0..5 {
+                assert!(
+                    (p[(i, j)] as f64 - joseph[(i, j)]).abs() < 1e-5,
+                    "({i}, {j})"
+                );
+                assert_eq!(p[(i, j)], p[(j, i)]);
+            }
+        }
     }
 }

@@ -29,7 +29,7 @@ pub use health::{SensorHealth, SensorStatus};
 
 use crate::math::atmosphere::pressure_altitude;
 use crate::math::frames::{course_and_speed, AirData, Euler};
-use crate::math::geodetic::{ned_offset, offset_point, GeoPoint};
+use crate::math::geodetic::{ned_offset, offset_point, GeoPoint, LocalFrame};
 use crate::sensors::{limits, BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
 use ins::{Fusion, GpsNoise, Ins, Motion, ProcessNoise};
@@ -138,6 +138,8 @@ pub struct Estimator {
     baro_alt: Option<f32>,
     density: f32,
     home: Option<Home>,
+    /// The local frame about home's point, worked out when home moves (see [`LocalFrame`]).
+    frame: Option<LocalFrame>,
     /// The barometer offset when home was set: heights above home follow the barometer.
     home_baro_offset: f32,
     /// Home as set by arming or `DO_SET_HOME`, held as reported from then on; `None` while
@@ -174,6 +176,7 @@ impl Estimator {
             baro_alt: None,
             density: DEFAULT_DENSITY,
             home: None,
+            frame: None,
             home_baro_offset: 0.0,
             home_held: None,
             mag_nis: 0.0,
@@ -512,6 +515,7 @@ impl Estimator {
                 alt_amsl_m: fix.alt_amsl_m,
             };
             self.home = Some(home);
+            self.frame = Some(LocalFrame::new(home.point));
             let baro_offset = self.baro_alt.map_or(0.0, |b| b - fix.alt_amsl_m);
             self.ins.start_nav(
                 self.t,
@@ -527,7 +531,7 @@ impl Estimator {
             return;
         };
 
-        let (n, e): (f32, f32) = ned_offset(home.point, fix.position);
+        let (n, e) = self.ned_of(home.point, fix.position);
         let pos = Vector3::new(n, e, home.alt_amsl_m - fix.alt_amsl_m);
         let t_fix = self.t - f64::from(c.gps_delay);
         let (fp, fv) = self
@@ -609,6 +613,7 @@ impl Estimator {
             point: home.point,
             alt_amsl_m: old.alt_amsl_m + up,
         });
+        self.frame = Some(LocalFrame::new(home.point));
         self.home_held = Some(home);
         true
     }
@@ -631,6 +636,28 @@ impl Estimator {
     /// 1-sigma uncertainty of the gyro bias, rad/s.
     pub fn gyro_bias_sigma(&self) -> Vector3<f32> {
         self.ins.bias_sigma()
+    }
+
+    /// North and east of `p` from `origin`, m: through the cached frame when it is about
+    /// `origin`.
+    fn ned_of(&self, origin: GeoPoint, p: GeoPoint) -> (f32, f32) {
+        match self.frame.filter(|f| f.origin() == origin) {
+            Some(f) => f.ned_offset(p),
+            None => ned_offset(origin, p),
+        }
+    }
+
+    /// Home as [`EstimatedState::home`] gives it, without forming the whole estimate.
+    pub fn home(&self) -> Option<Home> {
+        let drift = self.baro_drift_m();
+        match (self.home_held, self.home) {
+            (Some(held), _) => Some(held),
+            (None, Some(h)) if drift.is_finite() => Some(Home {
+                alt_amsl_m: h.alt_amsl_m - drift,
+                ..h
+            }),
+            (None, h) => h,
+        }
     }
 
     /// The current estimate.
@@ -667,16 +694,12 @@ impl Estimator {
         } else {
             pos
         };
-        let home = match (self.home_held, self.home) {
-            (Some(held), _) => Some(held),
-            (None, Some(h)) if drift.is_finite() => Some(Home {
-                alt_amsl_m: h.alt_amsl_m - drift,
-                ..h
-            }),
-            (None, h) => h,
-        };
+        let home = self.home();
         let (position, alt_amsl_m) = match home {
-            Some(h) => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
+            Some(h) => match self.frame.filter(|f| f.origin() == h.point) {
+                Some(f) => (f.offset_point(pos.x, pos.y), h.alt_amsl_m - pos.z),
+                None => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
+            },
             None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
         };
         EstimatedState {

@@ -40,6 +40,28 @@ pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
     }
 }
 
+/// Largest rotation angle, rad, that [`rotation_from_vector`] takes by its series.
+const SERIES_MAX_ANGLE: f32 = 0.3;
+
+/// The rotation by the rotation vector `v` (axis times angle, rad), as nalgebra's
+/// `UnitQuaternion::from_scaled_axis`. The filter's rotations (a gyro sample's 10 ms, a
+/// correction) are small: below 0.3 rad the half-angle's cosine and `sin(x)/x` are their
+/// Taylor series to the x^6 term, whose remainder (below 2e-11) lies far under `f32`'s
+/// resolution, in `f32` arithmetic; `libm`'s `sinf`/`cosf` evaluate in `f64`, which the
+/// Cortex-M4F does in software. Larger angles go to nalgebra.
+pub fn rotation_from_vector(v: &nalgebra::Vector3<f32>) -> nalgebra::UnitQuaternion<f32> {
+    let theta2 = v.norm_squared();
+    if theta2.is_nan() || theta2 >= SERIES_MAX_ANGLE * SERIES_MAX_ANGLE {
+        return nalgebra::UnitQuaternion::from_scaled_axis(*v);
+    }
+    // With h the half angle: cos h and sin(h) / (2 h), so the vector part is v sin(h) / theta.
+    let h2 = 0.25 * theta2;
+    let cos_h = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0));
+    let sinc_half = 0.5 * (1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0)));
+    let xyz = v * sinc_half;
+    nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(cos_h, xyz.x, xyz.y, xyz.z))
+}
+
 #[cfg(test)]
 mod tests {
     use super::clamp;
@@ -63,5 +85,26 @@ mod tests {
         assert_eq!(clamp(5.0, 1.0, -1.0), -1.0);
         assert_eq!(clamp(-5.0, 1.0, -1.0), 1.0);
         assert_eq!(clamp(5.0, f32::NAN, f32::NAN), 5.0);
+    }
+
+    #[test]
+    fn the_small_rotation_series_matches_nalgebra_in_f64() {
+        use super::rotation_from_vector;
+        use nalgebra::{UnitQuaternion, Vector3};
+        let mut worst = 0.0_f64;
+        for i in 0..2000 {
+            let k = f64::from(i);
+            let axis = Vector3::new((k * 0.37).sin(), (k * 1.13).cos(), (k * 0.71).sin() + 0.2)
+                .normalize();
+            // Angles from 0 past the series' limit, where nalgebra takes over.
+            let angle = k / 2000.0 * 0.4;
+            let v = axis * angle;
+            let reference = UnitQuaternion::from_scaled_axis(v);
+            let got = rotation_from_vector(&v.cast::<f32>()).cast::<f64>();
+            let err = (got.coords - reference.coords).amax();
+            worst = worst.max(err);
+        }
+        // f32's resolution of a unit quaternion's components.
+        assert!(worst < 2e-7, "worst component error {worst:e}");
     }
 }

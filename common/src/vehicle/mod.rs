@@ -169,7 +169,7 @@ impl Vehicle {
     /// checked against.
     pub fn stores(&mut self) -> (&mut ParamStore, &mut MissionStore, PlanRules) {
         let rules = PlanRules {
-            home: self.estimator.state().home,
+            home: self.estimator.home(),
             limits: self.limits,
             nav: *self.commander.navigator().params(),
         };
@@ -223,7 +223,7 @@ impl Vehicle {
         if !self.commander.flown_mode().needs_navigator() {
             return sp;
         }
-        let home_alt = self.estimator.state().home.map_or(0.0, |h| h.alt_amsl_m);
+        let home_alt = self.estimator.home().map_or(0.0, |h| h.alt_amsl_m);
         match self.commander.navigation().guidance {
             Some(g) => Setpoints {
                 course: g.course,
@@ -330,6 +330,10 @@ impl Vehicle {
 
     /// Acts on requests a ground link accepted.
     pub fn apply(&mut self, r: &VehicleRequests) {
+        // Nothing asked (most sensor frames): the estimate is not worth forming.
+        if *r == VehicleRequests::default() {
+            return;
+        }
         let e = self.estimator.state();
         if let Some(home) = self.commander.apply(r, &e) {
             self.estimator.set_home(home);

@@ -131,49 +131,75 @@ impl GroundPort {
         };
         let before = parser.stats();
         let now = vehicle.time_us().unwrap_or(0);
-        let snapshot = vehicle.snapshot();
-        let (params, plan, rules) = vehicle.stores();
-        let mut stores = Stores {
-            params,
-            plan,
-            rules,
-        };
         // Signed frames are checked against the key in force when they arrive.
         parser.set_key(self.link.signing().key().copied());
         // Both callbacks answer through the link, one frame at a time, in order. The parser
         // never calls one from inside the other, so the borrow is always free: `try_` keeps
-        // the image free of the panic path `borrow_mut` would bring.
-        let link = core::cell::RefCell::new(&mut self.link);
+        // the image free of the panic path `borrow_mut` would bring. The vehicle's snapshot
+        // is formed at the first complete frame, not per call: bytes that complete no frame
+        // cost their framing only.
+        let shared = core::cell::RefCell::new((&mut self.link, &mut *vehicle, None));
+        let frames = core::cell::Cell::new(0u32);
         let mut on_frame = |f: common::link::framing::Frame| {
-            if let Ok(mut link) = link.try_borrow_mut() {
+            if let Ok(mut guard) = shared.try_borrow_mut() {
+                let (link, vehicle, snapshot) = &mut *guard;
+                let snapshot = snapshot.get_or_insert_with(|| vehicle.snapshot());
+                let (params, plan, rules) = vehicle.stores();
+                let mut stores = Stores {
+                    params,
+                    plan,
+                    rules,
+                };
                 let origin = Origin {
                     channel,
                     signed: f.signed,
                 };
-                link.handle(&f.header, &f.message, now, &snapshot, &mut stores, origin)
+                frames.set(frames.get().saturating_add(1));
+                link.handle(&f.header, &f.message, now, snapshot, &mut stores, origin)
             }
         };
         let mut on_undecoded = |raw: common::link::framing::Undecoded<'_>| {
-            if let Ok(mut link) = link.try_borrow_mut() {
-                link.handle_undecoded(&raw.header, raw.id, raw.payload, channel)
+            if let Ok(mut guard) = shared.try_borrow_mut() {
+                frames.set(frames.get().saturating_add(1));
+                guard
+                    .0
+                    .handle_undecoded(&raw.header, raw.id, raw.payload, channel)
             }
         };
         parser.push_with(bytes, &mut on_frame, &mut on_undecoded);
         if datagram {
             parser.end_of_datagram_with(&mut on_frame, &mut on_undecoded);
         }
+        let (_, _, snapshot) = shared.into_inner();
         let after = parser.stats();
         let bad = after.crc_errors.wrapping_sub(before.crc_errors)
             + after.parse_errors.wrapping_sub(before.parse_errors);
         for _ in 0..bad.min(64) {
             self.link.note_rx_error();
         }
-        vehicle.apply(&self.link.take_requests());
-        self.poll(now, vehicle);
+        // Nothing reached the link: nothing to act on or answer before the next poll.
+        if frames.get() == 0 {
+            return;
+        }
+        let requests = self.link.take_requests();
+        vehicle.apply(&requests);
+        // Nothing the vehicle acted on: the snapshot the frames saw still describes it.
+        let unchanged = requests == common::vehicle::requests::VehicleRequests::default();
+        self.poll_with(now, vehicle, snapshot.filter(|_| unchanged));
     }
 
     /// The vehicle's notices to the link, then everything due at `now_us` into the buffer.
     pub fn poll(&mut self, now_us: u64, vehicle: &mut Vehicle) {
+        self.poll_with(now_us, vehicle, None);
+    }
+
+    /// [`GroundPort::poll`] with the vehicle's snapshot when one was just taken.
+    fn poll_with(
+        &mut self,
+        now_us: u64,
+        vehicle: &mut Vehicle,
+        snapshot: Option<common::vehicle::snapshot::VehicleSnapshot>,
+    ) {
         while let Some(n) = vehicle.next_notice() {
             match n {
                 Notice::Text(s, text) => self.link.send_statustext(severity(s), text),
@@ -182,7 +208,7 @@ impl GroundPort {
                 }
             }
         }
-        let snapshot = vehicle.snapshot();
+        let snapshot = snapshot.unwrap_or_else(|| vehicle.snapshot());
         let (params, plan, rules) = vehicle.stores();
         let stores = Stores {
             params,
