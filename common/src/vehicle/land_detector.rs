@@ -5,8 +5,10 @@
 //! ground under `LND_VXY_MAX`, vertical speed under `LND_VZ_MAX`, airspeed under
 //! `LND_ASPD_MAX` and a specific force within `LND_ACC_TOL` of 1 g (no manoeuvre, no
 //! climb-out). Each input is low-passed first (time constant [`FILTER_TAU_S`]), so a short
-//! gust or bump neither lands nor launches it. Any sign of flight ends "landed" at once: an
-//! airspeed, ground speed or vertical speed over its threshold. Disarmed, the airspeed is not
+//! gust or bump neither lands nor launches it. Any sign of flight ends "landed" at once: a
+//! ground speed or vertical speed over its threshold, or an airspeed over `LND_ASPD_TO`
+//! (higher than `LND_ASPD_MAX`, so the wind over an aircraft stopped on the runway, gusts
+//! and all, does not launch it). Disarmed, the airspeed is not
 //! evidence (wind over a parked aircraft) and the aircraft is on the ground as soon as it is
 //! at rest over the ground: a disarmed airframe with its motor stopped does not hover.
 //!
@@ -31,7 +33,7 @@ pub const PARAMS: Group<LandParams> = Group {
         param!(
             ParamDef::real(
                 "LND_VXY_MAX",
-                5.0,
+                8.0,
                 0.5,
                 20.0,
                 "m/s",
@@ -53,13 +55,24 @@ pub const PARAMS: Group<LandParams> = Group {
         param!(
             ParamDef::real(
                 "LND_ASPD_MAX",
-                8.0,
+                10.0,
                 2.0,
                 30.0,
                 "m/s",
-                "Landed only under this airspeed while armed (more is flight at once)",
+                "Landed only under this airspeed while armed (more in flight: still flying)",
             ),
             LandParams => airspeed_max
+        ),
+        param!(
+            ParamDef::real(
+                "LND_ASPD_TO",
+                12.0,
+                2.0,
+                40.0,
+                "m/s",
+                "Armed on the ground, an airspeed over this is a take-off (not LND_ASPD_MAX: gusts)",
+            ),
+            LandParams => airspeed_takeoff
         ),
         param!(
             ParamDef::real(
@@ -88,6 +101,7 @@ pub const PARAMS: Group<LandParams> = Group {
         vel_xy_max: 0.0,
         vel_z_max: 0.0,
         airspeed_max: 0.0,
+        airspeed_takeoff: 0.0,
         accel_tol: 0.0,
         trigger_s: 0.0,
     },
@@ -103,6 +117,8 @@ pub struct LandParams {
     pub vel_z_max: f32,
     /// `LND_ASPD_MAX`: airspeed at rest (armed), m/s.
     pub airspeed_max: f32,
+    /// `LND_ASPD_TO`: airspeed that, landed and armed, shows a take-off, m/s.
+    pub airspeed_takeoff: f32,
     /// `LND_ACC_TOL`: specific force's tolerance around 1 g at rest, m/s^2.
     pub accel_tol: f32,
     /// `LND_TRIG_S`: time at rest that makes a landing, s.
@@ -199,7 +215,14 @@ impl LandDetector {
         };
         self.filtered = Some(f);
         let moving = f.ground_speed > p.vel_xy_max || libm::fabsf(f.vel_down) > p.vel_z_max;
-        let flying_air = i.armed && f.airspeed > p.airspeed_max;
+        // Landed, only an airspeed near flying speed is a take-off: wind and its gusts over
+        // the stopped aircraft are not (hysteresis between the two thresholds).
+        let airspeed_max = if self.landed {
+            p.airspeed_takeoff.max(p.airspeed_max)
+        } else {
+            p.airspeed_max
+        };
+        let flying_air = i.armed && f.airspeed > airspeed_max;
         if moving || flying_air {
             // Evidence of flight (or of a take-off run): not landed, at once.
             self.landed = false;
@@ -256,7 +279,7 @@ mod tests {
     #[test]
     fn parameters_are_well_formed_and_named_within_16_characters() {
         let p = LandParams::default();
-        assert_eq!(p.vel_xy_max, 5.0);
+        assert_eq!(p.vel_xy_max, 8.0);
         assert_eq!(p.trigger_s, 1.5);
         for d in PARAMS.params {
             assert!(d.def.name.len() <= 16, "{}", d.def.name);
@@ -292,10 +315,10 @@ mod tests {
             }
             t += DT;
         }
-        // Not landed from about 5-6 m/s (the filtered speed over LND_VXY_MAX), well before
+        // Not landed from just over LND_VXY_MAX (8 m/s, the filter's lag behind it), before
         // the rotation at 13 m/s.
         let v = left_ground_at.expect("never left the landed state");
-        assert!((5.0..8.0).contains(&v), "{v}");
+        assert!((8.0..11.0).contains(&v), "{v}");
         // Climbing out at 17 m/s, 2 m/s up, pulling 1.2 g: flying all along.
         let climb = LandInputs {
             ground_speed: 17.0,
@@ -372,10 +395,10 @@ mod tests {
         }
         let (t, v) = landed_at.expect("never landed");
         // Not while rolling fast: under LND_VXY_MAX, and LND_TRIG_S after it got there
-        // (12 - 5 = 7 m/s at 1.5 m/s^2: 4.7 s).
-        assert!(v < 5.0, "{v}");
-        assert!(t >= 4.7 + 1.5 - 0.1, "{t}");
-        assert!(t < 4.7 + 1.5 + 1.0, "{t}");
+        // (12 - 8 = 4 m/s at 1.5 m/s^2: 2.7 s).
+        assert!(v < 8.0, "{v}");
+        assert!(t >= 2.7 + 1.5 - 0.1, "{t}");
+        assert!(t < 2.7 + 1.5 + 1.0, "{t}");
     }
 
     #[test]
@@ -417,10 +440,10 @@ mod tests {
             ..at_rest(true)
         };
         run(&mut d, &fly, 1.0);
-        // Stopped on the runway, 12 m/s of wind over the wings: armed, the airspeed keeps it
+        // Stopped on the runway, 11 m/s of wind over the wings: armed, the airspeed keeps it
         // "flying"; disarmed, the wind is no evidence.
         let windy = LandInputs {
-            airspeed: 12.0,
+            airspeed: 11.0,
             ..at_rest(true)
         };
         assert!(run(&mut d, &windy, 3.0).iter().all(|&l| !l));
@@ -433,6 +456,28 @@ mod tests {
             },
             DT
         ));
+    }
+
+    #[test]
+    fn landed_and_armed_a_gusty_wind_under_the_take_off_airspeed_does_not_launch_it() {
+        let mut d = LandDetector::new();
+        let p = LandParams::default();
+        // Stopped, armed, the wind gusting between 6 and 11.5 m/s every second.
+        for k in 0..500 {
+            let gust = if (k / 50) % 2 == 0 { 6.0 } else { 11.5 };
+            let i = LandInputs {
+                airspeed: gust,
+                ..at_rest(true)
+            };
+            assert!(d.update(&p, &i, DT), "launched at step {k}");
+        }
+        // The take-off run's airspeed over LND_ASPD_TO is a take-off.
+        let run_up = LandInputs {
+            airspeed: 13.0,
+            ground_speed: 6.0,
+            ..at_rest(true)
+        };
+        assert!(run(&mut d, &run_up, 1.0).iter().any(|&l| !l));
     }
 
     #[test]
