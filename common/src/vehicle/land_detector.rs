@@ -200,7 +200,7 @@ impl LandDetector {
             && raw.vel_down.is_finite()
             && raw.airspeed.is_finite()
             && raw.accel_dev.is_finite();
-        if !finite || !(dt.is_finite() && dt > 0.0) {
+        if !(finite && dt.is_finite() && dt > 0.0) {
             return self.landed;
         }
         let k = dt / (FILTER_TAU_S + dt);
