@@ -136,12 +136,65 @@ fn lands_on_the_runway(o: &FlightOutcome, calm: bool) {
         "landing item {land_seq} reported reached: {:?}",
         m.reached
     );
+    the_station_saw_the_landing_honestly(o, td.time_s);
     // The flight stops early only when the autopilot has disarmed with the aircraft at rest
     // on the ground (the frame it disarms on may be the last, logged still armed).
     let last = o.samples.last().expect("samples");
     assert!(
         !last.armed || last.t + 1.0 < runway_mission(Vec::new()).duration_s,
         "disarmed after the landing: {last:?}"
+    );
+}
+
+/// The landed state the scripted station read (EXTENDED_SYS_STATE, 1 Hz and on change) was
+/// honest about the landing: TAKEOFF then IN_AIR after arming, IN_AIR or LANDING (never
+/// ON_GROUND) from lift-off until the plant's wheels touched at `touchdown_s`, LANDING on the
+/// approach, and ON_GROUND within a few seconds of the touchdown (the roll-out slowing under
+/// `LND_VXY_MAX`, then `LND_TRIG_S`).
+fn the_station_saw_the_landing_honestly(o: &FlightOutcome, touchdown_s: f64) {
+    let states = &o.summary.landed_states;
+    eprintln!("landed states {states:?}, touchdown at {touchdown_s:.2} s");
+    let has = |name: &str| states.iter().any(|(_, s)| s == name);
+    assert!(has("TAKEOFF"), "TAKEOFF reported: {states:?}");
+    assert!(has("LANDING"), "LANDING reported: {states:?}");
+    let first_air = states
+        .iter()
+        .find(|(_, s)| s == "IN_AIR")
+        .map(|&(t, _)| t)
+        .expect("IN_AIR reported");
+    // Between the first IN_AIR and the touchdown: never ON_GROUND.
+    let early: Vec<_> = states
+        .iter()
+        .filter(|(t, s)| *t > first_air && *t < touchdown_s && s == "ON_GROUND")
+        .collect();
+    assert!(
+        early.is_empty(),
+        "ON_GROUND before the touchdown: {early:?}"
+    );
+    // What the station held at the touchdown: the landing (or flight).
+    let at_touchdown = states
+        .iter()
+        .rev()
+        .find(|(t, _)| *t <= touchdown_s)
+        .map(|(_, s)| s.as_str());
+    assert!(
+        matches!(at_touchdown, Some("LANDING") | Some("IN_AIR")),
+        "at the touchdown the station read {at_touchdown:?}"
+    );
+    // After it: ON_GROUND, within a few seconds, and it stays.
+    let (t_ground, last) = states.last().expect("states");
+    assert_eq!(last, "ON_GROUND", "{states:?}");
+    let on_ground_at = states
+        .iter()
+        .filter(|(t, s)| *t >= touchdown_s && s == "ON_GROUND")
+        .map(|&(t, _)| t)
+        .next()
+        .expect("ON_GROUND after the touchdown");
+    assert_eq!(on_ground_at, *t_ground, "{states:?}");
+    assert!(
+        on_ground_at - touchdown_s < 12.0,
+        "ON_GROUND {:.1} s after the touchdown",
+        on_ground_at - touchdown_s
     );
 }
 
@@ -194,6 +247,38 @@ fn circling(samples: &[&Sample], center: (f64, f64)) -> (f64, f64, f64) {
     let min = r.iter().cloned().fold(f64::INFINITY, f64::min);
     let max = r.iter().cloned().fold(0.0, f64::max);
     (min, max, swept)
+}
+
+/// With no fault at all, the scripted station reads TAKEOFF on the runway, IN_AIR on the
+/// mission, LANDING on the approach down to the wheels touching (4.5 m over home included),
+/// and ON_GROUND only after the plant's touchdown, within seconds, before the disarm.
+#[test]
+fn the_station_reads_the_landing_until_the_touchdown_and_on_ground_within_seconds_after_it() {
+    let o = mission_flight(Vec::new(), |_| {});
+    let (_, td) = touchdown_near_the_land_point(&o);
+    the_station_saw_the_landing_honestly(&o, td.time_s);
+    // On the approach, 4.5 m over the field (where a height rule said ON_GROUND): LANDING.
+    let states = &o.summary.landed_states;
+    let field = o.samples.first().expect("samples").alt;
+    let low = o
+        .samples
+        .iter()
+        .filter(|s| s.t < td.time_s && s.armed)
+        .rfind(|s| s.alt - field > 4.5)
+        .expect("a sample over 4.5 m before the touchdown");
+    let read = states
+        .iter()
+        .rev()
+        .find(|(t, _)| *t <= low.t)
+        .map(|(_, s)| s.as_str());
+    assert_eq!(read, Some("LANDING"), "at {:.1} s", low.t);
+    // The disarm came after the station read ON_GROUND.
+    let disarmed = said(&o, "Landed, disarmed", td.time_s).expect("disarmed after landing");
+    let on_ground = states.last().expect("states").0;
+    assert!(
+        on_ground <= disarmed + 1.0,
+        "ON_GROUND {on_ground:.1} s, disarmed {disarmed:.1} s"
+    );
 }
 
 #[test]

@@ -700,6 +700,73 @@ fn arming_with_and_without_prearm_conditions() {
     );
 }
 
+/// A disarm asked of a vehicle flying 3 m over home (the land detector's verdict, through the
+/// snapshot the link checks commands against) is refused unless forced; EXTENDED_SYS_STATE
+/// says it is in the air.
+#[test]
+fn a_disarm_asked_in_flight_below_5_m_is_refused_unless_forced() {
+    use crate::estimator::{Estimator, Home as EstHome};
+    use crate::math::geodetic::GeoPoint;
+    use crate::vehicle::commander::Commander;
+    use crate::vehicle::land_detector::LandParams;
+    use crate::vehicle::report::{snapshot, Extras};
+    use crate::vehicle::requests::VehicleRequests;
+    let mut e = Estimator::default().state();
+    e.home = Some(EstHome {
+        point: GeoPoint {
+            lat_e7: 449_000_000,
+            lon_e7: -932_000_000,
+        },
+        alt_amsl_m: 300.0,
+    });
+    e.alt_amsl_m = 303.0;
+    e.pos_ned = nalgebra::Vector3::new(0.0, 0.0, -3.0);
+    e.airspeed = 15.0;
+    e.ground_speed = 15.0;
+    e.vel_ned = nalgebra::Vector3::new(15.0, 0.0, 0.5);
+    let mut c = Commander::new();
+    c.apply(
+        &VehicleRequests {
+            arm: Some(ArmRequest {
+                arm: true,
+                forced: false,
+            }),
+            ..Default::default()
+        },
+        &e,
+    );
+    for _ in 0..100 {
+        c.detect_landing(&LandParams::default(), &e, Some(9.81), 0.02);
+    }
+    let v = snapshot(
+        &e,
+        &c,
+        &Extras {
+            time_us: Some(1_000_000),
+            ..Default::default()
+        },
+    );
+    assert!(v.armed);
+    assert_eq!(v.landed, LandedState::InAir);
+    let MavMessage::EXTENDED_SYS_STATE(x) = telemetry::extended_sys_state(&v) else {
+        panic!("EXTENDED_SYS_STATE expected")
+    };
+    assert_eq!(x.landed_state, MavLandedState::MAV_LANDED_STATE_IN_AIR);
+    let mut l = link();
+    let out = exchange(&mut l, &v, 0, arm_cmd(false, false));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(l.take_requests().arm, None);
+    let out = exchange(&mut l, &v, 1, arm_cmd(false, true));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert_eq!(
+        l.take_requests().arm,
+        Some(ArmRequest {
+            arm: false,
+            forced: true
+        })
+    );
+}
+
 /// PX4's custom_mode numbers, written out independently of `FlightMode`.
 fn px4(main: u32, sub: u32) -> u32 {
     (main << 16) | (sub << 24)

@@ -8,9 +8,10 @@
 
 use heapless::Deque;
 
+use super::land_detector::{LandDetector, LandInputs, LandParams};
 use super::modes::FlightMode;
 use super::requests::VehicleRequests;
-use super::snapshot::MissionRunState;
+use super::snapshot::{LandedState, MissionRunState};
 use crate::actuators::Surfaces;
 use crate::battery::Warning;
 use crate::control::autopilot::{Commands, GainSet};
@@ -103,6 +104,7 @@ pub struct Commander {
     mission_seq: u16,
     mission_state: MissionRunState,
     failsafes: Failsafes,
+    land: LandDetector,
     notices: Deque<Notice, NOTICE_CAPACITY>,
     dropped_notices: u32,
 }
@@ -113,8 +115,9 @@ impl Default for Commander {
     }
 }
 
-/// Armed flight is told from the ground by airspeed and height (there is no weight-on-wheels
-/// switch): above 8 m/s and 5 m above home.
+/// The arming rule's test of a take-off already made: above 8 m/s and 5 m above home, arming
+/// does not move home (an air start keeps the home it has). It decides nothing else: whether
+/// the aircraft is flying is the land detector's ([`Commander::landed_state`]).
 pub fn in_air(e: &EstimatedState) -> bool {
     let height = e.home.map_or(0.0, |h| e.alt_amsl_m - h.alt_amsl_m);
     e.airspeed > 8.0 && height > 5.0
@@ -164,6 +167,7 @@ impl Commander {
             mission_seq: 0,
             mission_state: MissionRunState::NotStarted,
             failsafes: Failsafes::new(),
+            land: LandDetector::new(),
             notices: Deque::new(),
             dropped_notices: 0,
         }
@@ -187,6 +191,53 @@ impl Commander {
             Reaction::Loiter => FlightMode::Loiter,
             Reaction::Return => FlightMode::Return,
             Reaction::Land => FlightMode::Land,
+        }
+    }
+
+    /// The land detector's verdict: on the ground.
+    pub fn landed(&self) -> bool {
+        self.land.landed()
+    }
+
+    /// Armed and not on the ground: the failsafes watch, a disarm must be forced.
+    pub fn flying(&self) -> bool {
+        self.armed && !self.land.landed()
+    }
+
+    /// Steps the land detector at the control rate: `specific_force` is the magnitude of the
+    /// last accelerometer sample, m/s^2.
+    pub fn detect_landing(
+        &mut self,
+        p: &LandParams,
+        e: &EstimatedState,
+        specific_force: Option<f32>,
+        dt: f32,
+    ) {
+        let inputs = LandInputs {
+            armed: self.armed,
+            ground_speed: e.ground_speed,
+            vel_down: e.vel_ned.z,
+            airspeed: e.airspeed,
+            specific_force,
+        };
+        self.land.update(p, &inputs, dt);
+    }
+
+    /// The landed state reported (`EXTENDED_SYS_STATE`): the land detector's verdict, told
+    /// apart by what the navigator flies. Taking off: armed in the take-off roll or in the
+    /// climb to the take-off altitude. Landing: airborne on a landing's approach or flare (or
+    /// rolling out fast enough to count as moving). In the air: airborne otherwise. On the
+    /// ground: the detector's landed, outside a take-off.
+    pub fn landed_state(&self) -> LandedState {
+        let phase = (self.armed && self.nav_for.is_some() && self.flown_mode().needs_navigator())
+            .then_some(self.nav.phase);
+        let takeoff = matches!(phase, Some(Phase::TakeoffRoll | Phase::TakeoffClimb));
+        let landing = matches!(phase, Some(Phase::Approach | Phase::Flare | Phase::Landed));
+        match (self.land.landed(), takeoff, landing) {
+            (_, true, _) => LandedState::Takeoff,
+            (true, false, _) => LandedState::OnGround,
+            (false, false, true) => LandedState::Landing,
+            (false, false, false) => LandedState::InAir,
         }
     }
 
@@ -354,7 +405,7 @@ impl Commander {
         gcs_heard_us: Option<u64>,
         battery: Option<Warning>,
     ) {
-        let flying = self.armed && in_air(e);
+        let flying = self.flying();
         let fence_breached = match e.home {
             Some(h) => {
                 breached(plan.items(PlanKind::Fence), &h, &e.pos_ned, &watch.fence).is_some()

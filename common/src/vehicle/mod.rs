@@ -19,11 +19,13 @@
 //! - [`requests`]: requests a ground link accepted, for the vehicle to act on.
 //! - [`commander`]: arming, mode entry, failsafe reactions, the navigator hand-off, mode to
 //!   commands.
+//! - [`land_detector`]: on the ground or flying, told from the estimate and the accelerometer.
 //! - [`params`]: the one registry of every parameter.
 //! - [`report`], [`snapshot`]: the state the vehicle reports each tick.
 
 pub mod clock;
 pub mod commander;
+pub mod land_detector;
 pub mod modes;
 pub mod params;
 pub mod report;
@@ -74,6 +76,9 @@ pub struct Vehicle {
     commander: Commander,
     battery: BatteryMonitor,
     watch: Watch,
+    land: land_detector::LandParams,
+    /// Magnitude of the last accelerometer sample, m/s^2.
+    specific_force: Option<f32>,
     limits: MissionLimits,
     use_truth: bool,
     params_seen: Option<u32>,
@@ -131,6 +136,8 @@ impl Vehicle {
             commander: Commander::new(),
             battery: BatteryMonitor::default(),
             watch: Watch::default(),
+            land: land_detector::LandParams::default(),
+            specific_force: None,
             limits: MissionLimits::default(),
             use_truth: false,
             params_seen: None,
@@ -280,6 +287,10 @@ impl Vehicle {
         // The gyro integrates over the time since the last *accepted* IMU sample, so a
         // rejected sample does not lose its share of the rotation.
         if let Some(imu) = f.imu {
+            let force = imu.accel.norm();
+            if force.is_finite() {
+                self.specific_force = Some(force);
+            }
             if let Some(last) = self.last_imu_us.filter(|&l| t > l) {
                 self.estimator
                     .update_imu(&imu, t.saturating_sub(last) as f32 * 1e-6);
@@ -360,6 +371,8 @@ impl Vehicle {
         // One estimate for the whole control step.
         let e = self.estimator.state();
         let b = self.battery.report(Some(now_us));
+        self.commander
+            .detect_landing(&self.land, &e, self.specific_force, dt);
         self.commander.check_failsafes(
             now_us,
             &e,
@@ -443,6 +456,7 @@ impl Vehicle {
         );
         self.limits = p.load(&validate::PARAMS);
         self.battery.set_config(p.load(&battery::PARAMS));
+        self.land = p.load(&land_detector::PARAMS);
         self.watch = Watch {
             failsafe: p.load(&failsafe::PARAMS),
             fence: p.load(&fence::PARAMS),

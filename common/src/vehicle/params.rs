@@ -61,6 +61,7 @@ pub const REGISTRY: Registry = &[
     &fence::PARAMS,
     &battery::PARAMS,
     &failsafe::PARAMS,
+    &super::land_detector::PARAMS,
     &PARAMS,
 ];
 

@@ -1,11 +1,9 @@
 //! What the vehicle reports: its [`VehicleSnapshot`], built from the estimate and the
 //! commander's state, which the ground link turns into telemetry and checks commands against.
 
-use super::commander::{in_air, Commander};
+use super::commander::Commander;
 use super::modes::{FlightMode, ModeSet};
-use super::snapshot::{
-    GpsRaw, Home, LandedState, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot,
-};
+use super::snapshot::{GpsRaw, Home, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot};
 use crate::battery::Battery;
 use crate::estimator::EstimatedState;
 use crate::math::{course_and_speed, wrap_two_pi};
@@ -88,11 +86,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         failsafe: c.failsafe_active(),
         mode: c.flown_mode(),
         modes_available: available_modes(e),
-        landed: if in_air(e) {
-            LandedState::InAir
-        } else {
-            LandedState::OnGround
-        },
+        landed: c.landed_state(),
         health,
         roll: e.euler.phi,
         pitch: e.euler.theta,

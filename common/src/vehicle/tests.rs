@@ -185,6 +185,8 @@ fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() 
     let e = flying();
     c.apply(&arm(), &e);
     c.apply(&mode(FlightMode::Hold), &e);
+    // The land detector has seen the flight.
+    detect(&mut c, &e, 0.1);
     texts(&mut c);
     let watch = Watch::default();
     let plan = MissionStore::default();
@@ -253,4 +255,133 @@ fn a_gain_set_chosen_by_parameter_is_flown_and_read_back() {
     v.on_sensors(&f, &FromGround::default());
     // The Minnesota set's roll gain (Table 3.10) is now in the store.
     assert_eq!(v.params().get("RLL_KP"), Some(-0.52));
+}
+
+/// Steps the land detector (default parameters, 1 g on the accelerometer) for `seconds`.
+fn detect(c: &mut Commander, e: &EstimatedState, seconds: f32) {
+    let p = land_detector::LandParams::default();
+    for _ in 0..(seconds / 0.02).round() as usize {
+        c.detect_landing(&p, e, Some(9.81), 0.02);
+    }
+}
+
+#[test]
+fn standing_still_on_the_ground_the_vehicle_reports_on_ground_armed_or_not() {
+    use super::snapshot::LandedState;
+    let mut c = Commander::new();
+    let e = {
+        let mut e = on_ground();
+        e.ground_speed = 0.0;
+        e
+    };
+    detect(&mut c, &e, 2.0);
+    assert_eq!(c.landed_state(), LandedState::OnGround);
+    c.apply(&arm(), &e);
+    c.apply(&mode(FlightMode::Hold), &e);
+    detect(&mut c, &e, 2.0);
+    assert_eq!(c.landed_state(), LandedState::OnGround);
+    assert!(!c.flying());
+}
+
+#[test]
+fn a_take_off_reports_takeoff_from_the_roll_to_its_altitude_then_in_air() {
+    use super::snapshot::LandedState;
+    let mut c = Commander::new();
+    let mut e = on_ground();
+    e.ground_speed = 0.0;
+    c.apply(&arm(), &e);
+    c.apply(&mode(FlightMode::Takeoff), &e);
+    let plan = MissionStore::default();
+    let tick = |c: &mut Commander, e: &EstimatedState| {
+        c.detect_landing(&land_detector::LandParams::default(), e, Some(9.81), 0.02);
+        c.demand(0, 0.02, e, &plan, &DESIGNED);
+    };
+    tick(&mut c, &e);
+    assert_eq!(
+        c.navigation().phase,
+        crate::navigation::navigator::io::Phase::TakeoffRoll
+    );
+    assert_eq!(c.landed_state(), LandedState::Takeoff);
+    // Rolling at 10 m/s: still the take-off, failsafes watching once it moves like flight.
+    e.ground_speed = 10.0;
+    e.airspeed = 10.0;
+    e.vel_ned = Vector3::new(0.0, 10.0, 0.0);
+    for _ in 0..50 {
+        tick(&mut c, &e);
+    }
+    assert_eq!(c.landed_state(), LandedState::Takeoff);
+    // Airborne at 3 m, climbing: the take-off until its altitude.
+    e.airspeed = 16.0;
+    e.ground_speed = 16.0;
+    e.vel_ned = Vector3::new(0.0, 16.0, -2.0);
+    e.pos_ned.z = -3.0;
+    e.alt_amsl_m = 303.0;
+    for _ in 0..50 {
+        tick(&mut c, &e);
+    }
+    assert_eq!(
+        c.navigation().phase,
+        crate::navigation::navigator::io::Phase::TakeoffClimb
+    );
+    assert_eq!(c.landed_state(), LandedState::Takeoff);
+    assert!(c.flying(), "airborne at 3 m: the failsafes watch");
+    // At the take-off altitude it circles: in the air.
+    let top = c.navigator().params().rtl_alt;
+    e.pos_ned.z = -top;
+    e.alt_amsl_m = 300.0 + top;
+    e.vel_ned.z = 0.0;
+    for _ in 0..50 {
+        tick(&mut c, &e);
+    }
+    assert_ne!(
+        c.navigation().phase,
+        crate::navigation::navigator::io::Phase::TakeoffClimb
+    );
+    assert_eq!(c.landed_state(), LandedState::InAir);
+}
+
+#[test]
+fn at_4_5_m_over_home_sinking_at_approach_speed_it_is_flying_and_the_failsafes_watch() {
+    use super::snapshot::LandedState;
+    let mut c = Commander::new();
+    // 4.5 m above home, 14 m/s, sinking 1.5 m/s.
+    let mut e = flying();
+    e.pos_ned = Vector3::new(-30.0, 0.0, -4.5);
+    e.alt_amsl_m = 304.5;
+    e.airspeed = 14.0;
+    e.ground_speed = 14.0;
+    e.vel_ned = Vector3::new(14.0, 0.0, 1.5);
+    c.apply(&arm(), &e);
+    c.apply(&mode(FlightMode::Hold), &e);
+    detect(&mut c, &e, 3.0);
+    // Below 5 m over home and still flying: not on the ground.
+    assert_eq!(c.landed_state(), LandedState::InAir);
+    assert!(c.flying());
+    // The failsafes watch below 5 m too: a silent ground link returns.
+    c.check_failsafes(
+        10_000_000,
+        &e,
+        &Watch::default(),
+        &MissionStore::default(),
+        Some(0),
+        None,
+    );
+    assert_eq!(c.reaction(), Reaction::Return);
+}
+
+#[test]
+fn an_air_start_below_home_altitude_at_cruise_speed_is_in_air() {
+    use super::snapshot::LandedState;
+    let mut c = Commander::new();
+    let mut e = flying();
+    // 40 m below home, cruising.
+    e.alt_amsl_m = 260.0;
+    e.pos_ned = Vector3::new(0.0, 0.0, 40.0);
+    e.vel_ned = Vector3::new(0.0, 17.0, 0.0);
+    detect(&mut c, &e, 0.02);
+    assert_eq!(c.landed_state(), LandedState::InAir);
+    let _ = c.apply(&arm(), &e);
+    detect(&mut c, &e, 2.0);
+    assert_eq!(c.landed_state(), LandedState::InAir);
+    assert!(c.flying());
 }

@@ -16,7 +16,7 @@ use common::gcs::client::{command_long, gcs_heartbeat};
 use common::gcs::Dest;
 use common::link::framing::{FrameParser, Sender};
 use mavlink::dialects::common::{
-    MavCmd, MavMessage, MavMissionResult, MavMissionType, MavParamType, MavResult,
+    MavCmd, MavLandedState, MavMessage, MavMissionResult, MavMissionType, MavParamType, MavResult,
     MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
 };
 use serde::Serialize;
@@ -154,6 +154,8 @@ pub struct GroundStation {
     pub uploads: Vec<(String, f64, String)>,
     /// MISSION_ITEM_REACHED: time, item.
     pub reached: Vec<(f64, u16)>,
+    /// The landed state of EXTENDED_SYS_STATE each time it changed: time, state.
+    pub landed_states: Vec<(f64, MavLandedState)>,
     uploaded: bool,
     next_heartbeat_s: f64,
     silent: bool,
@@ -180,6 +182,7 @@ impl GroundStation {
             texts: Vec::new(),
             uploads: Vec::new(),
             reached: Vec::new(),
+            landed_states: Vec::new(),
             uploaded: false,
             next_heartbeat_s: 0.0,
             silent: false,
@@ -473,7 +476,8 @@ impl GroundStation {
             }
         }
         let mut messages = Vec::new();
-        let (texts, reached) = (&mut self.texts, &mut self.reached);
+        let (texts, reached, landed) =
+            (&mut self.texts, &mut self.reached, &mut self.landed_states);
         self.parser.push(&answer, |f| {
             match &f.message {
                 MavMessage::STATUSTEXT(s) => {
@@ -481,6 +485,11 @@ impl GroundStation {
                     texts.push((t_s, text));
                 }
                 MavMessage::MISSION_ITEM_REACHED(r) => reached.push((t_s, r.seq)),
+                MavMessage::EXTENDED_SYS_STATE(x)
+                    if landed.last().is_none_or(|&(_, l)| l != x.landed_state) =>
+                {
+                    landed.push((t_s, x.landed_state));
+                }
                 _ => {}
             }
             messages.push(f.message.clone());

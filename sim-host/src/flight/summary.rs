@@ -135,6 +135,9 @@ pub struct FlightSummary {
     pub commands: Vec<CommandRecord>,
     /// The autopilot's STATUSTEXT messages.
     pub texts: Vec<(f64, String)>,
+    /// The landed state the station read in EXTENDED_SYS_STATE, each time it changed: time,
+    /// state (`ON_GROUND`, `TAKEOFF`, `IN_AIR`, `LANDING`, `UNDEFINED`).
+    pub landed_states: Vec<(f64, String)>,
     /// Framing counters of the autopilot's answers (simulator side).
     pub sim_rx: LinkStatsJson,
     /// The autopilot's counters of what it received (`None`: an autopilot outside this
@@ -580,6 +583,19 @@ pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts)
             .unwrap_or_default(),
         commands: f.gcs.map(|g| g.commands.clone()).unwrap_or_default(),
         texts: f.gcs.map(|g| g.texts.clone()).unwrap_or_default(),
+        landed_states: f
+            .gcs
+            .map(|g| {
+                g.landed_states
+                    .iter()
+                    .map(|&(t, l)| {
+                        let name = format!("{l:?}");
+                        let short = name.trim_start_matches("MAV_LANDED_STATE_").to_string();
+                        (t, short)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default(),
         sim_rx: f.sim_rx.into(),
         autopilot_rx: f.health.map(|(health, ap_stats)| AutopilotRx {
             framing: ap_stats.into(),
