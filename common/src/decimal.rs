@@ -13,6 +13,7 @@
 //! `17` read better than `0.050000` and `17.000000`.
 
 use core::fmt;
+use core::num::NonZeroU64;
 
 /// The most decimals written: `10^9 * 2^24` still fits in 64 bits.
 pub const MAX_PLACES: u8 = 9;
@@ -73,8 +74,9 @@ impl fmt::Display for Decimal {
             return self.write_fraction(f, 0, places);
         }
         let shift = e.unsigned_abs();
-        let scale = 10u64.pow(places);
-        let scaled = u64::from(m) * scale;
+        // Never zero; as `NonZeroU64` the divisions below carry no panic path.
+        let scale = NonZeroU64::new(10u64.pow(places)).unwrap_or(NonZeroU64::MIN);
+        let scaled = u64::from(m) * scale.get();
         // Below 2^-64, m * 10^places < 2^54 is under half a unit: it rounds to zero.
         let q = if shift >= 64 {
             0
