@@ -137,8 +137,9 @@ fn crc_change_of_signed_flag(after: usize) -> u16 {
     const ZEROS: [u8; 32] = [0; 32];
     let mut flipped = CRCu16::crc16mcrf4cc();
     let mut zero = CRCu16::crc16mcrf4cc();
-    flipped.digest(&[IFLAG_SIGNED]);
-    zero.digest(&[0u8]);
+    // Slices, as mavlink's own checksum passes them: one monomorphisation of `digest`.
+    flipped.digest(&[IFLAG_SIGNED][..]);
+    zero.digest(&[0u8][..]);
     let mut left = after;
     while left > 0 {
         let k = left.min(ZEROS.len());
