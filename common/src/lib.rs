@@ -30,6 +30,7 @@
 //! - [`gcs`]: the ground-station protocols (routing, parameters, missions, commands,
 //!   telemetry), transport-agnostic.
 //! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
+//! - [`decimal`]: numbers in texts as fixed-point decimals, without float formatting.
 //! - [`storage`]: power-cut-safe persistence of parameters and missions in flash.
 //! - [`math`]: the one definition of every frame change, rotation, geodetic conversion,
 //!   gravity and the standard atmosphere, generic over the float type so the f64 plant and
@@ -48,6 +49,7 @@
 pub mod actuators;
 pub mod battery;
 pub mod control;
+pub mod decimal;
 pub mod estimator;
 pub mod failsafe;
 pub mod gcs;

@@ -5,6 +5,7 @@ use super::outbox::{After, Command, Pending};
 use super::peer::Peer;
 use super::streams::Stream;
 use super::{telemetry, GroundLink, Stores, FORCE_ARM_MAGIC, HEARTBEAT_INTERVAL_US};
+use crate::decimal::trimmed;
 use crate::navigation::plan::MissionStore;
 use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::{AltitudeSetpoint, ArmRequest, CourseSetpoint};
@@ -106,7 +107,12 @@ impl GroundLink {
                 } else if !(lo..=hi).contains(&c.p[1]) {
                     self.textf(
                         MavSeverity::MAV_SEVERITY_WARNING,
-                        format_args!("Airspeed {} refused: outside [{}, {}] m/s", c.p[1], lo, hi),
+                        format_args!(
+                            "Airspeed {} refused: outside [{}, {}] m/s",
+                            trimmed(c.p[1], 2),
+                            trimmed(lo, 2),
+                            trimmed(hi, 2)
+                        ),
                     );
                     MavResult::MAV_RESULT_DENIED
                 } else {

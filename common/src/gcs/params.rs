@@ -4,6 +4,7 @@
 use super::outbox::Pending;
 use super::peer::{Dest, Peer};
 use super::GroundLink;
+use crate::decimal::trimmed;
 use crate::params::store::{encode_wire, param_id_str, ParamStore};
 use crate::params::ParamKind;
 use mavlink::dialects::common::*;
@@ -123,7 +124,13 @@ impl GroundLink {
         if let Err((why, error)) = result {
             self.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Param {} refused: {} [{}, {}]", name, why, def.min, def.max),
+                format_args!(
+                    "Param {} refused: {} [{}, {}]",
+                    name,
+                    why,
+                    trimmed(def.min, 6),
+                    trimmed(def.max, 6)
+                ),
             );
             self.param_error(&d.param_id[..], index as i16, error, from);
         }

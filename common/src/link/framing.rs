@@ -3,13 +3,19 @@
 //! The `mavlink` crate's own reader skips corrupt frames silently; an autopilot must count
 //! them (bad CRC, unknown message, undecodable payload) and report them, so this parser does
 //! the frame synchronisation itself and leaves every check of substance to the crate:
-//! [`MAVLinkV2MessageRaw::has_valid_crc`] for the checksum and [`Message::parse`] for the
-//! payload. It takes bytes in whatever chunks a UART, a socket or a pipe delivers them, never
-//! allocates and never panics.
+//! [`MAVLinkV2MessageRaw::has_valid_crc_with_extra_crc`] for the checksum and the dialect's
+//! decoders for the payload. It takes bytes in whatever chunks a UART, a socket or a pipe
+//! delivers them, never allocates and never panics.
+//!
+//! The parser and the [`Sender`] are generic over the [`Dialect`] they speak: the whole common
+//! set ([`Common`], the default, for the host's tools) or the autopilot's own ([`Autopilot`]),
+//! whose image then holds the code of its own messages only.
 
+use super::dialect::{Autopilot, Common, Dialect};
 use super::signing::{self, Key, Signed};
+use core::marker::PhantomData;
 use mavlink::dialects::common::MavMessage;
-use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message};
+use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion};
 
 const STX_V1: u8 = 0xFE;
 const STX_V2: u8 = 0xFD;
@@ -86,18 +92,19 @@ pub struct Frame {
     pub signed: Option<Signed>,
 }
 
-/// Incremental MAVLink 1 and 2 frame parser.
-pub struct FrameParser {
+/// Incremental MAVLink 1 and 2 frame parser of the messages of dialect `D`.
+pub struct FrameParser<D = Common> {
     buf: [u8; MAX_FRAME],
     len: usize,
     stats: LinkStats,
     last_seq: Option<(u32, u8)>,
     key: Option<Key>,
+    dialect: PhantomData<D>,
 }
 
-impl Default for FrameParser {
+impl<D: Dialect> Default for FrameParser<D> {
     fn default() -> Self {
-        Self::new()
+        Self::for_dialect()
     }
 }
 
@@ -112,9 +119,23 @@ enum Check {
     Done(Frame, usize),
 }
 
-impl FrameParser {
-    /// An empty parser.
+impl FrameParser<Common> {
+    /// An empty parser of the whole common dialect.
     pub const fn new() -> Self {
+        Self::for_dialect()
+    }
+}
+
+impl FrameParser<Autopilot> {
+    /// An empty parser of the autopilot's dialect.
+    pub const fn autopilot() -> Self {
+        Self::for_dialect()
+    }
+}
+
+impl<D: Dialect> FrameParser<D> {
+    /// An empty parser of dialect `D`.
+    pub const fn for_dialect() -> Self {
         Self {
             buf: [0; MAX_FRAME],
             len: 0,
@@ -130,6 +151,7 @@ impl FrameParser {
             },
             last_seq: None,
             key: None,
+            dialect: PhantomData,
         }
     }
 
@@ -304,8 +326,8 @@ impl FrameParser {
                 return Check::Bad;
             }
             let id = raw.message_id();
-            if !raw.has_valid_crc::<MavMessage>() {
-                return self.classify_failure(id);
+            if let Some(bad) = self.check_crc(id, |x| raw.has_valid_crc_with_extra_crc(x)) {
+                return bad;
             }
             let header = MavHeader {
                 system_id: raw.system_id(),
@@ -336,8 +358,8 @@ impl FrameParser {
                 return Check::Bad;
             }
             let id = u32::from(raw.message_id());
-            if !raw.has_valid_crc::<MavMessage>() {
-                return self.classify_failure(id);
+            if let Some(bad) = self.check_crc(id, |x| raw.has_valid_crc_with_extra_crc(x)) {
+                return bad;
             }
             let header = MavHeader {
                 system_id: u32::from(raw.system_id()),
@@ -349,16 +371,22 @@ impl FrameParser {
         }
     }
 
-    fn classify_failure(&mut self, id: u32) -> Check {
-        if MavMessage::default_message_from_id(id).is_none() {
+    /// `None` when the checksum of a frame of message `id` matches; else the candidate is
+    /// bad, counted as an unknown id or a checksum error.
+    fn check_crc(&mut self, id: u32, valid: impl FnOnce(u8) -> bool) -> Option<Check> {
+        match D::extra_crc(id) {
             // Its checksum cannot be checked, so its length cannot be trusted either: a
             // corrupt start marker with a garbage id must not swallow the real frame behind
             // it. Resynchronise as after any bad candidate.
-            self.stats.unknown_ids = self.stats.unknown_ids.wrapping_add(1);
-            Check::Bad
-        } else {
-            self.stats.crc_errors = self.stats.crc_errors.wrapping_add(1);
-            Check::Bad
+            None => {
+                self.stats.unknown_ids = self.stats.unknown_ids.wrapping_add(1);
+                Some(Check::Bad)
+            }
+            Some(extra) if !valid(extra) => {
+                self.stats.crc_errors = self.stats.crc_errors.wrapping_add(1);
+                Some(Check::Bad)
+            }
+            Some(_) => None,
         }
     }
 
@@ -371,7 +399,7 @@ impl FrameParser {
         payload_start: usize,
         total: usize,
     ) -> Check {
-        match MavMessage::parse(version, id, payload) {
+        match D::decode(version, id, payload) {
             Ok(message) => Check::Done(
                 Frame {
                     header,
@@ -401,50 +429,80 @@ fn copy_into(dst: &mut [u8], src: &[u8], n: usize) -> bool {
     }
 }
 
-/// Encodes one MAVLink 2 frame; returns the buffer holding it (`raw_bytes()` is the frame).
+/// Encodes one MAVLink 2 frame of the whole common dialect; returns the buffer holding it
+/// (`raw_bytes()` is the frame).
 pub fn encode_v2(header: MavHeader, message: &MavMessage) -> MAVLinkV2MessageRaw {
     let mut raw = MAVLinkV2MessageRaw::new();
     raw.serialize_message(header, message);
     raw
 }
 
-/// Hands out the sequence numbers of one sender on one link.
+/// Hands out the sequence numbers of one sender on one link, which writes the messages of
+/// dialect `D`.
 #[derive(Clone, Copy, Debug)]
-pub struct Sender {
+pub struct Sender<D = Common> {
     system_id: u8,
     component_id: u8,
     sequence: u8,
+    dialect: PhantomData<D>,
 }
 
-impl Sender {
-    /// A sender with the given identity.
+impl Sender<Common> {
+    /// A sender of the whole common dialect with the given identity.
     pub const fn new(system_id: u8, component_id: u8) -> Self {
-        Self {
-            system_id,
-            component_id,
-            sequence: 0,
-        }
-    }
-
-    /// The header for the next frame.
-    pub fn next_header(&mut self) -> MavHeader {
-        let h = MavHeader {
-            system_id: u32::from(self.system_id),
-            component_id: self.component_id,
-            sequence: self.sequence,
-        };
-        self.sequence = self.sequence.wrapping_add(1);
-        h
+        Self::for_dialect(system_id, component_id)
     }
 
     /// Encodes `message` as the next MAVLink 2 frame of this sender.
     pub fn encode(&mut self, message: &MavMessage) -> MAVLinkV2MessageRaw {
         encode_v2(self.next_header(), message)
     }
+}
+
+impl Sender<Autopilot> {
+    /// A sender of the autopilot's dialect with the given identity.
+    pub const fn autopilot(system_id: u8, component_id: u8) -> Self {
+        Self::for_dialect(system_id, component_id)
+    }
+}
+
+impl<D: Dialect> Sender<D> {
+    /// A sender of dialect `D` with the given identity.
+    pub const fn for_dialect(system_id: u8, component_id: u8) -> Self {
+        Self {
+            system_id,
+            component_id,
+            sequence: 0,
+            dialect: PhantomData,
+        }
+    }
+
+    fn header(&self) -> MavHeader {
+        MavHeader {
+            system_id: u32::from(self.system_id),
+            component_id: self.component_id,
+            sequence: self.sequence,
+        }
+    }
+
+    /// The header for the next frame.
+    pub fn next_header(&mut self) -> MavHeader {
+        let h = self.header();
+        self.sequence = self.sequence.wrapping_add(1);
+        h
+    }
+
+    /// Encodes `message` as the next MAVLink 2 frame of this sender; `None` (and no sequence
+    /// number spent) for a message its dialect does not write.
+    pub fn try_encode(&mut self, message: &MavMessage) -> Option<MAVLinkV2MessageRaw> {
+        let raw = D::encode(self.header(), message)?;
+        self.sequence = self.sequence.wrapping_add(1);
+        Some(raw)
+    }
 
     /// Encodes one message's data (a type of the dialect's, or one written for a case the
     /// dialect's types cannot express) as the next MAVLink 2 frame of this sender.
-    pub fn encode_data<D: mavlink::MessageData>(&mut self, data: &D) -> MAVLinkV2MessageRaw {
+    pub fn encode_data<M: mavlink::MessageData>(&mut self, data: &M) -> MAVLinkV2MessageRaw {
         let mut raw = MAVLinkV2MessageRaw::new();
         raw.serialize_message_data(self.next_header(), data);
         raw

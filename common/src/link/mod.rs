@@ -4,6 +4,7 @@
 // Counts, lengths and offsets here come from outside: every operation on them is checked.
 #![cfg_attr(not(test), deny(clippy::arithmetic_side_effects))]
 
+pub mod dialect;
 pub mod framing;
 pub mod signing;
 pub mod simlink;

@@ -7,8 +7,7 @@
 //! its default features). What a receiver accepts (which frames must be signed, replays)
 //! is the ground link's policy (`gcs::signing`).
 
-use mavlink::dialects::common::MavMessage;
-use mavlink::Message;
+use crc_any::CRCu16;
 use sha2::{Digest, Sha256};
 
 /// Length of the secret key, bytes.
@@ -90,7 +89,10 @@ pub fn check(frame: &[u8], key: &Key) -> Option<Signed> {
 
 /// Signs an encoded, unsigned MAVLink 2 `frame`: sets the signed flag, recomputes the
 /// checksum (it covers the flags) and appends link id, timestamp and signature. `None` for a
-/// frame that is not a whole MAVLink 2 frame of a message of the dialect.
+/// frame that is not a whole MAVLink 2 frame.
+///
+/// The checksum is updated, not recomputed, so signing needs no dialect (no `CRC_EXTRA` of
+/// the message): see [`crc_change_of_signed_flag`].
 pub fn sign(
     frame: &[u8],
     key: &Key,
@@ -103,15 +105,21 @@ pub fn sign(
     let n = unsigned_len(frame)?;
     let mut out: heapless::Vec<u8, MAX_SIGNED_FRAME> =
         heapless::Vec::from_slice(frame.get(..n)?).ok()?;
-    *out.get_mut(2)? |= IFLAG_SIGNED;
-    let &[a, b, c] = out.get(7..10)? else {
-        return None;
-    };
-    let id = u32::from_le_bytes([a, b, c, 0]);
-    let extra = MavMessage::extra_crc(id);
+    let flags = out.get_mut(2)?;
+    let was_signed = *flags & IFLAG_SIGNED != 0;
+    *flags |= IFLAG_SIGNED;
     let crc_at = n.checked_sub(2)?;
-    let crc = mavlink::calculate_crc(out.get(1..crc_at)?, extra);
-    out.get_mut(crc_at..n)?.copy_from_slice(&crc.to_le_bytes());
+    if !was_signed {
+        let &[lo, hi] = out.get(crc_at..n)? else {
+            return None;
+        };
+        // The checksum covers the frame from its length byte to its payload's end, then
+        // CRC_EXTRA: after the flags byte (index 2) come crc_at - 3 bytes of the frame and
+        // CRC_EXTRA.
+        let after_flags = crc_at.checked_sub(2)?;
+        let crc = u16::from_le_bytes([lo, hi]) ^ crc_change_of_signed_flag(after_flags);
+        out.get_mut(crc_at..n)?.copy_from_slice(&crc.to_le_bytes());
+    }
     let sig = signature(key, &out, link_id, timestamp);
     out.push(link_id).ok()?;
     out.extend_from_slice(&timestamp_bytes(timestamp)).ok()?;
@@ -119,13 +127,69 @@ pub fn sign(
     Some(out)
 }
 
+/// What setting the signed flag does to a frame's checksum, with `after` bytes covered after
+/// the flags byte.
+///
+/// MAVLink's checksum (CRC-16/MCRF4XX) is affine in the bytes it covers: for two messages of
+/// the same length, `crc(a) ^ crc(b)` depends on `a ^ b` alone. So flipping one bit changes the
+/// checksum by `crc(flip) ^ crc(zeros)`, whatever the frame, its message or its `CRC_EXTRA`.
+fn crc_change_of_signed_flag(after: usize) -> u16 {
+    const ZEROS: [u8; 32] = [0; 32];
+    let mut flipped = CRCu16::crc16mcrf4cc();
+    let mut zero = CRCu16::crc16mcrf4cc();
+    // Slices, as mavlink's own checksum passes them: one monomorphisation of `digest`.
+    flipped.digest(&[IFLAG_SIGNED][..]);
+    zero.digest(&[0u8][..]);
+    let mut left = after;
+    while left > 0 {
+        let k = left.min(ZEROS.len());
+        let z = ZEROS.get(..k).unwrap_or(&[]);
+        flipped.digest(z);
+        zero.digest(z);
+        left = left.saturating_sub(k);
+    }
+    flipped.get_crc() ^ zero.get_crc()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::link::framing::{FrameParser, Sender};
-    use mavlink::dialects::common::HEARTBEAT_DATA;
+    use mavlink::dialects::common::{
+        MavMessage, HEARTBEAT_DATA, PARAM_VALUE_DATA, STATUSTEXT_DATA,
+    };
+    use mavlink::Message;
 
     extern crate std;
+
+    #[test]
+    fn the_signed_checksum_is_the_one_computed_afresh_with_the_message_s_crc_extra() {
+        // Payloads of 1 (trailing zeros cut) to 54 bytes: the updated checksum against the
+        // MAVLink guide's recipe, a fresh CRC over the signed header and payload with CRC_EXTRA.
+        let text = STATUSTEXT_DATA {
+            text: "a longer text, so the payload runs to fifty bytes".into(),
+            ..Default::default()
+        };
+        let value = PARAM_VALUE_DATA {
+            param_value: 1.5,
+            param_count: 300,
+            ..Default::default()
+        };
+        let msgs = [
+            MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()),
+            MavMessage::PARAM_VALUE(value),
+            MavMessage::STATUSTEXT(text),
+        ];
+        let mut s = Sender::new(1, 1);
+        for m in &msgs {
+            let frame = s.encode(m);
+            let signed = sign(frame.raw_bytes(), &[3; KEY_LEN], 1, 99).unwrap();
+            let n = signed.len() - SIGNATURE_LEN;
+            let want =
+                mavlink::calculate_crc(&signed[1..n - 2], MavMessage::extra_crc(m.message_id()));
+            assert_eq!(signed[n - 2..n], want.to_le_bytes(), "{}", m.message_name());
+        }
+    }
 
     #[test]
     fn the_signature_of_a_known_frame_is_the_known_one() {

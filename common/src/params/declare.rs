@@ -33,9 +33,9 @@ pub struct ParamDef {
     pub min: f32,
     /// Largest accepted value.
     pub max: f32,
-    /// Unit, empty when dimensionless.
+    /// Unit, empty when dimensionless (and on the MCU: see [`host_only`]).
     pub unit: &'static str,
-    /// One line saying what the parameter does.
+    /// One line saying what the parameter does (empty on the MCU: see [`host_only`]).
     pub description: &'static str,
     /// What kind of value it is.
     pub kind: ParamKind,
@@ -74,6 +74,18 @@ impl ParamError {
     }
 }
 
+/// `text` on the host, empty on the MCU. Units and descriptions reach a ground station in the
+/// parameter metadata file, which the firmware's build script writes on the host and the image
+/// serves compressed; nothing on board reads them, so the image does not carry them twice
+/// (some 7 KB of flash).
+const fn host_only(text: &'static str) -> &'static str {
+    if cfg!(target_os = "none") {
+        ""
+    } else {
+        text
+    }
+}
+
 impl ParamDef {
     /// A real-valued parameter.
     pub const fn real(
@@ -89,8 +101,8 @@ impl ParamDef {
             default,
             min,
             max,
-            unit,
-            description,
+            unit: host_only(unit),
+            description: host_only(description),
             kind: ParamKind::Real,
         }
     }
@@ -109,8 +121,8 @@ impl ParamDef {
             default: default as f32,
             min: min as f32,
             max: max as f32,
-            unit,
-            description,
+            unit: host_only(unit),
+            description: host_only(description),
             kind: ParamKind::Int,
         }
     }
@@ -123,7 +135,7 @@ impl ParamDef {
             min: 0.0,
             max: 1.0,
             unit: "",
-            description,
+            description: host_only(description),
             kind: ParamKind::Bool,
         }
     }
@@ -141,7 +153,7 @@ impl ParamDef {
             min: 0.0,
             max: (labels.len() - 1) as f32,
             unit: "",
-            description,
+            description: host_only(description),
             kind: ParamKind::Enum(labels),
         }
     }

@@ -7,6 +7,7 @@ use common::gcs::ftp::{self, File};
 use common::gcs::{
     Dest, GroundLink, LinkConfig, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID,
 };
+use common::link::dialect::Autopilot;
 use common::link::framing::{FrameParser, LinkStats, Sender};
 use common::link::signing;
 use common::vehicle::commander::Severity;
@@ -49,8 +50,8 @@ const TO_ALL: u8 = 0xFF;
 
 /// The ground link with its framing and output buffer.
 pub struct GroundPort {
-    parsers: [FrameParser; CHANNELS],
-    tx: Sender,
+    parsers: [FrameParser<Autopilot>; CHANNELS],
+    tx: Sender<Autopilot>,
     link: GroundLink,
     /// Frames waiting, each as `[destination, length lo, length hi, frame...]`.
     out: heapless::Vec<u8, GCS_OUT>,
@@ -75,8 +76,8 @@ impl GroundPort {
     /// A port with the autopilot's identity and nothing received.
     pub fn new() -> Self {
         Self {
-            parsers: core::array::from_fn(|_| FrameParser::new()),
-            tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
+            parsers: core::array::from_fn(|_| FrameParser::autopilot()),
+            tx: Sender::autopilot(SYSTEM_ID, COMPONENT_ID),
             link: GroundLink::new(LinkConfig {
                 files: &FILES,
                 ..LinkConfig::default()
@@ -231,9 +232,12 @@ impl GroundPort {
     /// A message of the board's own (its figures of itself) to every station, framed and
     /// signed as the link's own.
     pub fn send(&mut self, msg: &MavMessage) {
-        let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
-        let msg = Outgoing::Message(msg.clone());
-        queue(tx, out, dropped, self.link.signing_mut(), Dest::All, &msg);
+        // Encoded from the borrowed message: no copy of it (a clone of `MavMessage` is a match
+        // over the whole common dialect in the image).
+        if let Some(raw) = self.tx.try_encode(msg) {
+            let (out, dropped) = (&mut self.out, &mut self.bytes_dropped);
+            push_frame(out, dropped, self.link.signing_mut(), Dest::All, &raw);
+        }
     }
 
     /// Hands out the frames waiting, one call per frame with where it goes, and empties the
@@ -259,7 +263,7 @@ impl GroundPort {
 /// Encodes `msg` (signed when `signing` has a key) into the output buffer `buf`, or counts its
 /// bytes in `dropped` when the buffer is full.
 fn queue(
-    tx: &mut Sender,
+    tx: &mut Sender<Autopilot>,
     buf: &mut heapless::Vec<u8, GCS_OUT>,
     dropped: &mut u32,
     signing: &mut common::gcs::signing::Signing,
@@ -267,9 +271,25 @@ fn queue(
     msg: &Outgoing,
 ) {
     let raw = match msg {
-        Outgoing::Message(m) => tx.encode(m),
+        Outgoing::Message(m) => match tx.try_encode(m) {
+            Some(raw) => raw,
+            // Not in the autopilot's dialect: nothing to send.
+            None => return,
+        },
         Outgoing::Ack(a) => tx.encode_data(a),
     };
+    push_frame(buf, dropped, signing, dest, &raw);
+}
+
+/// Puts an encoded frame (signed when `signing` has a key) into the output buffer `buf`, or
+/// counts its bytes in `dropped` when the buffer is full.
+fn push_frame(
+    buf: &mut heapless::Vec<u8, GCS_OUT>,
+    dropped: &mut u32,
+    signing: &mut common::gcs::signing::Signing,
+    dest: Dest,
+    raw: &mavlink::MAVLinkV2MessageRaw,
+) {
     // With signing on, every frame is signed; the link id says which channel.
     let link_id = match dest {
         Dest::All => 0,

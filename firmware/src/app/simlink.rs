@@ -4,6 +4,7 @@
 //! vehicle for the `SIM_USE_TRUTH` comparison.
 
 use common::control::inputs::Measurements;
+use common::link::dialect::Autopilot;
 use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
 use common::vehicle::Vehicle;
@@ -47,8 +48,8 @@ pub struct SimLinkHealth {
 
 /// The simulator link with its framing and counters.
 pub struct SimPort {
-    parser: FrameParser,
-    tx: Sender,
+    parser: FrameParser<Autopilot>,
+    tx: Sender<Autopilot>,
     health: SimLinkHealth,
 }
 
@@ -62,8 +63,8 @@ impl SimPort {
     /// A port with the autopilot's identity and nothing received.
     pub fn new() -> Self {
         Self {
-            parser: FrameParser::new(),
-            tx: Sender::new(SYSTEM_ID, COMPONENT_ID),
+            parser: FrameParser::autopilot(),
+            tx: Sender::autopilot(SYSTEM_ID, COMPONENT_ID),
             health: SimLinkHealth::default(),
         }
     }
@@ -78,10 +79,13 @@ impl SimPort {
         self.parser.stats()
     }
 
-    /// Encodes a message from the autopilot on this link.
+    /// Encodes a message from the autopilot on this link (nothing for a message outside the
+    /// autopilot's dialect).
     pub fn encode(&mut self, msg: &MavMessage) -> heapless::Vec<u8, 280> {
-        let raw = self.tx.encode(msg);
-        heapless::Vec::from_slice(raw.raw_bytes()).unwrap_or_default()
+        self.tx
+            .try_encode(msg)
+            .and_then(|raw| heapless::Vec::from_slice(raw.raw_bytes()).ok())
+            .unwrap_or_default()
     }
 
     /// Bytes from the simulator; `out` receives the answers.
@@ -122,7 +126,9 @@ impl SimPort {
                     armed: vehicle.armed(),
                 };
                 let msg = MavMessage::HIL_ACTUATOR_CONTROLS(simlink::encode_actuators(&answer));
-                out(self.tx.encode(&msg).raw_bytes());
+                if let Some(raw) = self.tx.try_encode(&msg) {
+                    out(raw.raw_bytes());
+                }
             }
             MavMessage::HIL_GPS(d) => match simlink::decode_hil_gps(d) {
                 Some(fix) => {
