@@ -69,3 +69,14 @@ pub fn tool_available(name: &str) -> bool {
 pub fn build_sim_host_with_mcu_libm() -> PathBuf {
     cargo_build("mcu-libm", &["-p", "sim-host", "--features", "mcu-libm"]).join("release/sim-host")
 }
+
+/// A child process (QEMU, a station) ended with the test that started it, however the test
+/// ends.
+pub struct Kill(pub std::process::Child);
+
+impl Drop for Kill {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}

@@ -7,17 +7,9 @@ use mavlink::dialects::common::MavMessage;
 use nalgebra::Vector3;
 use sim_host::link::lockstep::Lockstep;
 use sim_host::link::transport::TcpServer;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::Duration;
-use system_tests::{build_mcu_firmware, tool_available};
-
-struct Kill(Child);
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+use system_tests::{build_mcu_firmware, tool_available, Kill};
 
 #[test]
 fn the_emulated_stm32f405_answers_every_sensor_frame() {

@@ -22,7 +22,7 @@ use sim_host::link::qemu::{QemuConfig, BUILD_COMMAND};
 use sim_host::plant::ModelParams;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use system_tests::{build_mcu_firmware, build_sim_host_with_mcu_libm, tool_available};
+use system_tests::{build_mcu_firmware, build_sim_host_with_mcu_libm, tool_available, Kill};
 
 /// Simulated time of the flight CI flies: the take-off (item 0, done at about 28 s) and the
 /// first two legs (items 1 and 2, reached at about 49 s and 71 s).
@@ -430,15 +430,6 @@ fn a_profile_from_qemus_trace_counts_the_work_the_image_counts_with_its_own_cloc
             p.functions.iter().any(|f| f.function.contains(stage)),
             "{stage} missing from the profile"
         );
-    }
-}
-
-/// Ends QEMU with the test.
-struct Kill(std::process::Child);
-impl Drop for Kill {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
     }
 }
 

@@ -362,8 +362,6 @@ pub struct BoardRecordRef<'a> {
     pub signing: SigningRecord,
 }
 
-pub use stream::{load_board_into, save_board, BoardLoaded};
-
 /// Error of [`RamFlash`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RamFlashError {
@@ -505,7 +503,7 @@ fn self_spend(budget: &mut Option<usize>, ops: &mut usize) -> Result<bool, RamFl
 }
 
 pub mod f4;
-mod stream;
+pub mod stream;
 
 #[cfg(test)]
 mod tests;

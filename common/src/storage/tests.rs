@@ -4,6 +4,7 @@ extern crate std;
 
 use serde::{Deserialize, Serialize};
 
+use super::stream::{load_board_into, save_board};
 use super::*;
 use crate::navigation::plan::{MissionItem, MissionStore};
 use crate::param;

@@ -7,10 +7,9 @@
 //! to 0.8 s. `MAV_CMD_PREFLIGHT_STORAGE` is answered once its save is done.
 
 use common::params::store::ImportReport;
+use common::storage::stream::{load_board_into, save_board};
 use common::storage::StorageError;
-use common::storage::{
-    load_board_into, save_board, AbRegion, BoardRecordRef, Flash, SigningRecord,
-};
+use common::storage::{AbRegion, BoardRecordRef, Flash, SigningRecord};
 
 use super::App;
 
