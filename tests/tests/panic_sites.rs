@@ -16,10 +16,10 @@ use object::{Object, ObjectSection, ObjectSymbol, SectionKind, SymbolKind};
 use system_tests::build_mcu_firmware;
 
 /// Sites allowed in everything else the image links (the `mavlink` crate, `crc_any`, `libm`,
-/// `core`'s float formatting, the runtime and the logger): the count at the time of writing.
+/// `heapless`'s rings, the runtime and the logger): the count at the time of writing.
 /// Lower it as sites go; never raise it without saying in `docs/RELIABILITY.md` why the new
 /// ones cannot fire.
-const DEPENDENCY_SITES: usize = 347;
+const DEPENDENCY_SITES: usize = 73;
 
 /// Whether a (demangled, hash-free) function name is one of core's panic entry points.
 fn is_panic_entry(name: &str) -> bool {
@@ -45,6 +45,20 @@ fn crate_of(name: &str) -> &str {
     match &n[..end] {
         "" => "?",
         c => c,
+    }
+}
+
+/// Whose site it is: the crate of the function holding it, except `heapless`'s SPSC ring
+/// arithmetic inlined into the USART driver. heapless 0.9's `Producer` and `Consumer` step
+/// their indices `% capacity` with the capacity read from the queue at run time, so the
+/// compiler keeps a division-by-zero check in every function that moves a byte; the rings'
+/// capacity is a constant (512), never zero (docs/RELIABILITY.md). Only that check, in that
+/// module, is counted as heapless's.
+fn owner(s: &Site) -> &str {
+    if s.function.starts_with("firmware::mcu::usart::") && s.callee.ends_with("rem_by_zero") {
+        "heapless (spsc, inlined into firmware::mcu::usart)"
+    } else {
+        crate_of(&s.function)
     }
 }
 
@@ -169,7 +183,7 @@ fn panic_call_sites_in_the_mcu_image_do_not_grow() {
     let sites = panic_sites(&bytes);
     let mut by_crate: BTreeMap<&str, Vec<&Site>> = BTreeMap::new();
     for s in &sites {
-        by_crate.entry(crate_of(&s.function)).or_default().push(s);
+        by_crate.entry(owner(s)).or_default().push(s);
     }
     println!("panic call sites in the MCU image: {}", sites.len());
     for (krate, list) in &by_crate {

@@ -732,21 +732,26 @@ type Gain = super::kalman::Gain<N>;
 /// not yet changed and no copy of the matrix is made. The caller's conditioning makes the
 /// result exactly symmetric.
 fn propagate(p: &mut Mat, blocks: &[(usize, usize, &Matrix3<f32>)]) {
+    // Checked element access: the block offsets are the filter's own constants, but the image
+    // carries no panic path for them (tests/tests/panic_sites.rs).
+    let at = |p: &Mat, r: usize, c: usize| p.get((r, c)).copied().unwrap_or(0.0);
     for &(row, col, b) in blocks.iter().rev() {
         for c in 0..N {
-            let x = Vector3::new(p[(col, c)], p[(col + 1, c)], p[(col + 2, c)]);
-            let y = b * x;
-            for k in 0..3 {
-                p[(row + k, c)] += y[k];
+            let y = b * Vector3::new(at(p, col, c), at(p, col + 1, c), at(p, col + 2, c));
+            for (k, yk) in y.iter().enumerate() {
+                if let Some(v) = p.get_mut((row + k, c)) {
+                    *v += yk;
+                }
             }
         }
     }
     for &(row, col, b) in blocks.iter().rev() {
         for r in 0..N {
-            let x = Vector3::new(p[(r, col)], p[(r, col + 1)], p[(r, col + 2)]);
-            let y = b * x;
-            for k in 0..3 {
-                p[(r, row + k)] += y[k];
+            let y = b * Vector3::new(at(p, r, col), at(p, r, col + 1), at(p, r, col + 2));
+            for (k, yk) in y.iter().enumerate() {
+                if let Some(v) = p.get_mut((r, row + k)) {
+                    *v += yk;
+                }
             }
         }
     }
