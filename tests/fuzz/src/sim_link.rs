@@ -315,9 +315,12 @@ impl Harness {
                 }
                 // Datagrams: a cut frame never holds back the simulator's next one.
                 self.app.on_gcs_datagram(1, &bytes);
+                // What it answered is checked as it is drained. The heartbeat is not asked of
+                // it: a datagram that asks the vehicle nothing costs its framing only, and the
+                // link's next run is the next sensor frame's, where the heartbeat is checked.
                 let sent = drain(&mut self.app);
                 let now = self.app.vehicle().time_us().unwrap_or(0);
-                self.heartbeat.after_poll(now, &sent);
+                self.heartbeat.note(now, &sent);
             }
         }
     }

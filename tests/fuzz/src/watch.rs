@@ -185,6 +185,17 @@ pub struct Heartbeat {
 }
 
 impl Heartbeat {
+    /// After a call that may not have run the ground link (a datagram that asked nothing): a
+    /// heartbeat it sent is recorded, none is asked of it.
+    pub fn note(&mut self, now_us: u64, sent: &[Sent]) {
+        let beat = sent
+            .iter()
+            .any(|s| matches!(s.message, MavMessage::HEARTBEAT(_)) && s.dest == Dest::All);
+        if beat {
+            self.last_us = Some(now_us);
+        }
+    }
+
     /// After a call that ran the ground link at vehicle time `now_us` and sent `sent`.
     pub fn after_poll(&mut self, now_us: u64, sent: &[Sent]) {
         let beat = sent
@@ -212,12 +223,14 @@ impl Heartbeat {
     }
 }
 
-/// After a call that ran the ground link: what it sent, checked (the heartbeat, every
-/// `PARAM_VALUE` against the store, every stored value against its checks).
+/// After a call into the ground port: what it sent, checked (every `PARAM_VALUE` against the
+/// store, every stored value against its checks). A datagram that asks the vehicle nothing
+/// costs its framing only and does not run the link, so a heartbeat is recorded here but
+/// asked only after sensor frames (`sim_link`), which always run it.
 pub fn after_ground(app: &mut App, heartbeat: &mut Heartbeat) -> Vec<Sent> {
     let sent = drain(app);
     let now = app.vehicle().time_us().unwrap_or(0);
-    heartbeat.after_poll(now, &sent);
+    heartbeat.note(now, &sent);
     let store = app.vehicle().params();
     for s in &sent {
         check_param_value(&s.message, store);
