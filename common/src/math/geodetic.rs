@@ -71,16 +71,23 @@ fn deg_e7_to_rad(d: i64) -> f64 {
     d as f64 / E7_PER_DEG * core::f64::consts::PI / 180.0
 }
 
+/// A longitude, or a difference of two, in 1e-7 deg brought within half a turn of zero (the
+/// short way across the antimeridian).
+fn wrap_lon_e7(d: i64) -> i64 {
+    if d > DEG_E7_FULL_TURN / 2 {
+        d - DEG_E7_FULL_TURN
+    } else if d < -DEG_E7_FULL_TURN / 2 {
+        d + DEG_E7_FULL_TURN
+    } else {
+        d
+    }
+}
+
 /// North and east offsets (m) of `p` from `origin`.
 pub fn ned_offset<T: RealField + Copy>(origin: GeoPoint, p: GeoPoint) -> (T, T) {
     let dlat = i64::from(p.lat_e7) - i64::from(origin.lat_e7);
-    let mut dlon = i64::from(p.lon_e7) - i64::from(origin.lon_e7);
     // Take the short way across the antimeridian.
-    if dlon > DEG_E7_FULL_TURN / 2 {
-        dlon -= DEG_E7_FULL_TURN;
-    } else if dlon < -DEG_E7_FULL_TURN / 2 {
-        dlon += DEG_E7_FULL_TURN;
-    }
+    let dlon = wrap_lon_e7(i64::from(p.lon_e7) - i64::from(origin.lon_e7));
     // Radii at the middle latitude: the parallel shrinks with latitude, and scaling east by
     // the reference's cosine alone costs 3 cm at 1 km on the diagonal.
     let lat_mid = deg_e7_to_rad(i64::from(origin.lat_e7)) + 0.5 * deg_e7_to_rad(dlat);
@@ -185,12 +192,7 @@ impl LocalFrame {
     /// North and east offsets (m) of `p` from the origin (as [`ned_offset`]).
     pub fn ned_offset(&self, p: GeoPoint) -> (f32, f32) {
         let dlat = i64::from(p.lat_e7) - i64::from(self.origin.lat_e7);
-        let mut dlon = i64::from(p.lon_e7) - i64::from(self.origin.lon_e7);
-        if dlon > DEG_E7_FULL_TURN / 2 {
-            dlon -= DEG_E7_FULL_TURN;
-        } else if dlon < -DEG_E7_FULL_TURN / 2 {
-            dlon += DEG_E7_FULL_TURN;
-        }
+        let dlon = wrap_lon_e7(i64::from(p.lon_e7) - i64::from(self.origin.lon_e7));
         let k = RAD_PER_E7 as f32;
         let (dlat, dlon) = (dlat as f32 * k, dlon as f32 * k);
         let mid = 0.5 * dlat;
@@ -215,12 +217,7 @@ impl LocalFrame {
             r as i64
         };
         let lat = i64::from(self.origin.lat_e7).saturating_add(round(dlat / k));
-        let mut lon = i64::from(self.origin.lon_e7).saturating_add(round(dlon / k));
-        if lon > DEG_E7_FULL_TURN / 2 {
-            lon -= DEG_E7_FULL_TURN;
-        } else if lon < -DEG_E7_FULL_TURN / 2 {
-            lon += DEG_E7_FULL_TURN;
-        }
+        let lon = wrap_lon_e7(i64::from(self.origin.lon_e7).saturating_add(round(dlon / k)));
         let to_i32 = |x: i64| x.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
         GeoPoint {
             lat_e7: to_i32(lat),
