@@ -80,3 +80,22 @@ impl Drop for Kill {
         let _ = self.0.wait();
     }
 }
+
+/// QEMU started by `command` (sim-host's `QemuConfig::command`, given the two addresses) with
+/// its two USARTs on fresh loopback listeners and its standard streams closed; the listeners
+/// (USART1, USART2) wait for it to connect.
+pub fn spawn_qemu(
+    command: impl FnOnce(std::net::SocketAddr, std::net::SocketAddr) -> Command,
+) -> (Kill, std::net::TcpListener, std::net::TcpListener) {
+    use std::process::Stdio;
+    let sim = std::net::TcpListener::bind("127.0.0.1:0").expect("sim listener");
+    let gcs = std::net::TcpListener::bind("127.0.0.1:0").expect("gcs listener");
+    let addr = |l: &std::net::TcpListener| l.local_addr().expect("a bound address");
+    let child = command(addr(&sim), addr(&gcs))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("qemu starts");
+    (Kill(child), sim, gcs)
+}

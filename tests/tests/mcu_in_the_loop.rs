@@ -9,7 +9,7 @@ use sim_host::link::lockstep::Lockstep;
 use sim_host::link::transport::TcpServer;
 use std::process::{Command, Stdio};
 use std::time::Duration;
-use system_tests::{build_mcu_firmware, tool_available, Kill};
+use system_tests::{build_mcu_firmware, spawn_qemu, tool_available, Kill};
 
 #[test]
 fn the_emulated_stm32f405_answers_every_sensor_frame() {
@@ -183,22 +183,13 @@ fn boot_with_storage(
     std::thread::JoinHandle<()>,
     std::sync::Arc<std::sync::atomic::AtomicUsize>,
 ) {
-    let sim = std::net::TcpListener::bind("127.0.0.1:0").expect("sim listener");
-    let gcs = std::net::TcpListener::bind("127.0.0.1:0").expect("gcs listener");
     // The command line sim-host runs the image with, the storage file as its argument.
     let cfg = sim_host::link::qemu::QemuConfig {
         elf: elf.to_path_buf(),
         storage: Some(storage.to_path_buf()),
         ..Default::default()
     };
-    let child = cfg
-        .command(sim.local_addr().unwrap(), gcs.local_addr().unwrap())
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("qemu starts");
-    let qemu = Kill(child);
+    let (qemu, sim, gcs) = spawn_qemu(|s, g| cfg.command(s, g));
     let (sim, _) = sim.accept().expect("QEMU connects USART1");
     // Nobody simulates: the simulator link only counts boots (a heartbeat at each).
     let boots = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));

@@ -22,7 +22,7 @@ use sim_host::link::qemu::{QemuConfig, BUILD_COMMAND};
 use sim_host::plant::ModelParams;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use system_tests::{build_mcu_firmware, build_sim_host_with_mcu_libm, tool_available, Kill};
+use system_tests::{build_mcu_firmware, build_sim_host_with_mcu_libm, spawn_qemu, tool_available};
 
 /// Simulated time of the flight CI flies: the take-off (item 0, done at about 28 s) and the
 /// first two legs (items 1 and 2, reached at about 49 s and 71 s).
@@ -447,21 +447,10 @@ fn ground_bursts_sent_while_the_image_is_busy_are_answered_in_full_with_no_byte_
     use sim_host::link::transport::TcpServer;
     use std::collections::BTreeSet;
     use std::io::{Read, Write};
-    use std::net::TcpListener;
-    use std::process::Stdio;
     use std::sync::{Arc, Mutex};
 
     let Some(qemu) = mcu() else { return };
-    let sim = TcpListener::bind("127.0.0.1:0").expect("sim listener");
-    let gcs = TcpListener::bind("127.0.0.1:0").expect("gcs listener");
-    let child = qemu
-        .command(sim.local_addr().unwrap(), gcs.local_addr().unwrap())
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("qemu starts");
-    let _qemu = Kill(child);
+    let (_qemu, sim, gcs) = spawn_qemu(|s, g| qemu.command(s, g));
     let sim = TcpServer::accept(&sim, Some(Duration::from_secs(20)), || Ok(()))
         .expect("QEMU connects USART1");
     let (mut station, _) = gcs.accept().expect("QEMU connects USART2");
