@@ -263,6 +263,14 @@ pub enum RollMode {
     Roll(f32),
     /// Hold this course over ground, rad (any value; the error is wrapped to +-pi).
     Course(f32),
+    /// Hold `course` (rad) banking no further than `roll_max` (rad; the roll limit when
+    /// larger): close to the ground, where a wing tip would touch.
+    CourseWithin {
+        /// Course over ground, rad.
+        course: f32,
+        /// Largest roll angle, rad.
+        roll_max: f32,
+    },
 }
 
 /// What the rudder does in every mode the autopilot flies by itself: the yaw damper. The
@@ -452,6 +460,12 @@ impl Lateral {
             }
             RollMode::Roll(phi_c) => (RollKind::Roll, phi_c),
             RollMode::Course(chi_c) => (RollKind::Course, chi_c),
+            RollMode::CourseWithin { course, .. } => (RollKind::Course, course),
+        };
+        // NaN (never from the navigator) leaves the roll limit alone.
+        let within = match mode {
+            RollMode::CourseWithin { roll_max, .. } if roll_max >= 0.0 => roll_max,
+            _ => g.roll_max,
         };
         let mut bad = InputFlags::empty();
         bad.set(InputFlags::ROLL, !m.roll.is_finite());
@@ -486,7 +500,10 @@ impl Lateral {
                     self.course.reset_to(from, Bumpless::Fade);
                 }
                 let e = wrap_pi(setpoint - m.course);
-                self.course.step(e, Derivative::None, 0.0, dt)
+                // The tighter limit clamps the loop's output, not its integrator: the course
+                // integral is slow (CRS_KI 0.01/s) and close to the ground lasts seconds.
+                let phi = self.course.step(e, Derivative::None, 0.0, dt);
+                clamp(phi, -within, within)
             }
             _ => {
                 self.course.reset();
@@ -695,6 +712,42 @@ mod tests {
         let wild = Measurements { roll: 3.0, ..m };
         let o = lat.step(&wild, RollMode::Roll(-80.0 * D), YawMode::Off, DT);
         assert!(o.aileron.abs() <= SURFACE_LIMIT_RAD + 1e-6);
+    }
+
+    /// Close to the ground the course loop banks no further than it is allowed, either way,
+    /// whatever the course error; a limit above the roll limit leaves the roll limit, and a
+    /// NaN limit is ignored.
+    #[test]
+    fn a_course_held_within_a_bank_limit_banks_no_further() {
+        let mut lat = Lateral::new(&zero_trim(), 1.0);
+        let m = Measurements::level(17.0, 100.0);
+        for (course, roll_max, expected) in [
+            (150.0f32, 5.0f32, 5.0f32),
+            (-150.0, 5.0, -5.0),
+            (150.0, 20.0, 20.0),
+            (150.0, 80.0, 45.0),
+            (150.0, f32::NAN, 45.0),
+        ] {
+            // Past the bumpless fade from the previous command.
+            let mut o = LateralOutput::default();
+            for _ in 0..500 {
+                o = lat.step(
+                    &m,
+                    RollMode::CourseWithin {
+                        course: course * D,
+                        roll_max: roll_max * D,
+                    },
+                    YawMode::Off,
+                    DT,
+                );
+                assert!(o.roll_cmd.abs() <= expected.abs() * D + 1e-6);
+            }
+            assert!(
+                (o.roll_cmd - expected * D).abs() < 1e-6,
+                "{course} within {roll_max}: {}",
+                o.roll_cmd / D
+            );
+        }
     }
 
     #[test]
