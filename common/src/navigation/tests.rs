@@ -80,6 +80,7 @@ impl Plane {
             vel_ned: Vector3::new(v.x, v.y, -self.climb),
             heading: self.k.heading,
             airspeed: self.k.airspeed,
+            yaw_rate: 0.0,
         }
     }
 
@@ -91,7 +92,7 @@ impl Plane {
         let h = self.height();
         let max_rate = crate::math::GRAVITY / self.k.airspeed.max(5.0);
         match c.roll {
-            RollMode::Course(chi) if h > 0.5 => {
+            RollMode::Course(chi) | RollMode::CourseWithin { course: chi, .. } if h > 0.5 => {
                 let rate =
                     (wrap_pi(chi - self.k.course()) / self.k.tau_course).clamp(-max_rate, max_rate);
                 self.k.heading = wrap_pi(self.k.heading + rate * dt);
@@ -540,6 +541,56 @@ fn runway_takeoff() {
     assert!(plane.k.airspeed >= vr);
 }
 
+/// A take-off item 60 deg off the heading the aircraft stands on (an item placed anywhere by a
+/// ground station): the roll and the climb follow the runway the aircraft stands on, never
+/// towards the item, until the item's altitude; with `NAV_TKO_TO_ITEM` the line runs to the
+/// item instead.
+#[test]
+fn a_take_off_follows_the_heading_the_aircraft_stands_on_not_an_item_off_the_runway() {
+    let bearing = 60f32.to_radians();
+    let items = [item(
+        NAV_TAKEOFF,
+        [0.0; 4],
+        600.0 * libm::cosf(bearing),
+        600.0 * libm::sinf(bearing),
+        40.0,
+    )];
+    for to_item in [false, true] {
+        let mut nav = navigator();
+        let mut p = *nav.params();
+        EXEC_PARAMS
+            .set(&mut p, "NAV_TKO_TO_ITEM", if to_item { 1.0 } else { 0.0 })
+            .expect("in range");
+        nav.set_params(&p);
+        let mut plane = Plane::flying(0.0, 0.0, 0.0, 0.0);
+        plane.k.airspeed = 0.0;
+        nav.start_mission(0);
+        let log = fly(&mut nav, &mut plane, &items, 120.0, |o| {
+            o.reached == Some(0)
+        });
+        assert_eq!(log.reached, [0], "NAV_TKO_TO_ITEM {to_item}");
+        let (_, first, _) = &log.outs[0];
+        let far = first.target.expect("a take-off flies to a point");
+        let runway = libm::atan2f(far.y, far.x);
+        let expected = if to_item { bearing } else { 0.0 };
+        assert!(
+            (runway - expected).abs() < 0.01,
+            "NAV_TKO_TO_ITEM {to_item}: runway {} deg",
+            runway.to_degrees()
+        );
+        if !to_item {
+            for (_, o, p) in &log.outs {
+                assert!(
+                    matches!(o.phase, Phase::TakeoffRoll | Phase::TakeoffClimb),
+                    "{:?}",
+                    o.phase
+                );
+                assert!(p.y.abs() < 0.5, "off the runway by {} m", p.y);
+            }
+        }
+    }
+}
+
 /// Landing from a waypoint 900 m north of the land point at 60 m: level until the 6-degree
 /// glide slope, down it, flare, touchdown near the land point, on the line, `landed`
 /// reported after a second on the ground, with the item reached. On the slope the height is
@@ -767,6 +818,7 @@ fn garbage_items_and_state_do_not_panic() {
             vel_ned: Vector3::new(f32::NAN, 0.0, 0.0),
             heading: f32::NAN,
             airspeed: f32::NAN,
+            yaw_rate: f32::NAN,
         };
         nav.set_current((next() % 14) as u16);
         let _ = nav.step(&items, &home(), &bad, f32::NAN);

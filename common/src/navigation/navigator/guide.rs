@@ -7,7 +7,7 @@ use crate::control::autopilot::Commands;
 use crate::control::lateral::{RollMode, YawMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::guidance::{Guidance, GuidanceOutput, OrbitDirection, Path};
-use crate::math::wrap_pi;
+use crate::math::{wrap_pi, DEG};
 use nalgebra::Vector3;
 
 /// Largest steering deflection, rad.
@@ -54,6 +54,25 @@ pub(super) fn follow(g: &GuidanceOutput) -> Commands {
     }
 }
 
+/// Holding `course` (rad) at `height` (m) above the ground: the bank allowed widens linearly
+/// from `NAV_GND_RLL_DEG` at the ground to 90 deg at `NAV_GND_RLL_M` (the roll limit governs
+/// once it is the smaller), so a wing tip cannot touch (the Ultra Stick's does at 17 deg of
+/// bank with its wheels on the ground, at 38 deg with them 0.2 m up, at none from 0.45 m).
+pub(super) fn course_near_ground(course: f32, height: f32, p: &NavParams) -> RollMode {
+    let frac = if p.ground_roll_height > 0.0 && height.is_finite() {
+        (height / p.ground_roll_height).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    if frac >= 1.0 {
+        return RollMode::Course(course);
+    }
+    RollMode::CourseWithin {
+        course,
+        roll_max: p.ground_roll_max + (90.0 * DEG - p.ground_roll_max) * frac,
+    }
+}
+
 /// Distance between two points over the ground, m.
 pub(super) fn horizontal_dist(a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
     libm::hypotf(a.x - b.x, a.y - b.y)
@@ -95,12 +114,46 @@ impl Flight<'_> {
     /// Tail-wheel steering towards `course` (rad): on the runway the heading is the course.
     pub fn steer(&self, course: f32) -> YawMode {
         let err = wrap_pi(course - self.state.heading);
-        // Positive rudder (trailing edge left) turns the nose left.
-        let d = -self.params.steer_k * err;
+        // Positive rudder (trailing edge left) turns the nose left. A taildragger's centre of
+        // gravity behind its main wheels makes it swing further once it swings: the yaw-rate
+        // term opposes the swing before the heading error has grown.
+        let d = -self.params.steer_k * err + self.params.steer_d * self.state.yaw_rate;
         YawMode::Rudder(if d.is_finite() {
             d.clamp(-STEER_MAX, STEER_MAX)
         } else {
             0.0
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bank allowed on a course close to the ground: `NAV_GND_RLL_DEG` (5 deg) on it, widening
+    /// linearly to 90 deg at `NAV_GND_RLL_M` (3 m), where the roll limit alone governs.
+    #[test]
+    fn the_bank_allowed_near_the_ground_widens_with_height() {
+        let p = NavParams::default();
+        for (h, expected) in [(-1.0, 5.0), (0.0, 5.0), (0.3, 13.5), (1.5, 47.5)] {
+            match course_near_ground(0.3, h, &p) {
+                RollMode::CourseWithin { course, roll_max } => {
+                    assert_eq!(course, 0.3);
+                    assert!(
+                        (roll_max.to_degrees() - expected).abs() < 1e-3,
+                        "at {h} m: {} deg",
+                        roll_max.to_degrees()
+                    );
+                }
+                other => panic!("at {h} m: {other:?}"),
+            }
+        }
+        for h in [3.0, 50.0, f32::NAN] {
+            assert_eq!(
+                course_near_ground(0.3, h, &p),
+                RollMode::Course(0.3),
+                "at {h} m"
+            );
+        }
     }
 }

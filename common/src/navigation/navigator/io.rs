@@ -17,6 +17,8 @@ pub struct NavState {
     pub heading: f32,
     /// Airspeed, m/s.
     pub airspeed: f32,
+    /// Yaw rate about the body's z axis, rad/s (the heading's rate on the runway).
+    pub yaw_rate: f32,
 }
 
 impl NavState {
@@ -27,6 +29,7 @@ impl NavState {
             vel_ned: s.vel_ned,
             heading: s.euler.psi,
             airspeed: s.airspeed,
+            yaw_rate: s.body_rates.z,
         }
     }
 

@@ -13,7 +13,7 @@
 //! than 0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
 //! stopped.
 
-use super::guide::{follow, horizontal_dist, Flight};
+use super::guide::{course_near_ground, follow, horizontal_dist, Flight};
 use super::io::{NavOutput, Phase};
 use super::params::NavParams;
 use crate::control::autopilot::Commands;
@@ -46,6 +46,28 @@ const PAST_SINK_MAX: f32 = 1.0;
 /// Climb rate that, below the touchdown height, shows the wheels have touched and kicked the
 /// aircraft up, m/s.
 const BOUNCE_CLIMB: f32 = 0.3;
+
+/// Pitch held on the roll-out once slow, rad: above the taildragger's three-point attitude
+/// (8.7 deg on the Ultra Stick), so the elevator holds the tail wheel down for steering, as a
+/// pilot holds the stick back. Pitch 0 there (the wheel landing's attitude) has the pitch loop
+/// wind up against the tail wheel in a headwind and, once the tail lifts, put the nose onto
+/// the propeller.
+const TAIL_DOWN_PITCH: f32 = 10.0 * DEG;
+/// Airspeeds between which the roll-out's pitch goes from [`TAIL_DOWN_PITCH`] to the wheel
+/// landing's 0, m/s. Fast, the low attitude keeps the wing's lift under the weight (at 13 m/s
+/// the three-point attitude's C_L of about 0.9 on 0.31 m^2 lifts 29 N, against 19 N); at 6
+/// m/s the three-point attitude lifts a third of the weight.
+const TAIL_DOWN_AIRSPEEDS: (f32, f32) = (6.0, 9.0);
+
+/// The roll-out's pitch at `airspeed` (m/s); the tail down when the airspeed is unknown, as
+/// the aircraft has stopped flying.
+fn rollout_pitch(airspeed: f32) -> f32 {
+    let (slow, fast) = TAIL_DOWN_AIRSPEEDS;
+    if !airspeed.is_finite() {
+        return TAIL_DOWN_PITCH;
+    }
+    TAIL_DOWN_PITCH * ((fast - airspeed) / (fast - slow)).clamp(0.0, 1.0)
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum LandPhase {
@@ -207,6 +229,7 @@ impl Landing {
                 // `NAV_APP_DIVE_M` below the present height, and the landing is long instead.
                 let cmd = (g.altitude + self.slope_trim).max(state.height() - p.approach_dive);
                 out.commands = Some(Commands {
+                    roll: course_near_ground(g.course, hagl, p),
                     lon: LonMode::Glide {
                         altitude: cmd,
                         airspeed: g.airspeed,
@@ -251,7 +274,7 @@ impl Landing {
                     RUDDER
                 };
                 out.commands = Some(Commands {
-                    roll: RollMode::Course(g.course),
+                    roll: course_near_ground(g.course, hagl, p),
                     yaw,
                     lon: LonMode::Pitch {
                         pitch,
@@ -266,7 +289,7 @@ impl Landing {
                     roll: RollMode::Roll(0.0),
                     yaw: f.steer(g.path_course),
                     lon: LonMode::Pitch {
-                        pitch: 0.0,
+                        pitch: rollout_pitch(state.airspeed),
                         throttle: 0.0,
                     },
                 });

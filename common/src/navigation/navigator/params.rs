@@ -248,6 +248,47 @@ pub const PARAMS: Group<NavParams> = Group {
             ),
             NavParams => steer_k
         ),
+        param!(
+            ParamDef::real(
+                "NAV_STEER_D",
+                0.3,
+                0.0,
+                2.0,
+                "s",
+                "Ground steering: rudder (tail wheel) per rad/s of yaw rate, against it (damps the taildragger's swing on the runway)",
+            ),
+            NavParams => steer_d
+        ),
+        param!(
+            ParamDef::boolean(
+                "NAV_TKO_TO_ITEM",
+                false,
+                "Take-off along the line to the take-off item's position; off: along the heading the aircraft stands on when the roll starts (its runway)",
+            ),
+            NavParams => takeoff_to_item, flag
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_GND_RLL_DEG",
+                5.0,
+                0.0,
+                45.0,
+                "deg",
+                "Largest bank at the ground in take-off, approach and flare; it widens linearly with height to 90 deg at NAV_GND_RLL_M (LIM_ROLL_DEG governs once it is the smaller)",
+            ),
+            NavParams => ground_roll_max, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_GND_RLL_M",
+                3.0,
+                0.5,
+                50.0,
+                "m",
+                "Height at which the bank allowed near the ground has widened from NAV_GND_RLL_DEG to 90 deg",
+            ),
+            NavParams => ground_roll_height
+        ),
     ],
     base: || ZERO,
     check: consistent,
@@ -293,6 +334,14 @@ pub struct NavParams {
     pub touchdown_alt: f32,
     /// Ground steering gain, rad of rudder per rad of course error.
     pub steer_k: f32,
+    /// Ground steering yaw-rate damping, rad of rudder per rad/s.
+    pub steer_d: f32,
+    /// Take off along the line to the item's position rather than the standing heading.
+    pub takeoff_to_item: bool,
+    /// Largest bank at the ground, rad.
+    pub ground_roll_max: f32,
+    /// Height at which the bank allowed near the ground has widened to 90 deg, m.
+    pub ground_roll_height: f32,
     /// Approach integral gain on the height error, 1/s.
     pub approach_i: f32,
     /// Largest height the approach's command lies below the present height, m.
@@ -322,6 +371,10 @@ const ZERO: NavParams = NavParams {
     flare_k: 0.0,
     touchdown_alt: 0.0,
     steer_k: 0.0,
+    steer_d: 0.0,
+    takeoff_to_item: false,
+    ground_roll_max: 0.0,
+    ground_roll_height: 0.0,
     approach_i: 0.0,
     approach_dive: 0.0,
     flare_past_k: 0.0,

@@ -2,10 +2,13 @@
 //!
 //! Take-off is a runway take-off: full throttle, wings level, pitch 0 until the rotation
 //! airspeed, then the thesis's take-off regime (`LonMode::TakeOff`: fixed pitch, full
-//! throttle to the clear height, then climb) to the item's altitude; the course is held along
-//! the runway once above the clear height.
+//! throttle to the clear height, then climb) to the item's altitude. The runway is the line
+//! along the heading the aircraft stands on when the roll starts, as a pilot lines it up
+//! (`NAV_TKO_TO_ITEM` takes the line to the item's position instead): the tail wheel holds
+//! it until the wheels are off, and the bank allowed near the ground is small
+//! (`NAV_GND_RLL_DEG`), widening with height.
 
-use super::guide::{horizontal_dist, Flight, Orbit};
+use super::guide::{course_near_ground, horizontal_dist, Flight, Orbit};
 use super::io::{NavOutput, NavState, Phase};
 use super::params::NavParams;
 use crate::control::autopilot::Commands;
@@ -32,9 +35,9 @@ pub(super) struct Takeoff {
 }
 
 impl Takeoff {
-    /// The take-off of `item`, whose position is `target` (NED from home): along the line to
-    /// that point when it lies more than 20 m away, else on the item's yaw (`param4`), else
-    /// on the present heading.
+    /// The take-off of `item`, whose position is `target` (NED from home): along the present
+    /// heading; with `NAV_TKO_TO_ITEM`, along the line to that point when it lies more than
+    /// 20 m away, else on the item's yaw (`param4`), else on the present heading.
     pub fn item(
         item: &MissionItem,
         target: Vector3<f32>,
@@ -44,6 +47,7 @@ impl Takeoff {
     ) -> Self {
         let pos = state.pos_ned;
         let course = match items::point(item) {
+            _ if !p.takeoff_to_item => state.heading,
             Some(_) if horizontal_dist(&target, &pos) > 20.0 => {
                 libm::atan2f(target.y - pos.y, target.x - pos.x)
             }
@@ -97,15 +101,20 @@ impl Takeoff {
             out.phase = Phase::TakeoffClimb;
             let g = line.map(|l| f.guidance.step(&l, &pos, vg));
             out.guidance = g;
-            // Along the runway line from lift-off: near the line the vector field asks
-            // for a few degrees of course, so little bank close to the ground.
+            let height = state.height() + self.start.z;
             let roll = match g {
-                Some(g) => RollMode::Course(g.course),
+                Some(g) => course_near_ground(g.course, height, p),
                 None => RollMode::Roll(0.0),
+            };
+            // Rotated but still on its wheels, the aircraft is steered as on the roll: a
+            // yaw damper alone lets the tail wheel, pressed down by the rotation, swing it.
+            let yaw = match g {
+                Some(g) if height < p.touchdown_alt => f.steer(g.course),
+                _ => RUDDER,
             };
             out.commands = Some(Commands {
                 roll,
-                yaw: RUDDER,
+                yaw,
                 lon: LonMode::TakeOff {
                     altitude: self.height,
                     airspeed: f.cruise,
