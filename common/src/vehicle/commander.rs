@@ -454,11 +454,20 @@ impl Commander {
         let sticks = self
             .sticks
             .filter(|s| now_us.saturating_sub(s.time_us) <= STICK_TIMEOUT_US);
+        // On the ground with no pilot on the sticks, the motor idles and the surfaces rest at
+        // trim, as PX4 idles a landed fixed wing: otherwise arming would run it at its trim
+        // throttle (57 %) at once, and the loops of the holding modes would wind up against
+        // the wheels. The loops take over from these positions once airborne.
+        let idle = Surfaces {
+            throttle: 0.0,
+            ..trim_surfaces(gains)
+        };
         if self.mode == FlightMode::Manual {
             // Pass-through: sticks straight to the surfaces (PX4's normalised sense), trim
-            // when no stick is live.
+            // when no stick is live (idle on the ground).
             let s = match sticks {
                 Some(s) => Surfaces::from_px4_controls([s.roll, s.pitch, s.yaw, s.throttle]),
+                None if self.land.landed() => idle,
                 None => trim_surfaces(gains),
             };
             return (Demand::Surfaces(s), None);
@@ -480,6 +489,14 @@ impl Commander {
             // No home yet (refused before, so only after a reset): hold what we have.
             let c = commands.unwrap_or(hold(sp.alt_amsl_m));
             return (Demand::Commands(c), home);
+        }
+        let unflown = match flown {
+            FlightMode::Altitude | FlightMode::Hold => true,
+            FlightMode::Stabilized => sticks.is_none(),
+            _ => false,
+        };
+        if self.land.landed() && unflown {
+            return (Demand::Surfaces(idle), None);
         }
         let commands = match flown {
             FlightMode::Stabilized => Commands {

@@ -109,6 +109,7 @@ fn arming_in_the_air_keeps_home() {
 fn entering_hold_holds_the_present_course_and_altitude() {
     let mut c = Commander::new();
     let e = flying();
+    detect(&mut c, &e, 0.1);
     c.apply(&mode(FlightMode::Hold), &e);
     let sp = c.setpoints();
     assert_eq!((sp.course, sp.alt_amsl_m), (e.course, 360.0));
@@ -151,6 +152,8 @@ fn an_altitude_above_home_needs_a_home() {
 fn manual_passes_the_sticks_and_falls_back_to_the_thesis_trim_without_them() {
     let mut c = Commander::new();
     let e = flying();
+    // In the air (on the ground the motor idles without sticks).
+    detect(&mut c, &e, 0.1);
     let (d, _) = c.demand(1_000_000, 0.02, &e, &MissionStore::default(), &DESIGNED);
     let trim = Surfaces {
         elevator: -0.0963,
@@ -225,7 +228,8 @@ fn the_vehicle_runs_its_control_tick_every_20_ms_of_sensor_time() {
         gyro: Vector3::zeros(),
     };
     let g = FromGround::default();
-    // 100 Hz frames: the Manual trim is applied at the first frame and held.
+    // 100 Hz frames: the Manual trim, motor idle on the ground, is applied at the first
+    // frame and held.
     for k in 0..10u64 {
         let f = SensorFrame {
             time_us: k * 10_000,
@@ -234,7 +238,11 @@ fn the_vehicle_runs_its_control_tick_every_20_ms_of_sensor_time() {
         };
         v.on_sensors(&f, &g);
     }
-    assert_eq!(v.surfaces(), trim_surfaces(&DESIGNED));
+    let idle = Surfaces {
+        throttle: 0.0,
+        ..trim_surfaces(&DESIGNED)
+    };
+    assert_eq!(v.surfaces(), idle);
     assert_eq!(v.time_us(), Some(90_000));
     // A frame from the past is counted, and the clock does not go back.
     let old = SensorFrame {
@@ -384,4 +392,39 @@ fn an_air_start_below_home_altitude_at_cruise_speed_is_in_air() {
     detect(&mut c, &e, 2.0);
     assert_eq!(c.landed_state(), LandedState::InAir);
     assert!(c.flying());
+}
+
+/// Armed on the ground with no pilot on the sticks, neither Manual's pass-through nor the
+/// attitude and altitude holds run the motor at its trim (57 %) the moment the vehicle is
+/// armed: it idles, surfaces at trim, until a take-off; in the air the same modes fly.
+#[test]
+fn armed_on_the_ground_without_sticks_the_motor_idles() {
+    let mut e = on_ground();
+    e.ground_speed = 0.0;
+    for m in [
+        FlightMode::Manual,
+        FlightMode::Stabilized,
+        FlightMode::Altitude,
+        FlightMode::Hold,
+    ] {
+        let mut c = Commander::new();
+        detect(&mut c, &e, 2.0);
+        c.apply(&arm(), &e);
+        c.apply(&mode(m), &e);
+        detect(&mut c, &e, 0.1);
+        let (d, _) = c.demand(0, 0.02, &e, &MissionStore::default(), &DESIGNED);
+        match d {
+            Demand::Surfaces(s) => {
+                assert_eq!(s.throttle, 0.0, "{m:?}");
+                assert_eq!(s.elevator, DESIGNED.longitudinal.trim_elevator, "{m:?}");
+            }
+            Demand::Commands(c) => panic!("{m:?} on the ground flies {c:?}"),
+        }
+    }
+    let mut c = Commander::new();
+    c.apply(&arm(), &flying());
+    c.apply(&mode(FlightMode::Stabilized), &flying());
+    detect(&mut c, &flying(), 0.1);
+    let (d, _) = c.demand(0, 0.02, &flying(), &MissionStore::default(), &DESIGNED);
+    assert!(matches!(d, Demand::Commands(_)), "in the air: {d:?}");
 }
