@@ -168,8 +168,13 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     }
     let (mut plant, trim_controls) = match cfg.runway_heading {
         // On the wheels, engine off, surfaces at trim until the autopilot takes over.
+        // Held where it stands until the take-off roll's run-up, as on a real runway.
         Some(hdg) => (
-            Plant::at_rest_on_ground(aircraft, 0.0, 0.0, hdg),
+            {
+                let mut p = Plant::at_rest_on_ground(aircraft, 0.0, 0.0, hdg);
+                p.hold_until_throttle();
+                p
+            },
             Controls {
                 throttle: 0.0,
                 ..trim.controls

@@ -86,7 +86,13 @@ pub struct Plant {
     airborne_since_s: Option<f64>,
     touchdown: Option<Touchdown>,
     liftoff_s: Option<f64>,
+    /// The state it is held still in until the throttle first reaches
+    /// [`HOLD_RELEASE_THROTTLE`]: see [`Plant::hold_until_throttle`].
+    hold: Option<StateVector>,
 }
+
+/// Throttle at which a held aircraft is let go: the take-off roll's run-up.
+pub const HOLD_RELEASE_THROTTLE: f64 = 0.2;
 
 impl Plant {
     /// A plant of the given aircraft at `state`, time zero, neutral controls, calm air.
@@ -108,6 +114,7 @@ impl Plant {
             airborne_since_s: (!in_contact).then_some(0.0),
             touchdown: None,
             liftoff_s: None,
+            hold: None,
         }
     }
 
@@ -123,6 +130,21 @@ impl Plant {
         let params = ModelParams::new(aircraft);
         let (state, _) = ground::rest_state(&params, north_m, east_m, heading_rad);
         Self::from_params(params, state)
+    }
+
+    /// Holds the aircraft still where it stands until the throttle first reaches
+    /// [`HOLD_RELEASE_THROTTLE`], as a helper's hand (or chocks and a tie-down) does before a
+    /// take-off. Without it a parked taildragger creeps round into the wind (the friction law
+    /// is smooth below its slip speed, so has no static friction: 84 deg before arming in
+    /// 5 m/s of wind), and a gust above its lift-off speed on the three-point attitude lifts
+    /// it off the ground.
+    pub fn hold_until_throttle(&mut self) {
+        self.hold = Some(self.x);
+    }
+
+    /// The aircraft is held still ([`Plant::hold_until_throttle`]).
+    pub fn held(&self) -> bool {
+        self.hold.is_some()
     }
 
     /// The model parameters.
@@ -145,6 +167,16 @@ impl Plant {
             dt,
         );
         dynamics::normalise(&mut self.x, p);
+        if let Some(held) = self.hold {
+            if controls.throttle >= HOLD_RELEASE_THROTTLE {
+                self.hold = None;
+            } else {
+                // Still, but the engine turns with the throttle.
+                let engine = self.x[13];
+                self.x = held;
+                self.x[13] = engine;
+            }
+        }
         self.time_s += dt;
         self.track_contact(&x0, dt);
     }
@@ -324,6 +356,12 @@ impl Plant {
     /// Specific force in body axes (non-gravitational force / mass), m/s^2: what an
     /// accelerometer at the CG reads (level flight: z close to -g).
     pub fn specific_force_body(&self) -> Vector3<f64> {
+        if self.hold.is_some() {
+            // Held still, whatever holds it takes the rest: the reading is the ground's
+            // reaction to gravity alone.
+            let g_ned = Vector3::new(0.0, 0.0, -self.params.g);
+            return quat_of(&self.x).inverse_transform_vector(&g_ned);
+        }
         self.derivatives().specific_force_body
     }
 
