@@ -739,10 +739,12 @@ fn cruise_power_w(a: &Aircraft) -> f64 {
     Battery::new(&a.battery).electrical_power_w(motor_power_w(&p, default_of("TRIM_THR")))
 }
 
-fn armed_s(o: &FlightOutcome) -> f64 {
-    let armed: Vec<&Sample> = o.samples.iter().filter(|s| s.armed).collect();
-    match (armed.first(), armed.last()) {
-        (Some(a), Some(b)) => b.t - a.t,
+/// Time the motor runs: from the first throttle to the touchdown (the flare closes it, and
+/// the roll-out to the stop is unpowered), s.
+fn motor_s(o: &FlightOutcome) -> f64 {
+    let start = o.samples.iter().find(|s| s.armed && s.throttle > 0.0);
+    match (start, o.summary.touchdown.as_ref()) {
+        (Some(a), Some(td)) => td.time_s - a.t,
         _ => 0.0,
     }
 }
@@ -750,21 +752,22 @@ fn armed_s(o: &FlightOutcome) -> f64 {
 #[test]
 fn a_full_pack_flies_the_default_mission_with_more_than_60_percent_left_as_cruise_power_predicts() {
     // Cruise: TRIM_THR 0.569 is 92 W on the shaft, 127 W from the pack; at the 11.4 V a 3S
-    // pack sags to in the middle of its curve that is 11.1 A. The mission is armed for about
-    // 340 s (take-off to the stop on the runway): 340 x 127 / 11.4 / 3.6 = 1050 mAh, 33 % of
-    // 3200 mAh. On top of cruise: the take-off run and climb to 60 m at full throttle (324 W
-    // for about 15 s, 0.8 Wh more than cruise), the turns (at the 30 deg bank of the loiter
-    // the induced drag is a third higher) and the glide of the approach (less): within
-    // +25 % / -25 % of the cruise figure, so more than 100 - 1.25 x 33 = 59 % is left, and
+    // pack sags to in the middle of its curve that is 11.1 A. The motor runs for about 325 s
+    // (the take-off roll to the touchdown; the roll-out to the stop is unpowered): 325 x 127
+    // / 11.4 / 3.6 = 1005 mAh, 31 % of 3200 mAh. On top of cruise: the take-off run and
+    // climb to 60 m at full throttle (324 W for about 15 s, 0.8 Wh more than cruise), the
+    // turns (at the 30 deg bank of the loiter the induced drag is a third higher) and the
+    // glide of the approach (less): within
+    // +25 % / -25 % of the cruise figure, so more than 100 - 1.25 x 31 = 61 % is left, and
     // the 60 % of the name holds with a margin for a mission a few seconds longer.
     let a = aircraft();
     let o = battery_flight(&a);
     let b = o.summary.battery.expect("battery figures");
-    let t = armed_s(&o);
+    let t = motor_s(&o);
     let p = cruise_power_w(&a);
     let predicted_mah = p * t / 11.4 / 3.6;
     eprintln!(
-        "armed {t:.1} s; cruise {p:.1} W predicts {predicted_mah:.0} mAh; flown: {:.2} Wh, {:.0} mAh, lowest {:.2} V, {:.1} % left (estimate {:.1} %)",
+        "motor on {t:.1} s; cruise {p:.1} W predicts {predicted_mah:.0} mAh; flown: {:.2} Wh, {:.0} mAh, lowest {:.2} V, {:.1} % left (estimate {:.1} %)",
         b.energy_wh, b.charge_mah, b.min_voltage_v, b.final_remaining_pct, b.final_estimate_pct
     );
     // TRIM_THR is 0.569: 126.67 W.
