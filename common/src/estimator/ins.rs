@@ -403,8 +403,33 @@ impl Ins {
             (IP, IV, &idt),
         ];
         let blocks = if self.nav_ok { &all[..] } else { &all[..1] };
-        let mut cov = self.cov;
-        propagate(&mut cov, blocks);
+        // The covariance is propagated in place, a copy kept only to fall back on: a refused
+        // step leaves the state and the covariance as they were (one copy of the matrix per
+        // step rather than three).
+        if let Some(state) = self.checked_state(q, v, p, self.bias, self.baro_offset) {
+            let before = self.cov;
+            if self.propagate_covariance(blocks, dt, noise) {
+                self.set_state(state);
+            } else {
+                self.cov = before;
+            }
+        }
+        if self.nav_ok {
+            self.remember(t_us);
+        }
+    }
+
+    /// Propagates the covariance over `dt` through the transition's `blocks` with the process
+    /// noise, and conditions it. False when the result is not finite (the covariance is then
+    /// left half-done: the caller restores it).
+    fn propagate_covariance(
+        &mut self,
+        blocks: &[(usize, usize, &Matrix3<f32>)],
+        dt: f32,
+        noise: &ProcessNoise,
+    ) -> bool {
+        let cov = &mut self.cov;
+        propagate(cov, blocks);
         let g = noise.gyro * noise.gyro * dt;
         let qa = noise.accel * noise.accel * dt;
         let b = noise.gyro_bias * noise.gyro_bias * dt;
@@ -420,10 +445,7 @@ impl Ins {
             }
         }
         cov[(IBO, IBO)] += noise.baro_offset * noise.baro_offset * dt;
-        self.commit(q, v, p, self.bias, self.baro_offset, cov);
-        if self.nav_ok {
-            self.remember(t_us);
-        }
+        condition(cov, MIN_VAR, MAX_VAR)
     }
 
     /// Fuses one scalar component: `innov` against the error-state row `h`.
@@ -648,28 +670,6 @@ impl Ins {
             self.cov[(IBO, i)] = 0.0;
         }
         self.cov[(IBO, IBO)] = self.cov[(IP + 2, IP + 2)] + 1.0;
-    }
-
-    /// Accepts a new state only when everything in it is finite; the covariance is kept
-    /// symmetric and bounded. Returns whether the state was accepted.
-    fn commit(
-        &mut self,
-        q: UnitQuaternion<f32>,
-        v: Vector3<f32>,
-        p: Vector3<f32>,
-        bias: Vector3<f32>,
-        baro_offset: f32,
-        mut cov: Mat,
-    ) -> bool {
-        let Some(state) = self.checked_state(q, v, p, bias, baro_offset) else {
-            return false;
-        };
-        if !condition(&mut cov, MIN_VAR, MAX_VAR) {
-            return false;
-        }
-        self.set_state(state);
-        self.cov = cov;
-        true
     }
 
     /// The state with its quaternion normalised, if everything in it is finite.
