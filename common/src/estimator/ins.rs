@@ -239,6 +239,21 @@ impl Ins {
         Vector3::new(self.sigma(IBG), self.sigma(IBG + 1), self.sigma(IBG + 2))
     }
 
+    /// Whether the attitude, gyro-bias and navigation uncertainties are all within their
+    /// 1-sigma bounds (rad, rad, rad/s, m, m/s): roll/pitch combined, heading, each bias axis,
+    /// horizontal position and velocity (largest axis). Compared as variances, so without a
+    /// square root (a software one on the MCU, asked several times a control period); a
+    /// bound that is not positive is never met.
+    pub fn sigmas_within(&self, tilt: f32, heading: f32, bias: f32, pos: f32, vel: f32) -> bool {
+        let d = self.cov.diagonal();
+        let within = |var: f32, bound: f32| bound > 0.0 && var < bound * bound;
+        within(d[ITH] + d[ITH + 1], tilt)
+            && within(d[ITH + 2], heading)
+            && within(d[IBG].max(d[IBG + 1]).max(d[IBG + 2]), bias)
+            && within(d[IP].max(d[IP + 1]), pos)
+            && within(d[IV].max(d[IV + 1]).max(d[IV + 2]), vel)
+    }
+
     /// 1-sigma horizontal position, vertical position and velocity (largest axis) uncertainty.
     pub fn nav_sigmas(&self) -> (f32, f32, f32) {
         let d = self.cov.diagonal();
@@ -845,6 +860,35 @@ mod tests {
         // Confident enough to pass the default convergence threshold (EST_CONV_TILT).
         let (tilt, _) = f.tilt_heading_sigma();
         assert!(tilt < 0.0175, "tilt sigma {tilt}");
+    }
+
+    /// The convergence bounds, compared as variances, say what the 1-sigma figures say:
+    /// each bound is met just above its sigma and missed just below, and a bound that is not
+    /// positive is never met.
+    #[test]
+    fn the_convergence_bounds_say_what_the_sigmas_say() {
+        let f = Ins::new();
+        let (tilt, heading) = f.tilt_heading_sigma();
+        let bias = f.bias_sigma().max();
+        let (pos, _, vel) = f.nav_sigmas();
+        let all = [tilt, heading, bias, pos, vel];
+        let above = all.map(|x| x * 1.001);
+        assert!(f.sigmas_within(above[0], above[1], above[2], above[3], above[4]));
+        for i in 0..5 {
+            let mut b = above;
+            b[i] = all[i] * 0.999;
+            assert!(!f.sigmas_within(b[0], b[1], b[2], b[3], b[4]), "bound {i}");
+            b[i] = 0.0;
+            assert!(
+                !f.sigmas_within(b[0], b[1], b[2], b[3], b[4]),
+                "bound {i} at 0"
+            );
+            b[i] = -1e9;
+            assert!(
+                !f.sigmas_within(b[0], b[1], b[2], b[3], b[4]),
+                "bound {i} negative"
+            );
+        }
     }
 
     #[test]

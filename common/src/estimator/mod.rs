@@ -573,18 +573,18 @@ impl Estimator {
     pub fn is_converged(&self) -> bool {
         let c = &self.cfg;
         let h = &self.health;
-        let (tilt, hdg) = self.ins.tilt_heading_sigma();
-        let (pos, _, vel) = self.ins.nav_sigmas();
         self.ins.attitude_initialized()
-            && tilt < c.conv_tilt
-            && hdg < c.conv_heading
-            && self.ins.bias_sigma().max() < c.conv_gyro_bias
             && self.mag_nis < c.conv_nis
             && self.ins.nav_initialized()
             && self.aided_fixes >= CONV_MIN_FIXES
             && self.vel_nis < c.conv_nis
-            && pos < c.conv_pos
-            && vel < c.conv_vel
+            && self.ins.sigmas_within(
+                c.conv_tilt,
+                c.conv_heading,
+                c.conv_gyro_bias,
+                c.conv_pos,
+                c.conv_vel,
+            )
             && h.imu.healthy
             && h.mag.healthy
             && h.baro.healthy
