@@ -16,7 +16,7 @@ pub struct SensorStatus {
     pub resets: u32,
     consecutive: u32,
     gated_streak: u32,
-    last_ok_s: Option<f64>,
+    last_ok_us: Option<u64>,
 }
 
 impl SensorStatus {
@@ -25,9 +25,9 @@ impl SensorStatus {
         self.consecutive = self.consecutive.saturating_add(1);
     }
 
-    pub(super) fn accept(&mut self, t: f64) {
+    pub(super) fn accept(&mut self, t_us: u64) {
         self.consecutive = 0;
-        self.last_ok_s = Some(t);
+        self.last_ok_us = Some(t_us);
     }
 
     /// Books `gated` refused components of a sample; `all` when none was fused. Returns true
@@ -47,9 +47,17 @@ impl SensorStatus {
         false
     }
 
-    pub(super) fn evaluate(&mut self, t: f64, timeout: f32, max_rejections: u32) {
-        self.healthy = match self.last_ok_s {
-            Some(last) => t - last <= f64::from(timeout) && self.consecutive < max_rejections,
+    /// Judges the sensor at time `t_us` (µs): healthy while its last good sample is at most
+    /// `timeout` s old and fewer than `max_rejections` in a row were refused.
+    pub(super) fn evaluate(&mut self, t_us: u64, timeout: f32, max_rejections: u32) {
+        self.healthy = match self.last_ok_us {
+            // In µs as f32 (exact up to 16.7 s; an infinite timeout stays infinite), through
+            // u32 so that the conversion is the FPU's: saturating at 71 minutes, beyond any
+            // timeout.
+            Some(last) => {
+                let age_us = u32::try_from(t_us.saturating_sub(last)).unwrap_or(u32::MAX);
+                age_us as f32 <= timeout * 1e6 && self.consecutive < max_rejections
+            }
             None => false,
         };
     }

@@ -121,10 +121,11 @@ pub struct ProcessNoise {
     pub baro_offset: f32,
 }
 
-/// One stored state: attitude, velocity and position at time `t`.
+/// One stored state: attitude, velocity and position at time `t_us`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Snapshot {
-    t: f64,
+    /// Estimator clock, µs.
+    t_us: u64,
     q: UnitQuaternion<f32>,
     v: Vector3<f32>,
     p: Vector3<f32>,
@@ -133,7 +134,7 @@ struct Snapshot {
 impl Default for Snapshot {
     fn default() -> Self {
         Self {
-            t: f64::NEG_INFINITY,
+            t_us: 0,
             q: UnitQuaternion::identity(),
             v: Vector3::zeros(),
             p: Vector3::zeros(),
@@ -154,7 +155,7 @@ pub struct Ins {
     head: usize,
     len: usize,
     /// Corrections of the fusions in progress, to be carried into the stored states once the
-    /// measurement's components are all fused: from time `t` on, rotated by `q`, velocity
+    /// measurement's components are all fused: from time `t_us` on, rotated by `q`, velocity
     /// moved by `v` and position by `p`.
     pending: Option<Snapshot>,
     attitude_ok: bool,
@@ -236,6 +237,21 @@ impl Ins {
     /// 1-sigma uncertainty of each gyro bias component, rad/s.
     pub fn bias_sigma(&self) -> Vector3<f32> {
         Vector3::new(self.sigma(IBG), self.sigma(IBG + 1), self.sigma(IBG + 2))
+    }
+
+    /// Whether the attitude, gyro-bias and navigation uncertainties are all within their
+    /// 1-sigma bounds (rad, rad, rad/s, m, m/s): roll/pitch combined, heading, each bias axis,
+    /// horizontal position and velocity (largest axis). Compared as variances, so without a
+    /// square root (a software one on the MCU, asked several times a control period); a
+    /// bound that is not positive is never met.
+    pub fn sigmas_within(&self, tilt: f32, heading: f32, bias: f32, pos: f32, vel: f32) -> bool {
+        let d = self.cov.diagonal();
+        let within = |var: f32, bound: f32| bound > 0.0 && var < bound * bound;
+        within(d[ITH] + d[ITH + 1], tilt)
+            && within(d[ITH + 2], heading)
+            && within(d[IBG].max(d[IBG + 1]).max(d[IBG + 2]), bias)
+            && within(d[IP].max(d[IP + 1]), pos)
+            && within(d[IV].max(d[IV + 1]).max(d[IV + 2]), vel)
     }
 
     /// 1-sigma horizontal position, vertical position and velocity (largest axis) uncertainty.
@@ -320,7 +336,7 @@ impl Ins {
     /// velocity `vel`, barometer offset `baro_offset` (0 without a barometer reading).
     pub fn start_nav(
         &mut self,
-        t: f64,
+        t_us: u64,
         pos: &Vector3<f32>,
         vel: &Vector3<f32>,
         delay: f32,
@@ -340,7 +356,7 @@ impl Ins {
         self.len = 0;
         self.head = 0;
         self.nav_ok = true;
-        self.remember(t);
+        self.remember(t_us);
     }
 
     /// Sets the velocity, position and baro-offset variances and drops their correlations.
@@ -366,11 +382,11 @@ impl Ins {
         self.cov[(IBO, IBO)] = offset * offset;
     }
 
-    /// Propagates the state and covariance over `dt` ending at time `t` with one IMU sample
+    /// Propagates the state and covariance over `dt` ending at time `t_us` (µs) with one IMU sample
     /// (specific force `accel`, m/s^2, and rates `gyro`, rad/s, both body axes).
     pub fn predict(
         &mut self,
-        t: f64,
+        t_us: u64,
         accel: &Vector3<f32>,
         gyro: &Vector3<f32>,
         dt: f32,
@@ -402,8 +418,33 @@ impl Ins {
             (IP, IV, &idt),
         ];
         let blocks = if self.nav_ok { &all[..] } else { &all[..1] };
-        let mut cov = self.cov;
-        propagate(&mut cov, blocks);
+        // The covariance is propagated in place, a copy kept only to fall back on: a refused
+        // step leaves the state and the covariance as they were (one copy of the matrix per
+        // step rather than three).
+        if let Some(state) = self.checked_state(q, v, p, self.bias, self.baro_offset) {
+            let before = self.cov;
+            if self.propagate_covariance(blocks, dt, noise) {
+                self.set_state(state);
+            } else {
+                self.cov = before;
+            }
+        }
+        if self.nav_ok {
+            self.remember(t_us);
+        }
+    }
+
+    /// Propagates the covariance over `dt` through the transition's `blocks` with the process
+    /// noise, and conditions it. False when the result is not finite (the covariance is then
+    /// left half-done: the caller restores it).
+    fn propagate_covariance(
+        &mut self,
+        blocks: &[(usize, usize, &Matrix3<f32>)],
+        dt: f32,
+        noise: &ProcessNoise,
+    ) -> bool {
+        let cov = &mut self.cov;
+        propagate(cov, blocks);
         let g = noise.gyro * noise.gyro * dt;
         let qa = noise.accel * noise.accel * dt;
         let b = noise.gyro_bias * noise.gyro_bias * dt;
@@ -419,10 +460,7 @@ impl Ins {
             }
         }
         cov[(IBO, IBO)] += noise.baro_offset * noise.baro_offset * dt;
-        self.commit(q, v, p, self.bias, self.baro_offset, cov);
-        if self.nav_ok {
-            self.remember(t);
-        }
+        condition(cov, MIN_VAR, MAX_VAR)
     }
 
     /// Fuses one scalar component: `innov` against the error-state row `h`.
@@ -432,12 +470,12 @@ impl Ins {
         innov: f32,
         r: f32,
         gate_sigma: f32,
-        t_meas: f64,
+        t_meas_us: u64,
         out: &mut Fusion,
     ) {
         match gain(&self.cov, h, innov, r, gate_sigma) {
             Ok(g) => {
-                if self.apply(&g, t_meas) {
+                if self.apply(&g, t_meas_us) {
                     out.fused += 1;
                     out.nis_sum += g.fused.nis;
                 }
@@ -447,10 +485,10 @@ impl Ins {
         }
     }
 
-    /// Fuses a GPS fix taken at time `t_meas`: position NED from home and velocity NED.
+    /// Fuses a GPS fix taken at time `t_meas_us` (µs): position NED from home and velocity NED.
     pub fn fuse_gps(
         &mut self,
-        t_meas: f64,
+        t_meas_us: u64,
         pos: &Vector3<f32>,
         vel: &Vector3<f32>,
         noise: &GpsNoise,
@@ -461,7 +499,7 @@ impl Ins {
         if !self.nav_ok {
             return (pos_out, vel_out);
         }
-        let past = self.state_at(t_meas);
+        let past = self.state_at(t_meas_us);
         let (v0, p0) = (self.v, self.p);
         let h2 = noise.horizontal * noise.horizontal;
         let z2 = noise.vertical * noise.vertical;
@@ -471,20 +509,20 @@ impl Ins {
             let mut h = Vecn::zeros();
             h[IV + i] = 1.0;
             let innov = vel[i] - (past.v[i] + (self.v[i] - v0[i]));
-            self.fuse_scalar(&h, innov, v2, gate_sigma, t_meas, &mut vel_out);
+            self.fuse_scalar(&h, innov, v2, gate_sigma, t_meas_us, &mut vel_out);
         }
         for (i, r) in [h2, h2, z2].into_iter().enumerate() {
             let mut h = Vecn::zeros();
             h[IP + i] = 1.0;
             let innov = pos[i] - (past.p[i] + (self.p[i] - p0[i]));
-            self.fuse_scalar(&h, innov, r, gate_sigma, t_meas, &mut pos_out);
+            self.fuse_scalar(&h, innov, r, gate_sigma, t_meas_us, &mut pos_out);
         }
         self.flush_shift();
         (pos_out, vel_out)
     }
 
     /// Fuses a barometric altitude: `home_minus_baro = home_alt - baro_alt` (m).
-    pub fn fuse_baro(&mut self, t: f64, home_minus_baro: f32, noise: f32, gate: f32) -> Fusion {
+    pub fn fuse_baro(&mut self, t_us: u64, home_minus_baro: f32, noise: f32, gate: f32) -> Fusion {
         let mut out = Fusion::default();
         if !self.nav_ok {
             return out;
@@ -493,14 +531,14 @@ impl Ins {
         h[IP + 2] = 1.0;
         h[IBO] = -1.0;
         let innov = home_minus_baro - (self.p.z - self.baro_offset);
-        self.fuse_scalar(&h, innov, noise * noise, gate, t, &mut out);
+        self.fuse_scalar(&h, innov, noise * noise, gate, t_us, &mut out);
         self.flush_shift();
         out
     }
 
     /// Fuses a horizontal velocity (north, east) known to `noise` m/s, e.g. from air data.
     /// Not gated: it stands in for GPS while GPS is missing and must not lock itself out.
-    pub fn fuse_horizontal_velocity(&mut self, t: f64, vn: f32, ve: f32, noise: f32) -> Fusion {
+    pub fn fuse_horizontal_velocity(&mut self, t_us: u64, vn: f32, ve: f32, noise: f32) -> Fusion {
         let mut out = Fusion::default();
         if !self.nav_ok {
             return out;
@@ -509,7 +547,7 @@ impl Ins {
             let mut h = Vecn::zeros();
             h[IV + i] = 1.0;
             let innov = z - self.v[i];
-            self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t, &mut out);
+            self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t_us, &mut out);
         }
         self.flush_shift();
         out
@@ -525,7 +563,7 @@ impl Ins {
     /// bias error, which the centripetal term of the gravity reference turns back into roll.
     pub fn fuse_mag_heading(
         &mut self,
-        t: f64,
+        t_us: u64,
         mag: &Vector3<f32>,
         earth_ned: &Vector3<f32>,
         noise: f32,
@@ -548,7 +586,7 @@ impl Ins {
         h[ITH + 1] = -earth_ned.z * earth_ned.y / bh2;
         h[ITH + 2] = 1.0;
         let sigma = noise / libm::sqrtf(bh2);
-        self.fuse_scalar(&h, innov, sigma * sigma, gate_sigma, t, &mut out);
+        self.fuse_scalar(&h, innov, sigma * sigma, gate_sigma, t_us, &mut out);
         self.flush_shift();
         out
     }
@@ -559,7 +597,7 @@ impl Ins {
     /// accelerates in a way the model does not know.
     pub fn fuse_gravity(
         &mut self,
-        t: f64,
+        t_us: u64,
         accel: &Vector3<f32>,
         motion: &Motion,
         noise: f32,
@@ -589,7 +627,7 @@ impl Ins {
             h.fixed_rows_mut::<3>(IBG)
                 .copy_from(&bias_jac.row(axis).transpose());
             let innov = accel[axis] - predicted[axis];
-            self.fuse_scalar(&h, innov, noise * noise, gate_sigma, t, &mut out);
+            self.fuse_scalar(&h, innov, noise * noise, gate_sigma, t_us, &mut out);
         }
         self.flush_shift();
         Some(out)
@@ -614,7 +652,7 @@ impl Ins {
         }
         self.p = now;
         self.v = *vel;
-        self.shift_stored(f64::NEG_INFINITY, &UnitQuaternion::identity(), &dv, &dp);
+        self.shift_stored(0, &UnitQuaternion::identity(), &dv, &dp);
         let offset = libm::sqrtf(self.cov[(IBO, IBO)] + noise.vertical * noise.vertical);
         self.reset_nav_covariance(
             noise.horizontal,
@@ -631,12 +669,7 @@ impl Ins {
             return;
         }
         self.p += delta;
-        self.shift_stored(
-            f64::NEG_INFINITY,
-            &UnitQuaternion::identity(),
-            &Vector3::zeros(),
-            delta,
-        );
+        self.shift_stored(0, &UnitQuaternion::identity(), &Vector3::zeros(), delta);
     }
 
     /// Makes the baro offset agree with one barometric altitude (`home_alt - baro_alt`) after
@@ -652,28 +685,6 @@ impl Ins {
             self.cov[(IBO, i)] = 0.0;
         }
         self.cov[(IBO, IBO)] = self.cov[(IP + 2, IP + 2)] + 1.0;
-    }
-
-    /// Accepts a new state only when everything in it is finite; the covariance is kept
-    /// symmetric and bounded. Returns whether the state was accepted.
-    fn commit(
-        &mut self,
-        q: UnitQuaternion<f32>,
-        v: Vector3<f32>,
-        p: Vector3<f32>,
-        bias: Vector3<f32>,
-        baro_offset: f32,
-        mut cov: Mat,
-    ) -> bool {
-        let Some(state) = self.checked_state(q, v, p, bias, baro_offset) else {
-            return false;
-        };
-        if !condition(&mut cov, MIN_VAR, MAX_VAR) {
-            return false;
-        }
-        self.set_state(state);
-        self.cov = cov;
-        true
     }
 
     /// The state with its quaternion normalised, if everything in it is finite.
@@ -825,12 +836,12 @@ mod tests {
         assert!(f.align(&level_accel, &mag, &EARTH, 0.01));
         f.q = Euler::new(0.14_f32, 0.10, 0.0).to_quaternion();
         let vel = Vector3::new(17.0, 0.0, 0.0);
-        f.start_nav(0.0, &Vector3::zeros(), &vel, 0.0, 0.0, &gps());
+        f.start_nav(0, &Vector3::zeros(), &vel, 0.0, 0.0, &gps());
         let dt = 0.01;
         let mut v_true = vel;
         let mut p_true = Vector3::zeros();
-        for k in 1..=3000 {
-            let t = f64::from(k) * f64::from(dt);
+        for k in 1..=3000_u16 {
+            let t = u64::from(k) * 10_000;
             // Gust load: the true specific force and the true vertical acceleration agree.
             let gust = if (k / 50) % 2 == 0 { 4.0 } else { -4.0 };
             let accel = Vector3::new(0.0, 0.0, -GRAVITY - gust);
@@ -851,6 +862,35 @@ mod tests {
         assert!(tilt < 0.0175, "tilt sigma {tilt}");
     }
 
+    /// The convergence bounds, compared as variances, say what the 1-sigma figures say:
+    /// each bound is met just above its sigma and missed just below, and a bound that is not
+    /// positive is never met.
+    #[test]
+    fn the_convergence_bounds_say_what_the_sigmas_say() {
+        let f = Ins::new();
+        let (tilt, heading) = f.tilt_heading_sigma();
+        let bias = f.bias_sigma().max();
+        let (pos, _, vel) = f.nav_sigmas();
+        let all = [tilt, heading, bias, pos, vel];
+        let above = all.map(|x| x * 1.001);
+        assert!(f.sigmas_within(above[0], above[1], above[2], above[3], above[4]));
+        for i in 0..5 {
+            let mut b = above;
+            b[i] = all[i] * 0.999;
+            assert!(!f.sigmas_within(b[0], b[1], b[2], b[3], b[4]), "bound {i}");
+            b[i] = 0.0;
+            assert!(
+                !f.sigmas_within(b[0], b[1], b[2], b[3], b[4]),
+                "bound {i} at 0"
+            );
+            b[i] = -1e9;
+            assert!(
+                !f.sigmas_within(b[0], b[1], b[2], b[3], b[4]),
+                "bound {i} negative"
+            );
+        }
+    }
+
     #[test]
     fn heading_fusion_corrects_heading_and_keeps_a_good_tilt() {
         let mut f = Ins::new();
@@ -858,8 +898,8 @@ mod tests {
         let truth = Euler::new(0.0_f32, 0.0, 0.5).to_quaternion();
         let mag = truth.inverse_transform_vector(&EARTH);
         assert!(f.align(&accel, &EARTH, &EARTH, 0.01));
-        for k in 0..500 {
-            let t = f64::from(k) * 0.02;
+        for k in 0..500_u16 {
+            let t = u64::from(k) * 20_000;
             f.predict(t, &accel, &Vector3::zeros(), 0.02, &noise());
             // At rest, the accelerometer holds the tilt while the heading is corrected.
             f.fuse_gravity(t, &accel, &Motion::default(), 0.7, 2.5, 100.0);
@@ -876,8 +916,8 @@ mod tests {
         let mut f = Ins::new();
         assert!(f.align(&accel, &EARTH, &EARTH, 0.05));
         f.q = Euler::new(0.087_f32, 0.0, 0.0).to_quaternion();
-        for k in 0..500 {
-            let t = f64::from(k) * 0.02;
+        for k in 0..500_u16 {
+            let t = u64::from(k) * 20_000;
             f.predict(t, &accel, &Vector3::zeros(), 0.02, &noise());
             f.fuse_gravity(t, &accel, &Motion::default(), 0.7, 2.5, 100.0);
         }

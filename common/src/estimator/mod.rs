@@ -70,8 +70,8 @@ pub struct Home {
 /// Everything the estimator knows, as the rest of the autopilot reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatedState {
-    /// Estimator clock (sum of accepted IMU time steps), s.
-    pub time_s: f64,
+    /// Estimator clock (sum of accepted IMU time steps, each to the microsecond), µs.
+    pub time_us: u64,
     /// Body-to-NED attitude.
     pub attitude: UnitQuaternion<f32>,
     /// The same attitude as 3-2-1 Euler angles, rad.
@@ -131,7 +131,9 @@ pub struct Estimator {
     wind: WindFilter,
     airspeed: AirspeedFilter,
     health: SensorHealth,
-    t: f64,
+    /// The clock, µs: integer, so that the health checks and the delayed fusion compare and
+    /// subtract times without software f64 on the MCU, and it never loses resolution.
+    t_us: u64,
     rates: Vector3<f32>,
     last_accel: Option<Vector3<f32>>,
     last_mag: Option<Vector3<f32>>,
@@ -148,7 +150,7 @@ pub struct Estimator {
     mag_nis: f32,
     vel_nis: f32,
     aided_fixes: u32,
-    last_pitot_t: Option<f64>,
+    last_pitot_us: Option<u64>,
     imu_silent_samples: u32,
     alpha_memory: f32,
     pending_dt: f32,
@@ -169,7 +171,7 @@ impl Estimator {
             wind: WindFilter::default(),
             airspeed: AirspeedFilter::default(),
             health: SensorHealth::default(),
-            t: 0.0,
+            t_us: 0,
             rates: Vector3::zeros(),
             last_accel: None,
             last_mag: None,
@@ -182,7 +184,7 @@ impl Estimator {
             mag_nis: 0.0,
             vel_nis: 0.0,
             aided_fixes: 0,
-            last_pitot_t: None,
+            last_pitot_us: None,
             imu_silent_samples: 0,
             alpha_memory: 0.0,
             pending_dt: 0.0,
@@ -221,7 +223,7 @@ impl Estimator {
     }
 
     fn refresh_health(&mut self) {
-        let t = self.t;
+        let t = self.t_us;
         let c = self.cfg;
         let h = &mut self.health;
         // The IMU is the clock: it is judged by rejections and by the other sensors' samples
@@ -318,8 +320,8 @@ impl Estimator {
         }
         let dt = (dt + self.pending_dt).min(MAX_IMU_DT_S);
         self.pending_dt = 0.0;
-        self.t += f64::from(dt);
-        self.health.imu.accept(self.t);
+        self.t_us = self.t_us.saturating_add(micros(dt).max(1));
+        self.health.imu.accept(self.t_us);
         self.imu_silent_samples = 0;
         self.last_accel = Some(sample.accel);
         self.refresh_health();
@@ -330,7 +332,7 @@ impl Estimator {
         let c = self.cfg;
         let noise = self.process_noise();
         self.ins
-            .predict(self.t, &sample.accel, &sample.gyro, dt, &noise);
+            .predict(self.t_us, &sample.accel, &sample.gyro, dt, &noise);
         self.rates = sample.gyro - self.ins.gyro_bias();
         let wn = self.wind_noise();
         self.wind.predict(dt, &wn);
@@ -351,7 +353,7 @@ impl Estimator {
             along_body: along,
         };
         if let Some(f) = self.ins.fuse_gravity(
-            self.t,
+            self.t_us,
             &sample.accel,
             &motion,
             c.accel_noise,
@@ -372,7 +374,7 @@ impl Estimator {
             self.refresh_health();
             return;
         }
-        self.health.mag.accept(self.t);
+        self.health.mag.accept(self.t_us);
         self.last_mag = Some(sample.field);
         self.refresh_health();
         if !self.ins.attitude_initialized() {
@@ -381,9 +383,9 @@ impl Estimator {
         }
         let earth = self.earth_field();
         let c = self.cfg;
-        let f = self
-            .ins
-            .fuse_mag_heading(self.t, &sample.field, &earth, c.mag_noise, c.gate_sigma);
+        let f =
+            self.ins
+                .fuse_mag_heading(self.t_us, &sample.field, &earth, c.mag_noise, c.gate_sigma);
         if f.fused == 0 && f.gated == 0 {
             return;
         }
@@ -404,15 +406,15 @@ impl Estimator {
             self.refresh_health();
             return;
         };
-        self.health.baro.accept(self.t);
+        self.health.baro.accept(self.t_us);
         self.refresh_health();
         self.baro_alt = Some(alt);
         self.density = rho;
         if let Some(home) = self.home {
             let c = self.cfg;
-            let f = self
-                .ins
-                .fuse_baro(self.t, home.alt_amsl_m - alt, c.baro_noise, c.gate_sigma);
+            let f =
+                self.ins
+                    .fuse_baro(self.t_us, home.alt_amsl_m - alt, c.baro_noise, c.gate_sigma);
             if self
                 .health
                 .baro
@@ -436,13 +438,13 @@ impl Estimator {
             self.refresh_health();
             return;
         }
-        self.health.pitot.accept(self.t);
+        self.health.pitot.accept(self.t_us);
         self.refresh_health();
-        let dt = match self.last_pitot_t {
-            Some(last) => ((self.t - last) as f32).clamp(0.0, 1.0),
+        let dt = match self.last_pitot_us {
+            Some(last) => seconds(self.t_us.saturating_sub(last)).clamp(0.0, 1.0),
             None => 0.0,
         };
-        self.last_pitot_t = Some(self.t);
+        self.last_pitot_us = Some(self.t_us);
         let c = self.cfg;
         let va = self.airspeed.update(
             true_airspeed(dp, self.density),
@@ -478,7 +480,7 @@ impl Estimator {
             let body = Vector3::new(va * libm::cosf(a), 0.0, va * libm::sinf(a));
             let v = q.transform_vector(&body) + self.wind.wind();
             self.ins
-                .fuse_horizontal_velocity(self.t, v.x, v.y, c.dead_reckon_vel_noise);
+                .fuse_horizontal_velocity(self.t_us, v.x, v.y, c.dead_reckon_vel_noise);
         }
     }
 
@@ -497,7 +499,7 @@ impl Estimator {
             return;
         }
         let was_healthy = self.health.gps.healthy;
-        self.health.gps.accept(self.t);
+        self.health.gps.accept(self.t_us);
         self.refresh_health();
         if !self.ins.attitude_initialized() {
             return;
@@ -518,7 +520,7 @@ impl Estimator {
             self.frame = Some(LocalFrame::new(home.point));
             let baro_offset = self.baro_alt.map_or(0.0, |b| b - fix.alt_amsl_m);
             self.ins.start_nav(
-                self.t,
+                self.t_us,
                 &Vector3::zeros(),
                 &fix.vel_ned,
                 c.gps_delay,
@@ -533,7 +535,7 @@ impl Estimator {
 
         let (n, e) = self.ned_of(home.point, fix.position);
         let pos = Vector3::new(n, e, home.alt_amsl_m - fix.alt_amsl_m);
-        let t_fix = self.t - f64::from(c.gps_delay);
+        let t_fix = self.t_us.saturating_sub(micros(c.gps_delay));
         let (fp, fv) = self
             .ins
             .fuse_gps(t_fix, &pos, &fix.vel_ned, &noise, c.gate_sigma);
@@ -571,18 +573,18 @@ impl Estimator {
     pub fn is_converged(&self) -> bool {
         let c = &self.cfg;
         let h = &self.health;
-        let (tilt, hdg) = self.ins.tilt_heading_sigma();
-        let (pos, _, vel) = self.ins.nav_sigmas();
         self.ins.attitude_initialized()
-            && tilt < c.conv_tilt
-            && hdg < c.conv_heading
-            && self.ins.bias_sigma().max() < c.conv_gyro_bias
             && self.mag_nis < c.conv_nis
             && self.ins.nav_initialized()
             && self.aided_fixes >= CONV_MIN_FIXES
             && self.vel_nis < c.conv_nis
-            && pos < c.conv_pos
-            && vel < c.conv_vel
+            && self.ins.sigmas_within(
+                c.conv_tilt,
+                c.conv_heading,
+                c.conv_gyro_bias,
+                c.conv_pos,
+                c.conv_vel,
+            )
             && h.imu.healthy
             && h.mag.healthy
             && h.baro.healthy
@@ -703,7 +705,7 @@ impl Estimator {
             None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
         };
         EstimatedState {
-            time_s: self.t,
+            time_us: self.t_us,
             attitude: q,
             euler: Euler::from_quaternion(&q),
             body_rates: self.rates,
@@ -728,6 +730,17 @@ impl Estimator {
             converged: self.is_converged(),
         }
     }
+}
+
+/// A duration in seconds as whole microseconds, to the nearest (negative and NaN give 0).
+fn micros(s: f32) -> u64 {
+    // `as` saturates: an absurd duration cannot wrap the clock.
+    (s * 1e6 + 0.5) as u64
+}
+
+/// A duration in microseconds as seconds (saturating at 71 minutes, beyond any timeout).
+fn seconds(us: u64) -> f32 {
+    u32::try_from(us).unwrap_or(u32::MAX) as f32 * 1e-6
 }
 
 /// The normalised innovation a monitor averages: a gated component enters at the gate, so a

@@ -858,3 +858,21 @@ fn home_is_held_and_height_above_it_follows_the_barometer() {
         drift.max
     );
 }
+
+/// The clock is the sum of the accepted IMU steps to the microsecond: after an hour of 100 Hz
+/// samples it reads exactly an hour (a sum of the f32 steps would be 80 µs short),
+/// and a refused step does not advance it.
+#[test]
+fn the_clock_reads_an_hour_after_an_hour_of_imu_samples() {
+    let mut e = Estimator::default();
+    let level = ImuSample {
+        accel: Vector3::new(0.0, 0.0, -9.81),
+        gyro: Vector3::zeros(),
+    };
+    for _ in 0..360_000 {
+        e.update_imu(&level, 0.01);
+    }
+    e.update_imu(&level, f32::NAN);
+    e.update_imu(&level, -0.01);
+    assert_eq!(e.state().time_us, 3_600_000_000);
+}

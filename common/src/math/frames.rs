@@ -27,9 +27,25 @@ impl<T: RealField + Copy> Euler<T> {
     }
 
     /// The angles of a body-to-NED quaternion (pitch in [-pi/2, pi/2], roll and yaw in (-pi, pi]).
+    ///
+    /// nalgebra's `euler_angles` divides both arguments of the roll and yaw `atan2` by the
+    /// cosine of the pitch: the same angles while that cosine is positive, for a cosine and
+    /// four divisions (on the MCU, f32 `cosf` runs a software f64 kernel: about 1,100
+    /// instructions a call). They are taken from the matrix directly; the poles (where the
+    /// 3-2-1 sequence is singular) stay nalgebra's.
     pub fn from_quaternion(q: &UnitQuaternion<T>) -> Self {
-        let (phi, theta, psi) = q.euler_angles();
-        Self { phi, theta, psi }
+        let r = q.to_rotation_matrix();
+        let m = r.matrix();
+        if m.m31.abs() < T::one() {
+            Self {
+                phi: m.m32.atan2(m.m33),
+                theta: -m.m31.asin(),
+                psi: m.m21.atan2(m.m11),
+            }
+        } else {
+            let (phi, theta, psi) = r.euler_angles();
+            Self { phi, theta, psi }
+        }
     }
 
     /// The direction cosine matrix that rotates body vectors into NED.
@@ -170,6 +186,37 @@ pub fn course_and_speed<T: RealField + Copy>(v_ned: &Vector3<T>) -> (T, T) {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    /// Over a grid of attitudes, pitch up to 89.9 deg, the angles agree with nalgebra's
+    /// `euler_angles` to float rounding, and rebuild the quaternion they came from.
+    #[test]
+    fn euler_angles_agree_with_nalgebras_over_all_attitudes() {
+        let mut worst = 0.0_f32;
+        for i in -6..=6 {
+            for j in -6..=6 {
+                for k in -6..=6 {
+                    let roll = i as f32 * 0.52;
+                    let pitch = j as f32 * 0.2616;
+                    let yaw = k as f32 * 0.52;
+                    let q = UnitQuaternion::from_euler_angles(roll, pitch, yaw);
+                    let (phi, theta, psi) = q.euler_angles();
+                    let e = Euler::from_quaternion(&q);
+                    let wrap = |a: f32| crate::math::wrap_pi(a).abs();
+                    worst = worst
+                        .max(wrap(e.phi - phi))
+                        .max(wrap(e.theta - theta))
+                        .max(wrap(e.psi - psi));
+                    assert!(q.angle_to(&e.to_quaternion()) < 2e-3, "{e:?} from {q:?}");
+                }
+            }
+        }
+        assert!(worst < 1e-5, "worst difference {worst} rad");
+        for p in [f32::to_radians(89.9), -f32::to_radians(89.9)] {
+            let q = UnitQuaternion::from_euler_angles(0.4, p, -1.2);
+            let e = Euler::from_quaternion(&q);
+            assert!((e.theta - p).abs() < 1e-3, "{e:?}");
+        }
+    }
 
     #[test]
     fn dcm_matches_quaternion() {

@@ -8,17 +8,17 @@ use crate::estimator::kalman::{clamp_diagonal, downdate};
 use nalgebra::{UnitQuaternion, Vector3};
 
 impl Ins {
-    pub(super) fn remember(&mut self, t: f64) {
+    pub(super) fn remember(&mut self, t_us: u64) {
         // The stored states are kept in time order (searches stop early on it): a clock that
         // went back starts the history again.
-        let newest = self.history.get(self.head).map(|s| s.t);
-        if self.len > 0 && newest.is_some_and(|n| t <= n) {
+        let newest = self.history.get(self.head).map(|s| s.t_us);
+        if self.len > 0 && newest.is_some_and(|n| t_us <= n) {
             self.len = 0;
         }
         self.head = (self.head + 1) % HISTORY;
         if let Some(s) = self.history.get_mut(self.head) {
             *s = Snapshot {
-                t,
+                t_us,
                 q: self.q,
                 v: self.v,
                 p: self.p,
@@ -27,20 +27,20 @@ impl Ins {
         self.len = (self.len + 1).min(HISTORY);
     }
 
-    /// The stored state closest to time `t` (the present state when nothing is stored).
-    pub(super) fn state_at(&self, t: f64) -> Snapshot {
+    /// The stored state closest to time `t_us` (the present state when nothing is stored).
+    pub(super) fn state_at(&self, t_us: u64) -> Snapshot {
         let mut best = Snapshot {
-            t,
+            t_us,
             q: self.q,
             v: self.v,
             p: self.p,
         };
-        let mut best_err = f64::INFINITY;
+        let mut best_err = u64::MAX;
         // Newest first, in time order: once the distance grows it only grows.
         for k in 0..self.len {
             let i = (self.head + HISTORY - k) % HISTORY;
             if let Some(s) = self.history.get(i) {
-                let e = (s.t - t).abs();
+                let e = s.t_us.abs_diff(t_us);
                 if e < best_err {
                     best_err = e;
                     best = *s;
@@ -52,11 +52,11 @@ impl Ins {
         best
     }
 
-    /// Moves the stored states from time `after` on as the present one moved: rotated by
+    /// Moves the stored states from time `after_us` on as the present one moved: rotated by
     /// `rot`, velocity by `dv`, position by `dp`.
     pub(super) fn shift_stored(
         &mut self,
-        after: f64,
+        after_us: u64,
         rot: &UnitQuaternion<f32>,
         dv: &Vector3<f32>,
         dp: &Vector3<f32>,
@@ -65,7 +65,7 @@ impl Ins {
             let i = (self.head + HISTORY - k) % HISTORY;
             if let Some(s) = self.history.get_mut(i) {
                 // Newest first, in time order: the rest are older still.
-                if s.t < after {
+                if s.t_us < after_us {
                     break;
                 }
                 s.q = rot * s.q;
@@ -76,9 +76,9 @@ impl Ins {
     }
 
     /// Applies an error-state correction to the present state and to the stored states after
-    /// `t_meas` (so the next delayed fix compares like with like). Returns whether the
+    /// `t_meas_us` (so the next delayed fix compares like with like). Returns whether the
     /// present state accepted it.
-    pub(super) fn apply(&mut self, g: &Gain, t_meas: f64) -> bool {
+    pub(super) fn apply(&mut self, g: &Gain, t_meas_us: u64) -> bool {
         let dx = &g.fused.dx;
         let dtheta = Vector3::new(dx[ITH], dx[ITH + 1], dx[ITH + 2]);
         let dv = Vector3::new(dx[IV], dx[IV + 1], dx[IV + 2]);
@@ -106,10 +106,11 @@ impl Ins {
         if ok {
             // One pass over the stored states per measurement, not per component: the
             // corrections compose.
-            let after = t_meas - 1e-4;
+            // 100 µs before the measurement: the state stored at its time moves too.
+            let after = t_meas_us.saturating_sub(100);
             let sum = match self.pending {
-                Some(s) if s.t == after => Snapshot {
-                    t: after,
+                Some(s) if s.t_us == after => Snapshot {
+                    t_us: after,
                     q: rot * s.q,
                     v: s.v + dv,
                     p: s.p + dp,
@@ -117,7 +118,7 @@ impl Ins {
                 _ => {
                     self.flush_shift();
                     Snapshot {
-                        t: after,
+                        t_us: after,
                         q: rot,
                         v: dv,
                         p: dp,
@@ -132,7 +133,7 @@ impl Ins {
     /// Carries the pending corrections into the stored states.
     pub(super) fn flush_shift(&mut self) {
         if let Some(s) = self.pending.take() {
-            self.shift_stored(s.t, &s.q, &s.v, &s.p);
+            self.shift_stored(s.t_us, &s.q, &s.v, &s.p);
         }
     }
 }
