@@ -32,9 +32,12 @@ const SLOPE_TRIM_MAX_M: f32 = 1.5;
 /// Ground speed under which a flaring aircraft counts as rolling on the runway, m/s: the
 /// estimated height alone carries the barometer's and GPS's offsets (tenths of a metre).
 const ROLLING_SPEED: f32 = 5.0;
-/// Ground speed under which a landed aircraft has stopped and may be disarmed, m/s: until
-/// then it is steered, since a taildragger rolling free swings round (a ground loop).
-const STOPPED_SPEED: f32 = 1.0;
+/// Ground speed under which a landed aircraft may be disarmed, m/s: until then it is steered,
+/// since a taildragger rolling free swings round (a ground loop), harmless at a walking pace.
+/// Waiting for a full stop (1 m/s) kept aircraft armed for minutes in a crosswind, where a
+/// loaded tail wheel steered against the drift sails the aircraft along (PX4 disarms a
+/// landed fixed wing under 5 m/s).
+const STOPPED_SPEED: f32 = 3.0;
 
 /// Time on the ground that makes a touchdown, s.
 const TOUCHDOWN_S: f32 = 1.0;
