@@ -96,6 +96,7 @@ pub fn run(data: &[u8]) {
                         vel_ned: vel,
                         heading,
                         airspeed,
+                        yaw_rate: 0.0,
                     };
                     let out = nav.step(&items, &home, &state, dt);
                     if let Some(g) = out.guidance {
