@@ -12,7 +12,7 @@
 use std::path::Path;
 
 use arbitrary::{Arbitrary, Unstructured};
-use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
+use mavlink::dialects::common::{MavCmd, MavMissionType, MISSION_ITEM_INT_DATA};
 use serde_json::{json, Value};
 use sim_host::mission_file::item::is_global;
 use sim_host::mission_file::{parse_mission_text, MissionFile};

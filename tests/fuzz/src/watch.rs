@@ -177,6 +177,12 @@ pub fn check_store(store: &ParamStore) {
     }
 }
 
+/// `sent` holds a heartbeat to every station.
+fn broadcasts_heartbeat(sent: &[Sent]) -> bool {
+    sent.iter()
+        .any(|s| matches!(s.message, MavMessage::HEARTBEAT(_)) && s.dest == Dest::All)
+}
+
 /// The heartbeat: whenever the ground link runs at a vehicle time a second or more after the
 /// last heartbeat, it sends one.
 #[derive(Default)]
@@ -188,19 +194,14 @@ impl Heartbeat {
     /// After a call that may not have run the ground link (a datagram that asked nothing): a
     /// heartbeat it sent is recorded, none is asked of it.
     pub fn note(&mut self, now_us: u64, sent: &[Sent]) {
-        let beat = sent
-            .iter()
-            .any(|s| matches!(s.message, MavMessage::HEARTBEAT(_)) && s.dest == Dest::All);
-        if beat {
+        if broadcasts_heartbeat(sent) {
             self.last_us = Some(now_us);
         }
     }
 
     /// After a call that ran the ground link at vehicle time `now_us` and sent `sent`.
     pub fn after_poll(&mut self, now_us: u64, sent: &[Sent]) {
-        let beat = sent
-            .iter()
-            .any(|s| matches!(s.message, MavMessage::HEARTBEAT(_)) && s.dest == Dest::All);
+        let beat = broadcasts_heartbeat(sent);
         // The first run of the link sends one at once.
         let due = match self.last_us {
             Some(last) => {
