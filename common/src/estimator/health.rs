@@ -51,12 +51,10 @@ impl SensorStatus {
     /// `timeout` s old and fewer than `max_rejections` in a row were refused.
     pub(super) fn evaluate(&mut self, t_us: u64, timeout: f32, max_rejections: u32) {
         self.healthy = match self.last_ok_us {
-            // In µs as f32 (exact up to 16.7 s; an infinite timeout stays infinite), through
-            // u32 so that the conversion is the FPU's: saturating at 71 minutes, beyond any
-            // timeout.
+            // Compared in µs (exact up to 16.7 s; an infinite timeout stays infinite).
             Some(last) => {
-                let age_us = u32::try_from(t_us.saturating_sub(last)).unwrap_or(u32::MAX);
-                age_us as f32 <= timeout * 1e6 && self.consecutive < max_rejections
+                super::micros_f32(t_us.saturating_sub(last)) <= timeout * 1e6
+                    && self.consecutive < max_rejections
             }
             None => false,
         };
