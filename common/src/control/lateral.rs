@@ -449,7 +449,7 @@ impl Lateral {
         rejected: &mut InputFlags,
     ) -> bool {
         let g = &self.gains;
-        let (kind, setpoint) = match mode {
+        let (kind, setpoint, within) = match mode {
             RollMode::Off => {
                 self.roll.reset();
                 self.course.reset();
@@ -458,14 +458,13 @@ impl Lateral {
                 self.aileron = g.trim_aileron;
                 return false;
             }
-            RollMode::Roll(phi_c) => (RollKind::Roll, phi_c),
-            RollMode::Course(chi_c) => (RollKind::Course, chi_c),
-            RollMode::CourseWithin { course, .. } => (RollKind::Course, course),
-        };
-        // NaN (never from the navigator) leaves the roll limit alone.
-        let within = match mode {
-            RollMode::CourseWithin { roll_max, .. } if roll_max >= 0.0 => roll_max,
-            _ => g.roll_max,
+            RollMode::Roll(phi_c) => (RollKind::Roll, phi_c, g.roll_max),
+            RollMode::Course(chi_c) => (RollKind::Course, chi_c, g.roll_max),
+            // NaN (never from the navigator) leaves the roll limit alone.
+            RollMode::CourseWithin { course, roll_max } if roll_max >= 0.0 => {
+                (RollKind::Course, course, roll_max)
+            }
+            RollMode::CourseWithin { course, .. } => (RollKind::Course, course, g.roll_max),
         };
         let mut bad = InputFlags::empty();
         bad.set(InputFlags::ROLL, !m.roll.is_finite());

@@ -46,13 +46,14 @@ impl Takeoff {
         p: &NavParams,
     ) -> Self {
         let pos = state.pos_ned;
-        let course = match items::point(item) {
-            _ if !p.takeoff_to_item => state.heading,
-            Some(_) if horizontal_dist(&target, &pos) > 20.0 => {
-                libm::atan2f(target.y - pos.y, target.x - pos.x)
-            }
-            _ if item.param(3).is_finite() => wrap_pi(item.param(3) * DEG),
-            _ => state.heading,
+        let course = if !p.takeoff_to_item {
+            state.heading
+        } else if items::point(item).is_some() && horizontal_dist(&target, &pos) > 20.0 {
+            libm::atan2f(target.y - pos.y, target.x - pos.x)
+        } else if item.param(3).is_finite() {
+            wrap_pi(item.param(3) * DEG)
+        } else {
+            state.heading
         };
         Self {
             start: pos,
