@@ -142,11 +142,6 @@ impl Plant {
         self.hold = Some(self.x);
     }
 
-    /// The aircraft is held still ([`Plant::hold_until_throttle`]).
-    pub fn held(&self) -> bool {
-        self.hold.is_some()
-    }
-
     /// The model parameters.
     pub fn params(&self) -> &ModelParams {
         &self.params
