@@ -53,7 +53,7 @@ impl SensorStatus {
         self.healthy = match self.last_ok_us {
             // Compared in µs (exact up to 16.7 s; an infinite timeout stays infinite).
             Some(last) => {
-                super::micros_f32(t_us.saturating_sub(last)) <= timeout * 1e6
+                micros_f32(t_us.saturating_sub(last)) <= timeout * 1e6
                     && self.consecutive < max_rejections
             }
             None => false,
@@ -75,4 +75,10 @@ pub struct SensorHealth {
     pub pitot: SensorStatus,
     /// GPS (a 3D fix counts as a good sample).
     pub gps: SensorStatus,
+}
+
+/// A duration in microseconds as an `f32` count of them, saturating at 71 minutes (beyond any
+/// timeout): through `u32`, so that the conversion is the FPU's, not a software u64 one.
+pub(super) fn micros_f32(us: u64) -> f32 {
+    u32::try_from(us).unwrap_or(u32::MAX) as f32
 }

@@ -738,15 +738,9 @@ fn micros(s: f32) -> u64 {
     (s * 1e6 + 0.5) as u64
 }
 
-/// A duration in microseconds as an `f32` count of them, saturating at 71 minutes (beyond any
-/// timeout): through `u32`, so that the conversion is the FPU's, not a software u64 one.
-fn micros_f32(us: u64) -> f32 {
-    u32::try_from(us).unwrap_or(u32::MAX) as f32
-}
-
-/// A duration in microseconds as seconds (saturating as [`micros_f32`]).
+/// A duration in microseconds as seconds (saturating as [`health::micros_f32`]).
 fn seconds(us: u64) -> f32 {
-    micros_f32(us) * 1e-6
+    health::micros_f32(us) * 1e-6
 }
 
 /// The normalised innovation a monitor averages: a gated component enters at the gate, so a
