@@ -31,10 +31,11 @@
 // layout's constants and loop indices below their dimension: no index comes from outside.
 #![allow(clippy::indexing_slicing)]
 
-use super::kalman::{condition, gain, Refused};
+use super::kalman::condition;
 use crate::math::frames::Euler;
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
+mod fuse;
 mod history;
 
 /// Standard gravity, m/s^2.
@@ -461,176 +462,6 @@ impl Ins {
         }
         cov[(IBO, IBO)] += noise.baro_offset * noise.baro_offset * dt;
         condition(cov, MIN_VAR, MAX_VAR)
-    }
-
-    /// Fuses one scalar component: `innov` against the error-state row `h`.
-    fn fuse_scalar(
-        &mut self,
-        h: &Vecn,
-        innov: f32,
-        r: f32,
-        gate_sigma: f32,
-        t_meas_us: u64,
-        out: &mut Fusion,
-    ) {
-        match gain(&self.cov, h, innov, r, gate_sigma) {
-            Ok(g) => {
-                if self.apply(&g, t_meas_us) {
-                    out.fused += 1;
-                    out.nis_sum += g.fused.nis;
-                }
-            }
-            Err(Refused::Gated) => out.gated += 1,
-            Err(Refused::Degenerate) => {}
-        }
-    }
-
-    /// Fuses a GPS fix taken at time `t_meas_us` (µs): position NED from home and velocity NED.
-    pub fn fuse_gps(
-        &mut self,
-        t_meas_us: u64,
-        pos: &Vector3<f32>,
-        vel: &Vector3<f32>,
-        noise: &GpsNoise,
-        gate_sigma: f32,
-    ) -> (Fusion, Fusion) {
-        let mut pos_out = Fusion::default();
-        let mut vel_out = Fusion::default();
-        if !self.nav_ok {
-            return (pos_out, vel_out);
-        }
-        let past = self.state_at(t_meas_us);
-        let (v0, p0) = (self.v, self.p);
-        let h2 = noise.horizontal * noise.horizontal;
-        let z2 = noise.vertical * noise.vertical;
-        let v2 = noise.velocity * noise.velocity;
-        // Velocity first: it carries the attitude information, and is the sharper measurement.
-        for i in 0..3 {
-            let mut h = Vecn::zeros();
-            h[IV + i] = 1.0;
-            let innov = vel[i] - (past.v[i] + (self.v[i] - v0[i]));
-            self.fuse_scalar(&h, innov, v2, gate_sigma, t_meas_us, &mut vel_out);
-        }
-        for (i, r) in [h2, h2, z2].into_iter().enumerate() {
-            let mut h = Vecn::zeros();
-            h[IP + i] = 1.0;
-            let innov = pos[i] - (past.p[i] + (self.p[i] - p0[i]));
-            self.fuse_scalar(&h, innov, r, gate_sigma, t_meas_us, &mut pos_out);
-        }
-        self.flush_shift();
-        (pos_out, vel_out)
-    }
-
-    /// Fuses a barometric altitude: `home_minus_baro = home_alt - baro_alt` (m).
-    pub fn fuse_baro(&mut self, t_us: u64, home_minus_baro: f32, noise: f32, gate: f32) -> Fusion {
-        let mut out = Fusion::default();
-        if !self.nav_ok {
-            return out;
-        }
-        let mut h = Vecn::zeros();
-        h[IP + 2] = 1.0;
-        h[IBO] = -1.0;
-        let innov = home_minus_baro - (self.p.z - self.baro_offset);
-        self.fuse_scalar(&h, innov, noise * noise, gate, t_us, &mut out);
-        self.flush_shift();
-        out
-    }
-
-    /// Fuses a horizontal velocity (north, east) known to `noise` m/s, e.g. from air data.
-    /// Not gated: it stands in for GPS while GPS is missing and must not lock itself out.
-    pub fn fuse_horizontal_velocity(&mut self, t_us: u64, vn: f32, ve: f32, noise: f32) -> Fusion {
-        let mut out = Fusion::default();
-        if !self.nav_ok {
-            return out;
-        }
-        for (i, z) in [(0, vn), (1, ve)] {
-            let mut h = Vecn::zeros();
-            h[IV + i] = 1.0;
-            let innov = z - self.v[i];
-            self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t_us, &mut out);
-        }
-        self.flush_shift();
-        out
-    }
-
-    /// Fuses the magnetic heading: the direction of the magnetometer's field `mag`, rotated
-    /// into NED with the estimated attitude, in the horizontal plane, against that of the
-    /// earth field `earth_ned`. `noise` is the per-axis field noise, gauss.
-    ///
-    /// A tilt error moves that direction too (by `B_d / B_h`, about 3 at mid-latitudes, per
-    /// radian of roll or pitch about the field's horizontal axis), and the Jacobian says so:
-    /// a heading fusion that ignored it would turn every roll error into a heading and gyro
-    /// bias error, which the centripetal term of the gravity reference turns back into roll.
-    pub fn fuse_mag_heading(
-        &mut self,
-        t_us: u64,
-        mag: &Vector3<f32>,
-        earth_ned: &Vector3<f32>,
-        noise: f32,
-        gate_sigma: f32,
-    ) -> Fusion {
-        let mut out = Fusion::default();
-        let bh2 = earth_ned.x * earth_ned.x + earth_ned.y * earth_ned.y;
-        if !self.attitude_ok || bh2 < 1e-6 {
-            return out;
-        }
-        let m_ned = self.q.transform_vector(mag);
-        if libm::hypotf(m_ned.x, m_ned.y) < 1e-4 {
-            return out;
-        }
-        let innov = crate::math::wrap_pi(
-            libm::atan2f(earth_ned.y, earth_ned.x) - libm::atan2f(m_ned.y, m_ned.x),
-        );
-        let mut h = Vecn::zeros();
-        h[ITH] = -earth_ned.z * earth_ned.x / bh2;
-        h[ITH + 1] = -earth_ned.z * earth_ned.y / bh2;
-        h[ITH + 2] = 1.0;
-        let sigma = noise / libm::sqrtf(bh2);
-        self.fuse_scalar(&h, innov, sigma * sigma, gate_sigma, t_us, &mut out);
-        self.flush_shift();
-        out
-    }
-
-    /// Fuses the accelerometer as a gravity reference: `accel` is the measured specific force
-    /// and `motion` what the aircraft is known to be doing. Skipped (None) when the
-    /// compensated specific force is further than `gate_mps2` from g: then the aircraft
-    /// accelerates in a way the model does not know.
-    pub fn fuse_gravity(
-        &mut self,
-        t_us: u64,
-        accel: &Vector3<f32>,
-        motion: &Motion,
-        noise: f32,
-        gate_mps2: f32,
-        gate_sigma: f32,
-    ) -> Option<Fusion> {
-        if !self.attitude_ok {
-            return None;
-        }
-        let v_air = &motion.v_air_body;
-        let maneuver = motion.rates.cross(v_air) + motion.along_body;
-        if libm::fabsf((accel - maneuver).norm() - GRAVITY) > gate_mps2 {
-            return None;
-        }
-        let minus_g = Vector3::new(0.0, 0.0, -GRAVITY);
-        // The centripetal term carries the bias error too: (w - db) x v = m + [v]x db. Left
-        // out, a bias error would read as a tilt and feed itself.
-        let bias_jac = v_air.cross_matrix();
-        let mut out = Fusion::default();
-        for axis in 0..3 {
-            let rt = self.q.to_rotation_matrix().into_inner().transpose();
-            let predicted = maneuver + rt * minus_g;
-            let jac = rt * minus_g.cross_matrix();
-            let mut h = Vecn::zeros();
-            h.fixed_rows_mut::<3>(ITH)
-                .copy_from(&jac.row(axis).transpose());
-            h.fixed_rows_mut::<3>(IBG)
-                .copy_from(&bias_jac.row(axis).transpose());
-            let innov = accel[axis] - predicted[axis];
-            self.fuse_scalar(&h, innov, noise * noise, gate_sigma, t_us, &mut out);
-        }
-        self.flush_shift();
-        Some(out)
     }
 
     /// Moves position and velocity to a GPS fix taken `delay` s ago (after a long outage or a
