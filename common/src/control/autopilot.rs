@@ -27,7 +27,7 @@ pub const PARAMS: Group<GainSet> = Group {
         ),
         GainSet => transfer_tc
     )],
-    base: || GainSet::THESIS,
+    base: || GainSet::FLIGHT,
     check: crate::params::independent,
 };
 
@@ -83,6 +83,15 @@ impl GainSet {
     pub const THESIS: GainSet = GainSet {
         lateral: lateral::THESIS,
         longitudinal: longitudinal::THESIS,
+        transfer_tc: TRANSFER_TC_S,
+    };
+
+    /// The flight defaults, every parameter's default: the thesis's designed set with the
+    /// loops that the full linear model shows unstable replaced ([`lateral::FLIGHT`],
+    /// [`longitudinal::FLIGHT`]).
+    pub const FLIGHT: GainSet = GainSet {
+        lateral: lateral::FLIGHT,
+        longitudinal: longitudinal::FLIGHT,
         transfer_tc: TRANSFER_TC_S,
     };
 
@@ -256,14 +265,14 @@ fn bump(c: &mut u32, on: bool) {
 
 impl Default for GainSet {
     fn default() -> Self {
-        GainSet::THESIS
+        GainSet::FLIGHT
     }
 }
 
 impl Default for Autopilot {
-    /// A disengaged autopilot flying the thesis's designed set (valid: tested).
+    /// A disengaged autopilot flying the flight defaults (valid: tested).
     fn default() -> Self {
-        Self::build(&GainSet::THESIS)
+        Self::build(&GainSet::FLIGHT)
     }
 }
 

@@ -41,6 +41,11 @@ pub use super::longitudinal::LongitudinalGains;
 /// (roll 45 deg, pitch 20 deg, surfaces 25 deg); filters Appendices D and E.
 pub const DESIGNED: GainSet = GainSet::THESIS;
 
+/// The flight defaults (every parameter's default): [`DESIGNED`] with the sideslip and both
+/// airspeed loops replaced, which the full linear model shows unstable as the thesis gives
+/// them ([`super::lateral::FLIGHT`], [`super::longitudinal::FLIGHT`]).
+pub const FLIGHT: GainSet = GainSet::FLIGHT;
+
 /// [`DESIGNED`] with the inner-loop reading of Table 3.10 and Appendix D ("My parameters":
 /// `kp_RT = -1.1216, ki_RT = -.01, kp_RD = -0.072`) and Table 3.10's course `ki` 0.008.
 pub const DESIGNED_T310: GainSet = {
@@ -98,6 +103,11 @@ pub const MINNESOTA_APPE: GainSet = {
 
 /// The named sets: name, set, one-line source.
 pub const NAMED: &[(&str, GainSet, &str)] = &[
+    (
+        "flight",
+        FLIGHT,
+        "the flight defaults: designed, airspeed and sideslip loops replaced",
+    ),
     ("designed", DESIGNED, "thesis Tables 3.3-3.9"),
     (
         "designed_t310",
@@ -119,6 +129,7 @@ pub const NAMED: &[(&str, GainSet, &str)] = &[
 
 /// Names of the sets in [`NAMED`].
 pub const NAMES: &[&str] = &[
+    "flight",
     "designed",
     "designed_t310",
     "designed_appe",
@@ -221,18 +232,32 @@ mod tests {
     }
 
     #[test]
-    fn the_stages_parameters_default_to_the_designed_set() {
+    fn the_stages_parameters_default_to_the_flight_set() {
         use crate::control::{autopilot, lateral, longitudinal};
         use crate::params::{ParamStore, Registry};
         const CONTROL: Registry = &[&lateral::PARAMS, &longitudinal::PARAMS, &autopilot::PARAMS];
         assert_eq!(ParamStore::validate(CONTROL), Ok(()));
         let store = ParamStore::new(CONTROL);
         let loaded = GainSet::from_store(&store);
-        for ((n, x), (m, y)) in DESIGNED.params().zip(loaded.params()) {
+        for ((n, x), (m, y)) in FLIGHT.params().zip(loaded.params()) {
             assert_eq!(n, m);
             assert!((x - y).abs() <= 1e-6 * x.abs().max(1.0), "{n}: {x} {y}");
         }
-        assert_eq!(DESIGNED.params().count(), store.len());
+        assert_eq!(FLIGHT.params().count(), store.len());
+        // The flight set is the designed one but for the loops it replaces.
+        let mut differ = FLIGHT
+            .params()
+            .zip(DESIGNED.params())
+            .filter(|((_, x), (_, y))| x != y)
+            .map(|((n, _), _)| n);
+        assert!(differ.by_ref().eq([
+            "SLIP_KP",
+            "SLIP_KI",
+            "ASPD_PTCH_KP",
+            "ASPD_PTCH_KI",
+            "ASPD_THR_KP",
+            "ASPD_THR_KI"
+        ]));
     }
 
     #[test]

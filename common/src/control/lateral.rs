@@ -76,7 +76,17 @@ pub const THESIS: LateralGains = LateralGains {
     trim_rudder: 0.00317,
 };
 
-const L: LateralGains = THESIS;
+/// The flight defaults: [`THESIS`] with the sideslip gains of the computed design
+/// (`sim-host design`). Table 3.5's magnitudes (3 and 0.8, sign corrected) leave the sideslip
+/// loop unstable on the full linear model once the servo, the two-sample delay and the yaw
+/// damper are in it (-25 deg of phase margin, docs/GAIN-DESIGN.md); 0.44 / 1.4 keep 53 deg.
+pub const FLIGHT: LateralGains = LateralGains {
+    slip_kp: 0.44,
+    slip_ki: 1.4,
+    ..THESIS
+};
+
+const L: LateralGains = FLIGHT;
 
 /// Trims inside the travel the loops may use: otherwise the loop could not return to trim.
 fn consistent(g: &LateralGains) -> Result<(), &'static str> {
@@ -249,7 +259,7 @@ pub const PARAMS: Group<LateralGains> = Group {
             LateralGains => trim_rudder, scale RAD2DEG
         ),
     ],
-    base: || THESIS,
+    base: || FLIGHT,
     check: consistent,
 };
 

@@ -258,7 +258,7 @@ fn the_vehicle_runs_its_control_tick_every_20_ms_of_sensor_time() {
 #[test]
 fn a_gain_set_chosen_by_parameter_is_flown_and_read_back() {
     let mut v = Vehicle::new();
-    v.params_mut().set("SYS_GAIN_SET", 3.0).unwrap();
+    v.params_mut().set("SYS_GAIN_SET", 4.0).unwrap();
     let f = SensorFrame::default();
     v.on_sensors(&f, &FromGround::default());
     // The Minnesota set's roll gain (Table 3.10) is now in the store.

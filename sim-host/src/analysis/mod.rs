@@ -7,5 +7,6 @@ pub mod linearize;
 pub mod lti;
 pub mod metrics;
 pub mod references;
+pub mod sampled;
 pub mod transfer;
 pub mod trim;

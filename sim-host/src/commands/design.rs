@@ -5,6 +5,7 @@ use super::Format;
 use crate::aircraft::Aircraft;
 use crate::analysis::design::inputs::DesignInputs;
 use crate::analysis::design::{describe_poles, design, Design};
+use crate::analysis::sampled::{SampledLoop, SampledLoops};
 use crate::report::sig;
 use crate::report::table::Table;
 use common::control::gains::GainSet;
@@ -17,6 +18,9 @@ pub struct DesignReport {
     pub design: Design,
     /// The resulting gain set, as it loads into the parameter store.
     pub gain_set: GainSet,
+    /// Every loop of the computed set, the flight defaults and the thesis's designed set on
+    /// the full linear model sampled at the autopilot's rate: (set, loops).
+    pub sampled: Vec<(String, Vec<SampledLoop>)>,
     /// Tables printed.
     #[serde(skip)]
     pub tables: Vec<Table>,
@@ -156,10 +160,58 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
             opt(l.margins.phase_margin_deg, 3),
         ]);
     }
+    let inputs = &d.inputs;
+    let model = SampledLoops::at_level_trim(
+        aircraft,
+        inputs.sample_time_s,
+        inputs.delay_samples.round().max(0.0) as u32,
+    )?;
+    let sampled: Vec<(String, Vec<SampledLoop>)> = [
+        ("computed", d.gains),
+        ("flight", common::control::gains::FLIGHT),
+        ("designed", common::control::gains::DESIGNED),
+    ]
+    .into_iter()
+    .map(|(name, g)| (name.to_string(), model.judge_all(&g)))
+    .collect();
+    let mut full = Table::new(
+        "On the full linear model at 50 Hz (every state of both axes, 8 Hz servos held over each period, measurements two periods late, every other loop closed): each loop broken at its controller's output, and a small step of its command",
+        &[
+            "loop",
+            "set",
+            "phase margin (deg)",
+            "gain margin (dB)",
+            "crossover (rad/s)",
+            "rise 10-90 % (s)",
+            "overshoot (%)",
+            "settling 2 % (s)",
+        ],
+    );
+    for (i, l) in d.loops.iter().enumerate() {
+        for (set, loops) in &sampled {
+            let Some(s) = loops.get(i) else { continue };
+            debug_assert_eq!(s.name, l.name);
+            full.row([
+                l.name.clone(),
+                set.clone(),
+                opt(s.margins.phase_margin_deg, 3),
+                opt(s.margins.gain_margin_db, 3),
+                opt(s.margins.gain_crossover_radps, 3),
+                opt(s.rise_time_s, 3),
+                if s.unstable {
+                    "unstable".into()
+                } else {
+                    sig(s.overshoot_pct, 3)
+                },
+                opt(s.settling_time_s, 3),
+            ]);
+        }
+    }
     Ok(DesignReport {
         gain_set: d.gains,
         design: d,
-        tables: vec![coeffs, appc, gains, pred],
+        sampled,
+        tables: vec![coeffs, appc, gains, pred, full],
     })
 }
 

@@ -410,6 +410,10 @@ pub fn mission_table(m: &MissionSummary) -> Table {
         "airspeed error (m/s)",
         format!("{} RMS", known(m.airspeed_rms_mps, 3)),
     );
+    row(
+        "throttle on a stop in level cruise (%)",
+        known(m.throttle_at_stops_pct, 3),
+    );
     row("flight time (s)", format!("{:.1}", m.flight_time_s));
     row("motor energy (Wh)", format!("{:.2}", m.energy_wh));
     match &m.touchdown {

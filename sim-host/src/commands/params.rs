@@ -133,8 +133,8 @@ mod tests {
         let land = find("NAV_RTL_LAND");
         assert_eq!(land["values"][1]["description"], "on");
         let set = find("SYS_GAIN_SET");
-        assert_eq!(set["values"][3]["description"], "minnesota");
-        assert_eq!(set["max"], 4);
+        assert_eq!(set["values"][4]["description"], "minnesota");
+        assert_eq!(set["max"], 5);
         // Every default lies within its bounds, as QGroundControl requires.
         for p in params {
             let (d, lo, hi) = (&p["default"], &p["min"], &p["max"]);

@@ -181,17 +181,9 @@ pub fn default_mission(home: GeoPoint) -> Vec<MISSION_ITEM_INT_DATA> {
         .build()
 }
 
-/// The airspeed-by-throttle gains the ground station sets before a mission, as an operator
-/// tunes an airframe: the thesis's Table 3.9 gains (1.0, 24) limit-cycle on this plant
-/// (`docs/RESULTS.md`), throwing the throttle between its stops and costing 0.9 m/s of
-/// airspeed error in calm air; Appendix E's (0.091, 0.02) are so slow that the altitude suffers
-/// (1.5 m RMS). 0.3 and 0.3 gave 0.43 m/s in calm air and 0.68-0.72 m/s in light turbulence
-/// with the altitude unchanged (`docs/NAVIGATION.md`).
-pub const MISSION_TUNING: [(&str, f32); 2] = [("ASPD_THR_KP", 0.3), ("ASPD_THR_KI", 0.3)];
-
 /// A flight of `mission` from the runway at home (heading north, engine off), as a pilot
-/// with QGroundControl flies it: [`MISSION_TUNING`] set, the mission uploaded, the autopilot
-/// armed once its estimator has converged, the mission started a second later; the flight
+/// with QGroundControl flies it: no parameter set (the firmware's defaults fly), the mission
+/// uploaded, the autopilot armed once its estimator has converged, the mission started a second later; the flight
 /// ends when the autopilot has landed and disarmed (or after 900 s).
 pub fn runway_mission(mission: Vec<MISSION_ITEM_INT_DATA>) -> FlightConfig {
     FlightConfig {
@@ -204,10 +196,6 @@ pub fn runway_mission(mission: Vec<MISSION_ITEM_INT_DATA>) -> FlightConfig {
                 action: Action::MissionStart,
             }],
             mission,
-            params: MISSION_TUNING
-                .iter()
-                .map(|(n, v)| (n.to_string(), *v))
-                .collect(),
             ..Script::thesis()
         },
         ..FlightConfig::default()

@@ -184,6 +184,9 @@ pub struct MissionSummary {
     pub alt_rms_m: f64,
     /// Airspeed error (commanded minus true) over the same items, RMS, m/s.
     pub airspeed_rms_mps: f64,
+    /// Share of level cruise (the same items, within the altitude-hold band of their
+    /// altitude, where the throttle holds the airspeed) with the throttle on a stop, %.
+    pub throttle_at_stops_pct: f64,
     /// Armed time, s.
     pub flight_time_s: f64,
     /// Energy the motor drew (the UMN motor-power curve at the commanded throttle), Wh.
@@ -216,6 +219,10 @@ pub struct TouchdownSummary {
 /// Cross-track error within which a loiter counts as arrived on its circle, m (the
 /// navigator's default acceptance radius, `NAV_ACC_RAD`).
 const ORBIT_ARRIVAL_M: f64 = 15.0;
+
+/// How near its stop (0 or 1) a throttle counts as on it: the flight defaults' THR_MIN and
+/// THR_MAX.
+const THROTTLE_STOP: f64 = 1e-3;
 
 /// Figures of a mission flight. `land_point` is the NAV_LAND item north and east of home.
 pub fn mission_summary(
@@ -275,8 +282,16 @@ pub fn mission_summary(
     });
     let datum = HomeDatum::of(samples);
     let (alt, va): (Vec<f64>, Vec<f64>) = cruising
+        .clone()
         .map(|s| (s.sp_alt - datum.truth_alt(s), s.sp_airspeed - s.airspeed))
         .unzip();
+    let band = f64::from(common::control::longitudinal::FLIGHT.alt_band);
+    let (stops, level) = cruising
+        .filter(|s| (s.sp_alt - s.est_alt).abs() < band)
+        .fold((0usize, 0usize), |(n, all), s| {
+            let on_stop = s.throttle <= THROTTLE_STOP || s.throttle >= 1.0 - THROTTLE_STOP;
+            (n + usize::from(on_stop), all + 1)
+        });
     let touchdown = touchdown.map(|t| touchdown_summary(t, land_point));
     MissionSummary {
         items: mission.len(),
@@ -289,6 +304,11 @@ pub fn mission_summary(
         orbit_xtrack_rms_m: rms(&orbit),
         alt_rms_m: rms(&alt),
         airspeed_rms_mps: rms(&va),
+        throttle_at_stops_pct: if level == 0 {
+            f64::NAN
+        } else {
+            100.0 * stops as f64 / level as f64
+        },
         flight_time_s: samples.iter().filter(|s| s.armed).count() as f64 * frame_s,
         energy_wh: energy_j / 3600.0,
         touchdown,

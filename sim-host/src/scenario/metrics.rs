@@ -156,7 +156,7 @@ pub fn run_metrics(scenario: &Scenario, run: &Run) -> RunMetrics {
     let surface = |x: &super::sim::Sample| match scenario.axis {
         Axis::Roll | Axis::Heading => x.aileron_deg,
         Axis::Sideslip => x.rudder_deg,
-        Axis::Pitch | Axis::Altitude => x.elevator_deg,
+        Axis::Pitch | Axis::Altitude | Axis::Airspeed => x.elevator_deg,
     };
     let travel: f64 = s
         .windows(2)

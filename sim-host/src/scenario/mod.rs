@@ -25,6 +25,15 @@
 //! | `altitude_step` | altitude | +5 m at 2 s; 40 s |
 //! | `altitude_doublet` | altitude | +5 m at 2 s, -5 m at 32 s, 0 at 62 s (10 m peak to peak); 90 s |
 //! | `climb` | altitude | +100 m at 2 s, then level; 80 s |
+//! | `roll_step_small` | roll | +5 deg at 2 s; 10 s |
+//! | `heading_step_small` | course | +5 deg at 2 s; 30 s |
+//! | `sideslip_step_small` | sideslip | +1 deg at 2 s; 10 s |
+//! | `pitch_step_small` | pitch | trim +2 deg at 2 s; 40 s |
+//! | `altitude_step_small` | altitude | +2 m at 2 s; 60 s |
+//! | `airspeed_step_small` | airspeed (throttle) | +1 m/s at 2 s, altitude held; 40 s |
+//!
+//! The `_small` steps do not saturate any loop, so the linear model's predictions
+//! ([`crate::analysis::sampled`]) can be held against them.
 
 pub mod metrics;
 pub mod sim;
@@ -49,6 +58,9 @@ pub enum Axis {
     Pitch,
     /// Altitude (regimes of Figure 3-16), m.
     Altitude,
+    /// Airspeed by throttle in altitude hold, m/s (not a thesis figure: the small-step check
+    /// of the airspeed loop's prediction).
+    Airspeed,
 }
 
 impl Axis {
@@ -60,6 +72,7 @@ impl Axis {
             Axis::Sideslip => "sideslip",
             Axis::Pitch => "pitch",
             Axis::Altitude => "altitude",
+            Axis::Airspeed => "airspeed",
         }
     }
 
@@ -67,6 +80,7 @@ impl Axis {
     pub fn unit(self) -> &'static str {
         match self {
             Axis::Altitude => "m",
+            Axis::Airspeed => "m/s",
             _ => "deg",
         }
     }
@@ -74,7 +88,7 @@ impl Axis {
     /// SI value per edge unit (rad per deg, or 1 for metres).
     pub fn si_per_unit(self) -> f64 {
         match self {
-            Axis::Altitude => 1.0,
+            Axis::Altitude | Axis::Airspeed => 1.0,
             _ => std::f64::consts::PI / 180.0,
         }
     }
@@ -82,7 +96,7 @@ impl Axis {
     /// An outer loop (heading, altitude): the 5 % overshoot requirement applies. Roll and pitch
     /// are the inner attitude loops (rise time under 1 s; pitch overshoot up to 7 %).
     pub fn is_outer(self) -> bool {
-        matches!(self, Axis::Heading | Axis::Altitude)
+        matches!(self, Axis::Heading | Axis::Altitude | Axis::Airspeed)
     }
 }
 
@@ -214,6 +228,54 @@ pub const SCENARIOS: &[Scenario] = &[
         duration_s: 80.0,
         slip_hold: false,
     },
+    Scenario {
+        name: "roll_step_small",
+        description: "Roll step of 5 deg, small enough to leave the aileron unsaturated",
+        axis: Axis::Roll,
+        steps: &[(2.0, 5.0)],
+        duration_s: 10.0,
+        slip_hold: false,
+    },
+    Scenario {
+        name: "heading_step_small",
+        description: "Heading step of 5 deg, small enough to leave the roll command unsaturated",
+        axis: Axis::Heading,
+        steps: &[(2.0, 5.0)],
+        duration_s: 30.0,
+        slip_hold: false,
+    },
+    Scenario {
+        name: "sideslip_step_small",
+        description: "Sideslip step of 1 deg, wings held level",
+        axis: Axis::Sideslip,
+        steps: &[(2.0, 1.0)],
+        duration_s: 10.0,
+        slip_hold: true,
+    },
+    Scenario {
+        name: "pitch_step_small",
+        description: "Pitch step of trim +2 deg",
+        axis: Axis::Pitch,
+        steps: &[(2.0, 2.0)],
+        duration_s: 40.0,
+        slip_hold: false,
+    },
+    Scenario {
+        name: "altitude_step_small",
+        description: "Altitude step of 2 m in altitude hold",
+        axis: Axis::Altitude,
+        steps: &[(2.0, 2.0)],
+        duration_s: 60.0,
+        slip_hold: false,
+    },
+    Scenario {
+        name: "airspeed_step_small",
+        description: "Airspeed step of 1 m/s by throttle in altitude hold",
+        axis: Axis::Airspeed,
+        steps: &[(2.0, 1.0)],
+        duration_s: 40.0,
+        slip_hold: false,
+    },
 ];
 
 /// Names of every scenario, in [`SCENARIOS`] order.
@@ -249,6 +311,7 @@ impl Scenario {
             Axis::Roll | Axis::Heading | Axis::Sideslip => 0.0,
             Axis::Pitch => trim.theta,
             Axis::Altitude => trim.target.alt_msl_m,
+            Axis::Airspeed => trim.target.va_mps,
         }
     }
 
@@ -312,6 +375,14 @@ impl Scenario {
                 lon: LonMode::Altitude {
                     altitude: c,
                     airspeed: AIRSPEED_MPS as f32,
+                },
+            },
+            Axis::Airspeed => Commands {
+                roll: RollMode::Roll(0.0),
+                yaw: slip0,
+                lon: LonMode::Altitude {
+                    altitude: trim.target.alt_msl_m as f32,
+                    airspeed: c,
                 },
             },
         }

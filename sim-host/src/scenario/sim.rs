@@ -222,6 +222,7 @@ pub fn simulate(
             Axis::Sideslip => air.beta,
             Axis::Pitch => e.theta,
             Axis::Altitude => plant.alt_msl_m(),
+            Axis::Airspeed => air.va,
         };
         samples.push(Sample {
             t,

@@ -28,7 +28,7 @@ use super::pid::{Bumpless, Derivative, Pid, PidGains};
 use crate::actuators::SURFACE_LIMIT_RAD;
 use crate::math::{clamp, wrap_pi};
 
-pub use gains::{LongitudinalGains, PARAMS, THESIS};
+pub use gains::{LongitudinalGains, FLIGHT, PARAMS, THESIS};
 pub use regime::{Regime, RegimeMachine};
 
 /// What the elevator and throttle do. Angles rad, altitudes m, airspeeds m/s.

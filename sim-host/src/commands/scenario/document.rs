@@ -7,6 +7,8 @@ use super::run::ScenarioReport;
 use crate::aircraft::Aircraft;
 use crate::analysis::design::design;
 use crate::analysis::design::inputs::DesignInputs;
+use crate::analysis::sampled::plant::out;
+use crate::analysis::sampled::{Arrangement, LatLaw, LoopCase, SampledLoop, SampledLoops, CASES};
 use crate::report::sig;
 use crate::report::template::block;
 use crate::scenario::SCENARIOS;
@@ -187,28 +189,62 @@ pub fn results_markdown(report: &ScenarioReport, command: &str, aircraft: &Aircr
     s
 }
 
-/// The computed set's linear predictions (`sim-host design`) beside what the nonlinear plant
-/// flies, first step of each test from trim.
+/// The computed set's linear predictions beside what the nonlinear plant flies, on the small
+/// steps: the reduced models of the design (`sim-host design`) and the full linear model
+/// sampled at the autopilot's rate ([`SampledLoops`]).
 fn prediction_vs_flight(report: &ScenarioReport, aircraft: &Aircraft) -> String {
     let Ok(d) = design(aircraft, &DesignInputs::default()) else {
         return String::new();
     };
+    let inputs = &d.inputs;
+    let Ok(model) = SampledLoops::at_level_trim(
+        aircraft,
+        inputs.sample_time_s,
+        inputs.delay_samples.round().max(0.0) as u32,
+    ) else {
+        return String::new();
+    };
+    // The tests feed the course loop the heading (the thesis's still-air assumption), so its
+    // prediction does too.
+    let full: Vec<SampledLoop> = CASES
+        .iter()
+        .map(|c| {
+            if c.arrangement.lat != LatLaw::Course {
+                return model.judge(&d.gains, c);
+            }
+            let heading = LoopCase {
+                arrangement: Arrangement {
+                    lat: LatLaw::Heading,
+                    ..c.arrangement
+                },
+                output: out::HEADING,
+                ..*c
+            };
+            model.judge(&d.gains, &heading)
+        })
+        .collect();
     let pairs = [
-        ("roll attitude", "roll_doublet"),
-        ("course", "heading_doublet"),
-        ("sideslip", "sideslip_doublet"),
-        ("pitch attitude", "pitch_doublet"),
-        ("altitude", "altitude_step"),
+        ("roll attitude", "roll_step_small"),
+        ("course", "heading_step_small"),
+        ("sideslip", "sideslip_step_small"),
+        ("pitch attitude", "pitch_step_small"),
+        ("altitude", "altitude_step_small"),
+        ("airspeed (throttle)", "airspeed_step_small"),
     ];
     let mut s =
         String::from("\n## The computed set: linear prediction against the nonlinear plant\n\n");
     s.push_str(&block(PROSE, "prediction", &[]));
     s.push_str(
-        "\n\n| loop | test | rise predicted (s) | rise flown (s) | difference | \
-         overshoot predicted (%) | overshoot flown (%) |\n|---|---|---|---|---|---|---|\n",
+        "\n\n| loop | test | rise, reduced model (s) | rise, full model (s) | rise flown (s) | \
+         full model against flown | overshoot, reduced model (%) | overshoot, full model (%) | \
+         overshoot flown (%) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
+    let opt = |v: Option<f64>| v.map_or_else(|| "-".into(), |v| sig(v, 3));
     for (name, sc) in pairs {
-        let Some(l) = d.loops.iter().find(|l| l.name.starts_with(name)) else {
+        let (Some(l), Some(f)) = (
+            d.loops.iter().find(|l| l.name.starts_with(name)),
+            full.iter().find(|l| l.name.starts_with(name)),
+        ) else {
             continue;
         };
         let Some(m) = report.get(sc, false).and_then(|r| r.metrics_of(COMPUTED)) else {
@@ -217,18 +253,20 @@ fn prediction_vs_flight(report: &ScenarioReport, aircraft: &Aircraft) -> String 
         let Some(first) = m.segments.first().map(|g| g.metrics) else {
             continue;
         };
-        let diff = match (l.rise_time_s, first.rise_time_s) {
-            (Some(p), Some(f)) => format!("{:+.0} %", (f - p) / p * 100.0),
+        let diff = match (f.rise_time_s, first.rise_time_s) {
+            (Some(p), Some(r)) => format!("{:+.0} %", (r - p) / p * 100.0),
             _ => "-".into(),
         };
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             l.name,
             sc,
-            l.rise_time_s.map_or_else(|| "-".into(), |v| sig(v, 3)),
-            first.rise_time_s.map_or_else(|| "-".into(), |v| sig(v, 3)),
+            opt(l.rise_time_s),
+            opt(f.rise_time_s),
+            opt(first.rise_time_s),
             diff,
             sig(l.overshoot_pct, 3),
+            sig(f.overshoot_pct, 3),
             sig(first.overshoot_pct, 3),
         ));
     }

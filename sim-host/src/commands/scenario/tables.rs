@@ -24,7 +24,7 @@ pub fn metrics_table(r: &ScenarioResult) -> Table {
     let surface = match r.scenario.axis {
         Axis::Roll | Axis::Heading => "peak |aileron| (deg)",
         Axis::Sideslip => "peak |rudder| (deg)",
-        Axis::Pitch | Axis::Altitude => "peak |elevator| (deg)",
+        Axis::Pitch | Axis::Altitude | Axis::Airspeed => "peak |elevator| (deg)",
     };
     let sse = format!("max |ss error| ({unit})");
     let ripple = format!("ripple RMS ({unit})");
@@ -46,7 +46,7 @@ pub fn metrics_table(r: &ScenarioResult) -> Table {
         let peak = match r.scenario.axis {
             Axis::Roll | Axis::Heading => m.peak_aileron_deg,
             Axis::Sideslip => m.peak_rudder_deg,
-            Axis::Pitch | Axis::Altitude => m.peak_elevator_deg,
+            Axis::Pitch | Axis::Altitude | Axis::Airspeed => m.peak_elevator_deg,
         };
         t.row([
             m.gains.clone(),
@@ -96,7 +96,7 @@ fn figure(r: &ScenarioResult) -> Figure {
     let (sname, sfn): (&str, fn(&crate::scenario::sim::Sample) -> f64) = match axis {
         Axis::Roll | Axis::Heading => ("aileron", |s| s.aileron_deg),
         Axis::Sideslip => ("rudder", |s| s.rudder_deg),
-        Axis::Pitch | Axis::Altitude => ("elevator", |s| s.elevator_deg),
+        Axis::Pitch | Axis::Altitude | Axis::Airspeed => ("elevator", |s| s.elevator_deg),
     };
     let surf = per_set(sfn);
     let mut panels = vec![
