@@ -230,10 +230,10 @@ pub(crate) struct FlyArgs {
     /// it), simlink.tlog, the PNG plots and summary.json.
     #[arg(long, default_value = "out/fly")]
     pub(crate) out: PathBuf,
-    /// Gain set loaded before arming (SYS_GAIN_SET): 0 designed, 1 designed_t310,
-    /// 2 designed_appe, 3 minnesota, 4 minnesota_appe. Without it the "computed" set
-    /// (`sim-host design`) is uploaded parameter by parameter, as a ground station would;
-    /// with `--mission` the firmware's defaults (the designed set) fly.
+    /// Gain set loaded before arming (SYS_GAIN_SET): 0 flight (the defaults), 1 designed,
+    /// 2 designed_t310, 3 designed_appe, 4 minnesota, 5 minnesota_appe. Without it the
+    /// "computed" set (`sim-host design`) is uploaded parameter by parameter, as a ground
+    /// station would; with `--mission` the firmware's defaults (the flight set) fly.
     #[arg(long)]
     pub(crate) gains: Option<u32>,
     /// Fly on the simulator's truth instead of the estimator (SIM_USE_TRUTH = 1).
@@ -263,8 +263,8 @@ pub(crate) struct FlyArgs {
     /// Wall-clock pace with --realtime: simulated seconds per wall second.
     #[arg(long, default_value_t = 1.0)]
     pub(crate) speed: f64,
-    /// Set an autopilot parameter before arming (PARAM_SET from the ground station), after
-    /// the mission's own tuning; repeatable: `--param NAV_LND_SLP_DEG=6`.
+    /// Set an autopilot parameter before arming (PARAM_SET from the ground station);
+    /// repeatable: `--param NAV_LND_SLP_DEG=6`.
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     pub(crate) params: Vec<(String, f32)>,
 }

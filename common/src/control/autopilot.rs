@@ -4,6 +4,7 @@
 pub use super::inputs::{InputFlags, Measurements};
 use super::lateral::{self, Lateral, LateralGains, RollMode, YawMode};
 use super::longitudinal::{self, LonMode, Longitudinal, LongitudinalGains, Regime};
+use super::scaling::surface_scale;
 use crate::actuators::Surfaces;
 use crate::param;
 use crate::params::{Group, ParamDef, ParamError, ParamStore};
@@ -13,20 +14,37 @@ use serde::{Deserialize, Serialize};
 /// chosen here, a few times the inner loops' rise time).
 pub const TRANSFER_TC_S: f32 = 1.0;
 
+/// The flight defaults' scaling airspeed, m/s: the trim airspeed every loop was designed at
+/// (Table 2.3 trim I). The thesis's sets fly unscaled, as in the thesis.
+pub const SCALING_AIRSPEED_MPS: f32 = 17.0;
+
 /// Parameters of the autopilot as a whole.
 pub const PARAMS: Group<GainSet> = Group {
     name: "Autopilot",
-    params: &[param!(
-        ParamDef::real(
-            "XFER_TC_S",
-            TRANSFER_TC_S,
-            0.05,
-            20.0,
-            "s",
-            "Fade time constant of bumpless-transfer offsets (loops without integrator)",
+    params: &[
+        param!(
+            ParamDef::real(
+                "XFER_TC_S",
+                TRANSFER_TC_S,
+                0.05,
+                20.0,
+                "s",
+                "Fade time constant of bumpless-transfer offsets (loops without integrator)",
+            ),
+            GainSet => transfer_tc
         ),
-        GainSet => transfer_tc
-    )],
+        param!(
+            ParamDef::real(
+                "ASPD_SCL_REF",
+                SCALING_AIRSPEED_MPS,
+                0.0,
+                40.0,
+                "m/s",
+                "Airspeed the surface loops' gains hold at; scaled by (this/airspeed)^2 elsewhere (0: off)",
+            ),
+            GainSet => scaling_airspeed
+        ),
+    ],
     base: || GainSet::FLIGHT,
     check: crate::params::independent,
 };
@@ -41,6 +59,10 @@ pub struct GainSet {
     pub longitudinal: LongitudinalGains,
     /// Time constant with which a bumpless-transfer offset fades, s.
     pub transfer_tc: f32,
+    /// Airspeed at which the surface loops' gains are as given, m/s; at other airspeeds the
+    /// roll, pitch and sideslip loops and the yaw damper are scaled by `(this / airspeed)^2`
+    /// ([`super::scaling`]). Zero: no scaling.
+    pub scaling_airspeed: f32,
 }
 
 /// Why a gain set or a parameter value was refused; each names the parameter.
@@ -84,6 +106,7 @@ impl GainSet {
         lateral: lateral::THESIS,
         longitudinal: longitudinal::THESIS,
         transfer_tc: TRANSFER_TC_S,
+        scaling_airspeed: 0.0,
     };
 
     /// The flight defaults, every parameter's default: the thesis's designed set with the
@@ -93,6 +116,7 @@ impl GainSet {
         lateral: lateral::FLIGHT,
         longitudinal: longitudinal::FLIGHT,
         transfer_tc: TRANSFER_TC_S,
+        scaling_airspeed: SCALING_AIRSPEED_MPS,
     };
 
     /// Checks every value: finite, inside its parameter's bounds (the bounds of the loop gains
@@ -150,10 +174,12 @@ impl GainSet {
 
     /// The set the store holds (consistent by the store's own checks).
     pub fn from_store(store: &ParamStore) -> GainSet {
+        let own = store.load(&PARAMS);
         GainSet {
             lateral: store.load(&lateral::PARAMS),
             longitudinal: store.load(&longitudinal::PARAMS),
-            transfer_tc: store.load(&PARAMS).transfer_tc,
+            transfer_tc: own.transfer_tc,
+            scaling_airspeed: own.scaling_airspeed,
         }
     }
 }
@@ -326,6 +352,9 @@ impl Autopilot {
         let dt_ok = dt.is_finite() && dt > 0.0 && dt <= MAX_DT;
         // A refused dt reaches the stages as NaN: every engaged loop then holds.
         let dt_stage = if dt_ok { dt } else { f32::NAN };
+        let scale = surface_scale(m.airspeed, self.gains.scaling_airspeed);
+        self.lat.set_surface_scale(scale);
+        self.lon.set_surface_scale(scale);
         let lat = self.lat.step(m, c.roll, c.yaw, dt_stage);
         let lon = self.lon.step(m, c.lon, dt_stage);
         let mut rejected = lat.rejected | lon.rejected;
@@ -393,6 +422,43 @@ mod tests {
             airspeed: 16.5,
             sideslip: 0.01,
         }
+    }
+
+    #[test]
+    fn at_a_higher_airspeed_the_surface_loops_answer_by_the_inverse_square_of_it() {
+        // Engaged on the present attitude, then a step of both commands: the aileron's and
+        // elevator's moves scale as (17 / Va)^2 with the flight set, and not at all with the
+        // thesis's set (the rates are the same on both ticks, so only the error terms move).
+        let answer = |g: &GainSet, va: f32| {
+            let mut ap = Autopilot::new(g).unwrap();
+            let m = Measurements {
+                airspeed: va,
+                ..flying()
+            };
+            let c = |roll: f32, pitch: f32| Commands {
+                roll: RollMode::Roll(roll),
+                yaw: YawMode::Damper,
+                lon: LonMode::Pitch {
+                    pitch,
+                    throttle: 0.5,
+                },
+            };
+            let before = ap.step(&m, &c(m.roll, m.pitch), DT).surfaces;
+            let after = ap.step(&m, &c(0.2, 0.15), DT).surfaces;
+            (
+                after.aileron - before.aileron,
+                after.elevator - before.elevator,
+            )
+        };
+        let flight = GainSet::FLIGHT;
+        let (a17, e17) = answer(&flight, 17.0);
+        let (a25, e25) = answer(&flight, 25.0);
+        let expected = (17.0f32 / 25.0).powi(2);
+        assert!((a25 / a17 - expected).abs() < 1e-3, "{a17} {a25}");
+        assert!((e25 / e17 - expected).abs() < 1e-3, "{e17} {e25}");
+        let (t17, _) = answer(&DESIGNED, 17.0);
+        let (t25, _) = answer(&DESIGNED, 25.0);
+        assert_eq!(t17, t25);
     }
 
     #[test]

@@ -244,19 +244,20 @@ mod tests {
             assert!((x - y).abs() <= 1e-6 * x.abs().max(1.0), "{n}: {x} {y}");
         }
         assert_eq!(FLIGHT.params().count(), store.len());
-        // The flight set is the designed one but for the loops it replaces.
-        let mut differ = FLIGHT
+        // The flight set is the designed one but for the loops it replaces and the scaling.
+        let differ = FLIGHT
             .params()
             .zip(DESIGNED.params())
             .filter(|((_, x), (_, y))| x != y)
             .map(|((n, _), _)| n);
-        assert!(differ.by_ref().eq([
+        assert!(differ.eq([
             "SLIP_KP",
             "SLIP_KI",
             "ASPD_PTCH_KP",
             "ASPD_PTCH_KI",
             "ASPD_THR_KP",
-            "ASPD_THR_KI"
+            "ASPD_THR_KI",
+            "ASPD_SCL_REF"
         ]));
     }
 

@@ -354,6 +354,7 @@ pub struct Lateral {
     roll_cmd: f32,
     roll_resume: bool,
     yaw_resume: bool,
+    surface_scale: f32,
 }
 
 fn roll_gains(g: &LateralGains) -> PidGains {
@@ -399,6 +400,16 @@ impl Lateral {
             roll_cmd: f32::NAN,
             roll_resume: false,
             yaw_resume: false,
+            surface_scale: 1.0,
+        }
+    }
+
+    /// The factor on the roll and rudder loops' inputs for this airspeed
+    /// ([`super::scaling::surface_scale`]); 1 until set. A factor that is not finite and
+    /// positive is ignored.
+    pub fn set_surface_scale(&mut self, scale: f32) {
+        if scale.is_finite() && scale > 0.0 {
+            self.surface_scale = scale;
         }
     }
 
@@ -520,9 +531,10 @@ impl Lateral {
             }
         };
         let e = wrap_pi(phi_c - m.roll);
+        let k = self.surface_scale;
         self.aileron = self
             .roll
-            .step(e, Derivative::Rate(m.roll_rate), g.trim_aileron, dt);
+            .step(k * e, Derivative::Rate(k * m.roll_rate), g.trim_aileron, dt);
         self.roll_cmd = phi_c;
         self.roll_kind = kind;
         self.roll_resume = false;
@@ -592,7 +604,8 @@ impl Lateral {
             };
             self.slip.reset_to(self.rudder, how);
         }
-        let damper = g.yaw_damper_k * self.washout.step(m.yaw_rate, dt);
+        let k = self.surface_scale;
+        let damper = k * g.yaw_damper_k * self.washout.step(m.yaw_rate, dt);
         let e = if kind == YawKind::Sideslip {
             beta_c - m.sideslip
         } else {
@@ -600,7 +613,7 @@ impl Lateral {
         };
         self.rudder = self
             .slip
-            .step(e, Derivative::None, g.trim_rudder + damper, dt);
+            .step(k * e, Derivative::None, g.trim_rudder + damper, dt);
         self.yaw_kind = kind;
         self.yaw_resume = false;
         false

@@ -55,6 +55,7 @@ pub mod inputs;
 pub mod lateral;
 pub mod longitudinal;
 pub mod pid;
+pub mod scaling;
 
 #[cfg(test)]
 mod closed_loop_tests;

@@ -393,7 +393,7 @@ fn change_speed_and_set_home() {
     nav.step(&items, &home(), &plane.state(), DT);
     let o = nav.step(&items, &home(), &plane.state(), DT);
     assert_eq!(last.current_seq, Some(4));
-    assert_eq!(o.guidance.unwrap().airspeed, 25.0);
+    assert_eq!(o.guidance.unwrap().airspeed, nav.params().airspeed_max);
     // Crossed limits (a minimum above the maximum) are no reason to panic: the maximum wins.
     let mut nav = navigator();
     let mut p = *nav.params();

@@ -227,7 +227,7 @@ pub fn trim(aircraft: &Aircraft, target: &TrimTarget) -> TrimResult {
 
 /// [`trim`] with already derived parameters.
 pub fn trim_with(p: &ModelParams, target: &TrimTarget) -> TrimResult {
-    let mut z = Z::from_column_slice(&[
+    let guess = Z::from_column_slice(&[
         0.05,
         0.0,
         0.05 + target.gamma_rad,
@@ -237,6 +237,26 @@ pub fn trim_with(p: &ModelParams, target: &TrimTarget) -> TrimResult {
         0.56,
         827.0,
     ]);
+    solve(p, target, guess)
+}
+
+/// Trims `target` starting from the solution of a nearby trim `near` (continuation: the fixed
+/// guess of [`trim_with`] suits airspeeds about 17 m/s only).
+pub fn trim_near(p: &ModelParams, target: &TrimTarget, near: &TrimResult) -> TrimResult {
+    let guess = Z::from_column_slice(&[
+        near.alpha,
+        near.phi,
+        near.theta,
+        near.elevator,
+        near.aileron,
+        near.rudder,
+        near.throttle,
+        near.engine_speed,
+    ]);
+    solve(p, target, guess)
+}
+
+fn solve(p: &ModelParams, target: &TrimTarget, mut z: Z) -> TrimResult {
     let norm = |r: &Z| {
         let n = r.norm();
         if n.is_finite() {

@@ -5,7 +5,7 @@ use super::Format;
 use crate::aircraft::Aircraft;
 use crate::analysis::design::inputs::DesignInputs;
 use crate::analysis::design::{describe_poles, design, Design};
-use crate::analysis::sampled::{SampledLoop, SampledLoops};
+use crate::analysis::sampled::{scaled_at, SampledLoop, SampledLoops};
 use crate::report::sig;
 use crate::report::table::Table;
 use common::control::gains::GainSet;
@@ -21,6 +21,9 @@ pub struct DesignReport {
     /// Every loop of the computed set, the flight defaults and the thesis's designed set on
     /// the full linear model sampled at the autopilot's rate: (set, loops).
     pub sampled: Vec<(String, Vec<SampledLoop>)>,
+    /// The flight set at each airspeed of [`SCALING_AIRSPEEDS_MPS`], without and with the
+    /// airspeed scaling of its surface loops: (airspeed m/s, unscaled, scaled).
+    pub scaling: Vec<(f64, Vec<SampledLoop>, Vec<SampledLoop>)>,
     /// Tables printed.
     #[serde(skip)]
     pub tables: Vec<Table>,
@@ -207,12 +210,86 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
             ]);
         }
     }
+    let (scaling, scaling_table) = scaling_report(aircraft, inputs)?;
     Ok(DesignReport {
         gain_set: d.gains,
         design: d,
         sampled,
-        tables: vec![coeffs, appc, gains, pred, full],
+        scaling,
+        tables: vec![coeffs, appc, gains, pred, full, scaling_table],
     })
+}
+
+/// Airspeeds the flight set's scaling is judged at, m/s: the lowest and highest a mission may
+/// set (`NAV_ASPD_MIN`, `NAV_ASPD_MAX`) and the trim. Level flight ends at 23.6 m/s, where the
+/// throttle reaches its stop.
+pub const SCALING_AIRSPEEDS_MPS: [f64; 3] = [13.0, 17.0, 23.0];
+
+type ScalingRows = Vec<(f64, Vec<SampledLoop>, Vec<SampledLoop>)>;
+
+/// The flight set on the full sampled model at the trims of [`SCALING_AIRSPEEDS_MPS`], without
+/// and with airspeed scaling.
+fn scaling_report(
+    aircraft: &Aircraft,
+    inputs: &DesignInputs,
+) -> anyhow::Result<(ScalingRows, Table)> {
+    let flight = common::control::gains::FLIGHT;
+    let unscaled = GainSet {
+        scaling_airspeed: 0.0,
+        ..flight
+    };
+    let mut rows = Vec::new();
+    for va in SCALING_AIRSPEEDS_MPS {
+        let model = SampledLoops::at_level_airspeed(
+            aircraft,
+            va,
+            inputs.sample_time_s,
+            inputs.delay_samples.round().max(0.0) as u32,
+        )?;
+        rows.push((
+            va,
+            model.judge_all(&unscaled),
+            model.judge_all(&scaled_at(&flight, va)),
+        ));
+    }
+    let mut t = Table::new(
+        "Airspeed scaling: the flight set on the full sampled model at the level trims of 13, 17 and 23 m/s, its surface loops (roll, pitch, sideslip, yaw damper) unscaled and scaled by (17 / Va)^2 (ASPD_SCL_REF)",
+        &[
+            "loop",
+            "airspeed (m/s)",
+            "phase margin unscaled (deg)",
+            "phase margin scaled (deg)",
+            "gain margin unscaled (dB)",
+            "gain margin scaled (dB)",
+            "overshoot unscaled (%)",
+            "overshoot scaled (%)",
+        ],
+    );
+    let over = |l: &SampledLoop| {
+        if l.unstable {
+            "unstable".to_string()
+        } else {
+            sig(l.overshoot_pct, 3)
+        }
+    };
+    for i in 0..rows.first().map_or(0, |r| r.1.len()) {
+        for (va, plain, scaled) in &rows {
+            let (Some(p), Some(s)) = (plain.get(i), scaled.get(i)) else {
+                continue;
+            };
+            t.row([
+                p.name.to_string(),
+                sig(*va, 3),
+                opt(p.margins.phase_margin_deg, 3),
+                opt(s.margins.phase_margin_deg, 3),
+                opt(p.margins.gain_margin_db, 3),
+                opt(s.margins.gain_margin_db, 3),
+                over(p),
+                over(s),
+            ]);
+        }
+    }
+    Ok((rows, t))
 }
 
 /// The design as a Markdown document.

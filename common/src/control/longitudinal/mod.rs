@@ -180,6 +180,7 @@ pub struct Longitudinal {
     pitch_cmd: f32,
     elev_resume: bool,
     thr_resume: bool,
+    surface_scale: f32,
 }
 
 fn pitch_gains(g: &LongitudinalGains) -> PidGains {
@@ -229,6 +230,16 @@ impl Longitudinal {
             pitch_cmd: f32::NAN,
             elev_resume: false,
             thr_resume: false,
+            surface_scale: 1.0,
+        }
+    }
+
+    /// The factor on the pitch loop's inputs for this airspeed
+    /// ([`super::scaling::surface_scale`]); 1 until set. A factor that is not finite and
+    /// positive is ignored.
+    pub fn set_surface_scale(&mut self, scale: f32) {
+        if scale.is_finite() && scale > 0.0 {
+            self.surface_scale = scale;
         }
     }
 
@@ -469,9 +480,13 @@ impl Longitudinal {
             }
         };
         let e = wrap_pi(theta_c - m.pitch);
-        self.elevator = self
-            .pitch
-            .step(e, Derivative::Rate(m.pitch_rate), g.trim_elevator, dt);
+        let k = self.surface_scale;
+        self.elevator = self.pitch.step(
+            k * e,
+            Derivative::Rate(k * m.pitch_rate),
+            g.trim_elevator,
+            dt,
+        );
         self.pitch_cmd = theta_c;
         self.pitch_src = kind;
         self.elev_resume = false;

@@ -67,11 +67,11 @@ pub const PARAMS: Group<NavParams> = Group {
         param!(
             ParamDef::real(
                 "NAV_ASPD_MAX",
-                25.0,
+                23.0,
                 8.0,
                 40.0,
                 "m/s",
-                "Highest airspeed DO_CHANGE_SPEED may set",
+                "Highest airspeed DO_CHANGE_SPEED may set (level flight at full throttle ends at 23.6)",
             ),
             NavParams => airspeed_max
         ),

@@ -19,10 +19,11 @@ pub mod plant;
 use super::linearize::linearize;
 use super::lti::{margins, Margins};
 use super::metrics::step_metrics;
-use super::trim::{trim_with, TrimTarget};
+use super::trim::{trim_near, trim_with, TrimTarget};
 use crate::aircraft::Aircraft;
 use crate::plant::params::ModelParams;
 use common::control::gains::GainSet;
+use common::control::scaling::surface_scale;
 use nalgebra::{Complex, DMatrix};
 use plant::{cmd, out, SampledPlant};
 use rustfft::FftPlanner;
@@ -217,8 +218,34 @@ impl SampledLoops {
         period_s: f64,
         delay_samples: u32,
     ) -> anyhow::Result<Self> {
+        Self::at_level_airspeed(
+            aircraft,
+            TrimTarget::level().va_mps,
+            period_s,
+            delay_samples,
+        )
+    }
+
+    /// The loops at `aircraft`'s level trim at `airspeed_mps`, as [`Self::at_level_trim`].
+    pub fn at_level_airspeed(
+        aircraft: &Aircraft,
+        airspeed_mps: f64,
+        period_s: f64,
+        delay_samples: u32,
+    ) -> anyhow::Result<Self> {
         let params = ModelParams::new(aircraft);
-        let trim = trim_with(&params, &TrimTarget::level());
+        let level = TrimTarget::level();
+        let mut trim = trim_with(&params, &level);
+        // Continuation from the design trim in steps of at most 1 m/s.
+        let steps = (airspeed_mps - level.va_mps).abs().ceil().max(1.0) as usize;
+        for k in 1..=steps {
+            let va = level.va_mps + (airspeed_mps - level.va_mps) * k as f64 / steps as f64;
+            let target = TrimTarget {
+                va_mps: va,
+                ..level.clone()
+            };
+            trim = trim_near(&params, &target, &trim);
+        }
         anyhow::ensure!(
             trim.converged,
             "the level trim did not converge (residual {:.3e})",
@@ -275,6 +302,50 @@ impl SampledLoops {
         -(m[(channel, channel)] + back)
     }
 
+    /// Closed-loop poles of `arr` that diverge faster than [`SLOWEST_DIVERGENCE_S`] (0:
+    /// stable), by the argument principle on the return difference `det(I - M(z))`, whose
+    /// zeros outside a circle are the closed loop's poles there and whose poles there are the
+    /// open loop's (the aircraft's unstable modes; the controllers' poles lie inside or at 1).
+    /// The circle's radius `exp(T / SLOWEST_DIVERGENCE_S)` puts the integrators at `z = 1`
+    /// inside it, and with them the height's drift through the air density (an e-fold in hours
+    /// where no loop holds the height), which no loop of the autopilot is there to correct.
+    pub fn unstable_poles(&self, gains: &GainSet, arr: Arrangement) -> i64 {
+        let r = (self.plant.period_s / SLOWEST_DIVERGENCE_S).exp();
+        let open = self.plant.poles().iter().filter(|p| p.norm() > r).count() as i64;
+        let f = |theta: f64| {
+            let z = Complex::from_polar(r, theta);
+            let m = self.at(gains, arr, z).m;
+            let mut i_m = -m;
+            for a in 0..ch::N {
+                i_m[(a, a)] += 1.0;
+            }
+            i_m.determinant()
+        };
+        // Angles crowd towards z = 1, where the integrators turn the phase quickly.
+        let n = 2000;
+        let mut angles: Vec<f64> = (0..=n)
+            .map(|k| 1e-9 * (std::f64::consts::PI / 1e-9).powf(k as f64 / n as f64))
+            .collect();
+        let back: Vec<f64> = angles
+            .iter()
+            .rev()
+            .map(|a| 2.0 * std::f64::consts::PI - a)
+            .collect();
+        angles.extend(back);
+        let mut turn = 0.0;
+        let mut prev = f(angles[0]);
+        let mut prev_theta = angles[0];
+        for &theta in &angles[1..] {
+            turn += wrap_arg(&f, prev_theta, prev, theta, 0);
+            prev = f(theta);
+            prev_theta = theta;
+        }
+        let winding = (turn / (2.0 * std::f64::consts::PI)).round() as i64;
+        // Counter-clockwise round the circle, the winding counts zeros minus poles inside; the
+        // outside holds the rest of each, with F(infinity) = 1.
+        open - winding
+    }
+
     /// Margins of the loop broken at `channel`, up to the Nyquist frequency.
     pub fn margins(&self, gains: &GainSet, arr: Arrangement, channel: usize) -> Margins {
         let nyquist = std::f64::consts::PI / self.plant.period_s;
@@ -325,6 +396,42 @@ impl SampledLoops {
     }
 }
 
+/// The gains the surface loops fly with at `airspeed_mps`: the roll, pitch and sideslip loops
+/// and the yaw damper times the flight code's airspeed scaling ([`surface_scale`]), which is 1
+/// for a set without a scaling airspeed. (Scaling the loop's inputs is scaling its gains.)
+pub fn scaled_at(gains: &GainSet, airspeed_mps: f64) -> GainSet {
+    let k = surface_scale(airspeed_mps as f32, gains.scaling_airspeed);
+    let mut g = *gains;
+    let (lat, lon) = (&mut g.lateral, &mut g.longitudinal);
+    for v in [
+        &mut lat.roll_kp,
+        &mut lat.roll_ki,
+        &mut lat.roll_rate_kd,
+        &mut lat.slip_kp,
+        &mut lat.slip_ki,
+        &mut lat.yaw_damper_k,
+        &mut lon.pitch_kp,
+        &mut lon.pitch_ki,
+        &mut lon.pitch_rate_kd,
+    ] {
+        *v *= k;
+    }
+    g
+}
+
+/// The change of `arg f` from `a` (where `f` is `fa`) to `b`, halving the interval until each
+/// piece turns by less than a quarter turn.
+fn wrap_arg(f: &impl Fn(f64) -> Complex<f64>, a: f64, fa: Complex<f64>, b: f64, depth: u32) -> f64 {
+    let fb = f(b);
+    let d = (fb / fa).arg();
+    if d.abs() < std::f64::consts::FRAC_PI_2 || depth > 30 {
+        return d;
+    }
+    let mid = 0.5 * (a + b);
+    let fm = f(mid);
+    wrap_arg(f, a, fa, mid, depth + 1) + wrap_arg(f, mid, fm, b, depth + 1)
+}
+
 /// One loop's figures on the sampled full model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SampledLoop {
@@ -334,7 +441,7 @@ pub struct SampledLoop {
     pub arrangement: Arrangement,
     /// Margins with the loop broken at its controller's output.
     pub margins: Margins,
-    /// The closed loop is unstable (a negative phase or gain margin): no step figures.
+    /// The closed loop has poles outside the unit circle: no step figures.
     pub unstable: bool,
     /// 10-90 % rise time of a small reference step, s.
     pub rise_time_s: Option<f64>,
@@ -418,6 +525,9 @@ pub const CASES: [LoopCase; 7] = [
     },
 ];
 
+/// Slowest divergence counted as instability, s (an e-fold in five minutes).
+pub const SLOWEST_DIVERGENCE_S: f64 = 300.0;
+
 /// Periods of each predicted step: 2^14 at 50 Hz is 328 s, long after the slowest loop
 /// (altitude, a few tens of seconds) has settled.
 const STEP_PERIODS: usize = 1 << 14;
@@ -438,8 +548,7 @@ impl SampledLoops {
         let end = t.last().copied().unwrap_or(0.0) + 1.0;
         let m = step_metrics(&t, &y, 0.0, 1.0, 0.0, end);
         let margins = self.margins(gains, case.arrangement, case.channel);
-        let unstable = margins.phase_margin_deg.is_some_and(|p| p < 0.0)
-            || margins.gain_margin_db.is_some_and(|g| g < 0.0);
+        let unstable = self.unstable_poles(gains, case.arrangement) != 0;
         // An unstable loop's transform back is not its response (it never decays).
         let known = |v: Option<f64>| v.filter(|_| !unstable);
         SampledLoop {

@@ -167,6 +167,11 @@ impl SampledPlant {
         }
     }
 
+    /// Poles of the sampled aircraft (eigenvalues of `Ad`).
+    pub fn poles(&self) -> Vec<Complex<f64>> {
+        crate::analysis::lti::eigenvalues(&self.ad)
+    }
+
     /// Number of states (rigid body and servos).
     pub fn states(&self) -> usize {
         self.ad.nrows()

@@ -178,8 +178,41 @@ fn the_predicted_steps_are_what_the_flight_code_flies_on_the_same_model() {
 fn every_loop_of_the_computed_set_is_stable_on_the_full_sampled_model() {
     let (_, _, loops, gains) = setup();
     for l in loops.judge_all(&gains) {
+        assert!(!l.unstable, "{}", l.name);
         let pm = l.margins.phase_margin_deg.unwrap_or(90.0);
         assert!(pm > 30.0, "{}: {pm} deg", l.name);
         assert!(l.settling_time_s.is_some(), "{}: never settles", l.name);
+    }
+}
+
+#[test]
+fn the_thesis_sideslip_and_airspeed_loops_are_unstable_on_the_full_model_and_the_flight_set_is_not()
+{
+    let (_, _, loops, _) = setup();
+    let designed = common::control::gains::DESIGNED;
+    let flight = common::control::gains::FLIGHT;
+    for (k, c) in CASES.iter().enumerate() {
+        let thesis = loops.unstable_poles(&designed, c.arrangement);
+        // Sideslip (Table 3.5), airspeed by pitch (3.8), and altitude hold, whose arrangement
+        // holds the airspeed by throttle with Table 3.9's 1.0 / 24.
+        let expect_unstable = matches!(k, 2 | 4 | 5 | 6);
+        assert_eq!(
+            thesis > 0,
+            expect_unstable,
+            "designed, {}: {thesis}",
+            c.name
+        );
+        assert_eq!(
+            loops.unstable_poles(&flight, c.arrangement),
+            0,
+            "flight, {}",
+            c.name
+        );
+        let m = loops.margins(&flight, c.arrangement, c.channel);
+        assert!(
+            m.phase_margin_deg.unwrap_or(90.0) >= 45.0,
+            "flight, {}: {m:?}",
+            c.name
+        );
     }
 }
