@@ -253,7 +253,7 @@ fn scaling_report(
         ));
     }
     let mut t = Table::new(
-        "Airspeed scaling: the flight set on the full sampled model at the level trims of 13, 17 and 23 m/s, its surface loops (roll, pitch, sideslip, yaw damper) unscaled and scaled by (17 / Va)^2 (ASPD_SCL_REF)",
+        "Airspeed scaling: the flight set on the full sampled model at the level trims of 13, 17 and 23 m/s, its surface loops (roll, pitch, sideslip, yaw damper) and altitude loop unscaled and scaled by 17 / Va (ASPD_SCL_REF)",
         &[
             "loop",
             "airspeed (m/s)",

@@ -234,7 +234,7 @@ impl Longitudinal {
         }
     }
 
-    /// The factor on the pitch loop's inputs for this airspeed
+    /// The factor on the pitch and altitude loops' inputs for this airspeed
     /// ([`super::scaling::surface_scale`]); 1 until set. A factor that is not finite and
     /// positive is ignored.
     pub fn set_surface_scale(&mut self, scale: f32) {
@@ -474,10 +474,14 @@ impl Longitudinal {
                 self.aspd_pitch
                     .step(v - feedback, Derivative::None, g.trim_pitch, dt)
             }
-            PitchSource::Altitude(v, ff) => {
-                self.alt
-                    .step(v - feedback, Derivative::None, g.trim_pitch + ff, dt)
-            }
+            // A pitch change climbs at the airspeed times it: the altitude loop takes the
+            // surface loops' airspeed factor too.
+            PitchSource::Altitude(v, ff) => self.alt.step(
+                self.surface_scale * (v - feedback),
+                Derivative::None,
+                g.trim_pitch + ff,
+                dt,
+            ),
         };
         let e = wrap_pi(theta_c - m.pitch);
         let k = self.surface_scale;

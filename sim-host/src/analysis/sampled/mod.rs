@@ -396,9 +396,10 @@ impl SampledLoops {
     }
 }
 
-/// The gains the surface loops fly with at `airspeed_mps`: the roll, pitch and sideslip loops
-/// and the yaw damper times the flight code's airspeed scaling ([`surface_scale`]), which is 1
-/// for a set without a scaling airspeed. (Scaling the loop's inputs is scaling its gains.)
+/// The gains the loops fly with at `airspeed_mps`: the roll, pitch and sideslip loops, the yaw
+/// damper and the altitude loop times the flight code's airspeed scaling ([`surface_scale`]),
+/// which is 1 for a set without a scaling airspeed. (Scaling a loop's inputs is scaling its
+/// gains.)
 pub fn scaled_at(gains: &GainSet, airspeed_mps: f64) -> GainSet {
     let k = surface_scale(airspeed_mps as f32, gains.scaling_airspeed);
     let mut g = *gains;
@@ -413,6 +414,8 @@ pub fn scaled_at(gains: &GainSet, airspeed_mps: f64) -> GainSet {
         &mut lon.pitch_kp,
         &mut lon.pitch_ki,
         &mut lon.pitch_rate_kd,
+        &mut lon.alt_kp,
+        &mut lon.alt_ki,
     ] {
         *v *= k;
     }
