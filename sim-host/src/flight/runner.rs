@@ -348,8 +348,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         }
 
         for _ in 0..substeps {
-            let seen = servos.step(&command, dt);
-            plant.step(&seen, &env, dt);
+            let seen = plant.step_servos(&mut servos, &command, &env, dt);
             let shaft_w = motor_power_w(&params, seen.throttle);
             battery.step(battery.electrical_power_w(shaft_w), dt);
         }
