@@ -33,6 +33,7 @@ pub mod plots;
 pub mod record;
 pub mod runner;
 pub mod script;
+pub mod strikes;
 pub mod summary;
 
 pub use config::{
