@@ -47,10 +47,11 @@ impl Servo {
     /// overshoot) and at any RK4 stage time inside one. A command that is not finite holds the
     /// servo where it is.
     pub fn held(&self, command: f64, tau: f64) -> f64 {
-        if !command.is_finite() {
+        let error = command - self.position;
+        // At rest on its command (flaps, a surface held), or at the step's start: no motion.
+        if !error.is_finite() || error == 0.0 || tau <= 0.0 {
             return self.position;
         }
-        let error = command - self.position;
         let knee = self.rate_limit_radps / self.bandwidth_radps;
         let ramp_s = (error.abs() - knee).max(0.0) / self.rate_limit_radps;
         let position = if tau <= ramp_s {
