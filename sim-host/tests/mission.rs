@@ -29,6 +29,8 @@ fn flown_as_planned(o: &FlightOutcome) -> MissionSummary {
     );
     assert_eq!(m.reached, m.nav_items, "in order, each once");
     assert!(m.touchdown.is_some(), "touched down");
+    assert!(m.strikes.is_empty(), "strikes {:?}", m.strikes);
+    assert!(m.pass, "failed {:?}", m.failed);
     let last = o.samples.last().expect("samples");
     assert!(!last.armed, "disarmed after the landing");
     m
@@ -96,4 +98,76 @@ fn the_default_mission_meets_every_target_in_wind_and_turbulence_on_forty_seeds(
         on += usize::from(on_target(&m));
     }
     assert!(on >= 34, "{on} of 40 touchdowns on target");
+}
+
+/// A mission that reached every item, whose log has the right wing tip on the runway while
+/// armed (rolled 20 deg on the wheels: the tip reaches the ground at 14.6 deg), fails its
+/// summary on `no_strike` alone, with the strike as an event in the JSON and the printed
+/// table; a smaller roll, or the same roll while disarmed, passes.
+#[test]
+fn a_wing_tip_on_the_runway_while_armed_fails_the_mission_summary_on_no_strike() {
+    use sim_host::commands::fly::mission_table;
+    use sim_host::flight::strikes::{propeller_hub_m, strike_points, survey};
+    use sim_host::flight::Sample;
+    use sim_host::plant::Plant;
+
+    let a = Aircraft::ultrastick25e().expect("built-in aircraft");
+    let rest = Plant::at_rest_on_ground(&a, 0.0, 0.0, 0.0);
+    let e = rest.euler();
+    let home = a.environment.home_alt_msl_m;
+    let log = |rolls: &[f64], armed: bool| -> Vec<Sample> {
+        rolls
+            .iter()
+            .enumerate()
+            .map(|(k, r)| Sample {
+                t: k as f64,
+                armed,
+                alt: rest.alt_msl_m(),
+                roll: r.to_radians(),
+                pitch: e.theta,
+                yaw: e.psi,
+                ..Sample::default()
+            })
+            .collect()
+    };
+    let points = strike_points(&a, propeller_hub_m(&a, [0.0; 3]));
+    let judged = |samples: &[Sample]| {
+        let mut m = MissionSummary {
+            all_reached: true,
+            ..MissionSummary::default()
+        };
+        m.judge(survey(samples, &points, home));
+        m
+    };
+
+    let struck = judged(&log(&[0.0, 20.0, 0.0], true));
+    assert!(!struck.pass);
+    assert_eq!(struck.failed, ["no_strike"]);
+    assert_eq!(struck.strikes.len(), 1);
+    assert!(struck.strikes[0].point.starts_with("right wing tip"));
+    assert_eq!(struck.strikes[0].t_s, 1.0);
+    assert!(struck.min_clearance_m.is_some_and(|c| c < 0.0));
+    let json = serde_json::to_value(&struck).expect("json");
+    assert_eq!(json["failed"][0], "no_strike");
+    assert_eq!(json["strikes"][0]["t_s"], 1.0);
+    let text = mission_table(&struck).render_text();
+    assert!(text.contains("right wing tip at 1.0 s"), "{text}");
+    assert!(text.contains("fail: no_strike"), "{text}");
+
+    // Rolled 10 deg the tip stays clear; rolled 20 deg while disarmed (the hands of the crew
+    // before the flight) is no strike of the flight.
+    let tilted = judged(&log(&[0.0, 10.0, 0.0], true));
+    assert!(
+        tilted.pass && tilted.strikes.is_empty(),
+        "{:?}",
+        tilted.failed
+    );
+    let mut handled = log(&[0.0, 20.0, 0.0], true);
+    handled[1].armed = false;
+    let handled = judged(&handled);
+    assert!(
+        handled.pass && handled.strikes.is_empty(),
+        "{:?}",
+        handled.failed
+    );
 }

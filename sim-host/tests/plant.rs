@@ -2,8 +2,9 @@
 
 use nalgebra::Vector3;
 use sim_host::aircraft::Aircraft;
+use sim_host::analysis::linearize::{iu, ix, linearize};
 use sim_host::analysis::trim::{trim, TrimTarget};
-use sim_host::plant::{Environment, Plant, ServoBank};
+use sim_host::plant::{Environment, ModelParams, Plant, ServoBank};
 
 #[test]
 fn trimmed_flight_stays_trimmed() {
@@ -134,4 +135,35 @@ fn servo_bank_holds_trim_and_follows_a_command() {
         out = s.step(&cmd, 0.02);
     }
     assert!((out.rudder - 25f64.to_radians()).abs() < 1e-6);
+}
+
+#[test]
+fn an_elevator_step_through_the_servos_pitches_by_the_servo_motion_inside_the_step() {
+    // From trim, a 1 deg elevator step is held over one 5 ms step with the servos moving inside
+    // it: delta(t) = A (1 - exp(-w t)). To second order in the step the linear model gives
+    // dx = B I1 + A B I2, I1 and I2 the single and double integrals of delta over the step.
+    // Surfaces held at their end-of-step position would give about twice the pitch rate.
+    let a = Aircraft::ultrastick25e().unwrap();
+    let t = trim(&a, &TrimTarget::level());
+    let lin = linearize(&ModelParams::new(&a), &t);
+    let (amp, dt) = (1f64.to_radians(), 0.005);
+    let w = 2.0 * std::f64::consts::PI * a.actuators.bandwidth_Hz;
+    let decay = (1.0 - (-w * dt).exp()) / w;
+    let i1 = amp * (dt - decay);
+    let i2 = amp * (dt * dt / 2.0 - dt / w + decay / w);
+    let b = lin.b.column(iu::ELEVATOR).into_owned();
+    let predicted = b * i1 + lin.a * b * i2;
+
+    let mut plant = Plant::new(&a, t.state);
+    let mut servos = ServoBank::new(&a.actuators, &t.controls);
+    let mut cmd = t.controls;
+    cmd.elevator += amp;
+    let end = plant.step_servos(&mut servos, &cmd, &Environment::default(), dt);
+    assert!((end.elevator - t.controls.elevator - amp * (1.0 - (-w * dt).exp())).abs() < 1e-15);
+    let dq = plant.body_rates().y - t.state.omega_body.y;
+    let want = predicted[ix::Q];
+    assert!(
+        ((dq - want) / want).abs() < 0.01,
+        "pitch rate change {dq} against {want} rad/s"
+    );
 }

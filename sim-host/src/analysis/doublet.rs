@@ -2,8 +2,10 @@
 //!
 //! From a trim, a doublet (+A for a half period, then -A, then back to trim) is commanded on
 //! one surface. The command passes through the servo model and the servo output drives both the
-//! nonlinear plant and the full 13-state linear model about the same trim (RK4, same step, input
-//! held over each step), so the two see identical surface motion and only the model differs.
+//! nonlinear plant and the full 13-state linear model about the same trim (RK4, same step), so
+//! the two see identical surface motion and only the model differs. The command is held over
+//! each step and the servos move inside it, each RK4 stage seeing the surfaces at its time
+//! ([`ServoBank::rk4_held`], as in every simulation).
 
 use super::linearize::{ix, u5_of, Linearization, X13};
 use super::trim::TrimResult;
@@ -212,6 +214,8 @@ pub fn run(
     let params = ModelParams::new(aircraft);
     let mut plant = Plant::from_params(params, trim.state);
     let mut servos = ServoBank::new(&aircraft.actuators, &trim.controls);
+    // Each model has servos of its own, driven by the same command: the same surface motion.
+    let mut lin_servos = servos;
     let env = Environment::default();
     let u0 = u5_of(&trim.controls);
     let mut dx = X13::zeros();
@@ -231,11 +235,11 @@ pub fn run(
     });
     for k in 0..steps {
         let t = k as f64 * cfg.dt_s;
-        actual = servos.step(&command(&trim.controls, surface, cfg, t), cfg.dt_s);
-        plant.step(&actual, &env, cfg.dt_s);
-        let du = u5_of(&actual) - u0;
-        let bu = lin.b * du;
-        crate::plant::integrator::rk4_step(|x| lin.a * x + bu, &mut dx, cfg.dt_s);
+        let cmd = command(&trim.controls, surface, cfg, t);
+        actual = plant.step_servos(&mut servos, &cmd, &env, cfg.dt_s);
+        lin_servos.rk4_held(&cmd, &mut dx, cfg.dt_s, |c, x| {
+            lin.a * x + lin.b * (u5_of(c) - u0)
+        });
         samples.push(Sample {
             t: (k + 1) as f64 * cfg.dt_s,
             surface: surface_of(&actual),

@@ -9,10 +9,11 @@ use crate::flight::config::FlightConfig;
 use crate::flight::onboard::InprocOnboard;
 use crate::flight::record::Sample;
 use crate::flight::runner::{fly, FlightOutcome};
+use crate::flight::strikes::{clearance, phase_name, strike_points, survey, Point, Survey};
 use crate::flight::summary::HomeDatum;
 use crate::link::lockstep::Lockstep;
 use crate::link::transport::Inproc;
-use common::math::{wrap_pi, Euler};
+use common::math::wrap_pi;
 use common::vehicle::snapshot::LandedState;
 use firmware::app::App;
 use nalgebra::Vector3;
@@ -118,116 +119,19 @@ fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)
 }
 
-/// A non-wheel point of the airframe, from the CG in body axes, named for the report.
-#[derive(Clone, Debug, PartialEq)]
-struct Point {
-    name: String,
-    body: Vector3<f64>,
-    /// Extra reach below the point whatever the attitude's roll (the propeller disc's radius,
-    /// in the body y-z plane).
-    disc_radius: f64,
-}
-
-/// The points that must never touch: every belly point of the aircraft file and the lowest
-/// point of the propeller disc, whose hub is at `propeller_hub_m` from the CG.
-fn strike_points(a: &Aircraft, propeller_hub_m: [f64; 3]) -> Vec<Point> {
-    let half_span = 0.5 * a.geometry.b_m;
-    let mut v: Vec<Point> = a
-        .ground
-        .belly_points_m
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let what = if p[1].abs() > 0.5 * half_span {
-                if p[1] < 0.0 {
-                    "left wing tip"
-                } else {
-                    "right wing tip"
-                }
-            } else if p[0] > 0.15 {
-                "nose"
-            } else if p[0] < -0.2 {
-                "tail"
-            } else {
-                "fuselage"
-            };
-            Point {
-                name: format!("{what} (belly_points_m[{i}])"),
-                body: Vector3::from(*p),
-                disc_radius: 0.0,
-            }
-        })
-        .collect();
-    v.push(Point {
-        name: "propeller".into(),
-        body: Vector3::from(propeller_hub_m),
-        disc_radius: a.propulsion.prop_radius_m,
-    });
-    v
-}
-
-/// Where the propeller's hub is, from the CG in body axes, m. The aircraft file's
-/// `prop_arm_from_cg_m` is the UMN model's: only its z acts (the thrust is along x), and its x
-/// is the difference of the UMN station coordinates, which grow aft. The Ultra Stick is a
-/// tractor, so the hub is that far ahead of the CG; a shift `cg_shift_m` of the CG moves it
-/// back by as much.
-pub fn propeller_hub_m(nominal: &Aircraft, cg_shift_m: [f64; 3]) -> [f64; 3] {
-    let p = nominal.geometry.prop_arm_from_cg_m;
-    [
-        p[0].abs() - cg_shift_m[0],
-        p[1] - cg_shift_m[1],
-        p[2] - cg_shift_m[2],
-    ]
-}
-
-/// Height of a point above the ground at a sample (the ground is home's altitude).
-fn clearance(s: &Sample, home_alt: f64, p: &Point) -> f64 {
-    let r = Euler::new(s.roll, s.pitch, s.yaw).body_to_ned();
-    let down = (r * p.body).z;
-    // The disc spans the body y-z plane: its lowest point reaches R * sqrt(r_zy^2 + r_zz^2)
-    // further down.
-    let disc = p.disc_radius * r[(2, 1)].hypot(r[(2, 2)]);
-    (s.alt - home_alt) - down - disc
-}
-
-/// The navigator's phase by its index in the log, in words.
-fn phase_name(index: u8) -> String {
-    use common::navigation::Phase as P;
-    let known = [
-        (P::Idle, "idle (armed, mission not started)"),
-        (P::TakeoffRoll, "take-off roll"),
-        (P::TakeoffClimb, "take-off climb"),
-        (P::Waypoint, "waypoint"),
-        (P::Loiter, "loiter"),
-        (P::Return, "return"),
-        (P::ReturnLoiter, "return loiter"),
-        (P::Approach, "approach"),
-        (P::Flare, "flare"),
-        (P::Landed, "roll-out"),
-        (P::Hold, "hold"),
-        (P::Complete, "complete"),
-    ];
-    known
-        .iter()
-        .find(|(p, _)| *p as u8 == index)
-        .map_or_else(|| format!("phase {index}"), |(_, n)| n.to_string())
-}
-
 /// What the log shows while armed: the largest bank and pitch, when control was first lost,
-/// and the closest call of a non-wheel point.
+/// and the clearances of the non-wheel points.
 #[derive(Clone, Debug, Default)]
 struct Excursions {
     bank_deg: Option<f64>,
     pitch_deg: Option<f64>,
     loss_of_control: Option<(f64, String)>,
-    /// Clearance, point, time, phase.
-    closest: Option<(f64, String, f64, String)>,
+    clearances: Survey,
 }
 
 fn excursions(samples: &[Sample], points: &[Point], home_alt: f64) -> Excursions {
     use super::verdict::{LOC_BANK_DEG, LOC_PITCH_DEG};
     let mut x = Excursions::default();
-    let mut low: Option<(f64, usize, &Sample)> = None;
     for s in samples.iter().filter(|s| s.armed) {
         let (bank, pitch) = (s.roll.abs().to_degrees(), s.pitch.abs().to_degrees());
         x.bank_deg = Some(x.bank_deg.unwrap_or(0.0).max(bank));
@@ -235,14 +139,8 @@ fn excursions(samples: &[Sample], points: &[Point], home_alt: f64) -> Excursions
         if x.loss_of_control.is_none() && (bank > LOC_BANK_DEG || pitch > LOC_PITCH_DEG) {
             x.loss_of_control = Some((s.t, phase_name(s.nav_phase)));
         }
-        for (i, p) in points.iter().enumerate() {
-            let c = clearance(s, home_alt, p);
-            if low.is_none_or(|(m, _, _)| c < m) {
-                low = Some((c, i, s));
-            }
-        }
     }
-    x.closest = low.map(|(c, i, s)| (c, points[i].name.clone(), s.t, phase_name(s.nav_phase)));
+    x.clearances = survey(samples, points, home_alt);
     x
 }
 
@@ -327,16 +225,17 @@ pub fn figures_and_facts(
     let samples = &outcome.samples;
     let points = strike_points(aircraft, plan.propeller_hub_m);
     let x = excursions(samples, &points, home_alt);
+    let closest = x.clearances.closest.as_ref();
     let mut f = Figures {
         sim_s: finite(s.sim_s),
         max_bank_deg: x.bank_deg,
         max_pitch_deg: x.pitch_deg,
         loss_of_control_t_s: x.loss_of_control.as_ref().map(|l| l.0),
         loss_of_control_phase: x.loss_of_control.as_ref().map(|l| l.1.clone()),
-        min_clearance_m: x.closest.as_ref().map(|c| c.0),
-        min_clearance_point: x.closest.as_ref().map(|c| c.1.clone()),
-        min_clearance_t_s: x.closest.as_ref().map(|c| c.2),
-        min_clearance_phase: x.closest.as_ref().map(|c| c.3.clone()),
+        min_clearance_m: closest.map(|c| c.clearance_m),
+        min_clearance_point: closest.map(|c| c.point.clone()),
+        min_clearance_t_s: closest.map(|c| c.t_s),
+        min_clearance_phase: closest.map(|c| c.phase.clone()),
         est_heading_rms_deg: s
             .estimator_settled
             .as_ref()
@@ -398,7 +297,7 @@ pub fn figures_and_facts(
         on_ground: truth_on_ground,
         failsafes: f.failsafes.clone(),
         loss_of_control: x.loss_of_control,
-        closest_call: x.closest.map(|c| (c.2, c.1, c.3)),
+        closest_call: closest.map(|c| (c.t_s, c.point.clone(), c.phase.clone())),
         touchdown_at: f.touchdown_t_s.zip(f.touchdown_along_m),
         items: (
             f.items_reached.unwrap_or(0.0) as u32,
@@ -419,7 +318,8 @@ pub struct Plan {
     pub draws: Quantities,
     /// The dispersed aircraft.
     pub aircraft: Aircraft,
-    /// Where its propeller's hub is, from the CG, body axes, m ([`propeller_hub_m`]).
+    /// Where its propeller's hub is, from the CG, body axes, m
+    /// ([`crate::flight::strikes::propeller_hub_m`]).
     pub propeller_hub_m: [f64; 3],
     /// The flight.
     pub config: FlightConfig,
@@ -456,43 +356,15 @@ pub fn fly_record(plan: &Plan, reproduce: String) -> (FlightRecord, Option<Fligh
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plant::ground::rest_state;
-    use crate::plant::ModelParams;
-
-    fn at_rest(a: &Aircraft) -> Sample {
-        let (state, _) = rest_state(&ModelParams::new(a), 0.0, 0.0, 0.0);
-        let e = Euler::from_quaternion(&state.attitude);
-        Sample {
-            alt: a.environment.home_alt_msl_m - state.pos_ned.z,
-            roll: e.phi,
-            pitch: e.theta,
-            yaw: e.psi,
-            ..Sample::default()
-        }
-    }
+    use crate::flight::strikes::propeller_hub_m;
+    use crate::flight::strikes::tests::at_rest;
 
     #[test]
-    fn at_rest_every_non_wheel_point_clears_the_runway_and_a_20_degree_roll_puts_a_tip_on_it() {
+    fn the_truth_is_on_the_ground_at_rest_and_on_its_back_but_not_a_metre_up() {
         let a = Aircraft::ultrastick25e().unwrap();
         let points = strike_points(&a, propeller_hub_m(&a, [0.0; 3]));
         let home = a.environment.home_alt_msl_m;
         let rest = at_rest(&a);
-        for p in &points {
-            let c = clearance(&rest, home, p);
-            // The tail skid sits 5 cm up in the three-point attitude; the propeller more.
-            assert!(c > 0.04, "{}: {c}", p.name);
-        }
-        // The tips are 0.635 m out and 0.16 m up: the ground is reached at asin(0.16/0.635),
-        // about 14.6 degrees.
-        let rolled = Sample {
-            roll: 20f64.to_radians(),
-            ..rest
-        };
-        let tip = points
-            .iter()
-            .find(|p| p.name.starts_with("right wing tip"))
-            .unwrap();
-        assert!(clearance(&rolled, home, tip) < 0.0);
         assert!(on_ground(&rest, &a, &points, home));
         let aloft = Sample {
             alt: rest.alt + 1.0,
@@ -506,28 +378,5 @@ mod tests {
             ..rest
         };
         assert!(on_ground(&inverted, &a, &points, home));
-    }
-
-    #[test]
-    fn the_propeller_disc_reaches_its_radius_below_the_hub_whatever_the_roll() {
-        let a = Aircraft::ultrastick25e().unwrap();
-        let hub = propeller_hub_m(&a, [0.0; 3]);
-        assert!(
-            hub[0] > 0.25,
-            "a tractor's propeller is ahead of the CG: {hub:?}"
-        );
-        let p = Point {
-            name: "propeller".into(),
-            body: Vector3::from(hub),
-            disc_radius: 0.1524,
-        };
-        let level = Sample {
-            alt: 1.0,
-            ..Sample::default()
-        };
-        let rolled = Sample { roll: 0.7, ..level };
-        let expect = 1.0 - hub[2] - 0.1524;
-        assert!((clearance(&level, 0.0, &p) - expect).abs() < 1e-12);
-        assert!((clearance(&rolled, 0.0, &p) - clearance(&level, 0.0, &p)).abs() < 0.05);
     }
 }

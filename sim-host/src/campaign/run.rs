@@ -3,13 +3,14 @@
 
 use super::draws::{disperse_aircraft, draw_day, Sampler};
 use super::mission::{mission_for, MissionChoice};
-use super::record::{fly_record, propeller_hub_m, FlightRecord, Plan};
+use super::record::{fly_record, FlightRecord, Plan};
 use super::spec::CampaignSpec;
 use super::verdict::Criterion;
 use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
 use crate::flight::missions::runway_mission;
 use crate::flight::runner::FlightOutcome;
+use crate::flight::strikes::propeller_hub_m;
 use crate::plant::ModelParams;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

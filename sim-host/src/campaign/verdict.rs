@@ -4,9 +4,11 @@
 //! The facts come from what the simulator has today: the flight summary's figures, the
 //! plant's first contact of the landing, the autopilot's own landed state at the end, and
 //! the clearance of every non-wheel point of the airframe, computed from the plant's
-//! ground-contact geometry at each frame. When the plant reports strikes itself, or the
-//! autopilot gains a land detector, [`judge`] is the one place to read them instead.
+//! ground-contact geometry at each frame ([`crate::flight::strikes`], which the flight summary
+//! judges strikes by as well). When the plant reports strikes itself, or the autopilot gains a
+//! land detector, [`judge`] is the one place to read them instead.
 
+use crate::flight::strikes::{kind, strike_free};
 use serde::{Deserialize, Serialize};
 
 /// Largest bank angle before the flight counts as out of control, deg: the autopilot's
@@ -168,7 +170,7 @@ pub fn judge(f: &Facts) -> Verdict {
         Criterion::Items => ran && f.all_items_reached,
         Criterion::Touchdown => ran && within(f.touchdown_m, TOUCHDOWN_M, false),
         Criterion::Sink => ran && within(f.sink_mps, SINK_MPS, true),
-        Criterion::NoStrike => ran && f.min_clearance_m.is_some_and(|c| c >= 0.0),
+        Criterion::NoStrike => ran && strike_free(f.min_clearance_m),
         Criterion::LandedState => {
             ran && f.landed_state_agrees && (!f.on_ground || f.disarmed_on_ground)
         }
@@ -219,8 +221,7 @@ fn cause(f: &Facts, failed: &[String]) -> String {
     }
     if has(Criterion::NoStrike) {
         if let Some((t, point, phase)) = &f.closest_call {
-            let what = point.split(" (").next().unwrap_or(point);
-            timed.push((*t, format!("{what} strike in {phase}")));
+            timed.push((*t, format!("{} strike in {phase}", kind(point))));
         }
     }
     if let Some((t, along)) = f.touchdown_at {

@@ -6,6 +6,7 @@ use crate::aircraft::Aircraft;
 use crate::flight::config::FlightConfig;
 use crate::flight::onboard::{spawn_firmware, InprocOnboard};
 use crate::flight::runner::FlightOutcome;
+use crate::flight::strikes::kind;
 use crate::flight::summary::{BatterySummary, MissionSummary};
 use crate::link::qemu::QemuConfig;
 use crate::link::transport::{Inproc, PtyServer, TcpServer, UdpServer};
@@ -428,6 +429,35 @@ pub fn mission_table(m: &MissionSummary) -> Table {
         }
         None => row("touchdown", "none".into()),
     }
+    let strikes: Vec<String> = m
+        .strikes
+        .iter()
+        .map(|s| {
+            format!(
+                "{} at {:.1} s in {}, {:.1} cm deep",
+                kind(&s.point),
+                s.t_s,
+                s.phase,
+                s.depth_m * 100.0
+            )
+        })
+        .collect();
+    row(
+        "strikes",
+        if strikes.is_empty() {
+            "none".into()
+        } else {
+            strikes.join("; ")
+        },
+    );
+    row(
+        "verdict",
+        if m.pass {
+            "pass".into()
+        } else {
+            format!("fail: {}", m.failed.join(", "))
+        },
+    );
     t
 }
 

@@ -6,8 +6,11 @@
 //! ```text
 //! plant truth -> sensors -> HIL_GPS (when a fix is delivered), HIL_STATE_QUATERNION (truth),
 //!                           HIL_SENSOR -> lock-step exchange -> HIL_ACTUATOR_CONTROLS
-//!   -> servos -> plant (RK4, several steps of `dt_s` per frame)
+//!   -> servos and plant (RK4, several steps of `dt_s` per frame)
 //! ```
+//!
+//! The surfaces the autopilot answers are held over the frame; the servos move towards them
+//! inside each RK4 step, with the rigid body ([`crate::plant::Plant::step_servos`]).
 //!
 //! The HIL_SENSOR frame goes last in each batch, because the autopilot answers it: when the
 //! answer arrives, the autopilot has taken in the whole batch, whatever the transport, so the
@@ -30,6 +33,7 @@ pub mod plots;
 pub mod record;
 pub mod runner;
 pub mod script;
+pub mod strikes;
 pub mod summary;
 
 pub use config::{

@@ -4,6 +4,7 @@ use super::config::FlightConfig;
 use super::onboard::Onboard;
 use super::record::{AutopilotView, NavView, Sample};
 use super::script::GroundStation;
+use super::strikes::{propeller_hub_m, strike_points, survey};
 use super::summary::{
     mission_summary, summarise, touchdown_summary, Ending, FlightFacts, FlightSummary,
 };
@@ -348,8 +349,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         }
 
         for _ in 0..substeps {
-            let seen = servos.step(&command, dt);
-            plant.step(&seen, &env, dt);
+            let seen = plant.step_servos(&mut servos, &command, &env, dt);
             let shaft_w = motor_power_w(&params, seen.throttle);
             battery.step(battery.electrical_power_w(shaft_w), dt);
         }
@@ -411,7 +411,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     summary.touchdown = plant.touchdown().map(|t| touchdown_summary(t, land_point));
     if let Some(g) = gcs.as_ref().filter(|_| !cfg.script.mission.is_empty()) {
         let reached: Vec<u16> = g.reached.iter().map(|r| r.1).collect();
-        summary.mission = Some(mission_summary(
+        let mut m = mission_summary(
             &cfg.script.mission,
             land_point,
             &samples,
@@ -419,7 +419,12 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             plant.touchdown(),
             energy_j,
             frame_s,
-        ));
+        );
+        // The aircraft's file places the CG (a campaign, which shifts it, judges its flights
+        // with the propeller's hub moved too).
+        let points = strike_points(aircraft, propeller_hub_m(aircraft, [0.0; 3]));
+        m.judge(survey(&samples, &points, home_alt));
+        summary.mission = Some(m);
     }
     let outcome = FlightOutcome { samples, summary };
     match failure {

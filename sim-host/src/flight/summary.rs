@@ -4,7 +4,9 @@
 use super::config::{turbulence_name, FlightConfig};
 use super::record::{Sample, DEG};
 use super::script::{Action, CommandRecord, GroundStation};
+use super::strikes::{StrikeEvent, Survey};
 use crate::analysis::metrics::{step_metrics, StepMetrics};
+use crate::campaign::verdict::Criterion;
 use crate::plant::Touchdown;
 use common::link::framing::LinkStats;
 use common::math::wrap_pi;
@@ -193,6 +195,34 @@ pub struct MissionSummary {
     pub energy_wh: f64,
     /// The landing, when there was one.
     pub touchdown: Option<TouchdownSummary>,
+    /// Each contact of a point of the airframe other than its wheels with the ground while
+    /// armed ([`crate::flight::strikes`]).
+    pub strikes: Vec<StrikeEvent>,
+    /// Smallest clearance of such a point while armed, m (`None`: never armed).
+    pub min_clearance_m: Option<f64>,
+    /// Every criterion in `failed` met.
+    pub pass: bool,
+    /// The criteria not met, as a campaign judges and names them: `items` (a navigation item
+    /// not reached), `no_strike` (a strike, or never armed).
+    pub failed: Vec<String>,
+}
+
+impl MissionSummary {
+    /// Judges the mission with the clearances of its flight, and keeps its strikes.
+    pub fn judge(&mut self, clearances: Survey) {
+        let met = [
+            (Criterion::Items, self.all_reached),
+            (Criterion::NoStrike, clearances.strike_free()),
+        ];
+        self.failed = met
+            .iter()
+            .filter(|(_, ok)| !ok)
+            .map(|(c, _)| c.name().to_string())
+            .collect();
+        self.pass = self.failed.is_empty();
+        self.min_clearance_m = clearances.closest.map(|c| c.clearance_m);
+        self.strikes = clearances.strikes;
+    }
 }
 
 /// The first contact of a landing.
@@ -312,6 +342,7 @@ pub fn mission_summary(
         flight_time_s: samples.iter().filter(|s| s.armed).count() as f64 * frame_s,
         energy_wh: energy_j / 3600.0,
         touchdown,
+        ..MissionSummary::default()
     }
 }
 

@@ -10,8 +10,9 @@
 //! ```
 //! [`ground`] adds the contact of the landing gear and belly points ([`gear`]) with the runway
 //! (zero in the air). [`state`], [`inputs`] and [`params`] hold what every block reads.
-//! [`servo`] models the surface servos; simulations put it in front of the plant, trim and
-//! linearisation do not. [`battery`] is the flight pack, stepped beside the plant by the
+//! [`servo`] models the surface servos; simulations put it in front of the plant
+//! ([`Plant::step_servos`]: the command held over the step, the servos moving inside it), trim
+//! and linearisation do not. [`battery`] is the flight pack, stepped beside the plant by the
 //! flights (not part of the UMN model; it does not feed back into thrust).
 //!
 //! State (13 degrees of freedom, 14 numbers): NED position, body velocity, attitude quaternion
@@ -147,23 +148,57 @@ impl Plant {
         &self.params
     }
 
-    /// Advances the plant by `dt` s with one RK4 step, controls and environment held over it.
+    /// Advances the plant by `dt` s with one RK4 step, surfaces, throttle and environment
+    /// held over it (trim checks and the plant's own tests; flights go through the servos with
+    /// [`Plant::step_servos`]).
+    pub fn step(&mut self, controls: &Controls, env: &Environment, dt: f64) {
+        self.advance(env, dt, |p, x| {
+            integrator::rk4_step(
+                |_, x| dynamics::state_derivative(p, x, controls, env),
+                x,
+                dt,
+            );
+            *controls
+        });
+    }
+
+    /// Advances the plant by `dt` s with `command` held at the servos' inputs (zero-order
+    /// hold, as the flight software's output is held between its frames): the servos move
+    /// inside the step and every RK4 stage sees the surfaces where they are at its time
+    /// ([`ServoBank::rk4_held`]). Returns the surfaces at the end of the step.
+    pub fn step_servos(
+        &mut self,
+        servos: &mut ServoBank,
+        command: &Controls,
+        env: &Environment,
+        dt: f64,
+    ) -> Controls {
+        self.advance(env, dt, |p, x| {
+            servos.rk4_held(command, x, dt, |c, x| {
+                dynamics::state_derivative(p, x, c, env)
+            })
+        });
+        self.controls
+    }
+
+    /// One step of `integrate` (which moves the state and returns the controls at the end of
+    /// the step), then what every step does after it.
     ///
     /// The quaternion is renormalised and the engine speed kept inside its limits after the
     /// step (the Simulink integrator saturates it the same way).
-    pub fn step(&mut self, controls: &Controls, env: &Environment, dt: f64) {
-        self.controls = *controls;
+    fn advance(
+        &mut self,
+        env: &Environment,
+        dt: f64,
+        integrate: impl FnOnce(&ModelParams, &mut StateVector) -> Controls,
+    ) {
+        let x0 = self.x;
+        self.controls = integrate(&self.params, &mut self.x);
         self.env = *env;
         let p = &self.params;
-        let x0 = self.x;
-        integrator::rk4_step(
-            |x| dynamics::state_derivative(p, x, controls, env),
-            &mut self.x,
-            dt,
-        );
         dynamics::normalise(&mut self.x, p);
         if let Some(held) = self.hold {
-            if controls.throttle >= HOLD_RELEASE_THROTTLE {
+            if self.controls.throttle >= HOLD_RELEASE_THROTTLE {
                 self.hold = None;
             } else {
                 // Still, but the engine turns with the throttle.

@@ -2,8 +2,9 @@
 //!
 //! Per control tick (50 Hz): the plant truth is sampled into measurements (plus optional white
 //! noise), pushed through a delay line of [`SimConfig::delay_samples`] ticks, the autopilot
-//! steps on the delayed sample, and its surface commands drive the servos (first order, rate
-//! and position limited) and the plant, both advanced in [`SimConfig::substeps`] RK4 steps.
+//! steps on the delayed sample, and its surface commands, held until the next tick, drive the
+//! servos (first order, rate and position limited) and the plant, advanced together in
+//! [`SimConfig::substeps`] RK4 steps ([`Plant::step_servos`]).
 
 use super::{Axis, Scenario};
 use crate::aircraft::Aircraft;
@@ -247,8 +248,7 @@ pub fn simulate(
         }
         let cmd = Controls::from(out.surfaces);
         for _ in 0..cfg.substeps {
-            applied = servos.step(&cmd, h);
-            plant.step(&applied, &env, h);
+            applied = plant.step_servos(&mut servos, &cmd, &env, h);
         }
     }
     Ok(Run {

@@ -18,7 +18,7 @@
 //!   thesis picks it on a root locus without a stated rule);
 //! - course (PI on commanded roll): `kp = 2 zeta wn Va / g` (Appendix C) with
 //!   `wn_chi = wn_phi / 15` rather than Appendix C's `/ 10`: with the servo, the delay and the
-//!   roll loop's own 16 % overshoot in the nonlinear runs, `/ 10` overshot a 30 deg heading
+//!   roll loop's own 17 % overshoot in the nonlinear runs, `/ 10` overshot a 30 deg heading
 //!   step by 11 % (docs/RESULTS.md), `/ 15` by about 1 %; Appendix C's `ki = wn^2 Va / g` places the integrator zero at
 //!   `wn / (2 zeta)`, inside the loop's bandwidth, which costs ~20 % overshoot against the
 //!   5 % requirement, so the integrators of the loops whose plant already integrates (course,
