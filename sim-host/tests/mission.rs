@@ -9,8 +9,8 @@ use sim_host::environment::wind::Turbulence;
 use sim_host::flight::summary::MissionSummary;
 use sim_host::flight::FlightOutcome;
 
-/// The default mission from the runway, with the firmware's parameters and the ground
-/// station's mission tuning, as `sim-host navigation` flies it.
+/// The default mission from the runway, with the firmware's parameters (the ground station
+/// sets none), as `sim-host navigation` flies it.
 fn fly_default(wind_ned: [f64; 3], turbulence: Turbulence, seed: u64) -> FlightOutcome {
     let a = Aircraft::ultrastick25e().expect("built-in aircraft");
     navigation::fly_default(&a, wind_ned, turbulence, seed).expect("flight")
@@ -104,6 +104,31 @@ fn the_default_mission_meets_every_target_in_wind_and_turbulence_on_forty_seeds(
 /// armed (rolled 20 deg on the wheels: the tip reaches the ground at 14.6 deg), fails its
 /// summary on `no_strike` alone, with the strike as an event in the JSON and the printed
 /// table; a smaller roll, or the same roll while disarmed, passes.
+/// The slowest and fastest cruise airspeeds a mission may set (`NAV_ASPD_MIN` 13 m/s and
+/// `NAV_ASPD_MAX` 23 m/s; level flight ends at 23.6 m/s at full throttle), with the surface and
+/// altitude loops scaled by airspeed (`ASPD_SCL_REF`, docs/GAIN-DESIGN.md): the same targets
+/// as at the 17 m/s the gains were designed at.
+#[test]
+fn the_default_mission_flies_at_the_slowest_and_fastest_cruise_airspeeds() {
+    let a = Aircraft::ultrastick25e().expect("built-in aircraft");
+    for va in [13.0, 23.0] {
+        let o = navigation::fly_default_at_airspeed(&a, va).expect("flight");
+        let m = flown_as_planned(&o);
+        assert!(on_target(&m), "{va} m/s: touchdown {:?}", m.touchdown);
+        assert!(
+            m.xtrack_rms_m < 1.0,
+            "{va} m/s: cross-track {:.2} m",
+            m.xtrack_rms_m
+        );
+        assert!(m.alt_rms_m < 1.5, "{va} m/s: altitude {:.2} m", m.alt_rms_m);
+        assert!(
+            m.airspeed_rms_mps < 1.0,
+            "{va} m/s: airspeed {:.2} m/s",
+            m.airspeed_rms_mps
+        );
+    }
+}
+
 #[test]
 fn a_wing_tip_on_the_runway_while_armed_fails_the_mission_summary_on_no_strike() {
     use sim_host::commands::fly::mission_table;

@@ -66,6 +66,17 @@ pub fn fly_default_on(
     Ok(fly_report(aircraft, &cfg, opts)?.outcome)
 }
 
+/// Flies the default mission in calm air at the cruise airspeed `airspeed_mps`, set as a
+/// pilot sets it (`NAV_ASPD` by PARAM_SET before arming).
+pub fn fly_default_at_airspeed(
+    aircraft: &Aircraft,
+    airspeed_mps: f32,
+) -> anyhow::Result<FlightOutcome> {
+    let mut cfg = runway_mission(default_mission(ModelParams::new(aircraft).home));
+    cfg.script.params.push(("NAV_ASPD".into(), airspeed_mps));
+    Ok(fly_report(aircraft, &cfg, &FlyOptions::default())?.outcome)
+}
+
 /// A figure under `limit`; one that was not measured (NaN: the errors against guidance of an
 /// autopilot seen only through its links, the MCU image) is not held against the flight.
 fn under(figure: f64, limit: f64) -> bool {

@@ -107,6 +107,17 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_TKO_ASPD",
+                17.0,
+                8.0,
+                40.0,
+                "m/s",
+                "Airspeed of the take-off climb (the cruise airspeed when that is lower)",
+            ),
+            NavParams => takeoff_airspeed
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_TKO_CLR_M",
                 10.0,
                 1.0,
@@ -316,6 +327,10 @@ pub struct NavParams {
     pub rtl_land: bool,
     /// Rotation airspeed, m/s.
     pub takeoff_vr: f32,
+    /// Airspeed of the take-off climb, m/s: at full throttle the climb regime holds it by
+    /// pitch, so a fast cruise airspeed would make the climb a long shallow one (at 23 m/s
+    /// the aircraft crossed 2 km before reaching 60 m).
+    pub takeoff_airspeed: f32,
     /// Take-off regime clear height, m.
     pub takeoff_clear: f32,
     /// Glide slope, rad.
@@ -362,6 +377,7 @@ const ZERO: NavParams = NavParams {
     rtl_alt: 0.0,
     rtl_land: false,
     takeoff_vr: 0.0,
+    takeoff_airspeed: 0.0,
     takeoff_clear: 0.0,
     glide_slope: 0.0,
     land_airspeed: 0.0,

@@ -118,7 +118,7 @@ impl Takeoff {
                 yaw,
                 lon: LonMode::TakeOff {
                     altitude: self.height,
-                    airspeed: f.cruise,
+                    airspeed: f.cruise.min(p.takeoff_airspeed),
                     clear_altitude: -self.start.z + p.takeoff_clear,
                 },
             });
