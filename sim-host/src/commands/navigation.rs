@@ -216,7 +216,7 @@ pub fn navigation_markdown(
          heading north to 60 m, a 600 m x 400 m rectangle flown clockwise, two turns of 80 m \
          radius around its north-west corner, a descent to 40 m on the way back, a base leg \
          450 m south of the runway and a final approach northbound, landing at home. Gains: \
-         the firmware's defaults (the thesis's designed set).\n\n\
+         the firmware's defaults (the flight set: the thesis's designed gains with the loops the full linear model shows unstable replaced, `docs/GAIN-DESIGN.md`); the ground station sets no parameter.\n\n\
          Errors are those of the true aircraft (the simulator's truth) against what guidance \
          asked for; cross-track on straight legs excludes the fillets (the rounded corners), \
          on circles it counts from arrival on the circle. Targets: {TARGETS}.\n"
