@@ -1,23 +1,26 @@
-//! The checksums the autopilot computes itself, each a reflected CRC driven by a 16-entry
-//! table (four bits a step): a few dozen bytes of table where a byte-wide one takes 1 KiB
-//! (the `crc-any` crate's code was 14 KB of the MCU image, each digest in two copies).
+//! The checksums the autopilot computes itself, each a reflected CRC driven by a table the
+//! compiler builds (the `crc-any` crate's code was 14 KB of the MCU image, each digest in two
+//! to four copies).
 //!
-//! - [`Crc32`]: CRC-32 (polynomial 0x04C11DB7, reflected): the persisted flash records, the
+//! - [`Crc32`]: CRC-32 (polynomial 0x04C11DB7, reflected), four bits a step (a 64-byte table;
+//!   it runs at boot and on the ground's requests): the persisted flash records, the
 //!   mission's `opaque_id` ([`Crc32::ieee`]) and MAVLink FTP's file checksum
 //!   ([`Crc32::mavlink_ftp`]).
 //! - [`crc16_mcrf4xx`]: MAVLink's frame checksum (CRC-16/MCRF4XX, polynomial 0x1021,
-//!   reflected, from 0xFFFF, no final XOR).
+//!   reflected, from 0xFFFF, no final XOR), a byte a step (a 512-byte table: every frame in
+//!   and out is checked).
 
-/// The table of a reflected CRC with polynomial `poly` (bit-reversed), four bits a step.
-/// Evaluated by the compiler (an index out of range would fail the build, not the autopilot).
+/// The table of a reflected CRC with polynomial `poly` (bit-reversed) for `log2(N)` bits a
+/// step. Evaluated by the compiler (an index out of range would fail the build, not the
+/// autopilot).
 #[allow(clippy::indexing_slicing)]
-const fn nibble_table(poly: u32) -> [u32; 16] {
-    let mut table = [0u32; 16];
+const fn reflected_table<const N: usize>(poly: u32) -> [u32; N] {
+    let mut table = [0u32; N];
     let mut n = 0;
-    while n < 16 {
+    while n < N {
         let mut c = n as u32;
         let mut bit = 0;
-        while bit < 4 {
+        while bit < N.trailing_zeros() {
             c = if c & 1 == 1 { (c >> 1) ^ poly } else { c >> 1 };
             bit += 1;
         }
@@ -40,10 +43,18 @@ fn digest_nibbles(table: &[u32; 16], mut state: u32, bytes: &[u8]) -> u32 {
 }
 
 /// CRC-32's table (polynomial 0x04C11DB7 bit-reversed).
-const CRC32_TABLE: [u32; 16] = nibble_table(0xEDB8_8320);
+const CRC32_TABLE: [u32; 16] = reflected_table(0xEDB8_8320);
 
-/// CRC-16/MCRF4XX's table (polynomial 0x1021 bit-reversed).
-const CRC16_TABLE: [u32; 16] = nibble_table(0x8408);
+/// CRC-16/MCRF4XX's table (polynomial 0x1021 bit-reversed), a byte a step, in 16 bits.
+#[allow(clippy::indexing_slicing)]
+const CRC16_TABLE: [u16; 256] = {
+    let (wide, mut table, mut n) = (reflected_table::<256>(0x8408), [0u16; 256], 0);
+    while n < 256 {
+        table[n] = wide[n] as u16;
+        n += 1;
+    }
+    table
+};
 
 /// A CRC-32 fed digest by digest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,8 +92,15 @@ impl Crc32 {
 }
 
 /// MAVLink's CRC-16/MCRF4XX of `bytes`, continuing from `state` (0xFFFF to start).
-pub fn crc16_mcrf4xx(state: u16, bytes: &[u8]) -> u16 {
-    digest_nibbles(&CRC16_TABLE, u32::from(state), bytes) as u16
+pub fn crc16_mcrf4xx(mut state: u16, bytes: &[u8]) -> u16 {
+    for &b in bytes {
+        let low = CRC16_TABLE
+            .get(usize::from((state as u8) ^ b))
+            .copied()
+            .unwrap_or(0);
+        state = (state >> 8) ^ low;
+    }
+    state
 }
 
 #[cfg(test)]
