@@ -108,10 +108,10 @@ impl Vehicle {
     }
 
     /// The vehicle's state before the parameters are applied to its stages
-    /// ([`Vehicle::apply_params`]; [`Vehicle::new`] does both). Not inlined: a call builds its
-    /// result in the caller's destination (the variable it is bound to), where an inlined
-    /// literal is built on the stack and copied; the MCU builds its application this way, in
-    /// `main`'s frame, with no copy of it.
+    /// ([`Vehicle::apply_params`]; [`Vehicle::new`] does both). Not inlined, nor are the
+    /// constructors of its large parts: a call builds its result in the caller's destination
+    /// (the variable it is bound to), where an inlined literal is built on the stack and
+    /// copied; the MCU builds its application this way, in `main`'s frame, with no copy of it.
     #[inline(never)]
     pub fn fresh() -> Self {
         Self {
