@@ -176,7 +176,9 @@ impl<D: Dialect> FrameParser<D> {
     }
 
     /// As [`FrameParser::push`], and calls `on_undecoded` for every frame whose checksum
-    /// matched but whose payload did not decode.
+    /// matched but whose payload did not decode. Not inlined: the framing stays a function
+    /// of its own in the MCU image's profile (one call per chunk of bytes).
+    #[inline(never)]
     pub fn push_with(
         &mut self,
         bytes: &[u8],
