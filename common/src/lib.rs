@@ -30,6 +30,7 @@
 //! - [`gcs`]: the ground-station protocols (routing, parameters, missions, commands,
 //!   telemetry), transport-agnostic.
 //! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
+//! - [`crc`]: the CRC-32 of the stored records and files, MAVLink's CRC-16.
 //! - [`decimal`]: numbers in texts as fixed-point decimals, without float formatting.
 //! - [`storage`]: power-cut-safe persistence of parameters and missions in flash.
 //! - [`math`]: the one definition of every frame change, rotation, geodetic conversion,
@@ -49,6 +50,7 @@
 pub mod actuators;
 pub mod battery;
 pub mod control;
+pub mod crc;
 pub mod decimal;
 pub mod estimator;
 pub mod failsafe;

@@ -171,6 +171,8 @@ impl Default for Ins {
 
 impl Ins {
     /// An uninitialised filter (level, north, zero bias, no position).
+    /// Not inlined: see `Vehicle::fresh`.
+    #[inline(never)]
     pub fn new() -> Self {
         Self {
             q: UnitQuaternion::identity(),

@@ -164,6 +164,8 @@ impl Default for Estimator {
 
 impl Estimator {
     /// A fresh estimator with the given settings.
+    /// Not inlined: see `Vehicle::fresh`.
+    #[inline(never)]
     pub fn new(cfg: EstimatorConfig) -> Self {
         Self {
             cfg,

@@ -23,19 +23,14 @@ pub struct File {
 /// The name of the general metadata file, the one `COMPONENT_METADATA` points to.
 pub const GENERAL: &str = "general.json";
 
-/// MAVLink's CRC-32 of a file (component metadata's `file_crc`): the polynomial 0x04C11DB7
-/// bit-reversed (0xEDB88320, as the crate takes a reflected one), starting from 0 and with no
-/// final XOR. Ground stations use it as the key of
-/// their metadata cache, so it changes with every change of the file.
+/// MAVLink's CRC-32 of a file (component metadata's `file_crc`): the polynomial 0x04C11DB7,
+/// reflected, starting from 0 and with no final XOR ([`crate::crc::Crc32::mavlink_ftp`]).
+/// Ground stations use it as the key of their metadata cache, so it changes with every change
+/// of the file.
 pub fn file_crc(bytes: &[u8]) -> u32 {
-    let mut crc = crc_any::CRCu32::create_crc(0xEDB8_8320, 32, 0, 0, true);
-    // Called through an opaque pointer so that the crate's table lookups stay in the crate's
-    // own function: inlined here, the MCU image's panic-site scan (tests/tests/panic_sites.rs)
-    // would count its bounds checks as this crate's.
-    let digest: fn(&mut crc_any::CRCu32, &[u8]) =
-        core::hint::black_box(crc_any::CRCu32::digest::<[u8]>);
-    digest(&mut crc, bytes);
-    crc.get_crc()
+    let mut crc = crate::crc::Crc32::mavlink_ftp();
+    crc.digest(bytes);
+    crc.get()
 }
 
 /// The `mftp://` URI of a served file (QGroundControl opens `/name`, PX4's form).

@@ -145,6 +145,8 @@ impl Default for GroundLink {
 
 impl GroundLink {
     /// A link with these settings.
+    /// Not inlined: see `Vehicle::fresh`.
+    #[inline(never)]
     pub fn new(cfg: LinkConfig) -> Self {
         Self {
             cfg,

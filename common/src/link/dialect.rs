@@ -11,6 +11,7 @@
 //! the common dialect does not know is to the host's tools: counted as an unknown id and
 //! dropped.
 
+use crate::crc::crc16_mcrf4xx;
 use mavlink::dialects::common::*;
 use mavlink::error::ParserError;
 use mavlink::{MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message, MessageData};
@@ -51,6 +52,53 @@ impl Dialect for Common {
         raw.serialize_message(header, message);
         Some(raw)
     }
+}
+
+/// A payload written into a MAVLink 2 frame's buffer: its length, the message's id and its
+/// `CRC_EXTRA`.
+type Payload = (usize, u32, u8);
+
+/// Writes `data`'s payload into `raw` with the `mavlink` crate's `ser` (its trailing zeros
+/// cut), for [`finish_v2`].
+fn write_payload<D: MessageData>(raw: &mut MAVLinkV2MessageRaw, data: &D) -> Option<Payload> {
+    let payload = raw.as_mut_slice().get_mut(V2_HEAD..V2_HEAD + 255)?;
+    Some((data.ser(MavlinkVersion::V2, payload), D::ID, D::EXTRA_CRC))
+}
+
+/// The start marker and the nine bytes of a MAVLink 2 header.
+const V2_HEAD: usize = 10;
+
+/// Writes the header and checksum of an unsigned MAVLink 2 frame around the payload
+/// [`write_payload`] wrote, as the `mavlink` crate's `serialize_message_data` does. The crate's
+/// function reads its header size back from the buffer, and its bounds checks, inlined into
+/// this crate's code in the MCU image, would be panic sites of ours
+/// (`tests/tests/panic_sites.rs`). `None` for a system id over 255 (MAVLink's 32-bit system
+/// ids, which the autopilot never has).
+fn finish_v2(
+    raw: &mut MAVLinkV2MessageRaw,
+    header: MavHeader,
+    (len, id, extra_crc): Payload,
+) -> Option<()> {
+    let system = u8::try_from(header.system_id).ok()?;
+    let buf = raw.as_mut_slice();
+    let id = id.to_le_bytes();
+    let head = [
+        0xFD,
+        u8::try_from(len).ok()?,
+        0,
+        0,
+        header.sequence,
+        system,
+        header.component_id,
+        id[0],
+        id[1],
+        id[2],
+    ];
+    *<&mut [u8; V2_HEAD]>::try_from(buf.get_mut(..V2_HEAD)?).ok()? = head;
+    let end = V2_HEAD.checked_add(len)?;
+    let crc = crc16_mcrf4xx(crc16_mcrf4xx(0xFFFF, buf.get(1..end)?), &[extra_crc]);
+    *<&mut [u8; 2]>::try_from(buf.get_mut(end..end.checked_add(2)?)?).ok()? = crc.to_le_bytes();
+    Some(())
 }
 
 /// Writes the autopilot's dialect from two lists of `MavMessage` variants and their data
@@ -100,10 +148,11 @@ macro_rules! autopilot_dialect {
 
             fn encode(header: MavHeader, message: &MavMessage) -> Option<MAVLinkV2MessageRaw> {
                 let mut raw = MAVLinkV2MessageRaw::new();
-                match message {
-                    $(MavMessage::$w(d) => raw.serialize_message_data(header, d),)*
-                    _ => return None,
-                }
+                let payload = match message {
+                    $(MavMessage::$w(d) => write_payload(&mut raw, d),)*
+                    _ => None,
+                }?;
+                finish_v2(&mut raw, header, payload)?;
                 Some(raw)
             }
         }

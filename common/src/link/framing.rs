@@ -2,9 +2,8 @@
 //!
 //! The `mavlink` crate's own reader skips corrupt frames silently; an autopilot must count
 //! them (bad CRC, unknown message, undecodable payload) and report them, so this parser does
-//! the frame synchronisation itself and leaves every check of substance to the crate:
-//! [`MAVLinkV2MessageRaw::has_valid_crc_with_extra_crc`] for the checksum and the dialect's
-//! decoders for the payload. It takes bytes in whatever chunks a UART, a socket or a pipe
+//! the frame synchronisation itself and the checksum (MAVLink's CRC-16, [`crate::crc`]), and
+//! leaves the payload to the dialect's decoders. It takes bytes in whatever chunks a UART, a socket or a pipe
 //! delivers them, never allocates and never panics.
 //!
 //! The parser and the [`Sender`] are generic over the [`Dialect`] they speak: the whole common
@@ -13,6 +12,7 @@
 
 use super::dialect::{Autopilot, Common, Dialect};
 use super::signing::{self, Key, Signed};
+use crate::crc::crc16_mcrf4xx;
 use core::marker::PhantomData;
 use mavlink::dialects::common::MavMessage;
 use mavlink::{MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion};
@@ -176,7 +176,9 @@ impl<D: Dialect> FrameParser<D> {
     }
 
     /// As [`FrameParser::push`], and calls `on_undecoded` for every frame whose checksum
-    /// matched but whose payload did not decode.
+    /// matched but whose payload did not decode. Not inlined: the framing stays a function
+    /// of its own in the MCU image's profile (one call per chunk of bytes).
+    #[inline(never)]
     pub fn push_with(
         &mut self,
         bytes: &[u8],
@@ -326,7 +328,10 @@ impl<D: Dialect> FrameParser<D> {
                 return Check::Bad;
             }
             let id = raw.message_id();
-            if let Some(bad) = self.check_crc(id, |x| raw.has_valid_crc_with_extra_crc(x)) {
+            // At most 1 + 9 + 255: no overflow.
+            #[allow(clippy::arithmetic_side_effects)]
+            let end = 1 + V2_HEADER + payload_len;
+            if let Some(bad) = self.check_crc(id, |x| checksum_matches(raw.as_slice(), end, x)) {
                 return bad;
             }
             let header = MavHeader {
@@ -358,7 +363,10 @@ impl<D: Dialect> FrameParser<D> {
                 return Check::Bad;
             }
             let id = u32::from(raw.message_id());
-            if let Some(bad) = self.check_crc(id, |x| raw.has_valid_crc_with_extra_crc(x)) {
+            // At most 1 + 9 + 255: no overflow.
+            #[allow(clippy::arithmetic_side_effects)]
+            let end = 1 + V1_HEADER + payload_len;
+            if let Some(bad) = self.check_crc(id, |x| checksum_matches(raw.as_slice(), end, x)) {
                 return bad;
             }
             let header = MavHeader {
@@ -424,6 +432,19 @@ fn copy_into(dst: &mut [u8], src: &[u8], n: usize) -> bool {
         (Some(d), Some(s)) => {
             d.copy_from_slice(s);
             true
+        }
+        _ => false,
+    }
+}
+
+/// Whether the checksum behind the first `end` bytes of `frame` (start marker, header and
+/// payload) is MAVLink's of them and `extra_crc` (`common::crc`'s CRC-16, which the frames
+/// the autopilot writes carry).
+fn checksum_matches(frame: &[u8], end: usize, extra_crc: u8) -> bool {
+    match (frame.get(1..end), frame.get(end..end.saturating_add(2))) {
+        (Some(covered), Some(&[lo, hi])) => {
+            crc16_mcrf4xx(crc16_mcrf4xx(0xFFFF, covered), &[extra_crc])
+                == u16::from_le_bytes([lo, hi])
         }
         _ => false,
     }

@@ -7,7 +7,7 @@
 //! its default features). What a receiver accepts (which frames must be signed, replays)
 //! is the ground link's policy (`gcs::signing`).
 
-use crc_any::CRCu16;
+use crate::crc::crc16_mcrf4xx;
 use sha2::{Digest, Sha256};
 
 /// Length of the secret key, bytes.
@@ -135,20 +135,17 @@ pub fn sign(
 /// checksum by `crc(flip) ^ crc(zeros)`, whatever the frame, its message or its `CRC_EXTRA`.
 fn crc_change_of_signed_flag(after: usize) -> u16 {
     const ZEROS: [u8; 32] = [0; 32];
-    let mut flipped = CRCu16::crc16mcrf4cc();
-    let mut zero = CRCu16::crc16mcrf4cc();
-    // Slices, as mavlink's own checksum passes them: one monomorphisation of `digest`.
-    flipped.digest(&[IFLAG_SIGNED][..]);
-    zero.digest(&[0u8][..]);
+    let mut flipped = crc16_mcrf4xx(0xFFFF, &[IFLAG_SIGNED]);
+    let mut zero = crc16_mcrf4xx(0xFFFF, &[0]);
     let mut left = after;
     while left > 0 {
         let k = left.min(ZEROS.len());
         let z = ZEROS.get(..k).unwrap_or(&[]);
-        flipped.digest(z);
-        zero.digest(z);
+        flipped = crc16_mcrf4xx(flipped, z);
+        zero = crc16_mcrf4xx(zero, z);
         left = left.saturating_sub(k);
     }
-    flipped.get_crc() ^ zero.get_crc()
+    flipped ^ zero
 }
 
 #[cfg(test)]

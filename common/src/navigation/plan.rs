@@ -159,7 +159,7 @@ impl MissionStore {
         if items.is_empty() {
             return 0;
         }
-        let mut crc = crc_any::CRCu32::crc32();
+        let mut crc = crate::crc::Crc32::ieee();
         for it in items {
             for p in it.params {
                 crc.digest(&p.to_le_bytes());
@@ -170,6 +170,6 @@ impl MissionStore {
             crc.digest(&it.command.to_le_bytes());
             crc.digest(&[it.frame, u8::from(it.autocontinue)]);
         }
-        crc.get_crc().max(1)
+        crc.get().max(1)
     }
 }

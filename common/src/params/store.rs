@@ -99,6 +99,8 @@ impl ParamStore {
     /// A store holding every parameter of `registry` at its default. The registry is a
     /// constant of the firmware, checked by [`ParamStore::validate`] in its tests; parameters
     /// beyond [`MAX_PARAMS`] would be left out.
+    /// Not inlined: see `Vehicle::fresh`.
+    #[inline(never)]
     pub fn new(registry: Registry) -> Self {
         let mut values: Vec<f32, MAX_PARAMS> = Vec::new();
         for stage in registry.iter() {

@@ -110,7 +110,7 @@ fn crc_of<F: Flash>(
     seq: u32,
     len: u32,
 ) -> Result<u32, StorageError<F::Error>> {
-    let mut crc = crc_any::CRCu32::crc32();
+    let mut crc = crate::crc::Crc32::ieee();
     crc.digest(&seq.to_le_bytes());
     crc.digest(&len.to_le_bytes());
     let mut chunk = [0u8; 64];
@@ -123,7 +123,7 @@ fn crc_of<F: Flash>(
         crc.digest(buf);
         done = done.saturating_add(n as u32);
     }
-    Ok(crc.get_crc())
+    Ok(crc.get())
 }
 
 /// The header of a slot if the slot holds a complete, intact record of this region.
@@ -216,14 +216,14 @@ fn save_keeping<F: Flash, T: Serialize>(
         Some((addr, _)) if addr == region.slot_a => region.slot_b,
         _ => region.slot_a,
     };
-    let mut crc = crc_any::CRCu32::crc32();
+    let mut crc = crate::crc::Crc32::ieee();
     crc.digest(&seq.to_le_bytes());
     crc.digest(&len.to_le_bytes());
     crc.digest(payload);
     let mut header = [0u8; HEADER_LEN as usize];
     for (dst, w) in header
         .chunks_exact_mut(4)
-        .zip([region.magic, seq, len, crc.get_crc()])
+        .zip([region.magic, seq, len, crc.get()])
     {
         dst.copy_from_slice(&w.to_le_bytes());
     }

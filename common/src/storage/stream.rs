@@ -280,7 +280,7 @@ pub fn load_board_into<F: Flash>(
 /// given, checksummed when `crc` is, counted always.
 struct Writer<'f, F: Flash> {
     flash: Option<&'f mut F>,
-    crc: Option<crc_any::CRCu32>,
+    crc: Option<crate::crc::Crc32>,
     at: u32,
     limit: u32,
     len: u32,
@@ -358,7 +358,7 @@ impl<F: Flash> postcard::ser_flavors::Flavor for &mut Writer<'_, F> {
 fn measure<T: Serialize, F: Flash>(value: &T, limit: u32, seq: u32) -> Option<(u32, u32)> {
     let mut count = Writer::<F>::new(limit);
     count.encode(value).ok()?;
-    let mut crc = crc_any::CRCu32::crc32();
+    let mut crc = crate::crc::Crc32::ieee();
     crc.digest(&seq.to_le_bytes());
     crc.digest(&count.len.to_le_bytes());
     let mut sum = Writer::<F> {
@@ -366,7 +366,7 @@ fn measure<T: Serialize, F: Flash>(value: &T, limit: u32, seq: u32) -> Option<(u
         ..Writer::new(limit)
     };
     sum.encode(value).ok()?;
-    Some((count.len, sum.crc?.get_crc()))
+    Some((count.len, sum.crc?.get()))
 }
 
 /// Saves the board record into the slot not holding the newest intact copy (or over the

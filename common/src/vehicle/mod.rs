@@ -107,27 +107,13 @@ impl Vehicle {
         v
     }
 
-    /// [`Vehicle::new`] written into `slot` (a static on the MCU): one copy of the vehicle on
-    /// the stack while it is built (`new` takes one more for its return), in a frame of its own
-    /// that is gone before the caller builds anything else.
-    pub fn init_in(slot: &mut core::mem::MaybeUninit<Vehicle>) -> &mut Vehicle {
-        let v = Self::write_fresh(slot);
-        v.apply_params();
-        v
-    }
-
-    /// [`Vehicle::fresh`] into `slot`, in a frame of its own: the copy it takes on the stack is
-    /// gone before the parameters are applied.
+    /// The vehicle's state before the parameters are applied to its stages
+    /// ([`Vehicle::apply_params`]; [`Vehicle::new`] does both). Not inlined, nor are the
+    /// constructors of its large parts: a call builds its result in the caller's destination
+    /// (the variable it is bound to), where an inlined literal is built on the stack and
+    /// copied; the MCU builds its application this way, in `main`'s frame, with no copy of it.
     #[inline(never)]
-    fn write_fresh(slot: &mut core::mem::MaybeUninit<Vehicle>) -> &mut Vehicle {
-        slot.write(Self::fresh())
-    }
-
-    /// The vehicle's state before the parameters are applied to its stages. Not inlined: a
-    /// call builds its result in the caller's destination, where an inlined literal is built
-    /// on the stack and copied.
-    #[inline(never)]
-    fn fresh() -> Self {
+    pub fn fresh() -> Self {
         Self {
             params: ParamStore::new(params::REGISTRY),
             plan: MissionStore::default(),
@@ -423,7 +409,7 @@ impl Vehicle {
     }
 
     /// Hands changed parameters to the stages.
-    fn apply_params(&mut self) {
+    pub fn apply_params(&mut self) {
         let count = self.params.change_count();
         if self.params_seen == Some(count) {
             return;

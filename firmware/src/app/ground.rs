@@ -74,6 +74,8 @@ fn severity(s: Severity) -> MavSeverity {
 
 impl GroundPort {
     /// A port with the autopilot's identity and nothing received.
+    /// Not inlined: see `App::fresh`.
+    #[inline(never)]
     pub fn new() -> Self {
         Self {
             parsers: core::array::from_fn(|_| FrameParser::autopilot()),

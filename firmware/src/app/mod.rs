@@ -57,28 +57,27 @@ impl Default for App {
 impl App {
     /// A freshly booted autopilot with default parameters: disarmed, in Manual.
     pub fn new() -> Self {
+        let mut app = Self::fresh();
+        app.apply_params();
+        app
+    }
+
+    /// The application before the vehicle's parameters are applied to its stages
+    /// ([`App::apply_params`]; [`App::new`] does both). Built where the caller binds it, with
+    /// no copy: the MCU binds it in `main`'s frame, where `App::new` would build it once more
+    /// for its return (13.6 KiB of the vehicle's on the stack besides the application).
+    #[inline(never)]
+    pub fn fresh() -> Self {
         Self {
-            vehicle: Vehicle::new(),
+            vehicle: Vehicle::fresh(),
             sim: SimPort::new(),
             ground: GroundPort::new(),
         }
     }
 
-    /// A freshly booted autopilot built in place in `slot` (a static on the MCU), stage by
-    /// stage: `App::new` would build the whole application in its own stack frame first and
-    /// then copy it out, which on the STM32F405 costs more stack than the image has.
-    pub fn init_in(slot: &mut core::mem::MaybeUninit<App>) -> &mut App {
-        let p = slot.as_mut_ptr();
-        // SAFETY: each field of the slot is written exactly once, through a raw pointer (or a
-        // `MaybeUninit` of the same layout) that never reads the uninitialised memory; after the three writes every field holds a
-        // valid value, so the whole `App` is initialised.
-        unsafe {
-            let vehicle = core::ptr::addr_of_mut!((*p).vehicle);
-            Vehicle::init_in(&mut *vehicle.cast::<core::mem::MaybeUninit<Vehicle>>());
-            core::ptr::addr_of_mut!((*p).sim).write(SimPort::new());
-            write_ground(&mut *core::ptr::addr_of_mut!((*p).ground).cast());
-            slot.assume_init_mut()
-        }
+    /// Hands the vehicle's parameters to its stages (after [`App::fresh`]).
+    pub fn apply_params(&mut self) {
+        self.vehicle.apply_params();
     }
 
     /// The vehicle.
@@ -243,13 +242,6 @@ impl App {
     }
 }
 
-/// Writes a new ground port into `slot`, in a frame of its own: the port is built on the stack
-/// and copied, and that copy must not sit under the vehicle's while the vehicle is built.
-#[inline(never)]
-fn write_ground(slot: &mut core::mem::MaybeUninit<GroundPort>) {
-    slot.write(GroundPort::new());
-}
-
 /// A heartbeat frame of the autopilot on its simulator link (the ground link's heartbeat, so
 /// both links describe the vehicle the same way).
 pub fn heartbeat_frame(app: &mut App) -> heapless::Vec<u8, 280> {
@@ -346,9 +338,10 @@ mod tests {
     }
 
     #[test]
-    fn an_application_built_in_place_answers_as_one_built_by_value() {
-        let mut slot = core::mem::MaybeUninit::uninit();
-        let in_place = App::init_in(&mut slot);
+    fn an_application_built_in_two_steps_answers_as_one_built_by_new() {
+        let mut two_steps = App::fresh();
+        two_steps.apply_params();
+        let in_place = &mut two_steps;
         let mut by_value = App::new();
         for k in 0..5 {
             let (a, b) = (actuators(in_place, k), actuators(&mut by_value, k));

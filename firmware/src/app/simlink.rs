@@ -61,6 +61,8 @@ impl Default for SimPort {
 
 impl SimPort {
     /// A port with the autopilot's identity and nothing received.
+    /// Not inlined: see `App::fresh`.
+    #[inline(never)]
     pub fn new() -> Self {
         Self {
             parser: FrameParser::autopilot(),

@@ -6,7 +6,6 @@
 //! buffers ([`usart`]) while the main loop keeps polling those rings (no WFI: under `-icount`
 //! it stalls QEMU 7.2 when UART interrupts are on).
 
-use core::mem::MaybeUninit;
 use cortex_m_rt::{entry, exception};
 use defmt_semihosting as _;
 use firmware::app::App;
@@ -45,10 +44,12 @@ fn main() -> ! {
     let mut boot_text = Some(boot_text);
     budget::start();
     let mut budget = budget::Budget::new();
-    // The application lives in a static, built in place (no stack frame holds it).
-    static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
-    // SAFETY: `main` runs once and is the only code that names APP.
-    let app = App::init_in(unsafe { &mut *core::ptr::addr_of_mut!(APP) });
+    // The application lives in `main`'s frame (`main` never returns), built where it is
+    // bound: `App::fresh` writes it there with no copy, and the parameters are applied in
+    // place. Its bytes are part of the measured stack peak.
+    let mut app = App::fresh();
+    let app = &mut app;
+    app.apply_params();
     let board_flash = flash::BoardFlash::open();
     let host_file = board_flash.is_host_file();
     let mut store = Persistence::new(board_flash, flash::REGION);
