@@ -118,6 +118,17 @@ pub(crate) enum Command {
     /// log, .tlog, plots and summary. No scripted station: fly it from QGroundControl, MAVSDK
     /// or pymavlink on the autopilot's own ground link.
     Sim(SimArgs),
+    /// Fly the longitudinal chapter-4 scenarios and the default mission with both
+    /// longitudinal laws (LON_LAW 0 and 1) and write the comparison into the results document.
+    Laws {
+        /// Results document whose laws section is rewritten (the rest of it is kept); without
+        /// it the section is printed.
+        #[arg(long)]
+        results: Option<PathBuf>,
+        /// Seeds of the windy mission flights (wind -3,-4,0 m/s, light turbulence).
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        seeds: Vec<u64>,
+    },
     /// Fly the default mission (calm air, and a 5 m/s wind with light turbulence over five
     /// seeds) and write the navigation results with ground-track plots.
     Navigation {

@@ -115,6 +115,8 @@ fn run() -> anyhow::Result<ExitCode> {
                 // The missions section belongs to `sim-host navigation`: kept as it is.
                 let old = std::fs::read_to_string(path).unwrap_or_default();
                 let md = sim_host::report::carry_section(&old, &md, commands::navigation::SECTION);
+                // So does the laws section, `sim-host laws`'s.
+                let md = sim_host::report::carry_section(&old, &md, commands::laws::SECTION);
                 if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                     std::fs::create_dir_all(dir)
                         .with_context(|| format!("cannot create `{}`", dir.display()))?;
@@ -155,6 +157,32 @@ fn run() -> anyhow::Result<ExitCode> {
         Some(Command::Sim(args)) => sim_command(&aircraft, args),
         Some(Command::Campaign(c)) => {
             cli_campaign::campaign_command(&aircraft, cli.aircraft.as_deref(), c, emit)
+        }
+        Some(Command::Laws { results, seeds }) => {
+            let seeds_arg = seeds
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(",");
+            let command = match &results {
+                Some(p) => format!(
+                    "cargo run --release -p sim-host -- laws --seeds {seeds_arg} --results {}",
+                    p.display()
+                ),
+                None => format!("cargo run --release -p sim-host -- laws --seeds {seeds_arg}"),
+            };
+            let md = commands::laws::laws_markdown(&aircraft, &command, &seeds)?;
+            match results {
+                Some(path) => {
+                    let old = std::fs::read_to_string(&path).unwrap_or_default();
+                    let doc = sim_host::report::splice_section(&old, commands::laws::SECTION, &md);
+                    std::fs::write(&path, doc)
+                        .with_context(|| format!("cannot write `{}`", path.display()))?;
+                    emit(&format!("wrote {}\n", path.display()))?;
+                }
+                None => emit(&md)?,
+            }
+            Ok(ExitCode::SUCCESS)
         }
         Some(Command::Navigation {
             out,

@@ -3,6 +3,7 @@
 
 pub use super::inputs::{InputFlags, Measurements};
 use super::lateral::{self, Lateral, LateralGains, RollMode, YawMode};
+use super::longitudinal::tecs::{self, TecsGains};
 use super::longitudinal::{self, LonMode, Longitudinal, LongitudinalGains, Regime};
 use super::scaling::surface_scale;
 use crate::actuators::Surfaces;
@@ -57,11 +58,17 @@ pub struct GainSet {
     pub lateral: LateralGains,
     /// Elevator and throttle.
     pub longitudinal: LongitudinalGains,
+    /// The longitudinal law of the altitude modes and the total energy control's gains
+    /// (absent from older gain files: then the designed gains, the law off).
+    #[serde(default)]
+    pub tecs: TecsGains,
     /// Time constant with which a bumpless-transfer offset fades, s.
     pub transfer_tc: f32,
     /// Airspeed at which the surface loops' gains are as given, m/s; at other airspeeds the
     /// roll, pitch and sideslip loops, the yaw damper and the altitude loop are scaled by
-    /// `this / airspeed` ([`super::scaling`]). Zero: no scaling.
+    /// `this / airspeed` ([`super::scaling`]). Zero: no scaling (and in older gain files,
+    /// which lack it).
+    #[serde(default)]
     pub scaling_airspeed: f32,
 }
 
@@ -105,6 +112,7 @@ impl GainSet {
     pub const THESIS: GainSet = GainSet {
         lateral: lateral::THESIS,
         longitudinal: longitudinal::THESIS,
+        tecs: tecs::gains::DESIGNED,
         transfer_tc: TRANSFER_TC_S,
         scaling_airspeed: 0.0,
     };
@@ -115,6 +123,7 @@ impl GainSet {
     pub const FLIGHT: GainSet = GainSet {
         lateral: lateral::FLIGHT,
         longitudinal: longitudinal::FLIGHT,
+        tecs: tecs::gains::DESIGNED,
         transfer_tc: TRANSFER_TC_S,
         scaling_airspeed: SCALING_AIRSPEED_MPS,
     };
@@ -132,6 +141,7 @@ impl GainSet {
         longitudinal::PARAMS
             .validate(&self.longitudinal)
             .map_err(named)?;
+        tecs::gains::PARAMS.validate(&self.tecs).map_err(named)?;
         PARAMS.validate(self).map_err(named)
     }
 
@@ -139,8 +149,10 @@ impl GainSet {
     pub fn params(&self) -> impl Iterator<Item = (&'static str, f32)> + Clone + '_ {
         let lat = lateral::PARAMS.params.iter();
         let lon = longitudinal::PARAMS.params.iter();
+        let energy = tecs::gains::PARAMS.params.iter();
         lat.map(move |p| (p.def.name, (p.get)(&self.lateral)))
             .chain(lon.map(move |p| (p.def.name, (p.get)(&self.longitudinal))))
+            .chain(energy.map(move |p| (p.def.name, (p.get)(&self.tecs))))
             .chain(
                 PARAMS
                     .params
@@ -161,6 +173,8 @@ impl GainSet {
             lateral::PARAMS.set(&mut self.lateral, name, value)
         } else if longitudinal::PARAMS.find(name).is_some() {
             longitudinal::PARAMS.set(&mut self.longitudinal, name, value)
+        } else if tecs::gains::PARAMS.find(name).is_some() {
+            tecs::gains::PARAMS.set(&mut self.tecs, name, value)
         } else {
             PARAMS.set(self, name, value)
         };
@@ -178,6 +192,7 @@ impl GainSet {
         GainSet {
             lateral: store.load(&lateral::PARAMS),
             longitudinal: store.load(&longitudinal::PARAMS),
+            tecs: store.load(&tecs::gains::PARAMS),
             transfer_tc: own.transfer_tc,
             scaling_airspeed: own.scaling_airspeed,
         }
@@ -310,10 +325,12 @@ impl Autopilot {
     }
 
     fn build(gains: &GainSet) -> Self {
+        let mut lon = Longitudinal::new(&gains.longitudinal, gains.transfer_tc);
+        lon.set_energy_law(&gains.tecs, gains.transfer_tc);
         Self {
             gains: *gains,
             lat: Lateral::new(&gains.lateral, gains.transfer_tc),
-            lon: Longitudinal::new(&gains.longitudinal, gains.transfer_tc),
+            lon,
             counters: HoldCounters::default(),
         }
     }
@@ -330,6 +347,7 @@ impl Autopilot {
         self.gains = *gains;
         self.lat.set_gains(&gains.lateral, gains.transfer_tc);
         self.lon.set_gains(&gains.longitudinal, gains.transfer_tc);
+        self.lon.set_energy_law(&gains.tecs, gains.transfer_tc);
         Ok(())
     }
 
@@ -565,7 +583,9 @@ mod tests {
                 _ => ((r >> 8) as f32 / (1u32 << 24) as f32 - 0.5) * 2.0 * scale,
             }
         };
-        for (_, g, _) in NAMED {
+        let mut energy = GainSet::FLIGHT;
+        energy.tecs = tecs::gains::ENGAGED;
+        for g in NAMED.iter().map(|(_, g, _)| g).chain([&energy]) {
             let mut ap = Autopilot::new(g).unwrap();
             for k in 0..3000 {
                 let m = Measurements {

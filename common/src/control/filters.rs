@@ -6,6 +6,9 @@
 //! - [`Washout`]: `s / (s + a)` on the yaw rate of the yaw damper, `a = 2 rad/s` (Appendix D:
 //!   `zpk(0, -2, 0.065)` then `c2d(.., SampleTime)`, MATLAB's default zero-order hold).
 //!
+//! - [`RateEstimator`]: a value and its rate from samples of the value alone (the total energy
+//!   control's climb rate and airspeed rate), not a thesis filter.
+//!
 //! Zero-order hold is what MATLAB's `c2d` did for the thesis, and it makes each filter's step
 //! response equal to the continuous one at every sample. Both filters start from their first
 //! input (the low-pass outputs it, the washout outputs zero), so engaging a loop in flight does
@@ -132,6 +135,58 @@ impl Washout {
     }
 }
 
+/// A value and its rate of change from noisy samples of the value: the observer
+/// `x' = r + 2 w (u - x)`, `r' = w^2 (u - x)` (both poles at `-w`), one Euler step per sample.
+///
+/// Why not a differenced low-pass: the observer's rate has no lag against a ramp in steady
+/// state (a ramp is what a climb or an acceleration is), and its noise falls off as `1/s`
+/// above `w` where a filtered difference only flattens. From the value alone, the rate's
+/// transfer is `s w^2 / (s^2 + 2 w s + w^2)` (a differentiator with a critically damped
+/// second-order roll-off): at `w / 3` it lags the true rate by 37 deg.
+#[derive(Clone, Copy, Debug)]
+pub struct RateEstimator {
+    w: f32,
+    state: Option<(f32, f32)>,
+}
+
+impl RateEstimator {
+    /// An estimator with both poles at `w` rad/s, empty until its first sample.
+    pub fn new(w: f32) -> Self {
+        Self { w, state: None }
+    }
+
+    /// Moves the poles (rad/s); the state is kept.
+    pub fn set_pole(&mut self, w: f32) {
+        self.w = w;
+    }
+
+    /// Forgets the state; the next sample initialises it at rest.
+    pub fn reset(&mut self) {
+        self.state = None;
+    }
+
+    /// The present value and rate, `None` before the first good sample.
+    pub fn output(&self) -> Option<(f32, f32)> {
+        self.state
+    }
+
+    /// Feeds sample `u`, returns `(value, rate)`. The first sample initialises the value to
+    /// itself with zero rate. A non-finite sample, pole or `dt`, or a `w dt` at which the Euler
+    /// step would be unstable (above 1), leaves the state alone.
+    pub fn step(&mut self, u: f32, dt: f32) -> Option<(f32, f32)> {
+        if !valid(self.w, dt, u) || self.w * dt > 1.0 {
+            return self.state;
+        }
+        let (mut x, mut r) = self.state.unwrap_or((u, 0.0));
+        x += r * dt;
+        let e = u - x;
+        x += 2.0 * self.w * dt * e;
+        r += self.w * self.w * dt * e;
+        self.state = Some((x, r));
+        self.state
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,5 +272,36 @@ mod tests {
         assert!((y - 0.1).abs() < 1e-6);
         assert_eq!(w.step(f32::NAN, 0.02), y);
         assert_eq!(w.step(0.4, f32::INFINITY), y);
+    }
+
+    /// On a ramp the observer's rate settles on the ramp's slope with no lag (a type-2 loop),
+    /// and its value on the ramp itself; a step makes the rate rise and come back to zero.
+    #[test]
+    fn rate_estimator_follows_a_ramp_without_lag() {
+        let mut f = RateEstimator::new(2.0);
+        assert_eq!(f.step(100.0, 0.02), Some((100.0, 0.0)));
+        let mut last = (0.0, 0.0);
+        for k in 1..=1000 {
+            last = f.step(100.0 + 1.5 * k as f32 * 0.02, 0.02).unwrap();
+        }
+        assert!((last.1 - 1.5).abs() < 1e-3, "{last:?}");
+        assert!((last.0 - 130.0).abs() < 1e-3, "{last:?}");
+        let mut g = RateEstimator::new(2.0);
+        g.step(0.0, 0.02);
+        let mut peak = 0.0f32;
+        let mut r = 0.0;
+        for _ in 0..1000 {
+            r = g.step(1.0, 0.02).unwrap().1;
+            peak = peak.max(r);
+        }
+        // Continuous response of s w^2/(s + w)^2 to a unit step: w^2 t e^(-w t), peak w/e.
+        assert!((peak - 2.0 / core::f32::consts::E).abs() < 0.03, "{peak}");
+        assert!(r.abs() < 1e-3);
+        // Bad samples and steps leave the state alone.
+        let held = g.output();
+        assert_eq!(g.step(f32::NAN, 0.02), held);
+        assert_eq!(g.step(1.0, -0.02), held);
+        assert_eq!(g.step(1.0, 2.0), held);
+        assert_eq!(RateEstimator::new(2.0).step(f32::INFINITY, 0.02), None);
     }
 }

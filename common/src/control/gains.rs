@@ -235,7 +235,12 @@ mod tests {
     fn the_stages_parameters_default_to_the_flight_set() {
         use crate::control::{autopilot, lateral, longitudinal};
         use crate::params::{ParamStore, Registry};
-        const CONTROL: Registry = &[&lateral::PARAMS, &longitudinal::PARAMS, &autopilot::PARAMS];
+        const CONTROL: Registry = &[
+            &lateral::PARAMS,
+            &longitudinal::PARAMS,
+            &longitudinal::tecs::gains::PARAMS,
+            &autopilot::PARAMS,
+        ];
         assert_eq!(ParamStore::validate(CONTROL), Ok(()));
         let store = ParamStore::new(CONTROL);
         let loaded = GainSet::from_store(&store);

@@ -25,6 +25,8 @@
 //!   theta_c ±20° ─► [PI pitch] ─┬─► elevator ±25° = trim + kp e + ki ∫e - kd q
 //!                   pitch rate q┘ (rate damper, innermost)
 //!   LPF = 2 rad/s first-order low-pass on altitude and airspeed (y[k+1] = 0.9608 y[k] + 0.0392 u[k])
+//!   LON_LAW = 1: outside the take-off regime the total energy control gives theta_c and the
+//!   throttle instead (throttle on the energy rate, pitch on its balance: longitudinal/tecs/)
 //! ```
 //!
 //! All stages run once per tick at the sample time of the thesis, 0.02 s (50 Hz), but every step

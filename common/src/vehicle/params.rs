@@ -52,6 +52,7 @@ pub const PARAMS: Group<SystemParams> = Group {
 pub const REGISTRY: Registry = &[
     &lateral::PARAMS,
     &longitudinal::PARAMS,
+    &longitudinal::tecs::gains::PARAMS,
     &autopilot::PARAMS,
     &estimator::config::PARAMS,
     &guidance::PARAMS,

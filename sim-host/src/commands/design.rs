@@ -24,6 +24,9 @@ pub struct DesignReport {
     /// The flight set at each airspeed of [`SCALING_AIRSPEEDS_MPS`], without and with the
     /// airspeed scaling of its surface loops: (airspeed m/s, unscaled, scaled).
     pub scaling: Vec<(f64, Vec<SampledLoop>, Vec<SampledLoop>)>,
+    /// The total energy control's two loops (`LON_LAW` = 1) with the flight defaults, on the
+    /// same model.
+    pub tecs: Vec<SampledLoop>,
     /// Tables printed.
     #[serde(skip)]
     pub tables: Vec<Table>,
@@ -179,44 +182,31 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
     .collect();
     let mut full = Table::new(
         "On the full linear model at 50 Hz (every state of both axes, 8 Hz servos held over each period, measurements two periods late, every other loop closed): each loop broken at its controller's output, and a small step of its command",
-        &[
-            "loop",
-            "set",
-            "phase margin (deg)",
-            "gain margin (dB)",
-            "crossover (rad/s)",
-            "rise 10-90 % (s)",
-            "overshoot (%)",
-            "settling 2 % (s)",
-        ],
+        &[&["loop", "set"][..], &FIGURES].concat(),
     );
     for (i, l) in d.loops.iter().enumerate() {
         for (set, loops) in &sampled {
             let Some(s) = loops.get(i) else { continue };
             debug_assert_eq!(s.name, l.name);
-            full.row([
-                l.name.clone(),
-                set.clone(),
-                opt(s.margins.phase_margin_deg, 3),
-                opt(s.margins.gain_margin_db, 3),
-                opt(s.margins.gain_crossover_radps, 3),
-                opt(s.rise_time_s, 3),
-                if s.unstable {
-                    "unstable".into()
-                } else {
-                    sig(s.overshoot_pct, 3)
-                },
-                opt(s.settling_time_s, 3),
-            ]);
+            full.row([l.name.clone(), set.clone()].into_iter().chain(figures(s)));
         }
     }
     let (scaling, scaling_table) = scaling_report(aircraft, inputs)?;
+    let tecs = model.judge_tecs(&common::control::gains::FLIGHT);
+    let mut energy = Table::new(
+        "The total energy control (LON_LAW = 1, its designed gains, the flight defaults' pitch loop) on the same model: the energy rate broken at the throttle with a small height step, the balance broken at the pitch command with a small airspeed step",
+        &[&["loop"][..], &FIGURES].concat(),
+    );
+    for s in &tecs {
+        energy.row(std::iter::once(s.name.to_string()).chain(figures(s)));
+    }
     Ok(DesignReport {
         gain_set: d.gains,
         design: d,
         sampled,
         scaling,
-        tables: vec![coeffs, appc, gains, pred, full, scaling_table],
+        tecs,
+        tables: vec![coeffs, appc, gains, pred, full, scaling_table, energy],
     })
 }
 
@@ -300,4 +290,30 @@ pub fn design_markdown(aircraft: &Aircraft) -> anyhow::Result<String> {
         include_str!("design_intro.md"),
         super::render(&r.tables, Format::Markdown)
     ))
+}
+
+/// Headers of [`figures`].
+const FIGURES: [&str; 6] = [
+    "phase margin (deg)",
+    "gain margin (dB)",
+    "crossover (rad/s)",
+    "rise 10-90 % (s)",
+    "overshoot (%)",
+    "settling 2 % (s)",
+];
+
+/// A loop's figures on the sampled model, as the tables print them: margins, crossover, step.
+fn figures(s: &SampledLoop) -> [String; 6] {
+    [
+        opt(s.margins.phase_margin_deg, 3),
+        opt(s.margins.gain_margin_db, 3),
+        opt(s.margins.gain_crossover_radps, 3),
+        opt(s.rise_time_s, 3),
+        if s.unstable {
+            "unstable".into()
+        } else {
+            sig(s.overshoot_pct, 3)
+        },
+        opt(s.settling_time_s, 3),
+    ]
 }

@@ -72,6 +72,7 @@ fn check_stages(store: &ParamStore) {
     }
     one(store, &lateral::PARAMS);
     one(store, &longitudinal::PARAMS);
+    one(store, &longitudinal::tecs::gains::PARAMS);
     one(store, &autopilot::PARAMS);
     one(store, &estimator::config::PARAMS);
     one(store, &guidance::PARAMS);

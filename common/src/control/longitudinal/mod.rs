@@ -16,11 +16,17 @@
 //! edge does not make the regime chatter. When a regime changes the source of the pitch or
 //! throttle command, the new source starts from the command the old one gave (bumpless).
 //!
+//! With `LON_LAW` = 1 ([`TecsGains::enabled`]) the altitude modes fly the total energy control
+//! ([`tecs`]) instead of the climb, hold and descent regimes: it gives the throttle and the pitch
+//! command, which the same pitch attitude loop flies. The take-off regime (fixed pitch, full
+//! throttle below the clear altitude) and the pitch modes stay as they are under either law.
+//!
 //! Signs (UMN): positive elevator pitches the nose down, so the pitch gains are negative and
 //! `-kd q` with `kd < 0` adds elevator against the pitch rate.
 
 pub mod gains;
 pub mod regime;
+pub mod tecs;
 
 use super::filters::LowPass;
 use super::inputs::{InputFlags, Measurements};
@@ -30,6 +36,7 @@ use crate::math::{clamp, wrap_pi};
 
 pub use gains::{LongitudinalGains, FLIGHT, PARAMS, THESIS};
 pub use regime::{Regime, RegimeMachine};
+pub use tecs::{Tecs, TecsDemand, TecsGains};
 
 /// What the elevator and throttle do. Angles rad, altitudes m, airspeeds m/s.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,6 +180,7 @@ pub struct Longitudinal {
     alt_lpf: LowPass,
     aspd_lpf: LowPass,
     machine: RegimeMachine,
+    tecs: Tecs,
     pitch_src: SourceKind,
     thr_src: SourceKind,
     elevator: f32,
@@ -210,6 +218,34 @@ fn aspd_thr_gains(g: &LongitudinalGains) -> PidGains {
     }
 }
 
+/// The sources of the pitch command and the throttle in regime `r` (Figure 3-16).
+fn regime_sources(
+    r: Regime,
+    g: &LongitudinalGains,
+    alt_c: f32,
+    aspd_c: f32,
+    pitch_ff: f32,
+) -> (PitchSource, ThrottleSource) {
+    match r {
+        Regime::TakeOff => (
+            PitchSource::Fixed(g.takeoff_pitch),
+            ThrottleSource::Fixed(g.throttle_max),
+        ),
+        Regime::Climb => (
+            PitchSource::Airspeed(aspd_c),
+            ThrottleSource::Fixed(g.throttle_max),
+        ),
+        Regime::AltitudeHold => (
+            PitchSource::Altitude(alt_c, pitch_ff),
+            ThrottleSource::Airspeed(aspd_c),
+        ),
+        Regime::Descent => (
+            PitchSource::Airspeed(aspd_c),
+            ThrottleSource::Fixed(g.throttle_min),
+        ),
+    }
+}
+
 impl Longitudinal {
     /// A disengaged longitudinal autopilot; `transfer_tc` is the bumpless fade time constant, s.
     /// Gains are expected to have passed [`super::GainSet::validate`].
@@ -223,6 +259,7 @@ impl Longitudinal {
             alt_lpf: LowPass::new(gains.feedback_lpf_pole),
             aspd_lpf: LowPass::new(gains.feedback_lpf_pole),
             machine: RegimeMachine::new(),
+            tecs: Tecs::new(&tecs::gains::DESIGNED, gains, transfer_tc),
             pitch_src: SourceKind::Off,
             thr_src: SourceKind::Off,
             elevator: gains.trim_elevator,
@@ -253,8 +290,16 @@ impl Longitudinal {
         self.aspd_thr.set_gains(aspd_thr_gains(gains), transfer_tc);
         self.alt_lpf.set_pole(gains.feedback_lpf_pole);
         self.aspd_lpf.set_pole(gains.feedback_lpf_pole);
+        let t = *self.tecs.gains();
+        self.tecs.set_gains(&t, gains, transfer_tc);
         self.elev_resume = true;
         self.thr_resume = true;
+    }
+
+    /// Chooses the law of the altitude modes and the energy control's gains
+    /// ([`TecsGains::enabled`]); a change of law takes effect bumplessly on the next step.
+    pub fn set_energy_law(&mut self, t: &TecsGains, transfer_tc: f32) {
+        self.tecs.set_gains(t, &self.gains, transfer_tc);
     }
 
     /// Makes the next engagement start from these positions instead of the trim.
@@ -291,9 +336,12 @@ impl Longitudinal {
         } else {
             self.aspd_lpf.output()
         };
+        // The estimators skip a bad sample or dt themselves.
+        self.tecs.observe(m.altitude, m.airspeed, dt);
 
         let mut rejected = InputFlags::empty();
         let mut pitch_ff = 0.0;
+        let mut rate_ff = 0.0;
         let (alt_c, aspd_c, clear) = match mode {
             LonMode::Off => {
                 self.pitch.reset();
@@ -301,6 +349,7 @@ impl Longitudinal {
                 self.aspd_pitch.reset();
                 self.aspd_thr.reset();
                 self.machine.reset();
+                self.tecs.disengage();
                 self.pitch_src = SourceKind::Off;
                 self.thr_src = SourceKind::Off;
                 self.elev_resume = false;
@@ -326,6 +375,7 @@ impl Longitudinal {
             } => {
                 // A bad rate or airspeed only loses the feed-forward; the loop still holds
                 // the altitude command.
+                rate_ff = climb_rate;
                 let ratio = climb_rate / airspeed;
                 if ratio.is_finite() {
                     pitch_ff = clamp(
@@ -343,6 +393,7 @@ impl Longitudinal {
             } => (altitude, airspeed, Some(clear_altitude)),
         };
 
+        let mut energy = false;
         let sources = match mode {
             LonMode::Pitch { pitch, throttle } => {
                 Some((PitchSource::Fixed(pitch), ThrottleSource::Fixed(throttle)))
@@ -367,27 +418,22 @@ impl Longitudinal {
                     _ if cmd_ok => self.machine.regime(),
                     _ => None,
                 };
-                regime.map(|r| match r {
-                    Regime::TakeOff => (
-                        PitchSource::Fixed(g.takeoff_pitch),
-                        ThrottleSource::Fixed(g.throttle_max),
-                    ),
-                    Regime::Climb => (
-                        PitchSource::Airspeed(aspd_c),
-                        ThrottleSource::Fixed(g.throttle_max),
-                    ),
-                    Regime::AltitudeHold => (
-                        PitchSource::Altitude(alt_c, pitch_ff),
-                        ThrottleSource::Airspeed(aspd_c),
-                    ),
-                    Regime::Descent => (
-                        PitchSource::Airspeed(aspd_c),
-                        ThrottleSource::Fixed(g.throttle_min),
-                    ),
-                })
+                energy = self.tecs.gains().enabled && regime.is_some_and(|r| r != Regime::TakeOff);
+                if energy {
+                    let demand = TecsDemand {
+                        altitude: alt_c,
+                        airspeed: aspd_c,
+                        climb_rate: rate_ff,
+                    };
+                    self.energy_sources(m, &demand, dt, &mut rejected)
+                } else {
+                    regime.map(|r| regime_sources(r, &g, alt_c, aspd_c, pitch_ff))
+                }
             }
         };
-
+        if !energy {
+            self.tecs.disengage();
+        }
         let (elevator_held, throttle_held) = match sources {
             None => {
                 // No regime (no good altitude yet, or a bad command): hold both.
@@ -406,11 +452,44 @@ impl Longitudinal {
             elevator: self.elevator,
             throttle: self.throttle,
             pitch_cmd: self.pitch_cmd,
-            regime: self.machine.regime(),
+            regime: if self.tecs.engaged() {
+                None
+            } else {
+                self.machine.regime()
+            },
             elevator_held,
             throttle_held,
             rejected,
         }
+    }
+
+    /// The energy control's throttle and pitch command as fixed sources for this step, engaging
+    /// it from the commands in force; `None` (hold both) when it cannot step.
+    fn energy_sources(
+        &mut self,
+        m: &Measurements,
+        demand: &TecsDemand,
+        dt: f32,
+        rejected: &mut InputFlags,
+    ) -> Option<(PitchSource, ThrottleSource)> {
+        if !self.tecs.engaged() {
+            let from = if self.pitch_src == SourceKind::Off {
+                m.pitch
+            } else {
+                self.pitch_cmd
+            };
+            self.tecs.engage(self.throttle, from);
+        }
+        rejected.set(InputFlags::AIRSPEED, !m.airspeed.is_finite());
+        if !(m.airspeed.is_finite() && m.altitude.is_finite()) {
+            return None;
+        }
+        self.tecs.step(demand, &self.gains, dt).map(|o| {
+            (
+                PitchSource::Fixed(o.pitch_cmd),
+                ThrottleSource::Fixed(o.throttle),
+            )
+        })
     }
 
     fn step_elevator(
@@ -798,5 +877,110 @@ mod tests {
             );
         }
         assert!(o.pitch_cmd < 0.0, "{o:?}");
+    }
+
+    fn energy_law() -> Longitudinal {
+        let mut lon = Longitudinal::new(&FLIGHT, 1.0);
+        lon.set_energy_law(&tecs::gains::ENGAGED, 1.0);
+        lon
+    }
+
+    /// Under the energy law an altitude mode at the trim state gives the trim throttle and
+    /// pitches to the trim pitch, and reports no regime; the take-off regime below the clear
+    /// altitude is the same fixed pitch and full throttle as under the regimes.
+    #[test]
+    fn the_energy_law_holds_trim_and_keeps_the_take_off_regime() {
+        let mut lon = energy_law();
+        let mode = LonMode::Altitude {
+            altitude: 100.0,
+            airspeed: 17.0,
+        };
+        let mut o = LongitudinalOutput::default();
+        for _ in 0..500 {
+            o = lon.step(&meas(FLIGHT.trim_pitch, 100.0, 17.0), mode, DT);
+        }
+        assert_eq!(o.regime, None);
+        assert!((o.throttle - FLIGHT.trim_throttle).abs() < 1e-4, "{o:?}");
+        assert!((o.pitch_cmd - FLIGHT.trim_pitch).abs() < 1e-4, "{o:?}");
+        let mut lon = energy_law();
+        let take_off = LonMode::TakeOff {
+            altitude: 160.0,
+            airspeed: 17.0,
+            clear_altitude: 120.0,
+        };
+        // Climbing at 2 m/s through the clear altitude.
+        let mut last = lon.step(&meas(0.1, 110.0, 15.0), take_off, DT);
+        let mut handed_over = false;
+        for k in 1..1000 {
+            let o = lon.step(&meas(0.1, 110.0 + 0.04 * k as f32, 15.0), take_off, DT);
+            if o.regime == Some(Regime::TakeOff) {
+                assert_eq!(o.throttle, FLIGHT.throttle_max);
+                assert!((o.pitch_cmd - FLIGHT.takeoff_pitch).abs() < 1e-6);
+            } else {
+                // The energy law takes over from those commands, no jump.
+                assert_eq!(o.regime, None);
+                assert!(
+                    (o.pitch_cmd - last.pitch_cmd).abs() < 1e-3,
+                    "{last:?} {o:?}"
+                );
+                assert!((o.throttle - last.throttle).abs() < 1e-3, "{last:?} {o:?}");
+                handed_over = true;
+                break;
+            }
+            last = o;
+        }
+        assert!(handed_over);
+    }
+
+    /// Switching the law in flight changes neither the throttle nor the pitch command at once.
+    #[test]
+    fn switching_the_law_in_flight_is_bumpless() {
+        let mut lon = Longitudinal::new(&FLIGHT, 1.0);
+        let mode = LonMode::Altitude {
+            altitude: 104.0,
+            airspeed: 17.0,
+        };
+        let m = meas(0.05, 100.0, 16.0);
+        let mut o = lon.step(&m, mode, DT);
+        for _ in 0..100 {
+            o = lon.step(&m, mode, DT);
+        }
+        assert_eq!(o.regime, Some(Regime::AltitudeHold));
+        lon.set_energy_law(&tecs::gains::ENGAGED, 1.0);
+        let o2 = lon.step(&m, mode, DT);
+        assert_eq!(o2.regime, None);
+        assert!((o2.pitch_cmd - o.pitch_cmd).abs() < 2e-3, "{o:?} {o2:?}");
+        assert!((o2.throttle - o.throttle).abs() < 2e-3, "{o:?} {o2:?}");
+        lon.set_energy_law(&tecs::gains::DESIGNED, 1.0);
+        let o3 = lon.step(&m, mode, DT);
+        assert_eq!(o3.regime, Some(Regime::AltitudeHold));
+        assert!((o3.pitch_cmd - o2.pitch_cmd).abs() < 2e-3, "{o2:?} {o3:?}");
+        assert!((o3.throttle - o2.throttle).abs() < 2e-3, "{o2:?} {o3:?}");
+    }
+
+    /// A bad airspeed under the energy law holds both outputs and says why; the law resumes
+    /// from the held values.
+    #[test]
+    fn the_energy_law_holds_on_a_bad_airspeed() {
+        let mut lon = energy_law();
+        let mode = LonMode::Glide {
+            altitude: 90.0,
+            airspeed: 15.0,
+            climb_rate: -1.0,
+        };
+        let mut prev = lon.step(&meas(0.0, 100.0, 15.0), mode, DT);
+        let mut o = prev;
+        for _ in 0..20 {
+            prev = o;
+            o = lon.step(&meas(0.0, 100.0, 15.0), mode, DT);
+        }
+        let bad = lon.step(&meas(0.0, 100.0, f32::NAN), mode, DT);
+        assert!(bad.elevator_held && bad.throttle_held);
+        assert!(bad.rejected.contains(InputFlags::AIRSPEED));
+        assert_eq!((bad.elevator, bad.throttle), (o.elevator, o.throttle));
+        let back = lon.step(&meas(0.0, 100.0, 15.0), mode, DT);
+        // It goes on at the pace it had: no larger a step than twice the last one.
+        let pace = (o.throttle - prev.throttle).abs();
+        assert!(!back.throttle_held && (back.throttle - o.throttle).abs() <= 2.0 * pace + 1e-4);
     }
 }

@@ -50,6 +50,9 @@ pub enum LonLaw {
     AltitudeHold,
     /// Airspeed by pitch, the throttle fixed (the climb and descent regimes).
     AirspeedPitch,
+    /// The total energy control: throttle on the energy rate, pitch command on its balance,
+    /// from the height and airspeed through the control's rate estimators.
+    Tecs,
 }
 
 /// What the ailerons hold.
@@ -123,7 +126,49 @@ impl Discrete {
         let p = (-f64::from(pole) * self.t).exp();
         (self.z - 1.0) / (self.z - p)
     }
+    /// The value and the rate out of the total energy control's rate estimator per unit of
+    /// its input: its Euler step `x- = x + r T`, `x = x- + 2 w T (u - x-)`,
+    /// `r += w^2 T (u - x-)`, solved at `z`.
+    fn rate_estimator(&self, w: f32) -> (Complex<f64>, Complex<f64>) {
+        let (w, t, zi) = (f64::from(w), self.t, 1.0 / self.z);
+        let (a, b) = (2.0 * w * t, w * w * t);
+        // [1 - (1 - a) / z, -T (1 - a) / z; b / z, 1 - (1 - b T) / z] [x; r] = [a; b]
+        let (m11, m12) = (1.0 - (1.0 - a) * zi, -t * (1.0 - a) * zi);
+        let (m21, m22) = (b * zi, 1.0 - (1.0 - b * t) * zi);
+        let det = m11 * m22 - m12 * m21;
+        ((a * m22 - m12 * b) / det, (m11 * b - m21 * a) / det)
+    }
 }
+
+/// The total energy control about the level trim at `va` m/s, no limit reached: throttle
+/// `(g / a_V2 + PI) E_d - PI E` and pitch command `(1 + PI) B_d - PI B` from the height and
+/// airspeed (`common::control::longitudinal::tecs`).
+fn tecs_controller(g: &GainSet, d: &Discrete, va: f64, ky: &mut CMat, kr: &mut CMat) {
+    const G: f64 = 9.81;
+    let t = &g.tecs;
+    let (x, r) = d.rate_estimator(t.rate_pole);
+    let w = f64::from(t.speed_weight);
+    let (w_h, w_v) = ((2.0 - w).min(1.0), w.min(1.0));
+    let (k_h, k_v) = (f64::from(t.height_k), f64::from(t.speed_k));
+    let thr = d.pi(t.thr_kp, t.thr_ki);
+    let thr_d = thr + G / f64::from(t.thr_accel);
+    let pitch = d.pi(t.pitch_kp, t.pitch_ki);
+    let pitch_d = pitch + 1.0;
+    // Per unit of height and of airspeed: the demands (through the estimated value) and the
+    // rates (through the estimated rate), as flight-path angles.
+    let (h_demand, v_demand) = (k_h / va, k_v / G);
+    let (h_rate, v_rate) = (r / va, r / G);
+    ky[(ch::THROTTLE, out::HEIGHT)] = -thr_d * x * h_demand - thr * h_rate;
+    ky[(ch::THROTTLE, out::AIRSPEED)] = -thr_d * x * v_demand - thr * v_rate;
+    kr[(ch::THROTTLE, reference::HEIGHT)] = thr_d * h_demand;
+    kr[(ch::THROTTLE, reference::AIRSPEED)] = thr_d * v_demand;
+    ky[(ch::PITCH_CMD, out::HEIGHT)] = -(pitch_d * x * h_demand + pitch * h_rate) * w_h;
+    ky[(ch::PITCH_CMD, out::AIRSPEED)] = (pitch_d * x * v_demand + pitch * v_rate) * w_v;
+    kr[(ch::PITCH_CMD, reference::HEIGHT)] = pitch_d * h_demand * w_h;
+    kr[(ch::PITCH_CMD, reference::AIRSPEED)] = -pitch_d * v_demand * w_v;
+}
+
+type CMat = DMatrix<Complex<f64>>;
 
 /// The controller as three maps into its outputs: from the measurements, from its own outputs
 /// (the inner loops take the outer loops' commands) and from the references.
@@ -133,7 +178,7 @@ struct Controller {
     kr: DMatrix<Complex<f64>>,
 }
 
-fn controller(g: &GainSet, arr: Arrangement, d: &Discrete) -> Controller {
+fn controller(g: &GainSet, arr: Arrangement, d: &Discrete, va: f64) -> Controller {
     let zero = Complex::new(0.0, 0.0);
     let mut ky = DMatrix::from_element(ch::N, out::N, zero);
     let mut kc = DMatrix::from_element(ch::N, ch::N, zero);
@@ -162,6 +207,7 @@ fn controller(g: &GainSet, arr: Arrangement, d: &Discrete) -> Controller {
             kr[(ch::PITCH_CMD, reference::AIRSPEED)] = ap;
             ky[(ch::PITCH_CMD, out::AIRSPEED)] = -ap * filter;
         }
+        LonLaw::Tecs => tecs_controller(g, d, va, &mut ky, &mut kr),
     }
 
     // Roll: aileron = PI (phi_c - phi) - kd p.
@@ -208,6 +254,8 @@ struct AtFrequency {
 pub struct SampledLoops {
     plant: SampledPlant,
     delay_samples: i32,
+    /// Airspeed of the trim the plant was linearised at, m/s.
+    va: f64,
 }
 
 impl SampledLoops {
@@ -253,14 +301,19 @@ impl SampledLoops {
         );
         let servo = 2.0 * std::f64::consts::PI * aircraft.actuators.bandwidth_Hz;
         let plant = SampledPlant::new(&linearize(&params, &trim), servo, period_s);
-        Ok(Self::new(plant, delay_samples))
+        Ok(Self {
+            va: trim.target.va_mps,
+            ..Self::new(plant, delay_samples)
+        })
     }
 
-    /// The loops on `plant`, the measurements `delay_samples` periods late.
+    /// The loops on `plant` (linearised at the level trim's airspeed), the measurements
+    /// `delay_samples` periods late.
     pub fn new(plant: SampledPlant, delay_samples: u32) -> Self {
         Self {
             plant,
             delay_samples: delay_samples.min(100) as i32,
+            va: TrimTarget::level().va_mps,
         }
     }
 
@@ -276,6 +329,7 @@ impl SampledLoops {
                 z,
                 t: self.plant.period_s,
             },
+            self.va,
         );
         let delay = z.powi(-self.delay_samples);
         let m = &k.ky * &g * delay + &k.kc;
@@ -531,6 +585,25 @@ pub const CASES: [LoopCase; 7] = [
 /// Slowest divergence counted as instability, s (an e-fold in five minutes).
 pub const SLOWEST_DIVERGENCE_S: f64 = 300.0;
 
+/// The total energy control's two loops, wings level: the energy rate broken at the throttle
+/// (a height step), the balance broken at the pitch command (an airspeed step).
+pub const TECS_CASES: [LoopCase; 2] = [
+    LoopCase {
+        name: "energy rate (throttle, TECS)",
+        arrangement: arrangement(LonLaw::Tecs, LatLaw::Roll, YawLaw::Damper),
+        channel: ch::THROTTLE,
+        reference: reference::HEIGHT,
+        output: out::HEIGHT,
+    },
+    LoopCase {
+        name: "energy balance (pitch command, TECS)",
+        arrangement: arrangement(LonLaw::Tecs, LatLaw::Roll, YawLaw::Damper),
+        channel: ch::PITCH_CMD,
+        reference: reference::AIRSPEED,
+        output: out::AIRSPEED,
+    },
+];
+
 /// Periods of each predicted step: 2^14 at 50 Hz is 328 s, long after the slowest loop
 /// (altitude, a few tens of seconds) has settled.
 const STEP_PERIODS: usize = 1 << 14;
@@ -568,6 +641,12 @@ impl SampledLoops {
     /// Every case of [`CASES`].
     pub fn judge_all(&self, gains: &GainSet) -> Vec<SampledLoop> {
         CASES.iter().map(|c| self.judge(gains, c)).collect()
+    }
+
+    /// Every case of [`TECS_CASES`] (whatever `LON_LAW` says: the gains are judged as if
+    /// flown).
+    pub fn judge_tecs(&self, gains: &GainSet) -> Vec<SampledLoop> {
+        TECS_CASES.iter().map(|c| self.judge(gains, c)).collect()
     }
 }
 

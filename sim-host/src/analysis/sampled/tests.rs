@@ -216,3 +216,17 @@ fn the_thesis_sideslip_and_airspeed_loops_are_unstable_on_the_full_model_and_the
         );
     }
 }
+
+/// The total energy control's designed gains keep both its loops stable, with the margins the
+/// other loops are held to, on the full sampled model; a height step settles.
+#[test]
+fn the_total_energy_control_is_stable_on_the_full_sampled_model() {
+    let (_, _, loops, _) = setup();
+    let g = common::control::gains::FLIGHT;
+    for l in loops.judge_tecs(&g) {
+        eprintln!("{l:?}");
+        let pm = l.margins.phase_margin_deg.unwrap_or(90.0);
+        assert!(pm > 30.0, "{}: {pm} deg", l.name);
+        assert!(l.settling_time_s.is_some(), "{}: never settles", l.name);
+    }
+}

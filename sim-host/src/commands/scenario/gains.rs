@@ -10,10 +10,21 @@ use common::control::gains::{GainSet, NAMES};
 /// ([`computed_gain_set`]).
 pub const COMPUTED: &str = "computed";
 
-/// Every gain set the command can fly: the named sets of `common`, then [`COMPUTED`].
+/// Name of the flight defaults with the altitude modes flown by the total energy control
+/// (`LON_LAW` = 1): the set `sim-host laws` holds against `flight`.
+pub const FLIGHT_TECS: &str = "flight_tecs";
+
+/// The gain sets the command flies by default: the named sets of `common`, then [`COMPUTED`].
 pub fn gain_set_names() -> Vec<&'static str> {
     let mut v = NAMES.to_vec();
     v.push(COMPUTED);
+    v
+}
+
+/// Every gain-set name the command knows: [`gain_set_names`] and [`FLIGHT_TECS`].
+pub fn known_gain_set_names() -> Vec<&'static str> {
+    let mut v = gain_set_names();
+    v.push(FLIGHT_TECS);
     v
 }
 
@@ -62,10 +73,15 @@ pub fn gain_set(aircraft: &Aircraft, name: &str) -> anyhow::Result<GainSet> {
     if name == COMPUTED {
         return computed_gain_set(aircraft).context("designing the computed gain set");
     }
+    if name == FLIGHT_TECS {
+        let mut g = GainSet::FLIGHT;
+        g.tecs = common::control::longitudinal::tecs::gains::ENGAGED;
+        return Ok(g);
+    }
     GainSet::named(name).map_err(|_| {
         UnknownGainSet {
             name: name.to_string(),
-            valid: gain_set_names(),
+            valid: known_gain_set_names(),
         }
         .into()
     })

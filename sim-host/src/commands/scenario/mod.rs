@@ -18,7 +18,10 @@ use std::path::Path;
 
 pub use claims::CLIMB_WINDOW_S;
 pub use document::results_markdown;
-pub use gains::{gain_file, gain_set, gain_set_names, UnknownGainSet, COMPUTED};
+pub use gains::{
+    gain_file, gain_set, gain_set_names, known_gain_set_names, UnknownGainSet, COMPUTED,
+    FLIGHT_TECS,
+};
 pub use run::{check_noise, fly, level_trim, ScenarioReport, ScenarioResult};
 pub use tables::{metrics_table, write_result};
 
