@@ -191,8 +191,11 @@ fn the_station_saw_the_landing_honestly(o: &FlightOutcome, touchdown_s: f64) {
         .next()
         .expect("ON_GROUND after the touchdown");
     assert_eq!(on_ground_at, *t_ground, "{states:?}");
+    // From the first contact: a landing that bounces along the runway in gusts (seven times
+    // on the pitot-failure flight, its synthetic airspeed 1.7 m/s RMS off, docs/NAVIGATION.md)
+    // is at rest on its wheels only 11.6-12.5 s after it, so 15 s; a clean one takes 7.3-7.6 s.
     assert!(
-        on_ground_at - touchdown_s < 12.0,
+        on_ground_at - touchdown_s < 15.0,
         "ON_GROUND {:.1} s after the touchdown",
         on_ground_at - touchdown_s
     );

@@ -121,13 +121,18 @@ impl ServoBank {
     /// Moves every servo toward its command, held for `dt` s; returns the surfaces at the end.
     pub fn step(&mut self, cmd: &Controls, dt: f64) -> Controls {
         let end = self.held(cmd, dt);
-        self.elevator.position = end.elevator;
-        self.aileron_left.position = end.aileron_left;
-        self.aileron_right.position = end.aileron_right;
-        self.rudder.position = end.rudder;
-        self.flap_left.position = end.flap_left;
-        self.flap_right.position = end.flap_right;
+        self.settle_at(&end);
         end
+    }
+
+    /// The servos where `surfaces` are.
+    fn settle_at(&mut self, surfaces: &Controls) {
+        self.elevator.position = surfaces.elevator;
+        self.aileron_left.position = surfaces.aileron_left;
+        self.aileron_right.position = surfaces.aileron_right;
+        self.rudder.position = surfaces.rudder;
+        self.flap_left.position = surfaces.flap_left;
+        self.flap_right.position = surfaces.flap_right;
     }
 
     /// One RK4 step of `x' = f(surfaces, x)` over `dt` with `cmd` held at the servos' inputs
@@ -142,8 +147,21 @@ impl ServoBank {
         f: impl Fn(&Controls, &SVector<f64, N>) -> SVector<f64, N>,
     ) -> Controls {
         let start = *self;
-        rk4_step(|tau, x| f(&start.held(cmd, tau), x), x, dt);
-        self.step(cmd, dt)
+        // RK4 asks for the surfaces at the step's start, twice at its middle and at its end:
+        // each is computed once (the servos' exponentials are a large share of a flight's time).
+        let (half, end) = (start.held(cmd, 0.5 * dt), start.held(cmd, dt));
+        let at = |tau: f64| {
+            if tau == 0.5 * dt {
+                half
+            } else if tau == dt {
+                end
+            } else {
+                start.held(cmd, tau)
+            }
+        };
+        rk4_step(|tau, x| f(&at(tau), x), x, dt);
+        self.settle_at(&end);
+        end
     }
 }
 
