@@ -100,10 +100,6 @@ fn the_default_mission_meets_every_target_in_wind_and_turbulence_on_forty_seeds(
     assert!(on >= 34, "{on} of 40 touchdowns on target");
 }
 
-/// A mission that reached every item, whose log has the right wing tip on the runway while
-/// armed (rolled 20 deg on the wheels: the tip reaches the ground at 14.6 deg), fails its
-/// summary on `no_strike` alone, with the strike as an event in the JSON and the printed
-/// table; a smaller roll, or the same roll while disarmed, passes.
 /// The slowest and fastest cruise airspeeds a mission may set (`NAV_ASPD_MIN` 13 m/s and
 /// `NAV_ASPD_MAX` 23 m/s; level flight ends at 23.6 m/s at full throttle), with the surface and
 /// altitude loops scaled by airspeed (`ASPD_SCL_REF`, docs/GAIN-DESIGN.md): the same targets
@@ -129,6 +125,10 @@ fn the_default_mission_flies_at_the_slowest_and_fastest_cruise_airspeeds() {
     }
 }
 
+/// A mission that reached every item, whose log has the right wing tip on the runway while
+/// armed (rolled 20 deg on the wheels: the tip reaches the ground at 14.6 deg), fails its
+/// summary on `no_strike` alone, with the strike as an event in the JSON and the printed
+/// table; a smaller roll, or the same roll while disarmed, passes.
 #[test]
 fn a_wing_tip_on_the_runway_while_armed_fails_the_mission_summary_on_no_strike() {
     use sim_host::commands::fly::mission_table;

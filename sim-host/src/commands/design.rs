@@ -167,11 +167,8 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
         ]);
     }
     let inputs = &d.inputs;
-    let model = SampledLoops::at_level_trim(
-        aircraft,
-        inputs.sample_time_s,
-        inputs.delay_samples.round().max(0.0) as u32,
-    )?;
+    let model =
+        SampledLoops::at_level_trim(aircraft, inputs.sample_time_s, inputs.delay_periods())?;
     let sampled: Vec<(String, Vec<SampledLoop>)> = [
         ("computed", d.gains),
         ("flight", common::control::gains::FLIGHT),
@@ -234,7 +231,7 @@ fn scaling_report(
             aircraft,
             va,
             inputs.sample_time_s,
-            inputs.delay_samples.round().max(0.0) as u32,
+            inputs.delay_periods(),
         )?;
         rows.push((
             va,

@@ -13,6 +13,7 @@ use crate::flight::config::FlightConfig;
 use crate::flight::missions::{default_mission, runway_mission};
 use crate::flight::record::Sample as FlightSample;
 use crate::flight::runner::FlightOutcome;
+use crate::flight::summary::share_on_stop_pct;
 use crate::plant::params::ModelParams;
 use crate::report::sig;
 use crate::scenario::sim::{Run, SimConfig};
@@ -46,18 +47,6 @@ pub fn throttle_travel_per_s(throttle: &[f64], duration_s: f64) -> f64 {
     } else {
         f64::NAN
     }
-}
-
-/// Share of the time the throttle sits on a stop (within 1 % of 0 or 1), %.
-pub fn share_on_stop_pct(throttle: &[f64]) -> f64 {
-    if throttle.is_empty() {
-        return f64::NAN;
-    }
-    let on = throttle
-        .iter()
-        .filter(|t| **t <= 0.01 || **t >= 0.99)
-        .count();
-    100.0 * on as f64 / throttle.len() as f64
 }
 
 /// One scenario run's figures: the step's own and the coupling into the other quantity.

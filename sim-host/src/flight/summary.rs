@@ -250,9 +250,18 @@ pub struct TouchdownSummary {
 /// navigator's default acceptance radius, `NAV_ACC_RAD`).
 const ORBIT_ARRIVAL_M: f64 = 15.0;
 
-/// How near its stop (0 or 1) a throttle counts as on it: the flight defaults' THR_MIN and
-/// THR_MAX.
-const THROTTLE_STOP: f64 = 1e-3;
+/// Share of the time the throttle sits on a stop (within 1 % of 0 or 1: the flight defaults'
+/// THR_MIN and THR_MAX), %; NaN without samples.
+pub fn share_on_stop_pct(throttle: &[f64]) -> f64 {
+    if throttle.is_empty() {
+        return f64::NAN;
+    }
+    let on = throttle
+        .iter()
+        .filter(|t| **t <= 0.01 || **t >= 0.99)
+        .count();
+    100.0 * on as f64 / throttle.len() as f64
+}
 
 /// Figures of a mission flight. `land_point` is the NAV_LAND item north and east of home.
 pub fn mission_summary(
@@ -316,12 +325,10 @@ pub fn mission_summary(
         .map(|s| (s.sp_alt - datum.truth_alt(s), s.sp_airspeed - s.airspeed))
         .unzip();
     let band = f64::from(common::control::longitudinal::FLIGHT.alt_band);
-    let (stops, level) = cruising
+    let level: Vec<f64> = cruising
         .filter(|s| (s.sp_alt - s.est_alt).abs() < band)
-        .fold((0usize, 0usize), |(n, all), s| {
-            let on_stop = s.throttle <= THROTTLE_STOP || s.throttle >= 1.0 - THROTTLE_STOP;
-            (n + usize::from(on_stop), all + 1)
-        });
+        .map(|s| s.throttle)
+        .collect();
     let touchdown = touchdown.map(|t| touchdown_summary(t, land_point));
     MissionSummary {
         items: mission.len(),
@@ -334,11 +341,7 @@ pub fn mission_summary(
         orbit_xtrack_rms_m: rms(&orbit),
         alt_rms_m: rms(&alt),
         airspeed_rms_mps: rms(&va),
-        throttle_at_stops_pct: if level == 0 {
-            f64::NAN
-        } else {
-            100.0 * stops as f64 / level as f64
-        },
+        throttle_at_stops_pct: share_on_stop_pct(&level),
         flight_time_s: samples.iter().filter(|s| s.armed).count() as f64 * frame_s,
         energy_wh: energy_j / 3600.0,
         touchdown,

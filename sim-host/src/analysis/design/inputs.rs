@@ -40,6 +40,13 @@ pub struct DesignInputs {
     pub inner_phase_margin_deg: f64,
 }
 
+impl DesignInputs {
+    /// The delay in whole control periods, as the sampled model takes it.
+    pub fn delay_periods(&self) -> u32 {
+        self.delay_samples.round().max(0.0) as u32
+    }
+}
+
 impl Default for DesignInputs {
     fn default() -> Self {
         Self {

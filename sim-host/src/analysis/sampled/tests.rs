@@ -109,19 +109,20 @@ fn the_predicted_steps_are_what_the_flight_code_flies_on_the_same_model() {
     // The loops engage at the trim and hold it for two seconds first: on engagement the flight
     // code fades its proportional kick in (bumpless transfer), which a step from rest would see.
     let (pre, n) = (100, 3000);
-    let after = |v: &[f64], scale: f64| -> Vec<f64> {
+    // The case's predicted unit step, scaled and started `pre` periods late.
+    let predicted = |case: &LoopCase, scale: f64| -> Vec<f64> {
+        let v = loops.step(
+            &gains,
+            case.arrangement,
+            case.reference,
+            case.output,
+            1 << 14,
+        );
         (0..n)
             .map(|k| if k < pre { 0.0 } else { scale * v[k - pre] })
             .collect()
     };
     // A 2 m height step in altitude hold: low-pass, altitude and airspeed PIs, pitch loop.
-    let predicted = loops.step(
-        &gains,
-        CASES[4].arrangement,
-        reference::HEIGHT,
-        out::HEIGHT,
-        1 << 14,
-    );
     let flown = fly_flight_code(
         &loops,
         &trim,
@@ -137,20 +138,13 @@ fn the_predicted_steps_are_what_the_flight_code_flies_on_the_same_model() {
         out::HEIGHT,
         n,
     );
-    let diff = largest_difference(&flown, &after(&predicted, 2.0));
+    let diff = largest_difference(&flown, &predicted(&CASES[4], 2.0));
     assert!(
         diff < 0.02,
         "height differs by up to {diff} m of a 2 m step"
     );
     // A 5 deg course step: course PI, roll loop, yaw damper's washout, dutch roll.
     let step = 5f64.to_radians();
-    let predicted = loops.step(
-        &gains,
-        CASES[1].arrangement,
-        reference::COURSE,
-        out::COURSE,
-        1 << 14,
-    );
     let flown = fly_flight_code(
         &loops,
         &trim,
@@ -166,7 +160,7 @@ fn the_predicted_steps_are_what_the_flight_code_flies_on_the_same_model() {
         out::COURSE,
         n,
     );
-    let diff = largest_difference(&flown, &after(&predicted, step));
+    let diff = largest_difference(&flown, &predicted(&CASES[1], step));
     assert!(
         diff < 0.01 * step,
         "course differs by up to {:.4} deg of a 5 deg step",

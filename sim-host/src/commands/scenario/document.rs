@@ -197,11 +197,9 @@ fn prediction_vs_flight(report: &ScenarioReport, aircraft: &Aircraft) -> String 
         return String::new();
     };
     let inputs = &d.inputs;
-    let Ok(model) = SampledLoops::at_level_trim(
-        aircraft,
-        inputs.sample_time_s,
-        inputs.delay_samples.round().max(0.0) as u32,
-    ) else {
+    let Ok(model) =
+        SampledLoops::at_level_trim(aircraft, inputs.sample_time_s, inputs.delay_periods())
+    else {
         return String::new();
     };
     // The tests feed the course loop the heading (the thesis's still-air assumption), so its
