@@ -385,8 +385,15 @@ fn ground_link_loss_returns_home_circles_and_the_pilot_resumes_the_mission() {
         "regained {:.2} s late",
         t_regained - t_back
     );
-    // Restarted: the mission goes on from the leg it left, and lands.
-    resumes_the_mission(&o, t_restart, before);
+    // Restarted: the mission goes on from the leg it left when the return began (the
+    // aircraft flies on for the failsafe's timeout after the last heartbeat, and may reach
+    // the leg's waypoint in it), and lands.
+    let left = o
+        .samples
+        .iter()
+        .rfind(|s| s.t < t_return)
+        .expect("samples before the return");
+    resumes_the_mission(&o, t_restart, left);
     lands_on_the_runway(&o, true);
 }
 

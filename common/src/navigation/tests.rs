@@ -481,9 +481,10 @@ fn loiter_time_and_to_altitude() {
     assert_eq!((last.current_seq, last.phase), (Some(2), Phase::Loiter));
 }
 
-/// A runway take-off heading east (param4 = 90 deg), no wind: rolls wings level at full
-/// throttle and pitch 0 below the rotation airspeed, then the take-off regime; reached at the
-/// item's altitude (less NAV_ALT_ACC), on the runway's line.
+/// A runway take-off heading east (param4 = 90 deg), no wind: rolls wings level at pitch 0
+/// below the rotation airspeed, the throttle opened from idle to full in `NAV_TKO_RAMP_S` (2 s:
+/// 0.5 after one second of the roll), then the take-off regime; reached at the item's altitude
+/// (less NAV_ALT_ACC), on the runway's line.
 #[test]
 fn runway_takeoff() {
     let items = [
@@ -504,19 +505,25 @@ fn runway_takeoff() {
     });
     assert_eq!(log.reached, [0]);
     let vr = nav.params().takeoff_vr;
-    let mut rolled = false;
+    let ramp = nav.params().takeoff_ramp;
+    assert_eq!(ramp, 2.0);
+    let mut rolled = 0;
     for (_, o, p) in &log.outs {
         let c = o.commands.unwrap();
         if o.phase == Phase::TakeoffRoll {
-            rolled = true;
+            rolled += 1;
+            let opened = (rolled as f32 * DT / ramp).min(1.0);
             assert_eq!(c.roll, RollMode::Roll(0.0));
-            assert_eq!(
-                c.lon,
-                LonMode::Pitch {
-                    pitch: 0.0,
-                    throttle: 1.0
+            match c.lon {
+                LonMode::Pitch { pitch, throttle } => {
+                    assert_eq!(pitch, 0.0);
+                    assert!(
+                        (throttle - opened).abs() < 1e-4,
+                        "throttle {throttle} after {rolled} steps, expected {opened}"
+                    );
                 }
-            );
+                other => panic!("take-off roll without a pitch command: {other:?}"),
+            }
             assert_eq!(-p.z, 0.0);
         } else {
             assert_eq!(o.phase, Phase::TakeoffClimb);
@@ -528,7 +535,10 @@ fn runway_takeoff() {
         }
         assert!(p.x.abs() < 0.5, "off the runway line by {}", p.x);
     }
-    assert!(rolled);
+    assert!(
+        rolled as f32 * DT > ramp,
+        "rolled {rolled} steps, shorter than the ramp"
+    );
     // Rotation at VR: the first climb step comes with the airspeed at or above it.
     let first_climb = log
         .outs
@@ -950,8 +960,9 @@ fn a_high_approach_comes_down_to_the_slope_without_diving() {
 
 /// A flare that has floated past the land point aims for a faster sink and may lower the
 /// nose below the flare's pitch: 15 m past at 1 m, `NAV_FLR_PAST_K` 0.05 asks for 0.75 m/s
-/// more sink than the schedule (up to 1 m/s), each m/s of it `NAV_FLR_K` (0.15 rad) less
-/// pitch, down to level at most; without it the pitch stays at or above `NAV_FLR_PTCH_DEG`.
+/// more sink than the schedule (up to 1 m/s), each m/s of it `NAV_FLR_K` (0.35 rad) less
+/// pitch, down to level at most; without it the pitch stays at or above the floor short of
+/// the point, `NAV_FLR_PTCH_DEG` times (1 - 1 m / `NAV_FLR_ALT`).
 #[test]
 fn a_flare_past_the_point_pitches_down_for_the_runway() {
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
@@ -973,23 +984,98 @@ fn a_flare_past_the_point_pitches_down_for_the_runway() {
         let out = nav.step(&items, &home(), &state, DT);
         assert_eq!(out.phase, Phase::Flare);
         match out.commands.map(|c| c.lon) {
-            Some(LonMode::Pitch { pitch, .. }) => (pitch, state.ground_speed(), *nav.params()),
+            Some(LonMode::Pitch { pitch, .. }) => (pitch, state, *nav.params()),
             other => panic!("flare without a pitch command: {other:?}"),
         }
     };
-    let (plain, v, p) = pitch_past(0.0);
+    let (plain, state, p) = pitch_past(0.0);
     let (steered, _, _) = pitch_past(0.05);
-    assert!(plain >= p.flare_pitch, "{plain} below the flare pitch");
+    let sink = state.vel_ned.z;
     // The schedule at 1 m of the flare's height: from the slope's sink to the touchdown's.
-    let s_a = v * libm::tanf(p.glide_slope);
+    let s_a = state.ground_speed() * libm::tanf(p.glide_slope);
     let aim = p.flare_sink + (s_a - p.flare_sink) * (1.0 / p.flare_alt);
     let aim_past = (aim + 0.05 * 15.0).min(aim.max(1.0));
-    let expected = (plain - p.flare_k * (aim_past - aim)).max(0.0);
+    let law = |aim: f32, floor: f32| {
+        (p.flare_pitch + p.flare_k * (sink - aim)).clamp(floor, 15f32.to_radians())
+    };
+    let floor = p.flare_pitch * (1.0 - 1.0 / p.flare_alt);
+    for (got, expected, what) in [
+        (plain, law(aim, floor), "plain"),
+        (steered, law(aim_past, 0.0), "steered"),
+    ] {
+        assert!(
+            (got - expected).abs() < 0.05f32.to_radians(),
+            "{what} {} deg, expected {} deg",
+            got.to_degrees(),
+            expected.to_degrees()
+        );
+    }
+    assert!(steered < plain, "steered {steered} not below plain {plain}");
+}
+
+/// The flare's pitch at `h` m over the land point, `dist` m short of it (negative: past it),
+/// climbing at `climb` m/s, after the steps `before` (each a height and climb rate) flown in
+/// the flare first, on the default parameters.
+fn flare_pitch_at(
+    before: &[(f32, f32)],
+    h: f32,
+    climb: f32,
+    dist: f32,
+) -> (f32, NavState, NavParams) {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
+    nav.start_mission(0);
+    fly(&mut nav, &mut plane, &items, 120.0, |o| {
+        o.phase == Phase::Flare
+    });
+    let mut pitch = None;
+    for &(h, climb) in before.iter().chain(&[(h, climb)]) {
+        plane.k.pos = Vector3::new(dist, 0.0, -h);
+        plane.climb = climb;
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        assert_eq!(out.phase, Phase::Flare);
+        pitch = match out.commands.map(|c| c.lon) {
+            Some(LonMode::Pitch { pitch, .. }) => Some(pitch),
+            other => panic!("flare without a pitch command: {other:?}"),
+        };
+    }
+    (pitch.expect("a step"), plane.state(), *nav.params())
+}
+
+/// Lifted by an updraft short of the point, the flare lowers the nose to its floor, which
+/// widens from `NAV_FLR_PTCH_DEG` at the ground to level at the flare's top: at 1.2 m of the
+/// 1.5 m flare, climbing 0.5 m/s (far above the schedule's sink), the pitch is 3 deg times
+/// 0.2, 0.6 deg, where the flare's pitch held all the way up floated the aircraft on.
+#[test]
+fn a_flare_lifted_by_an_updraft_short_of_the_point_lowers_the_nose_towards_level() {
+    let (pitch, _, p) = flare_pitch_at(&[], 1.2, 0.5, 20.0);
+    let expected = p.flare_pitch * (1.0 - 1.2 / p.flare_alt);
     assert!(
-        steered < plain && (steered - expected).abs() < 0.05f32.to_radians(),
-        "steered {} deg, expected {} deg (plain {} deg)",
-        steered.to_degrees(),
-        expected.to_degrees(),
-        plain.to_degrees()
+        (pitch - expected).abs() < 0.01f32.to_radians(),
+        "{} deg, expected {} deg",
+        pitch.to_degrees(),
+        expected.to_degrees()
+    );
+}
+
+/// A rise near the ground reads as the wheels' kick and levels the pitch (a wheel landing);
+/// sinking again faster than 0.6 m/s shows the aircraft is still flying, and the flare's law
+/// takes over again: at 0.3 m sinking 1 m/s, `NAV_FLR_PTCH_DEG` plus `NAV_FLR_K` times the
+/// sink above the schedule's, well above level.
+#[test]
+fn a_flare_that_sinks_again_after_a_seeming_touch_pitches_up_again() {
+    let kicked = [(0.3, 0.5)];
+    let (level, _, _) = flare_pitch_at(&kicked[..0], 0.3, 0.5, 20.0);
+    assert!(level.abs() < 1e-6, "after the kick {level} rad, not level");
+    let (pitch, state, p) = flare_pitch_at(&kicked, 0.3, -1.0, 20.0);
+    let approach_sink = state.ground_speed() * libm::tanf(p.glide_slope);
+    let aim = p.flare_sink + (approach_sink - p.flare_sink) * (0.3 / p.flare_alt);
+    let expected = p.flare_pitch + p.flare_k * (1.0 - aim);
+    assert!(
+        (pitch - expected).abs() < 0.05f32.to_radians(),
+        "{} deg, expected {} deg",
+        pitch.to_degrees(),
+        expected.to_degrees()
     );
 }

@@ -7,9 +7,11 @@
 //! the wheels, not the slope, meet the ground at the point. Below the flare height the
 //! throttle is closed and the pitch follows a sink rate that shrinks with height (past the
 //! point a faster one, so that a gust's extra speed does not float the aircraft far down
-//! the runway); once the wheels have touched (low and rising again) the pitch goes to 0, as
-//! in a wheel landing, so the ground's kick on the main wheels does not bounce the aircraft
-//! back into the air; a second on the ground (height under `NAV_LND_TD_M`, sinking slower
+//! the runway; short of it a nose that may come down to level at the flare's top, so that
+//! an updraft there does not either); once the wheels have touched (low and rising again)
+//! the pitch goes to 0, as in a wheel landing, so the ground's kick on the main wheels does
+//! not bounce the aircraft back into the air, unless it sinks again (then it was an
+//! updraft, and the flare goes on); a second on the ground (height under `NAV_LND_TD_M`, sinking slower
 //! than 0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
 //! stopped.
 
@@ -49,6 +51,12 @@ const PAST_SINK_MAX: f32 = 1.0;
 /// Climb rate that, below the touchdown height, shows the wheels have touched and kicked the
 /// aircraft up, m/s.
 const BOUNCE_CLIMB: f32 = 0.3;
+/// Sink rate that, after a touch, shows the aircraft is still (or again) in the air and
+/// falling, m/s: the flare takes over again. An updraft half a metre up looks like the
+/// wheels' kick to an estimated height that is tenths of a metre off, and the wheel
+/// landing's level pitch then met the next downdraft at up to 2 m/s (2 of 200 light
+/// turbulence landings, `docs/NAVIGATION.md`).
+const REFLARE_SINK: f32 = 0.6;
 
 /// Pitch held on the roll-out once slow, rad: above the taildragger's three-point attitude
 /// (8.7 deg on the Ultra Stick), so the elevator holds the tail wheel down for steering, as a
@@ -206,6 +214,8 @@ impl Landing {
             // balloon the aircraft): from then on the flare's pitch-up is over.
             if hagl < p.touchdown_alt && sink < -BOUNCE_CLIMB {
                 self.touched = true;
+            } else if sink > REFLARE_SINK {
+                self.touched = false;
             }
             if on_ground && sink < TOUCHDOWN_SINK {
                 self.ground_time += dt;
@@ -252,13 +262,18 @@ impl Landing {
                 // up on the gentlest touchdown for a nearer one: a faster sink aimed for the
                 // farther past, up to `PAST_SINK_MAX`, and the nose may come down to level.
                 let past = -signed_to_go;
+                // Short of the point the nose is held no lower than the flare's pitch at the
+                // ground, level at the flare's top: a gust that lifts the aircraft there is
+                // flown down again at the glide's attitude rather than floated on (a floor
+                // of the touchdown pitch all the way up carried two of 200 landings 22-25 m
+                // long).
                 let (aim, floor) = if past > 0.0 && p.flare_past_k > 0.0 {
                     (
                         (aim + p.flare_past_k * past).min(PAST_SINK_MAX.max(aim)),
                         0.0,
                     )
                 } else {
-                    (aim, p.flare_pitch)
+                    (aim, p.flare_pitch * (1.0 - frac))
                 };
                 let sink = state.vel_ned.z;
                 let pitch = if self.touched {

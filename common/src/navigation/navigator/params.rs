@@ -129,6 +129,17 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_TKO_RAMP_S",
+                2.0,
+                0.0,
+                10.0,
+                "s",
+                "Take-off roll: the throttle rises from idle to full over this time (0: at once)",
+            ),
+            NavParams => takeoff_ramp
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_LND_SLP_DEG",
                 5.0,
                 1.0,
@@ -185,7 +196,7 @@ pub const PARAMS: Group<NavParams> = Group {
         param!(
             ParamDef::real(
                 "NAV_FLR_K",
-                0.15,
+                0.35,
                 0.0,
                 1.0,
                 "rad s/m",
@@ -333,6 +344,8 @@ pub struct NavParams {
     pub takeoff_airspeed: f32,
     /// Take-off regime clear height, m.
     pub takeoff_clear: f32,
+    /// `NAV_TKO_RAMP_S`: time of the take-off roll's throttle ramp, s.
+    pub takeoff_ramp: f32,
     /// Glide slope, rad.
     pub glide_slope: f32,
     /// Approach airspeed, m/s.
@@ -379,6 +392,7 @@ const ZERO: NavParams = NavParams {
     takeoff_vr: 0.0,
     takeoff_airspeed: 0.0,
     takeoff_clear: 0.0,
+    takeoff_ramp: 0.0,
     glide_slope: 0.0,
     land_airspeed: 0.0,
     flare_alt: 0.0,

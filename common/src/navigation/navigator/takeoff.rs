@@ -1,8 +1,9 @@
 //! Take-off: the runway roll, rotation and climb-out of a `NAV_TAKEOFF` item.
 //!
-//! Take-off is a runway take-off: full throttle, wings level, pitch 0 until the rotation
-//! airspeed, then the thesis's take-off regime (`LonMode::TakeOff`: fixed pitch, full
-//! throttle to the clear height, then climb) to the item's altitude. The runway is the line
+//! Take-off is a runway take-off: the throttle opened to full over `NAV_TKO_RAMP_S`, wings
+//! level, pitch 0 until the rotation airspeed, then the thesis's take-off regime
+//! (`LonMode::TakeOff`: fixed pitch, full throttle to the clear height, then climb) to the
+//! item's altitude. The runway is the line
 //! along the heading the aircraft stands on when the roll starts, as a pilot lines it up
 //! (`NAV_TKO_TO_ITEM` takes the line to the item's position instead): the tail wheel holds
 //! it until the wheels are off, and the bank allowed near the ground is small
@@ -32,6 +33,8 @@ pub(super) struct Takeoff {
     height: f32,
     /// Still on the runway, below the rotation airspeed.
     rolling: bool,
+    /// Time on the take-off roll so far, s.
+    roll_s: f32,
 }
 
 impl Takeoff {
@@ -60,6 +63,7 @@ impl Takeoff {
             course,
             height: items::height(item, home).unwrap_or(p.rtl_alt),
             rolling: state.airspeed.is_nan() || state.airspeed < p.takeoff_vr,
+            roll_s: 0.0,
         }
     }
 
@@ -90,12 +94,24 @@ impl Takeoff {
             let course = line
                 .map(|l| f.guidance.step(&l, &pos, vg).course)
                 .unwrap_or(self.course);
+            // The throttle is opened over `NAV_TKO_RAMP_S`, as a pilot opens it (PX4's
+            // RWTO_RAMP_TIME): the propeller's spin-up reacts on the airframe in roll, and
+            // opened at once from idle it rolled the aircraft 15 deg onto a wing tip before
+            // the ailerons had any air (34 of 1000 dispersed take-offs).
+            if f.dt.is_finite() && f.dt > 0.0 {
+                self.roll_s += f.dt;
+            }
+            let throttle = if p.takeoff_ramp > 0.0 {
+                (self.roll_s / p.takeoff_ramp).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
             out.commands = Some(Commands {
                 roll: RollMode::Roll(0.0),
                 yaw: f.steer(course),
                 lon: LonMode::Pitch {
                     pitch: 0.0,
-                    throttle: 1.0,
+                    throttle,
                 },
             });
         } else {
