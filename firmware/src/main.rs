@@ -4,7 +4,7 @@
 //! talks to the ground over UARTs; on the host (SITL) the same loop talks to `sim-host` and
 //! the ground station over sockets.
 //!
-//! - MCU: `cargo run -p firmware --release --target thumbv7em-none-eabihf` boots the image in
+//! - MCU: `cargo run --profile mcu -p firmware --target thumbv7em-none-eabihf` boots the image in
 //!   QEMU's `netduinoplus2` (STM32F405) through the runner in `.cargo/config.toml`; QEMU's
 //!   flags after `--` (`-serial tcp:127.0.0.1:4560,nodelay=on -serial udp:...`) put its UARTs
 //!   on a running `sim-host sim` and a ground station. `sim-host fly --link qemu` flies this

@@ -195,7 +195,7 @@ pub(crate) struct EnvArgs {
 #[derive(clap::Args)]
 pub(crate) struct McuArgs {
     /// The MCU image (ELF) for --link qemu; built by
-    /// `cargo build --release -p firmware --target thumbv7em-none-eabihf`.
+    /// `cargo build --profile mcu -p firmware --target thumbv7em-none-eabihf`.
     #[arg(long, value_name = "PATH", default_value_os_t = sim_host::link::qemu::default_elf())]
     pub(crate) elf: PathBuf,
     /// The QEMU that runs it (a name on the PATH or a path).

@@ -13,7 +13,7 @@ pub fn workspace_root() -> PathBuf {
         .unwrap_or_default()
 }
 
-/// Builds the MCU image (release, thumbv7em-none-eabihf) and returns the ELF's path.
+/// Builds the MCU image (profile `mcu`, thumbv7em-none-eabihf) and returns the ELF's path.
 ///
 /// It builds into `target/cross`, apart from the host build that runs the tests, so the two
 /// never wait on each other's lock. A fresh toolchain lacks the target; adding it is
@@ -24,24 +24,37 @@ pub fn build_mcu_firmware() -> PathBuf {
         .status();
     let dir = cargo_build(
         "cross",
-        &["-p", "firmware", "--target", "thumbv7em-none-eabihf"],
+        &[
+            "--profile",
+            "mcu",
+            "-p",
+            "firmware",
+            "--target",
+            "thumbv7em-none-eabihf",
+        ],
     );
-    dir.join("thumbv7em-none-eabihf/release/firmware")
+    dir.join("thumbv7em-none-eabihf/mcu/firmware")
 }
 
-/// `cargo build --release ARGS` into `target/DIR` (a target directory of its own, so that the
-/// build does not wait for the lock of the one running the tests); returns that directory.
+/// `cargo build ARGS` into `target/DIR` (a target directory of its own, so that the build does
+/// not wait for the lock of the one running the tests); returns that directory. The release
+/// profile unless ARGS name another.
 fn cargo_build(dir: &str, args: &[&str]) -> PathBuf {
     let target_dir = workspace_root().join("target").join(dir);
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
         .current_dir(workspace_root())
-        .args(["build", "--release"])
+        .arg("build")
+        .args(if args.contains(&"--profile") {
+            &[][..]
+        } else {
+            &["--release"][..]
+        })
         .args(args)
         .env("CARGO_TARGET_DIR", &target_dir)
         .status()
         .expect("cargo runs");
-    assert!(status.success(), "cargo build --release {args:?} failed");
+    assert!(status.success(), "cargo build {args:?} failed");
     target_dir
 }
 

@@ -380,7 +380,7 @@ fn a_qemu_that_dies_mid_flight_ends_it_at_once_naming_how_and_the_log_is_kept() 
 /// 160 KiB; statics and the stack's measured peak at most 48 KiB; per 20 ms control period at
 /// most 100,000 instructions on average and 150,000 at most, over the take-off and first legs.
 #[test]
-#[ignore = "not met yet (docs/PERFORMANCE.md, MCU image budget): measured 2026-12-03 flash 246,740 B, statics 2,140 B + stack peak 34,908 B (met), 155,903 to 188,937 instructions per control period on average and 311,018 to 336,327 at most over 60 s of runway and take-off (two runs, load average 3.9 to 5.6), 91,455 per period in cruise"]
+#[ignore = "not met yet (docs/PERFORMANCE.md, MCU image budget): measured 2026-12-03 (profile mcu) flash 172,368 B, statics 2,140 B + stack peak 38,292 B (met), 113,047 instructions per control period on average and 205,776 at most over 60 s of runway and take-off (load average 4.4), 94,840 per period in cruise"]
 fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
     let Some(qemu) = mcu() else { return };
     let dir = tempfile::tempdir().expect("tempdir");

@@ -321,17 +321,23 @@ impl Ins {
         let b = bias_sigma * bias_sigma;
         let initial = [t, t, INIT_YAW_SIGMA * INIT_YAW_SIGMA, b, b, b];
         let states = [ITH, ITH + 1, ITH + 2, IBG, IBG + 1, IBG + 2];
+        // Checked element access: the loop over the states is not unrolled in the size-optimised
+        // MCU image, so indexing would leave panic paths (tests/tests/panic_sites.rs).
         for (k, init) in states.into_iter().zip(initial) {
-            let d = if keep_larger {
-                self.cov[(k, k)].max(init)
-            } else {
-                init
+            let d = match self.cov.get((k, k)) {
+                Some(&v) if keep_larger => v.max(init),
+                _ => init,
             };
             for i in 0..N {
-                self.cov[(i, k)] = 0.0;
-                self.cov[(k, i)] = 0.0;
+                for ij in [(i, k), (k, i)] {
+                    if let Some(v) = self.cov.get_mut(ij) {
+                        *v = 0.0;
+                    }
+                }
             }
-            self.cov[(k, k)] = d;
+            if let Some(v) = self.cov.get_mut((k, k)) {
+                *v = d;
+            }
         }
     }
 
@@ -386,7 +392,10 @@ impl Ins {
     }
 
     /// Propagates the state and covariance over `dt` ending at time `t_us` (µs) with one IMU sample
-    /// (specific force `accel`, m/s^2, and rates `gyro`, rad/s, both body axes).
+    /// (specific force `accel`, m/s^2, and rates `gyro`, rad/s, both body axes). Not inlined:
+    /// the prediction stays a function of its own in the MCU image's profile (one call a
+    /// sensor frame).
+    #[inline(never)]
     pub fn predict(
         &mut self,
         t_us: u64,
@@ -576,29 +585,53 @@ type Gain = super::kalman::Gain<N>;
 /// not yet changed and no copy of the matrix is made. The caller's conditioning makes the
 /// result exactly symmetric.
 fn propagate(p: &mut Mat, blocks: &[(usize, usize, &Matrix3<f32>)]) {
-    // Checked element access: the block offsets are the filter's own constants, but the image
-    // carries no panic path for them (tests/tests/panic_sites.rs).
-    let at = |p: &Mat, r: usize, c: usize| p.get((r, c)).copied().unwrap_or(0.0);
+    // The columns of `p` as arrays, and the block offsets' ranges taken with `get`: the
+    // offsets are the filter's own constants, but the image carries no panic path for them
+    // (tests/tests/panic_sites.rs). Plain loops over arrays: as fast optimised for size as
+    // for speed (no unrolling needed to drop nalgebra's checked 2-D indexing).
+    let cols = &mut p.data.0;
     for &(row, col, b) in blocks.iter().rev() {
-        for c in 0..N {
-            let y = b * Vector3::new(at(p, col, c), at(p, col + 1, c), at(p, col + 2, c));
-            for (k, yk) in y.iter().enumerate() {
-                if let Some(v) = p.get_mut((row + k, c)) {
-                    *v += yk;
-                }
+        let bt = b.transpose();
+        for c in cols.iter_mut() {
+            let Some(&[x0, x1, x2]) = c.get(col..col + 3) else {
+                continue;
+            };
+            let y = mul3(&bt, [x0, x1, x2]);
+            if let Some([d0, d1, d2]) = c.get_mut(row..row + 3) {
+                *d0 += y[0];
+                *d1 += y[1];
+                *d2 += y[2];
             }
         }
     }
     for &(row, col, b) in blocks.iter().rev() {
+        let bt = b.transpose();
+        let Some(&[s0, s1, s2]) = cols.get(col..col + 3) else {
+            continue;
+        };
+        let Some([d0, d1, d2]) = cols.get_mut(row..row + 3) else {
+            continue;
+        };
         for r in 0..N {
-            let y = b * Vector3::new(at(p, r, col), at(p, r, col + 1), at(p, r, col + 2));
-            for (k, yk) in y.iter().enumerate() {
-                if let Some(v) = p.get_mut((r, row + k)) {
-                    *v += yk;
-                }
-            }
+            let y = mul3(&bt, [s0[r], s1[r], s2[r]]);
+            d0[r] += y[0];
+            d1[r] += y[1];
+            d2[r] += y[2];
         }
     }
+}
+
+/// `b x` given `bt`, the transpose of `b` (its rows as arrays), with nalgebra's order of
+/// operations for a 3x3 matrix times a vector (the columns of `b` weighted and accumulated
+/// left to right), so the result is the same to the bit.
+#[inline(always)]
+fn mul3(bt: &Matrix3<f32>, x: [f32; 3]) -> [f32; 3] {
+    let [r0, r1, r2] = &bt.data.0;
+    [
+        r0[0] * x[0] + r0[1] * x[1] + r0[2] * x[2],
+        r1[0] * x[0] + r1[1] * x[1] + r1[2] * x[2],
+        r2[0] * x[0] + r2[1] * x[1] + r2[2] * x[2],
+    ]
 }
 
 /// Heading from a magnetometer sample levelled with roll `phi` and pitch `theta`, against the
@@ -784,7 +817,27 @@ mod tests {
         }
         let dense = phi * p64 * phi.transpose();
         let mut got = p64.cast::<f32>();
+        // To the bit what nalgebra's 3x3 products of the same blocks give, in the same order
+        // (rows first, then columns, the blocks taken last first).
+        let mut by_blocks = got;
+        for &(row, col, b) in blocks.iter().rev() {
+            for c in 0..N {
+                let y = b * by_blocks.fixed_view::<3, 1>(col, c);
+                let mut d = by_blocks.fixed_view_mut::<3, 1>(row, c);
+                d += y;
+            }
+        }
+        for &(row, col, b) in blocks.iter().rev() {
+            for r in 0..N {
+                let y = b * by_blocks.fixed_view::<1, 3>(r, col).transpose();
+                let mut d = by_blocks.fixed_view_mut::<1, 3>(r, row);
+                d += y.transpose();
+            }
+        }
         propagate(&mut got, &blocks);
+        for (a, b) in got.iter().zip(by_blocks.iter()) {
+            assert_eq!(a.to_bits(), b.to_bits());
+        }
         assert!(condition(&mut got, 0.0, f32::INFINITY));
         for i in 0..N {
             for j in 0..N {

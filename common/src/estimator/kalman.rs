@@ -49,9 +49,12 @@ pub fn gain<const N: usize>(
     gate_sigma: f32,
 ) -> Result<Gain<N>, Refused> {
     let mut ph = SVector::<f32, N>::zeros();
-    for (j, &hj) in h.iter().enumerate() {
+    let [acc] = &mut ph.data.0;
+    for (col, &hj) in p.data.0.iter().zip(h.iter()) {
         if hj != 0.0 {
-            ph += p.column(j) * hj;
+            for (a, &x) in acc.iter_mut().zip(col) {
+                *a += x * hj;
+            }
         }
     }
     let s = h.dot(&ph) + r;
@@ -80,24 +83,49 @@ pub fn gain<const N: usize>(
 /// result would hold a non-finite entry.
 pub fn downdate<const N: usize>(p: &mut SMatrix<f32, N, N>, g: &Gain<N>) -> bool {
     let k = g.ph / g.s;
+    let ([k], [ph]) = (&k.data.0, &g.ph.data.0);
+    // `p` by columns: `p[(i, j)]` is `cols[j][i]`; the upper triangle is `i <= j`.
+    let cols = &mut p.data.0;
     // Checked before anything is written: no copy of `p` is needed to keep it on refusal.
-    let mut finite = true;
-    for j in 0..N {
-        for i in 0..=j {
-            finite &= (p[(i, j)] - k[i] * g.ph[j]).is_finite();
+    let mut finite = 0.0;
+    for (j, (col, &phj)) in cols.iter().zip(ph).enumerate() {
+        for (&pij, &ki) in col.iter().zip(k).take(j + 1) {
+            finite = finite_sum(finite, pij - ki * phj);
         }
     }
-    if !finite {
+    if finite != 0.0 {
         return false;
     }
-    for j in 0..N {
-        for i in 0..=j {
-            let v = p[(i, j)] - k[i] * g.ph[j];
-            p[(i, j)] = v;
-            p[(j, i)] = v;
+    for (j, (col, &phj)) in cols.iter_mut().zip(ph).enumerate() {
+        for (pij, &ki) in col.iter_mut().zip(k).take(j + 1) {
+            *pij -= ki * phj;
         }
     }
+    mirror_upper(cols);
     true
+}
+
+/// `sum` plus `x * 0`: zero while every `x` given is finite, NaN from the first that is not
+/// (`x * 0` is NaN for an infinity or a NaN, and a NaN stays). Two operations a value, no
+/// branch.
+#[inline(always)]
+fn finite_sum(sum: f32, x: f32) -> f32 {
+    sum + x * 0.0
+}
+
+/// Copies the upper triangle of the matrix whose columns are `cols` onto its lower one.
+#[inline(always)]
+fn mirror_upper<const N: usize>(cols: &mut [[f32; N]; N]) {
+    for j in 1..N {
+        let (left, right) = cols.split_at_mut(j);
+        if let Some(col) = right.first() {
+            for (left_col, &v) in left.iter_mut().zip(col) {
+                if let Some(lower) = left_col.get_mut(j) {
+                    *lower = v;
+                }
+            }
+        }
+    }
 }
 
 /// Fuses one scalar measurement: [`gain`] then [`downdate`]. Returns the correction to add to
@@ -119,9 +147,10 @@ pub fn scalar_update<const N: usize>(
 /// Keeps the diagonal of `p` between `min_var` and `max_var`: the conditioning of a
 /// covariance already exactly symmetric and finite (as [`downdate`] leaves it).
 pub fn clamp_diagonal<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) {
-    for i in 0..N {
-        let d = p[(i, i)];
-        p[(i, i)] = clamp(d, min_var, max_var);
+    for (j, col) in p.data.0.iter_mut().enumerate() {
+        if let Some(d) = col.get_mut(j) {
+            *d = clamp(*d, min_var, max_var);
+        }
     }
 }
 
@@ -131,18 +160,29 @@ pub fn clamp_diagonal<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, 
 /// Returns false when `p` holds a non-finite entry (the caller then resets the filter); `p`
 /// is then left as it was.
 pub fn condition<const N: usize>(p: &mut SMatrix<f32, N, N>, min_var: f32, max_var: f32) -> bool {
-    if !p.iter().all(|x| x.is_finite()) {
+    let cols = &mut p.data.0;
+    let finite = cols
+        .iter()
+        .flatten()
+        .fold(0.0, |sum, &x| finite_sum(sum, x));
+    if finite != 0.0 {
         return false;
     }
-    for j in 0..N {
-        for i in 0..j {
-            let v = 0.5 * (p[(i, j)] + p[(j, i)]);
-            p[(i, j)] = v;
-            p[(j, i)] = v;
+    // `p[(i, j)]` is `cols[j][i]`: each pair above and below the diagonal is met once, at its
+    // column `j` and row `i < j`.
+    for j in 1..N {
+        let (left, right) = cols.split_at_mut(j);
+        if let Some(col) = right.first_mut() {
+            for (left_col, upper) in left.iter_mut().zip(col.iter_mut()) {
+                if let Some(lower) = left_col.get_mut(j) {
+                    let v = 0.5 * (*upper + *lower);
+                    *upper = v;
+                    *lower = v;
+                }
+            }
         }
-        let d = p[(j, j)];
-        p[(j, j)] = clamp(d, min_var, max_var);
     }
+    clamp_diagonal(p, min_var, max_var);
     true
 }
 
@@ -180,6 +220,82 @@ mod tests {
         assert_eq!(p, Matrix2::identity());
         let mut bad = Matrix2::new(f32::NAN, 0.0, 0.0, 1.0);
         assert!(!condition(&mut bad, 1e-9, 1e9));
+    }
+
+    /// The indexed forms these functions had: the loops over columns must give the same
+    /// bits (the host's flights do not change with them).
+    fn reference(p: &mut SMatrix<f32, 13, 13>, h: &SVector<f32, 13>) -> bool {
+        let mut ph = SVector::<f32, 13>::zeros();
+        for (j, &hj) in h.iter().enumerate() {
+            if hj != 0.0 {
+                ph += p.column(j) * hj;
+            }
+        }
+        let s = h.dot(&ph) + 0.1;
+        let k = ph / s;
+        let mut finite = true;
+        for j in 0..13 {
+            for i in 0..=j {
+                finite &= (p[(i, j)] - k[i] * ph[j]).is_finite();
+            }
+        }
+        if !finite {
+            return false;
+        }
+        for j in 0..13 {
+            for i in 0..=j {
+                let v = p[(i, j)] - k[i] * ph[j];
+                p[(i, j)] = v;
+                p[(j, i)] = v;
+            }
+        }
+        true
+    }
+
+    #[test]
+    fn the_column_loops_equal_the_indexed_forms_to_the_bit() {
+        // Entries with every bit of the mantissa in use: sines of integers.
+        let entry = |k: usize| libm::sinf(k as f32);
+        for case in 0..40 {
+            let a = SMatrix::<f32, 13, 13>::from_fn(|i, j| entry(case * 997 + i * 13 + j));
+            // Not exactly symmetric, as the prediction leaves it before conditioning.
+            let skew =
+                SMatrix::<f32, 13, 13>::from_fn(|i, j| entry(case * 991 + i * 17 + j) * 1e-3);
+            let p0 = a * a.transpose() + skew;
+            let mut h = SVector::<f32, 13>::zeros();
+            for j in 0..13 {
+                if (j + case) % 4 == 0 {
+                    h[j] = entry(case * 89 + j);
+                }
+            }
+            let mut want = p0;
+            if case == 7 {
+                want[(2, 5)] = f32::INFINITY;
+            }
+            let mut got = want;
+            let kept = reference(&mut want, &h);
+            let g = gain(&got, &h, 0.3, 0.1, f32::INFINITY);
+            let done = g.map(|g| downdate(&mut got, &g));
+            assert_eq!(done.is_ok_and(|d| d), kept, "{case}");
+            for (x, y) in got.iter().zip(want.iter()) {
+                assert_eq!(x.to_bits(), y.to_bits(), "{case}");
+            }
+            // The conditioning, against its indexed form.
+            let mut want = p0;
+            for j in 0..13 {
+                for i in 0..j {
+                    let v = 0.5 * (want[(i, j)] + want[(j, i)]);
+                    want[(i, j)] = v;
+                    want[(j, i)] = v;
+                }
+                want[(j, j)] = clamp(want[(j, j)], 0.05, 2.0);
+            }
+            let mut got = p0;
+            assert!(condition(&mut got, 0.05, 2.0));
+            for (x, y) in got.iter().zip(want.iter()) {
+                assert_eq!(x.to_bits(), y.to_bits(), "{case}");
+            }
+        }
     }
 
     #[test]

@@ -167,7 +167,14 @@ impl Signing {
                     if let Some(i) = (0..self.streams.len())
                         .min_by_key(|&i| self.streams.get(i).map_or(0, |t| t.timestamp))
                     {
-                        self.streams.swap_remove(i);
+                        // `swap_remove` without its panic path (heapless's bounds assertion,
+                        // inlined here in the size-optimised MCU image): the last stream
+                        // takes the place of the one removed.
+                        if let Some(last) = self.streams.pop() {
+                            if let Some(slot) = self.streams.get_mut(i) {
+                                *slot = last;
+                            }
+                        }
                     }
                 }
                 let _ = self.streams.push(Stream {

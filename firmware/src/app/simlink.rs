@@ -49,6 +49,12 @@ pub struct SimLinkHealth {
 /// The simulator link with its framing and counters.
 pub struct SimPort {
     parser: FrameParser<Autopilot>,
+    answers: Answers,
+}
+
+/// What the frames' handling needs besides the parser: borrowed apart from it, so the parser
+/// is not moved out of the port and back for every chunk of bytes (two copies of its buffer).
+struct Answers {
     tx: Sender<Autopilot>,
     health: SimLinkHealth,
 }
@@ -66,14 +72,16 @@ impl SimPort {
     pub fn new() -> Self {
         Self {
             parser: FrameParser::autopilot(),
-            tx: Sender::autopilot(SYSTEM_ID, COMPONENT_ID),
-            health: SimLinkHealth::default(),
+            answers: Answers {
+                tx: Sender::autopilot(SYSTEM_ID, COMPONENT_ID),
+                health: SimLinkHealth::default(),
+            },
         }
     }
 
     /// Counters of the frames received (the vehicle's stale-frame count filled in by the app).
     pub fn health(&self) -> SimLinkHealth {
-        self.health
+        self.answers.health
     }
 
     /// Framing counters.
@@ -84,7 +92,8 @@ impl SimPort {
     /// Encodes a message from the autopilot on this link (nothing for a message outside the
     /// autopilot's dialect).
     pub fn encode(&mut self, msg: &MavMessage) -> heapless::Vec<u8, 280> {
-        self.tx
+        self.answers
+            .tx
             .try_encode(msg)
             .and_then(|raw| heapless::Vec::from_slice(raw.raw_bytes()).ok())
             .unwrap_or_default()
@@ -98,11 +107,14 @@ impl SimPort {
         ground: &mut GroundPort,
         out: &mut impl FnMut(&[u8]),
     ) {
-        let mut parser = core::mem::take(&mut self.parser);
-        parser.push(bytes, |frame| self.on_frame(&frame, vehicle, ground, out));
-        self.parser = parser;
+        let answers = &mut self.answers;
+        self.parser.push(bytes, |frame| {
+            answers.on_frame(&frame, vehicle, ground, out)
+        });
     }
+}
 
+impl Answers {
     fn on_frame(
         &mut self,
         frame: &Frame,

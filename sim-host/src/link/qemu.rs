@@ -1,7 +1,7 @@
 //! The MCU image on QEMU's emulated STM32F405 (machine `netduinoplus2`): processor in the loop.
 //!
-//! QEMU runs the release image of `firmware` for `thumbv7em-none-eabihf` under `-icount`
-//! (every instruction advances the virtual clock by the same step, so the image runs the same
+//! QEMU runs the MCU image (`firmware` for `thumbv7em-none-eabihf`, profile `mcu`) under
+//! `-icount` (every instruction advances the virtual clock by the same step, so the image runs the same
 //! way on every machine), with its two UARTs on sockets of this process:
 //!
 //! ```text
@@ -32,7 +32,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The command that builds the MCU image.
-pub const BUILD_COMMAND: &str = "cargo build --release -p firmware --target thumbv7em-none-eabihf";
+pub const BUILD_COMMAND: &str =
+    "cargo build --profile mcu -p firmware --target thumbv7em-none-eabihf";
 
 /// The QEMU that runs the image when none is named.
 pub const DEFAULT_QEMU: &str = "qemu-system-arm";
@@ -92,7 +93,7 @@ pub fn default_elf() -> PathBuf {
                 .unwrap_or(Path::new("."))
                 .join("target")
         });
-    target.join("thumbv7em-none-eabihf/release/firmware")
+    target.join("thumbv7em-none-eabihf/mcu/firmware")
 }
 
 /// Why the MCU image could not be run.

@@ -91,10 +91,14 @@ impl Ins {
         if !self.nav_ok {
             return out;
         }
+        // Checked element access (a loop the size-optimised MCU image does not unroll: no
+        // panic path for its indices, tests/tests/panic_sites.rs).
         for (i, z) in [(0, vn), (1, ve)] {
             let mut h = Vecn::zeros();
-            h[IV + i] = 1.0;
-            let innov = z - self.v[i];
+            if let Some(hi) = h.get_mut(IV + i) {
+                *hi = 1.0;
+            }
+            let innov = z - self.v.get(i).copied().unwrap_or(f32::NAN);
             self.fuse_scalar(&h, innov, noise * noise, f32::INFINITY, t_us, &mut out);
         }
         self.flush_shift();
