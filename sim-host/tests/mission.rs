@@ -48,6 +48,31 @@ fn on_target(m: &MissionSummary) -> bool {
 fn the_default_mission_flies_from_runway_to_runway_in_calm_air() {
     let o = fly_default([0.0; 3], Turbulence::None, 1);
     let m = flown_as_planned(&o);
+    // Disarmed after the landing, the surfaces rest where they rested before arming (trim)
+    // from the next 20 ms control period on, even while the aircraft still rolls.
+    let rest = o.samples.first().expect("samples");
+    let armed = o.samples.iter().position(|s| s.armed).expect("armed");
+    let disarmed = armed
+        + o.samples[armed..]
+            .iter()
+            .position(|s| !s.armed)
+            .expect("disarmed after the flight");
+    let t_disarmed = o.samples[disarmed].t;
+    for s in o.samples[disarmed..]
+        .iter()
+        .filter(|s| s.t >= t_disarmed + 0.02 - 1e-6)
+    {
+        let off = [
+            s.elevator - rest.elevator,
+            s.aileron - rest.aileron,
+            s.rudder - rest.rudder,
+        ];
+        assert!(
+            off.iter().all(|d| d.abs() < 1e-3),
+            "surfaces {off:?} rad from rest at {:.2} s",
+            s.t
+        );
+    }
     assert!(on_target(&m), "touchdown {:?}", m.touchdown);
     assert!(m.xtrack_rms_m < 0.5, "cross-track {:.2} m", m.xtrack_rms_m);
     assert!(m.alt_rms_m < 1.5, "altitude {:.2} m", m.alt_rms_m);

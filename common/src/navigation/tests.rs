@@ -1079,3 +1079,44 @@ fn a_flare_that_sinks_again_after_a_seeming_touch_pitches_up_again() {
         expected.to_degrees()
     );
 }
+
+/// A landed aircraft that keeps rolling (sailing along the runway before a crosswind, its tail
+/// wheel a keel) is disarmed `NAV_LND_DISARM_S` (30 s) after the touchdown once its airspeed
+/// is under 10 m/s, where it cannot fly off with its surfaces at rest; faster through the air,
+/// it stays armed and steered; slower than 3 m/s over ground it is disarmed at once.
+#[test]
+fn a_landed_aircraft_still_rolling_is_disarmed_after_the_roll_out_time_when_it_cannot_fly() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let landed_after = |speed: f32, seconds: f32| {
+        let mut nav = navigator();
+        let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
+        nav.start_mission(0);
+        fly(&mut nav, &mut plane, &items, 200.0, |o| {
+            o.phase == Phase::Landed
+        });
+        // Rolling on along the runway at `speed` over ground and through the air.
+        plane.k.pos.z = 0.0;
+        plane.climb = 0.0;
+        plane.k.airspeed = speed;
+        let mut landed = false;
+        let steps = (seconds / DT).round() as usize;
+        for _ in 0..steps {
+            let out = nav.step(&items, &home(), &plane.state(), DT);
+            assert_eq!(out.phase, Phase::Landed);
+            landed = out.landed;
+        }
+        (landed, nav.params().land_disarm_s)
+    };
+    let (early, limit) = landed_after(8.0, 29.0);
+    assert_eq!(limit, 30.0);
+    assert!(!early, "disarmed 29 s after the touchdown at 8 m/s");
+    assert!(
+        landed_after(8.0, 31.0).0,
+        "still armed 31 s after it at 8 m/s"
+    );
+    assert!(
+        !landed_after(12.0, 31.0).0,
+        "disarmed at 12 m/s of airspeed"
+    );
+    assert!(landed_after(2.5, 0.1).0, "armed at a walking pace");
+}

@@ -484,6 +484,12 @@ impl Commander {
         if let (Reaction::WingsLevel, Some(alt)) = (self.reaction, self.wings_level) {
             return (Demand::Commands(hold(alt)), None);
         }
+        // Disarmed after a landing, the surfaces rest at trim even while the aircraft still
+        // rolls: the roll-out's steering and tail-down pitch, run on with no one to stop them,
+        // drove the rudder and elevator to their stops and hopped the aircraft into the air.
+        if !self.armed && self.nav.phase == Phase::Landed && flown.needs_navigator() {
+            return (Demand::Surfaces(idle), None);
+        }
         if flown.needs_navigator() {
             let (commands, home) = self.navigate(flown, dt, e, plan);
             // No home yet (refused before, so only after a reset): hold what we have.

@@ -41,6 +41,12 @@ const ROLLING_SPEED: f32 = 5.0;
 /// landed fixed wing under 5 m/s).
 const STOPPED_SPEED: f32 = 3.0;
 
+/// Airspeed under which a landed aircraft still rolling may be disarmed, m/s: at 10 m/s the
+/// three-point attitude's C_L of about 0.9 lifts 17 N of the 19 N weight, so the aircraft
+/// cannot fly off with its surfaces at rest. Disarmed at 14.6 m/s, it rotated past the
+/// three-point attitude and hopped a metre into the air.
+const DISARM_AIRSPEED: f32 = 10.0;
+
 /// Time on the ground that makes a touchdown, s.
 const TOUCHDOWN_S: f32 = 1.0;
 /// Sink rate under which the aircraft counts as on the ground, m/s.
@@ -100,6 +106,8 @@ pub(super) struct Landing {
     /// is held at 0 (a taildragger's main wheels, ahead of the centre of gravity, pitch it up
     /// as they touch; holding the flare's attitude there lifts it off again).
     touched: bool,
+    /// Time since the touchdown, s.
+    rollout_s: f32,
 }
 
 /// How far past the point where the glide slope meets the flare height the flare carries
@@ -134,6 +142,7 @@ impl Landing {
             ground_time: 0.0,
             slope_trim: 0.0,
             touched: false,
+            rollout_s: 0.0,
         }
     }
 
@@ -302,7 +311,15 @@ impl Landing {
             }
             LandPhase::Landed => {
                 out.phase = Phase::Landed;
-                out.landed = state.ground_speed() < STOPPED_SPEED;
+                // Slow enough to be left to itself, or rolling for longer than any roll-out
+                // that slows down takes (ArduPilot's LAND_DISARMDELAY): in a strong crosswind
+                // the tail wheel steered against the drift is a keel, and the aircraft sails
+                // along the runway at 10 m/s for minutes; disarmed, it weathervanes and stops.
+                if dt.is_finite() && dt > 0.0 {
+                    self.rollout_s += dt;
+                }
+                out.landed = state.ground_speed() < STOPPED_SPEED
+                    || (self.rollout_s >= p.land_disarm_s && state.airspeed < DISARM_AIRSPEED);
                 out.commands = Some(Commands {
                     roll: RollMode::Roll(0.0),
                     yaw: f.steer(g.path_course),

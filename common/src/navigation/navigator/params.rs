@@ -228,6 +228,17 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_LND_DISARM_S",
+                30.0,
+                5.0,
+                600.0,
+                "s",
+                "Landed: disarmed once slower than 3 m/s over ground, or this long after the touchdown",
+            ),
+            NavParams => land_disarm_s
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_FLR_THR",
                 0.0,
                 0.0,
@@ -344,6 +355,8 @@ pub struct NavParams {
     pub takeoff_airspeed: f32,
     /// Take-off regime clear height, m.
     pub takeoff_clear: f32,
+    /// `NAV_LND_DISARM_S`: longest roll-out before the disarm, s.
+    pub land_disarm_s: f32,
     /// `NAV_TKO_RAMP_S`: time of the take-off roll's throttle ramp, s.
     pub takeoff_ramp: f32,
     /// Glide slope, rad.
@@ -393,6 +406,7 @@ const ZERO: NavParams = NavParams {
     takeoff_airspeed: 0.0,
     takeoff_clear: 0.0,
     takeoff_ramp: 0.0,
+    land_disarm_s: 0.0,
     glide_slope: 0.0,
     land_airspeed: 0.0,
     flare_alt: 0.0,
