@@ -958,6 +958,15 @@ fn a_high_approach_comes_down_to_the_slope_without_diving() {
     );
 }
 
+/// The landing `items` (one, on the point under home) flown by `nav` from 300 m north at
+/// 30 m until the navigator is in `phase`; the plane as it is then.
+fn land_here_until(nav: &mut Navigator, items: &[MissionItem], phase: Phase) -> Plane {
+    let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
+    nav.start_mission(0);
+    fly(nav, &mut plane, items, 200.0, |o| o.phase == phase);
+    plane
+}
+
 /// A flare that has floated past the land point aims for a faster sink and may lower the
 /// nose below the flare's pitch: 15 m past at 1 m, `NAV_FLR_PAST_K` 0.05 asks for 0.75 m/s
 /// more sink than the schedule (up to 1 m/s), each m/s of it `NAV_FLR_K` (0.35 rad) less
@@ -973,11 +982,7 @@ fn a_flare_past_the_point_pitches_down_for_the_runway() {
             .set(&mut p, "NAV_FLR_PAST_K", k)
             .expect("in range");
         nav.set_params(&p);
-        let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
-        nav.start_mission(0);
-        fly(&mut nav, &mut plane, &items, 120.0, |o| {
-            o.phase == Phase::Flare
-        });
+        let mut plane = land_here_until(&mut nav, &items, Phase::Flare);
         // Floated on: 15 m past the point, 1 m up, sinking as the flare left it.
         plane.k.pos = Vector3::new(-15.0, 0.0, -1.0);
         let state = plane.state();
@@ -1024,11 +1029,7 @@ fn flare_pitch_at(
 ) -> (f32, NavState, NavParams) {
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
     let mut nav = navigator();
-    let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
-    nav.start_mission(0);
-    fly(&mut nav, &mut plane, &items, 120.0, |o| {
-        o.phase == Phase::Flare
-    });
+    let mut plane = land_here_until(&mut nav, &items, Phase::Flare);
     let mut pitch = None;
     for &(h, climb) in before.iter().chain(&[(h, climb)]) {
         plane.k.pos = Vector3::new(dist, 0.0, -h);
@@ -1089,11 +1090,7 @@ fn a_landed_aircraft_still_rolling_is_disarmed_after_the_roll_out_time_when_it_c
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
     let landed_after = |speed: f32, seconds: f32| {
         let mut nav = navigator();
-        let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
-        nav.start_mission(0);
-        fly(&mut nav, &mut plane, &items, 200.0, |o| {
-            o.phase == Phase::Landed
-        });
+        let mut plane = land_here_until(&mut nav, &items, Phase::Landed);
         // Rolling on along the runway at `speed` over ground and through the air.
         plane.k.pos.z = 0.0;
         plane.climb = 0.0;

@@ -250,15 +250,17 @@ pub struct TouchdownSummary {
 /// navigator's default acceptance radius, `NAV_ACC_RAD`).
 const ORBIT_ARRIVAL_M: f64 = 15.0;
 
-/// Share of the time the throttle sits on a stop (within 1 % of 0 or 1: the flight defaults'
-/// THR_MIN and THR_MAX), %; NaN without samples.
+/// Share of the time the throttle sits on a stop (within 0.01 of the flight defaults'
+/// `THR_MIN` or `THR_MAX`), %; NaN without samples.
 pub fn share_on_stop_pct(throttle: &[f64]) -> f64 {
     if throttle.is_empty() {
         return f64::NAN;
     }
+    let g = &common::control::longitudinal::FLIGHT;
+    let (lo, hi) = (f64::from(g.throttle_min), f64::from(g.throttle_max));
     let on = throttle
         .iter()
-        .filter(|t| **t <= 0.01 || **t >= 0.99)
+        .filter(|t| **t <= lo + 0.01 || **t >= hi - 0.01)
         .count();
     100.0 * on as f64 / throttle.len() as f64
 }

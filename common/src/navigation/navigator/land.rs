@@ -315,9 +315,7 @@ impl Landing {
                 // that slows down takes (ArduPilot's LAND_DISARMDELAY): in a strong crosswind
                 // the tail wheel steered against the drift is a keel, and the aircraft sails
                 // along the runway at 10 m/s for minutes; disarmed, it weathervanes and stops.
-                if dt.is_finite() && dt > 0.0 {
-                    self.rollout_s += dt;
-                }
+                self.rollout_s += dt;
                 out.landed = state.ground_speed() < STOPPED_SPEED
                     || (self.rollout_s >= p.land_disarm_s && state.airspeed < DISARM_AIRSPEED);
                 out.commands = Some(Commands {

@@ -98,9 +98,7 @@ impl Takeoff {
             // RWTO_RAMP_TIME): the propeller's spin-up reacts on the airframe in roll, and
             // opened at once from idle it rolled the aircraft 15 deg onto a wing tip before
             // the ailerons had any air (34 of 1000 dispersed take-offs).
-            if f.dt.is_finite() && f.dt > 0.0 {
-                self.roll_s += f.dt;
-            }
+            self.roll_s += f.dt;
             let throttle = if p.takeoff_ramp > 0.0 {
                 (self.roll_s / p.takeoff_ramp).clamp(0.0, 1.0)
             } else {

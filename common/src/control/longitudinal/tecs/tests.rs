@@ -15,6 +15,16 @@ fn steady(t: &TecsGains, h: f32, v: f32) -> Tecs {
     tecs
 }
 
+/// [`steady`], then ten seconds holding `h`, `v`: the engagement's offset has faded.
+fn settled(t: &TecsGains, h: f32, v: f32) -> Tecs {
+    let mut tecs = steady(t, h, v);
+    for _ in 0..500 {
+        tecs.observe(h, v, DT);
+        tecs.step(&demand(h, v), &FLIGHT, DT);
+    }
+    tecs
+}
+
 fn demand(altitude: f32, airspeed: f32) -> TecsDemand {
     TecsDemand {
         altitude,
@@ -46,12 +56,7 @@ const ENGAGED_FOR_TEST: TecsGains = gains::ENGAGED;
 #[test]
 fn a_climb_demand_raises_throttle_by_the_energy_rate_over_a_v2() {
     let t = ENGAGED_FOR_TEST;
-    let mut tecs = steady(&t, 100.0, 17.0);
-    // The engagement's offset has faded.
-    for _ in 0..500 {
-        tecs.observe(100.0, 17.0, DT);
-        tecs.step(&demand(100.0, 17.0), &FLIGHT, DT);
-    }
+    let mut tecs = settled(&t, 100.0, 17.0);
     tecs.observe(100.0, 17.0, DT);
     let glide = TecsDemand {
         climb_rate: 1.0,
@@ -75,12 +80,7 @@ fn a_climb_demand_raises_throttle_by_the_energy_rate_over_a_v2() {
 #[test]
 fn a_far_climb_is_rate_limited_and_the_throttle_integrator_does_not_wind_up() {
     let t = ENGAGED_FOR_TEST;
-    let mut tecs = steady(&t, 100.0, 17.0);
-    // The engagement's offset fades first.
-    for _ in 0..500 {
-        tecs.observe(100.0, 17.0, DT);
-        tecs.step(&demand(100.0, 17.0), &FLIGHT, DT);
-    }
+    let mut tecs = settled(&t, 100.0, 17.0);
     let mut o = TecsOutput::default();
     // Ten seconds asking for +300 m while the aircraft does not move.
     for _ in 0..500 {
