@@ -6,7 +6,7 @@ use super::record::{Figures, FlightRecord};
 use super::run::CampaignMeta;
 use super::stats::{quantile, spearman, wilson, Z95};
 use super::verdict::Criterion;
-use crate::report::sig;
+use crate::report::{sig, sig_or_dash};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -377,10 +377,6 @@ pub struct Images {
     pub sensitivity: String,
 }
 
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or("-".into(), |v| sig(v, digits))
-}
-
 fn pct(x: f64) -> String {
     format!("{:.1} %", 100.0 * x)
 }
@@ -418,11 +414,11 @@ fn brief_table(md: &mut String, flights: &[FlightBrief]) {
             f.index,
             f.cause.as_deref().unwrap_or("-"),
             sig(f.margin, 3),
-            opt(f.touchdown_m, 3),
-            opt(f.sink_mps, 3),
-            opt(f.max_bank_deg, 3),
-            opt(f.headwind_mps, 2),
-            opt(f.crosswind_mps, 2),
+            sig_or_dash(f.touchdown_m, 3),
+            sig_or_dash(f.sink_mps, 3),
+            sig_or_dash(f.max_bank_deg, 3),
+            sig_or_dash(f.headwind_mps, 2),
+            sig_or_dash(f.crosswind_mps, 2),
             f.reproduce
         );
     }
@@ -485,11 +481,11 @@ pub fn markdown(r: &Report, images: &Images) -> String {
             "| {} | {} | {} | {} | {} | {} | {} |",
             f.label,
             f.n,
-            opt(f.min, 3),
-            opt(f.p05, 3),
-            opt(f.median, 3),
-            opt(f.p95, 3),
-            opt(f.max, 3)
+            sig_or_dash(f.min, 3),
+            sig_or_dash(f.p05, 3),
+            sig_or_dash(f.median, 3),
+            sig_or_dash(f.p95, 3),
+            sig_or_dash(f.max, 3)
         );
     }
     let _ = writeln!(

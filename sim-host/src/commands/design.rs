@@ -6,8 +6,8 @@ use crate::aircraft::Aircraft;
 use crate::analysis::design::inputs::DesignInputs;
 use crate::analysis::design::{describe_poles, design, Design};
 use crate::analysis::sampled::{scaled_at, SampledLoop, SampledLoops};
-use crate::report::sig;
 use crate::report::table::Table;
+use crate::report::{sig, sig_or_dash};
 use common::control::gains::GainSet;
 use serde::Serialize;
 
@@ -30,10 +30,6 @@ pub struct DesignReport {
     /// Tables printed.
     #[serde(skip)]
     pub tables: Vec<Table>,
-}
-
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or_else(|| "-".into(), |v| sig(v, digits))
 }
 
 /// Designs the loops and tabulates them.
@@ -111,7 +107,7 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
         sig(a.wn_phi, 4),
         sig(a.roll_kp, 5),
         sig(a.roll_kd, 4),
-        opt(a.phase_margin_deg, 3),
+        sig_or_dash(a.phase_margin_deg, 3),
     ]);
 
     let mut gains = Table::new(
@@ -159,11 +155,11 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
             l.name.clone(),
             sig(l.wn_radps, 3),
             poles,
-            opt(l.rise_time_s, 3),
+            sig_or_dash(l.rise_time_s, 3),
             sig(l.overshoot_pct, 3),
-            opt(l.settling_time_s, 3),
-            opt(l.margins.gain_margin_db, 3),
-            opt(l.margins.phase_margin_deg, 3),
+            sig_or_dash(l.settling_time_s, 3),
+            sig_or_dash(l.margins.gain_margin_db, 3),
+            sig_or_dash(l.margins.phase_margin_deg, 3),
         ]);
     }
     let inputs = &d.inputs;
@@ -267,10 +263,10 @@ fn scaling_report(
             t.row([
                 p.name.to_string(),
                 sig(*va, 3),
-                opt(p.margins.phase_margin_deg, 3),
-                opt(s.margins.phase_margin_deg, 3),
-                opt(p.margins.gain_margin_db, 3),
-                opt(s.margins.gain_margin_db, 3),
+                sig_or_dash(p.margins.phase_margin_deg, 3),
+                sig_or_dash(s.margins.phase_margin_deg, 3),
+                sig_or_dash(p.margins.gain_margin_db, 3),
+                sig_or_dash(s.margins.gain_margin_db, 3),
                 over(p),
                 over(s),
             ]);
@@ -302,15 +298,15 @@ const FIGURES: [&str; 6] = [
 /// A loop's figures on the sampled model, as the tables print them: margins, crossover, step.
 fn figures(s: &SampledLoop) -> [String; 6] {
     [
-        opt(s.margins.phase_margin_deg, 3),
-        opt(s.margins.gain_margin_db, 3),
-        opt(s.margins.gain_crossover_radps, 3),
-        opt(s.rise_time_s, 3),
+        sig_or_dash(s.margins.phase_margin_deg, 3),
+        sig_or_dash(s.margins.gain_margin_db, 3),
+        sig_or_dash(s.margins.gain_crossover_radps, 3),
+        sig_or_dash(s.rise_time_s, 3),
         if s.unstable {
             "unstable".into()
         } else {
             sig(s.overshoot_pct, 3)
         },
-        opt(s.settling_time_s, 3),
+        sig_or_dash(s.settling_time_s, 3),
     ]
 }

@@ -13,9 +13,10 @@ use crate::flight::config::FlightConfig;
 use crate::flight::missions::{default_mission, runway_mission};
 use crate::flight::record::Sample as FlightSample;
 use crate::flight::runner::FlightOutcome;
+use crate::flight::summary::rms;
 use crate::flight::summary::share_on_stop_pct;
 use crate::plant::params::ModelParams;
-use crate::report::sig;
+use crate::report::{sig, sig_or_dash};
 use crate::scenario::sim::{Run, SimConfig};
 use crate::scenario::{Axis, Scenario, AIRSPEED_MPS};
 use anyhow::Context;
@@ -109,14 +110,7 @@ fn turn_alt_rms(samples: &[FlightSample]) -> f64 {
         .filter(|x| x.armed && x.roll.abs() > 10f64.to_radians() && x.sp_alt.is_finite())
         .map(|x| x.alt - x.sp_alt)
         .collect();
-    if e.is_empty() {
-        return f64::NAN;
-    }
-    (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt()
-}
-
-fn opt(x: Option<f64>) -> String {
-    x.map_or("-".into(), |v| sig(v, 3))
+    rms(&e)
 }
 
 /// The section: every figure with the command that produces it (`command`). `seeds`: the
@@ -158,9 +152,9 @@ pub fn laws_markdown(aircraft: &Aircraft, command: &str, seeds: &[u64]) -> anyho
             let _ = writeln!(
                 md,
                 "| `{name}` | {law} | {} | {} | {} | {} {unit} | {} | {} |",
-                opt(row.rise_s),
+                sig_or_dash(row.rise_s, 3),
                 sig(row.overshoot_pct, 3),
-                opt(row.settling_s),
+                sig_or_dash(row.settling_s, 3),
                 sig(row.coupling, 3),
                 sig(row.travel_per_s, 3),
                 sig(row.on_stop_pct, 3),

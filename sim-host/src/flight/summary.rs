@@ -426,7 +426,8 @@ pub struct AutopilotRx {
     pub stale_frames: u32,
 }
 
-fn rms(v: &[f64]) -> f64 {
+/// Root mean square of `v`; NaN when empty.
+pub fn rms(v: &[f64]) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }

@@ -14,6 +14,11 @@ pub fn to_json<T: serde::Serialize>(value: &T) -> anyhow::Result<String> {
     Ok(serde_json::to_string_pretty(value)?)
 }
 
+/// [`sig`] of a figure that may be missing, `-` when it is.
+pub fn sig_or_dash(x: Option<f64>, digits: usize) -> String {
+    x.map_or_else(|| "-".into(), |v| sig(v, digits))
+}
+
 /// Formats `x` with `digits` significant digits (plain notation for ordinary magnitudes).
 pub fn sig(x: f64, digits: usize) -> String {
     if !x.is_finite() {

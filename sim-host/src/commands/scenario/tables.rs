@@ -4,14 +4,10 @@ use super::run::ScenarioResult;
 use crate::report::csv_out::write_csv;
 use crate::report::plot::{Figure, Panel, Series};
 use crate::report::table::Table;
-use crate::report::{sig, to_json};
+use crate::report::{sig, sig_or_dash, to_json};
 use crate::scenario::Axis;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or_else(|| "-".into(), |v| sig(v, digits))
-}
 
 /// The metrics table of one result.
 pub fn metrics_table(r: &ScenarioResult) -> Table {
@@ -50,9 +46,9 @@ pub fn metrics_table(r: &ScenarioResult) -> Table {
         };
         t.row([
             m.gains.clone(),
-            opt(m.rise_time_s, 3),
+            sig_or_dash(m.rise_time_s, 3),
             sig(m.overshoot_pct, 3),
-            opt(m.settling_time_s, 3),
+            sig_or_dash(m.settling_time_s, 3),
             sig(m.steady_state_error.abs(), 2),
             sig(peak, 3),
             sig(m.ripple_rms, 2),
