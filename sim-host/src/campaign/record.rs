@@ -60,6 +60,9 @@ pub struct Figures {
     pub touchdown_ground_speed_mps: Option<f64>,
     /// Bounces after the first contact.
     pub bounces: Option<f64>,
+    /// The wind lifted the aircraft off the runway for a second or more after the disarm
+    /// (not its landing: [`crate::flight::FlightSummary::lifted_after_disarm`]).
+    pub lifted_after_disarm: Option<bool>,
     /// Largest |bank| while armed, deg.
     pub max_bank_deg: Option<f64>,
     /// Largest |pitch| while armed, deg.
@@ -257,6 +260,7 @@ pub fn figures_and_facts(
         f.battery_left_pct = finite(b.final_remaining_pct);
     }
     if let Some(m) = &s.mission {
+        f.lifted_after_disarm = Some(s.lifted_after_disarm.is_some());
         f.flight_time_s = finite(m.flight_time_s);
         f.energy_wh = finite(m.energy_wh);
         f.items = Some(m.nav_items.len() as f64);

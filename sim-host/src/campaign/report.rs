@@ -173,6 +173,8 @@ pub struct Report {
     pub criteria: Vec<CriterionCount>,
     /// The failing flights by what went wrong first, most frequent first.
     pub causes: Vec<(String, u64)>,
+    /// Flights the wind lifted off the runway after the disarm (not their landing).
+    pub lifted_after_disarm: u64,
     /// Every figure's distribution.
     pub figures: Vec<FigureStats>,
     /// Every dispersed quantity against the outcome, strongest relation first.
@@ -354,6 +356,10 @@ impl Report {
             pass_rate_ci95: wilson(passed, flights, Z95),
             criteria,
             causes: causes(&records),
+            lifted_after_disarm: records
+                .iter()
+                .filter(|r| r.figures.lifted_after_disarm == Some(true))
+                .count() as u64,
             figures: FIGURES.iter().map(|d| figure_stats(&records, d)).collect(),
             sensitivity: sens,
             failing: records
@@ -470,6 +476,14 @@ pub fn markdown(r: &Report, images: &Images) -> String {
             let _ = writeln!(md, "| {c} | {n} |");
         }
     }
+    let _ = writeln!(
+        md,
+        "\nA flight's touchdown is the first contact of the last landing it flew armed. After \
+         the disarm the aircraft is the ground crew's: the wind lifted {} of the {} aircraft \
+         left on the runway for a second or more (a gust over about 11 m/s at the three-point \
+         attitude), which is in each record (`lifted_after_disarm`) and not taken as its landing.",
+        r.lifted_after_disarm, r.flights
+    );
     let _ = writeln!(
         md,
         "\n## Figures\n\nOver the flights that have each figure (a flight that never touched \

@@ -234,6 +234,15 @@ pub fn summary_tables(r: &FlightOutcome) -> Vec<Table> {
             ),
         ]);
     }
+    if let Some(td) = &s.lifted_after_disarm {
+        run.row([
+            "lifted after the disarm".to_string(),
+            format!(
+                "the wind lifted the aircraft off the runway; down again at {:.1} s, {:.1} m N {:.1} m E of home (not the landing)",
+                td.time_s, td.north_m, td.east_m
+            ),
+        ]);
+    }
     run.row([
         "wind, turbulence".to_string(),
         format!(

@@ -19,7 +19,7 @@ use crate::plant::inputs::{Controls, Environment};
 use crate::plant::params::ModelParams;
 use crate::plant::propulsion::motor_power_w;
 use crate::plant::servo::ServoBank;
-use crate::plant::Plant;
+use crate::plant::{Plant, Touchdown};
 use crate::sensors::models::{SensorSuite, Truth};
 use common::link::simlink::{
     encode_battery_status, encode_hil_gps, encode_hil_sensor, encode_rc_channels,
@@ -236,6 +236,10 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     let start = Instant::now();
     let mut samples = Vec::with_capacity(frames.min(1 << 20) as usize + 1);
     let mut armed_frames = 0u64;
+    // The landing the autopilot flew: the plant's touchdown as it stood at the last armed
+    // frame. Once disarmed the aircraft is the ground crew's (a light model left on the runway
+    // in gusts lifts off at its three-point attitude; see `FlightSummary::lifted_after_disarm`).
+    let mut armed_touchdown = None;
     let mut energy_j = 0.0;
     let mut ended = Ending::Duration;
     let mut failure = None;
@@ -353,6 +357,9 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             let shaft_w = motor_power_w(&params, seen.throttle);
             battery.step(battery.electrical_power_w(shaft_w), dt);
         }
+        if answer.armed {
+            armed_touchdown = plant.touchdown().copied();
+        }
         let q = plant.attitude();
         env.wind_ned = wind.step(frame_s, plant.air_data().va, -plant.position_ned().z, &q);
 
@@ -408,7 +415,10 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             )
         })
         .filter(|_| gcs.is_some());
-    summary.touchdown = plant.touchdown().map(|t| touchdown_summary(t, land_point));
+    let (landing, lifted) =
+        landing_and_lift(armed_frames, armed_touchdown.as_ref(), plant.touchdown());
+    summary.touchdown = landing.map(|t| touchdown_summary(t, land_point));
+    summary.lifted_after_disarm = lifted.map(|t| touchdown_summary(t, land_point));
     if let Some(g) = gcs.as_ref().filter(|_| !cfg.script.mission.is_empty()) {
         let reached: Vec<u16> = g.reached.iter().map(|r| r.1).collect();
         let mut m = mission_summary(
@@ -416,7 +426,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             land_point,
             &samples,
             &reached,
-            plant.touchdown(),
+            landing,
             energy_j,
             frame_s,
         );
@@ -488,5 +498,67 @@ fn truth_frame(time_us: u64, t: &Truth, plant: &Plant, alt_amsl: f64) -> HIL_STA
         xacc: mg(t.specific_force_body.x),
         yacc: mg(t.specific_force_body.y),
         zacc: mg(t.specific_force_body.z),
+    }
+}
+
+/// The landing the autopilot flew and, apart from it, a touchdown after the wind lifted the
+/// disarmed aircraft: from the plant's touchdown as it stood at the last armed frame
+/// (`armed`) and at the end (`last`). A flight never armed has only the last.
+fn landing_and_lift<'a>(
+    armed_frames: u64,
+    armed: Option<&'a Touchdown>,
+    last: Option<&'a Touchdown>,
+) -> (Option<&'a Touchdown>, Option<&'a Touchdown>) {
+    if armed_frames == 0 {
+        return (last, None);
+    }
+    // The same touchdown has only gained bounces since.
+    let lifted = last.filter(|t| armed.is_none_or(|a| a.time_s != t.time_s));
+    (armed, lifted)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    fn at(time_s: f64, bounces: u32) -> Touchdown {
+        Touchdown {
+            time_s,
+            pos_ned: Vector3::zeros(),
+            vel_ned: Vector3::new(12.0, 0.0, 0.5),
+            point: 0,
+            bounces,
+        }
+    }
+
+    #[test]
+    fn a_flight_never_armed_lands_where_it_last_touched_down() {
+        let last = at(30.0, 0);
+        assert_eq!(landing_and_lift(0, None, Some(&last)), (Some(&last), None));
+    }
+
+    #[test]
+    fn bounces_after_the_disarm_leave_the_landing_as_it_was_flown() {
+        let (armed, last) = (at(300.0, 2), at(300.0, 5));
+        assert_eq!(
+            landing_and_lift(1000, Some(&armed), Some(&last)),
+            (Some(&armed), None)
+        );
+    }
+
+    #[test]
+    fn a_lift_by_the_wind_after_the_disarm_is_not_the_landing() {
+        let (armed, last) = (at(300.0, 2), at(340.0, 0));
+        assert_eq!(
+            landing_and_lift(1000, Some(&armed), Some(&last)),
+            (Some(&armed), Some(&last))
+        );
+        // Disarmed in the air (a failsafe's stop): whatever came after is not a landing
+        // the autopilot flew.
+        assert_eq!(
+            landing_and_lift(1000, None, Some(&last)),
+            (None, Some(&last))
+        );
     }
 }

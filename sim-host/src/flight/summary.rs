@@ -145,9 +145,15 @@ pub struct FlightSummary {
     /// The autopilot's counters of what it received (`None`: an autopilot outside this
     /// process keeps them to itself).
     pub autopilot_rx: Option<AutopilotRx>,
-    /// The first contact of the last landing, wherever it was (a mission's figures measure
-    /// it from its landing point).
+    /// The first contact of the last landing flown armed (of the last landing, when the flight
+    /// was never armed), wherever it was (a mission's figures measure it from its landing
+    /// point).
     pub touchdown: Option<TouchdownSummary>,
+    /// The first contact after an airborne phase of at least a second that began once the
+    /// autopilot had disarmed: the wind lifted the aircraft left on the runway (its
+    /// three-point attitude's C_L of about 0.8 carries the weight from about 11 m/s of
+    /// airspeed). Not the autopilot's landing; reported so that it is seen.
+    pub lifted_after_disarm: Option<TouchdownSummary>,
     /// Mission and geofence uploads: what, when, the MISSION_ACK result.
     pub uploads: Vec<(String, f64, String)>,
     /// How the mission went, when one was uploaded.
@@ -614,6 +620,7 @@ pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts)
         uploads: f.gcs.map(|g| g.uploads.clone()).unwrap_or_default(),
         mission: None,
         touchdown: None,
+        lifted_after_disarm: None,
         battery: battery_summary(samples),
         frames: f.frames,
         armed_frames: f.armed_frames,
