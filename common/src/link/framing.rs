@@ -165,6 +165,35 @@ impl<D: Dialect> FrameParser<D> {
         self.buf.get(..self.len).unwrap_or(&[])
     }
 
+    /// Bytes still missing before the candidate frame held can be checked: those up to its
+    /// first three bytes (marker, length, flags), then those up to its whole length (no frame
+    /// is shorter than either). A reader that hands the parser bytes only once that many have arrived
+    /// calls it once or twice a frame instead of once a byte; the frames found, and when, are
+    /// the same, since a candidate is checked only once it is whole.
+    pub fn bytes_wanted(&self) -> usize {
+        let held = self.len;
+        if held < 3 {
+            return 3usize.saturating_sub(held);
+        }
+        let (Some(&stx), Some(&payload_len), Some(&flags)) =
+            (self.buf.first(), self.buf.get(1), self.buf.get(2))
+        else {
+            return 1;
+        };
+        let payload_len = usize::from(payload_len);
+        let total = if stx == STX_V2 {
+            let sig = if flags & V2_IFLAG_SIGNED != 0 {
+                V2_SIGNATURE
+            } else {
+                0
+            };
+            1 + V2_HEADER + payload_len + CHECKSUM + sig
+        } else {
+            1 + V1_HEADER + payload_len + CHECKSUM
+        };
+        total.saturating_sub(held).max(1)
+    }
+
     /// What the parser has counted so far.
     pub fn stats(&self) -> LinkStats {
         self.stats

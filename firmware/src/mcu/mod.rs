@@ -67,14 +67,26 @@ fn main() -> ! {
     );
     watchdog::start();
     sim.write(&firmware::app::heartbeat_frame(app));
-    let (mut sim_chunk, mut gcs_chunk) = ([0u8; 64], [0u8; 64]);
+    let (mut sim_chunk, mut gcs_chunk) = ([0u8; 128], [0u8; 64]);
     loop {
         // Fed on every pass, idle ones included: a pass that never returns starves it.
         watchdog::feed();
-        // Gather what has arrived on each UART, then hand it over in one piece.
-        let n = sim.read_into(&mut sim_chunk);
+        // Gather what has arrived on each UART, then hand it over in one piece; bytes are
+        // left in the ring until they can complete what the link's parser waits for (a frame's
+        // header, then the frame), so a frame costs one or two passes and not one per byte
+        // (bytes arrive one at a time on a UART). Neither ring fills meanwhile: a parser
+        // never waits for more than a frame (280 bytes), and a ring holds 512.
+        let n = if sim.received() >= app.sim_bytes_wanted() {
+            sim.read_into(&mut sim_chunk)
+        } else {
+            0
+        };
         let sim_bytes = sim_chunk.get(..n).filter(|b| !b.is_empty());
-        let n = gcs.read_into(&mut gcs_chunk);
+        let n = if gcs.received() >= app.gcs_bytes_wanted() {
+            gcs.read_into(&mut gcs_chunk)
+        } else {
+            0
+        };
         let gcs_bytes = gcs_chunk.get(..n).filter(|b| !b.is_empty());
         let idle = sim_bytes.is_none() && gcs_bytes.is_none();
         let t0 = budget::budget_work_start();
