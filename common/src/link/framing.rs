@@ -709,6 +709,70 @@ mod tests {
         );
     }
 
+    /// Frames found, each with the number of bytes that had arrived when it was, and the
+    /// counters: the parser handed every byte as it arrives, or, as the MCU's loop does, the
+    /// bytes waiting once there are `bytes_wanted` of them.
+    fn arrivals(bytes: &[u8], wait: bool) -> (Vec<(u8, usize)>, LinkStats, usize) {
+        let mut p = FrameParser::new();
+        let (mut found, mut waiting, mut calls) = (Vec::new(), Vec::new(), 0);
+        for (i, &b) in bytes.iter().enumerate() {
+            waiting.push(b);
+            if wait && waiting.len() < p.bytes_wanted() {
+                continue;
+            }
+            calls += 1;
+            p.push(&waiting, |f| found.push((f.header.sequence, i + 1)));
+            waiting.clear();
+        }
+        (found, p.stats(), calls)
+    }
+
+    #[test]
+    fn bytes_handed_over_once_the_parser_wants_them_give_the_same_frames_at_the_same_bytes() {
+        let mut s = Vec::new();
+        for i in 0..3 {
+            s.extend(heartbeat(i));
+        }
+        let frames_only = s.len();
+        s.extend(b"\x00garbage\x01\x02");
+        let mut bad = heartbeat(3);
+        let n = bad.len();
+        bad[n - 1] ^= 0xFF;
+        s.extend(&bad);
+        let trunc = heartbeat(4);
+        s.extend(&trunc[..trunc.len() - 4]);
+        s.extend([STX_V2, 2, 0, 0, 9, 1, 1, 0xDE, 0xBC, 0x0A, 1, 2, 0x55, 0x66]);
+        s.extend([STX_V2, 9, 0x80]);
+        s.extend(heartbeat(5));
+        let mut v1 = MAVLinkV1MessageRaw::new();
+        let h = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 6,
+        };
+        v1.serialize_message(h, &MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()));
+        s.extend(v1.raw_bytes());
+        // Noise with markers among it, and a heartbeat now and then.
+        let mut x: u32 = 0x8765_4321;
+        for k in 0..5_000u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            s.push(if x & 7 == 0 { STX_V2 } else { (x >> 8) as u8 });
+            if k % 500 == 0 {
+                s.extend(heartbeat((k / 500) as u8 + 7));
+            }
+        }
+        let (byte_by_byte, stats, _) = arrivals(&s, false);
+        let (waited, waited_stats, _) = arrivals(&s, true);
+        assert!(byte_by_byte.len() >= 10, "{byte_by_byte:?}");
+        assert_eq!(waited, byte_by_byte);
+        assert_eq!(waited_stats, stats);
+        // Clean frames: two calls each (the first three bytes, then the rest).
+        let (_, _, calls) = arrivals(&s[..frames_only], true);
+        assert_eq!(calls, 6);
+    }
+
     #[test]
     fn random_bytes_never_panic() {
         // xorshift: deterministic noise, including many 0xFD/0xFE markers.
