@@ -181,6 +181,8 @@ impl<D: Dialect> FrameParser<D> {
             return 1;
         };
         let payload_len = usize::from(payload_len);
+        // At most 1 + 9 + 255 + 2 + 13: no overflow.
+        #[allow(clippy::arithmetic_side_effects)]
         let total = if stx == STX_V2 {
             let sig = if flags & V2_IFLAG_SIGNED != 0 {
                 V2_SIGNATURE
