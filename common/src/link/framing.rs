@@ -293,8 +293,13 @@ impl<D: Dialect> FrameParser<D> {
     fn drop_front(&mut self, n: usize) {
         let len = self.len.min(self.buf.len());
         let n = n.min(len);
-        if let Some(held) = self.buf.get_mut(..len) {
-            held.copy_within(n.., 0);
+        // Byte by byte from the front (the bytes kept move towards it, so none is overwritten
+        // before it is read): `copy_within` would be the image's only use of `memmove`.
+        for i in n..len {
+            let b = self.buf.get(i).copied().unwrap_or(0);
+            if let Some(d) = self.buf.get_mut(i.saturating_sub(n)) {
+                *d = b;
+            }
         }
         self.len = len.saturating_sub(n);
     }
