@@ -171,11 +171,6 @@ impl Usart {
         })
     }
 
-    /// Bytes received and not read yet.
-    pub fn received(&self) -> usize {
-        self.rx.len()
-    }
-
     /// Moves what has arrived into `buf`, up to its length; returns the bytes moved.
     pub fn read_into(&mut self, buf: &mut [u8]) -> usize {
         let mut n = 0;
