@@ -170,9 +170,18 @@ impl Signing {
                         // `swap_remove` without its panic path (heapless's bounds assertion,
                         // inlined here in the size-optimised MCU image): the last stream
                         // takes the place of the one removed.
-                        if let Some(last) = self.streams.pop() {
+                        if let Some(Stream {
+                            system,
+                            component,
+                            link_id,
+                            timestamp,
+                        }) = self.streams.pop()
+                        {
                             if let Some(slot) = self.streams.get_mut(i) {
-                                *slot = last;
+                                slot.system = system;
+                                slot.component = component;
+                                slot.link_id = link_id;
+                                slot.timestamp = timestamp;
                             }
                         }
                     }

@@ -94,6 +94,10 @@ impl Stream {
     }
 }
 
+/// Time between the first emissions of two streams, µs (see [`Scheduler::new`]): the eleven
+/// places 90 ms apart lie within the first second, each in a 20 ms control period of its own.
+pub const FIRST_DUE_STEP_US: u64 = 90_000;
+
 /// Fastest interval a stream may be set to, µs (1 kHz): faster requests are clamped.
 pub const MIN_INTERVAL_US: u32 = 1_000;
 
@@ -117,16 +121,26 @@ impl Default for Scheduler {
 }
 
 impl Scheduler {
-    /// All streams at their default interval, first emission at time 0.
+    /// All streams at their default interval. The fast ones (ATTITUDE, GLOBAL_POSITION_INT,
+    /// VFR_HUD) are first due at time 0; the once-a-second and slower ones are spread over the
+    /// first second ([`FIRST_DUE_STEP_US`] times their place in [`Stream::ALL`]), so that they
+    /// do not all fall due in the same control period: due together with the fast ones and
+    /// the heartbeat, their messages cost an MCU's control period some 70,000 instructions
+    /// more than the others, once a second.
     pub fn new() -> Self {
         let mut slots = [Slot {
             interval_us: 0,
             due_us: 0,
         }; STREAM_COUNT];
+        let mut first_due_us = 0;
         for s in Stream::ALL {
             if let Some(slot) = slots.get_mut(s.index()) {
                 slot.interval_us = s.default_interval_us();
+                if slot.interval_us >= 1_000_000 {
+                    slot.due_us = first_due_us;
+                }
             }
+            first_due_us = first_due_us.saturating_add(FIRST_DUE_STEP_US);
         }
         Self { slots }
     }

@@ -10,9 +10,10 @@ use crate::vehicle::snapshot::{LandedState, MissionRunState, VehicleSnapshot};
 
 use crate::math::RAD2DEG;
 
-/// Angle in rad to degrees in [0, 360).
+/// Angle in rad to degrees in [0, 360). `%` is the exact `fmodf` (the one `wrap_pi` uses
+/// too), so the image carries one copy of it.
 fn heading_deg(rad: f32) -> f32 {
-    let d = libm::fmodf(rad * RAD2DEG, 360.0);
+    let d = (rad * RAD2DEG) % 360.0;
     if d < 0.0 {
         d + 360.0
     } else {

@@ -165,6 +165,37 @@ impl<D: Dialect> FrameParser<D> {
         self.buf.get(..self.len).unwrap_or(&[])
     }
 
+    /// Bytes still missing before the candidate frame held can be checked: those up to its
+    /// first three bytes (marker, length, flags), then those up to its whole length (no frame
+    /// is shorter than either). A reader that hands the parser bytes only once that many have arrived
+    /// calls it once or twice a frame instead of once a byte; the frames found, and when, are
+    /// the same, since a candidate is checked only once it is whole.
+    pub fn bytes_wanted(&self) -> usize {
+        let held = self.len;
+        if held < 3 {
+            return 3usize.saturating_sub(held);
+        }
+        let (Some(&stx), Some(&payload_len), Some(&flags)) =
+            (self.buf.first(), self.buf.get(1), self.buf.get(2))
+        else {
+            return 1;
+        };
+        let payload_len = usize::from(payload_len);
+        // At most 1 + 9 + 255 + 2 + 13: no overflow.
+        #[allow(clippy::arithmetic_side_effects)]
+        let total = if stx == STX_V2 {
+            let sig = if flags & V2_IFLAG_SIGNED != 0 {
+                V2_SIGNATURE
+            } else {
+                0
+            };
+            1 + V2_HEADER + payload_len + CHECKSUM + sig
+        } else {
+            1 + V1_HEADER + payload_len + CHECKSUM
+        };
+        total.saturating_sub(held).max(1)
+    }
+
     /// What the parser has counted so far.
     pub fn stats(&self) -> LinkStats {
         self.stats
@@ -262,8 +293,13 @@ impl<D: Dialect> FrameParser<D> {
     fn drop_front(&mut self, n: usize) {
         let len = self.len.min(self.buf.len());
         let n = n.min(len);
-        if let Some(held) = self.buf.get_mut(..len) {
-            held.copy_within(n.., 0);
+        // Byte by byte from the front (the bytes kept move towards it, so none is overwritten
+        // before it is read): `copy_within` would be the image's only use of `memmove`.
+        for i in n..len {
+            let b = self.buf.get(i).copied().unwrap_or(0);
+            if let Some(d) = self.buf.get_mut(i.saturating_sub(n)) {
+                *d = b;
+            }
         }
         self.len = len.saturating_sub(n);
     }
@@ -678,6 +714,70 @@ mod tests {
             ),
             "{f:?}"
         );
+    }
+
+    /// Frames found, each with the number of bytes that had arrived when it was, and the
+    /// counters: the parser handed every byte as it arrives, or, as the MCU's loop does, the
+    /// bytes waiting once there are `bytes_wanted` of them.
+    fn arrivals(bytes: &[u8], wait: bool) -> (Vec<(u8, usize)>, LinkStats, usize) {
+        let mut p = FrameParser::new();
+        let (mut found, mut waiting, mut calls) = (Vec::new(), Vec::new(), 0);
+        for (i, &b) in bytes.iter().enumerate() {
+            waiting.push(b);
+            if wait && waiting.len() < p.bytes_wanted() {
+                continue;
+            }
+            calls += 1;
+            p.push(&waiting, |f| found.push((f.header.sequence, i + 1)));
+            waiting.clear();
+        }
+        (found, p.stats(), calls)
+    }
+
+    #[test]
+    fn bytes_handed_over_once_the_parser_wants_them_give_the_same_frames_at_the_same_bytes() {
+        let mut s = Vec::new();
+        for i in 0..3 {
+            s.extend(heartbeat(i));
+        }
+        let frames_only = s.len();
+        s.extend(b"\x00garbage\x01\x02");
+        let mut bad = heartbeat(3);
+        let n = bad.len();
+        bad[n - 1] ^= 0xFF;
+        s.extend(&bad);
+        let trunc = heartbeat(4);
+        s.extend(&trunc[..trunc.len() - 4]);
+        s.extend([STX_V2, 2, 0, 0, 9, 1, 1, 0xDE, 0xBC, 0x0A, 1, 2, 0x55, 0x66]);
+        s.extend([STX_V2, 9, 0x80]);
+        s.extend(heartbeat(5));
+        let mut v1 = MAVLinkV1MessageRaw::new();
+        let h = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 6,
+        };
+        v1.serialize_message(h, &MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()));
+        s.extend(v1.raw_bytes());
+        // Noise with markers among it, and a heartbeat now and then.
+        let mut x: u32 = 0x8765_4321;
+        for k in 0..5_000u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            s.push(if x & 7 == 0 { STX_V2 } else { (x >> 8) as u8 });
+            if k % 500 == 0 {
+                s.extend(heartbeat((k / 500) as u8 + 7));
+            }
+        }
+        let (byte_by_byte, stats, _) = arrivals(&s, false);
+        let (waited, waited_stats, _) = arrivals(&s, true);
+        assert!(byte_by_byte.len() >= 10, "{byte_by_byte:?}");
+        assert_eq!(waited, byte_by_byte);
+        assert_eq!(waited_stats, stats);
+        // Clean frames: two calls each (the first three bytes, then the rest).
+        let (_, _, calls) = arrivals(&s[..frames_only], true);
+        assert_eq!(calls, 6);
     }
 
     #[test]

@@ -111,6 +111,14 @@ impl GroundPort {
             .fold(LinkStats::default(), |a, p| a + p.stats())
     }
 
+    /// Bytes the parser of `channel` needs before it can check its next frame
+    /// ([`FrameParser::bytes_wanted`]); 1 for a channel the port does not have.
+    pub fn bytes_wanted(&self, channel: u8) -> usize {
+        self.parsers
+            .get(usize::from(channel))
+            .map_or(1, FrameParser::bytes_wanted)
+    }
+
     /// Bytes dropped because the output buffer was full.
     pub fn bytes_dropped(&self) -> u32 {
         self.bytes_dropped

@@ -212,6 +212,18 @@ impl App {
             .on_bytes(bytes, &mut self.vehicle, &mut self.ground, out);
     }
 
+    /// Bytes the simulator link's parser needs before it can check its next frame: a board
+    /// that hands it over no fewer (when that many have arrived) parses a frame in one or two
+    /// calls instead of one per byte, with the same frames at the same moments.
+    pub fn sim_bytes_wanted(&self) -> usize {
+        self.sim.bytes_wanted()
+    }
+
+    /// As [`App::sim_bytes_wanted`], for the ground link of a single-link board (channel 0).
+    pub fn gcs_bytes_wanted(&self) -> usize {
+        self.ground.bytes_wanted(0)
+    }
+
     /// Feeds bytes from the ground station of a single-link board (channel 0); the answers
     /// wait in [`App::drain_gcs`].
     pub fn on_gcs_bytes(&mut self, bytes: &[u8]) {

@@ -99,6 +99,12 @@ impl SimPort {
             .unwrap_or_default()
     }
 
+    /// Bytes the parser needs before it can check its next frame
+    /// ([`FrameParser::bytes_wanted`]).
+    pub fn bytes_wanted(&self) -> usize {
+        self.parser.bytes_wanted()
+    }
+
     /// Bytes from the simulator; `out` receives the answers.
     pub fn on_bytes(
         &mut self,

@@ -32,6 +32,9 @@ const CSR_ENABLE_CORE_CLOCK: u32 = 0b101;
 /// The paint cortex-m-rt's `paint-stack` leaves on the whole stack before `main`.
 const PAINT: u32 = 0xCCCC_CCCC;
 
+/// The reports fall due this long before each whole second of the vehicle's clock, µs.
+const REPORT_PHASE_US: u64 = 500_000;
+
 /// Instructions of the calibration loop: two per iteration (`subs`, `bne`).
 pub const CAL_INSTRUCTIONS: u32 = 20_000;
 
@@ -153,9 +156,15 @@ impl Budget {
         self.max = self.max.max(self.this_period);
     }
 
-    /// Once a second of the vehicle's clock: the figures to the ground.
+    /// Once a second of the vehicle's clock, half-way through it: the figures to the ground.
+    /// Their frames are sent from the next pass, whose period is measured: not at the whole
+    /// second, where the heartbeat and the fast telemetry streams fall due together.
     pub fn report(&mut self, app: &mut App) {
-        let Some(s) = app.vehicle().time_us().map(|t| t / 1_000_000) else {
+        let Some(s) = app
+            .vehicle()
+            .time_us()
+            .map(|t| t.saturating_add(REPORT_PHASE_US) / 1_000_000)
+        else {
             return;
         };
         if self.last_report_s == Some(s) {

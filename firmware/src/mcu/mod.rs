@@ -67,15 +67,19 @@ fn main() -> ! {
     );
     watchdog::start();
     sim.write(&firmware::app::heartbeat_frame(app));
-    let (mut sim_chunk, mut gcs_chunk) = ([0u8; 64], [0u8; 64]);
+    let (mut sim_held, mut gcs_held) = (Held::new(), Held::new());
     loop {
         // Fed on every pass, idle ones included: a pass that never returns starves it.
         watchdog::feed();
-        // Gather what has arrived on each UART, then hand it over in one piece.
-        let n = sim.read_into(&mut sim_chunk);
-        let sim_bytes = sim_chunk.get(..n).filter(|b| !b.is_empty());
-        let n = gcs.read_into(&mut gcs_chunk);
-        let gcs_bytes = gcs_chunk.get(..n).filter(|b| !b.is_empty());
+        // Gather what has arrived on each UART, then hand it over in one piece once there is
+        // as much as the link's parser waits for (a frame's first three bytes, then the rest
+        // of the frame): a frame costs one or two passes, not one per byte (bytes arrive one
+        // at a time on a UART). The rings are emptied on every pass as before; what waits is
+        // held here, never more than a frame.
+        sim_held.take_from(&mut sim);
+        let sim_bytes = sim_held.ready(app.sim_bytes_wanted());
+        gcs_held.take_from(&mut gcs);
+        let gcs_bytes = gcs_held.ready(app.gcs_bytes_wanted());
         let idle = sim_bytes.is_none() && gcs_bytes.is_none();
         let t0 = budget::budget_work_start();
         if let Some(bytes) = sim_bytes {
@@ -106,5 +110,40 @@ fn main() -> ! {
         }
         // Outside the measured work: the report scans the stack (sent with the next frames).
         budget.report(app);
+    }
+}
+
+/// Bytes of the longest frame: MAVLink 2, a 255-byte payload, signed.
+const HELD: usize = 280;
+
+/// Bytes taken from a UART's receive ring and held until the link's parser can use them.
+struct Held {
+    buf: [u8; HELD],
+    len: usize,
+}
+
+impl Held {
+    const fn new() -> Self {
+        Self {
+            buf: [0; HELD],
+            len: 0,
+        }
+    }
+
+    /// Takes what has arrived, as much as there is room for.
+    fn take_from(&mut self, usart: &mut Usart) {
+        if let Some(room) = self.buf.get_mut(self.len..) {
+            self.len = self.len.saturating_add(usart.read_into(room));
+        }
+    }
+
+    /// The bytes held, to be handed over now and forgotten here, once there are `wanted` of
+    /// them (or the buffer is full: a parser never waits for more than a frame).
+    fn ready(&mut self, wanted: usize) -> Option<&[u8]> {
+        if self.len == 0 || self.len < wanted.min(HELD) {
+            return None;
+        }
+        let n = core::mem::take(&mut self.len);
+        self.buf.get(..n)
     }
 }
