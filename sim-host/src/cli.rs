@@ -268,7 +268,8 @@ pub(crate) struct FlyArgs {
     pub(crate) json: bool,
     /// Fly a mission from the runway instead of the thesis's script: a QGroundControl `.plan`
     /// or `QGC WPL 110` file (mission and geofence are uploaded), or `default` for the
-    /// built-in take-off, rectangle, orbit, return and landing.
+    /// built-in take-off, rectangle, orbit, return and landing, or `runway-120` / `runway-250`
+    /// for the built-in missions from other runways (docs/NAVIGATION.md).
     #[arg(long, value_name = "FILE|default")]
     pub(crate) mission: Option<PathBuf>,
     /// Wall-clock pace with --realtime: simulated seconds per wall second.

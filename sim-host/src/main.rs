@@ -286,10 +286,20 @@ fn mission_config(
     aircraft: &Aircraft,
     which: &Path,
 ) -> anyhow::Result<sim_host::flight::FlightConfig> {
-    use sim_host::flight::missions::{default_mission, runway_mission};
+    use sim_host::flight::missions::{default_mission, other_runway_missions, runway_mission};
     let home = sim_host::plant::ModelParams::new(aircraft).home;
     if which == Path::new("default") {
         return Ok(runway_mission(default_mission(home)));
+    }
+    // `runway-120` and `runway-250`: the built-in missions on other runways, standing on them.
+    if let Some(m) = other_runway_missions(home)
+        .into_iter()
+        .find(|m| which == Path::new(&m.name.replace(' ', "-")))
+    {
+        return Ok(sim_host::flight::FlightConfig {
+            runway_heading: Some(m.runway_rad),
+            ..runway_mission(m.items)
+        });
     }
     let file = sim_host::mission_file::read_mission_file(which)?;
     anyhow::ensure!(

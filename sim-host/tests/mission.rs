@@ -221,3 +221,26 @@ fn a_wing_tip_on_the_runway_while_armed_fails_the_mission_summary_on_no_strike()
         handled.failed
     );
 }
+
+/// Missions from other runways, laid out as an outside planner laid them out (the take-off
+/// item 30 and 75 deg off the runway, turned rectangles, a speed change to 20 m/s, loiter
+/// turns, circuits from either side), flown with the firmware's defaults by a station that
+/// sets none: in calm air and in the default case's wind turned with each runway, with light
+/// turbulence, every navigation target is met, nothing but the wheels touches the ground, the
+/// throttle is on a stop in under 10 % of level cruise and the landed state the station read
+/// is honest from the start to the stop.
+#[test]
+fn missions_from_other_runways_fly_well_in_calm_air_and_in_wind() {
+    let aircraft = Aircraft::ultrastick25e().expect("built-in aircraft");
+    let home = sim_host::plant::ModelParams::new(&aircraft).home;
+    let opts = sim_host::commands::fly::FlyOptions::default();
+    for mission in sim_host::flight::missions::other_runway_missions(home) {
+        for (turbulence, calm) in [(Turbulence::None, true), (Turbulence::Light, false)] {
+            let o = navigation::fly_runway_mission(&aircraft, &mission, turbulence, 1, &opts)
+                .expect("flight");
+            if let Err(e) = navigation::flies_well(&o, calm) {
+                panic!("{} ({turbulence:?}): {e}", mission.name);
+            }
+        }
+    }
+}

@@ -72,6 +72,17 @@ impl GroundLink {
             }
             MavCmd::MAV_CMD_NAV_TAKEOFF => self.request_mode(FlightMode::Takeoff, v, stores.plan),
             MavCmd::MAV_CMD_NAV_LAND => self.request_mode(FlightMode::Land, v, stores.plan),
+            MavCmd::MAV_CMD_DO_GO_AROUND => {
+                // Only a landing can be given up (param1, the altitude, is not used: the
+                // go-around climbs to its circuit's height). A landing already rolling out is
+                // refused by the vehicle, which says so.
+                if v.armed && v.landed == LandedState::Landing {
+                    self.requests.go_around = true;
+                    MavResult::MAV_RESULT_ACCEPTED
+                } else {
+                    MavResult::MAV_RESULT_TEMPORARILY_REJECTED
+                }
+            }
             MavCmd::MAV_CMD_DO_SET_MISSION_CURRENT => {
                 let seq = c.p[0];
                 if (0.0..65536.0).contains(&seq)

@@ -2143,6 +2143,48 @@ fn change_speed_is_held_to_the_vehicles_airspeed_range() {
     assert_eq!(l.take_requests().airspeed, None);
 }
 
+/// `MAV_CMD_DO_GO_AROUND` (PX4's and ArduPilot's abort of a landing) is accepted while the
+/// vehicle is landing and armed, and queued for the navigator; in the air on any other leg,
+/// or disarmed, it is refused for now (`TEMPORARILY_REJECTED`) and nothing is queued.
+#[test]
+fn a_go_around_is_accepted_only_while_landing() {
+    let mut l = link();
+    let go_around = || cmd_long(MavCmd::MAV_CMD_DO_GO_AROUND, [0.0; 7]);
+    let mut v = healthy();
+    for (armed, landed, expected) in [
+        (true, LandedState::Landing, MavResult::MAV_RESULT_ACCEPTED),
+        (
+            true,
+            LandedState::InAir,
+            MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
+        ),
+        (
+            true,
+            LandedState::OnGround,
+            MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
+        ),
+        (
+            false,
+            LandedState::Landing,
+            MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
+        ),
+    ] {
+        v.armed = armed;
+        v.landed = landed;
+        let out = exchange(&mut l, &v, 0, go_around());
+        assert_eq!(
+            acks(&out),
+            [(MavCmd::MAV_CMD_DO_GO_AROUND, expected)],
+            "armed {armed}, {landed:?}"
+        );
+        assert_eq!(
+            l.take_requests().go_around,
+            expected == MavResult::MAV_RESULT_ACCEPTED,
+            "armed {armed}, {landed:?}"
+        );
+    }
+}
+
 /// What the next poll sends back on `channel` (answers to its stations and broadcasts).
 fn poll_channel(l: &mut Bench, v: &VehicleSnapshot, now: u64, channel: u8) -> Vec<MavMessage> {
     let mut out = Vec::new();

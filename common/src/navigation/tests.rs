@@ -1117,3 +1117,127 @@ fn a_landed_aircraft_still_rolling_is_disarmed_after_the_roll_out_time_when_it_c
     );
     assert!(landed_after(2.5, 0.1).0, "armed at a walking pace");
 }
+
+/// A flare still in the air 20 m past the land point (`NAV_LND_ABORT_M`) goes around: it
+/// climbs away on the runway's line at full throttle (the take-off regime) to the approach's
+/// start height (30 m here), flies back on a leg parallel to the runway two loiter radii
+/// (2 x 60 m) to its left, turns onto a new approach far enough out to meet the glide slope
+/// from that height (6 deg in these tests), and lands there on the point.
+#[test]
+fn a_flare_floating_past_the_abort_distance_goes_around_and_lands_on_a_new_approach() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = land_here_until(&mut nav, &items, Phase::Flare);
+    // The approach runs south; floated on 19 m past the point, 1 m up, it keeps flaring.
+    plane.k.pos = Vector3::new(-19.0, 0.0, -1.0);
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.phase, Phase::Flare, "19 m past");
+    plane.k.pos = Vector3::new(-21.0, 0.0, -1.0);
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.phase, Phase::GoAround, "21 m past");
+    assert!(
+        matches!(out.commands.map(|c| c.lon), Some(LonMode::TakeOff { .. })),
+        "{:?}",
+        out.commands
+    );
+    let log = fly(&mut nav, &mut plane, &items, 600.0, |o| {
+        o.phase == Phase::Landed
+    });
+    let circuit: Vec<_> = log
+        .outs
+        .iter()
+        .filter(|o| o.1.phase == Phase::GoAround)
+        .collect();
+    let top = circuit.iter().map(|o| -o.2.z).fold(0.0, f32::max);
+    assert!((top - 30.0).abs() < 2.0, "circuit at {top} m");
+    // The downwind leg: east of the runway (left of an approach heading south), 120 m off.
+    let abeam = circuit
+        .iter()
+        .find(|o| o.2.x > 200.0)
+        .expect("the circuit passes abeam the approach");
+    assert!(
+        (abeam.2.y - 120.0).abs() < 5.0,
+        "downwind leg at {}",
+        abeam.2
+    );
+    let landed = log.outs.last().expect("steps");
+    assert_eq!(landed.1.phase, Phase::Landed);
+    assert!(
+        landed.2.x.abs() < 30.0 && landed.2.y.abs() < 5.0,
+        "second landing at {}",
+        landed.2
+    );
+    assert!(log.reached.contains(&0));
+}
+
+/// A landing goes around at most twice: a flare lifted out of itself (above twice
+/// `NAV_FLR_ALT`, 8 m in these tests) goes around each of the first two times, and lands from the third.
+#[test]
+fn a_landing_goes_around_at_most_twice() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+    for attempt in 0..3 {
+        fly(&mut nav, &mut plane, &items, 600.0, |o| {
+            o.phase == Phase::Flare
+        });
+        plane.k.pos.z = -(2.0 * nav.params().flare_alt + 0.1);
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        let expected = if attempt < 2 {
+            Phase::GoAround
+        } else {
+            Phase::Flare
+        };
+        assert_eq!(out.phase, expected, "ballooned flare {attempt}");
+    }
+    assert!(!nav.go_around(), "a third go-around was accepted");
+}
+
+/// A go-around asked for (`MAV_CMD_DO_GO_AROUND`) is flown only from a landing's approach
+/// or flare: not on a waypoint leg, nor once rolling out.
+#[test]
+fn a_go_around_is_flown_only_from_an_approach_or_a_flare() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+    assert!(nav.go_around());
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.phase, Phase::GoAround);
+    fly(&mut nav, &mut plane, &items, 900.0, |o| {
+        o.phase == Phase::Landed
+    });
+    assert!(!nav.go_around(), "went around from the roll-out");
+    let mut nav = navigator();
+    let mut plane = Plane::flying(0.0, 0.0, 30.0, 0.0);
+    let legs = [wp(500.0, 0.0, 30.0)];
+    nav.start_mission(0);
+    fly(&mut nav, &mut plane, &legs, 1.0, |_| false);
+    assert!(!nav.go_around(), "went around from a waypoint leg");
+}
+
+/// A leg that starts where the aircraft is (no waypoint before it, as after a take-off or a
+/// loiter) 90 deg off its heading is joined by turning towards the waypoint, the line drawn
+/// anew from the aircraft until its course is within 15 deg of it: the turn is not a straight
+/// leg, and on the straight leg that follows the cross-track stays within what the 15 deg
+/// left carries the aircraft over its 1 s course lag, 17 m/s x 1 s x sin 15 deg = 4.4 m.
+/// Drawn once from where the turn began, the line is overshot by about a turn radius (29 m
+/// at 17 m/s and this model's largest turn rate, g / V).
+#[test]
+fn a_leg_from_the_present_position_is_joined_without_overshooting_its_line() {
+    let items = [wp(0.0, 500.0, 30.0)];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(0.0, 0.0, 30.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 120.0, |o| o.reached.is_some());
+    assert_eq!(log.reached, [0]);
+    let turning = log.outs.iter().take_while(|o| !o.1.straight).count();
+    assert!(turning > 10, "the turn onto the leg took {turning} steps");
+    let straight_xt = log
+        .outs
+        .iter()
+        .filter(|o| o.1.straight)
+        .filter_map(|o| o.1.guidance.map(|g| g.cross_track.abs()))
+        .fold(0.0, f32::max);
+    let bound = 17.0 * 1.0 * libm::sinf(15f32.to_radians());
+    assert!(straight_xt < bound, "{straight_xt} m off the straight leg");
+}

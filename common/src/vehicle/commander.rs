@@ -380,6 +380,16 @@ impl Commander {
         if let Some(v) = r.airspeed {
             self.setpoints.airspeed = v;
         }
+        if r.go_around {
+            if self.navigator.go_around() {
+                self.text(Severity::Info, "Going around");
+            } else {
+                self.text(
+                    Severity::Warning,
+                    "Go-around refused: not in the air on a landing",
+                );
+            }
+        }
         if r.manual.is_some() {
             self.sticks = r.manual;
         }

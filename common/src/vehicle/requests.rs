@@ -33,6 +33,8 @@ pub struct VehicleRequests {
     pub course: Option<CourseSetpoint>,
     /// The latest stick positions (`MANUAL_CONTROL`: QGC's virtual joystick or a gamepad).
     pub manual: Option<ManualInput>,
+    /// Give up the landing being flown (`MAV_CMD_DO_GO_AROUND`).
+    pub go_around: bool,
 }
 
 /// An altitude the ground station asked for.

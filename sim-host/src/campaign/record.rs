@@ -63,6 +63,8 @@ pub struct Figures {
     /// The wind lifted the aircraft off the runway for a second or more after the disarm
     /// (not its landing: [`crate::flight::FlightSummary::lifted_after_disarm`]).
     pub lifted_after_disarm: Option<bool>,
+    /// Go-arounds flown (each entry into the navigator's go-around while armed).
+    pub go_arounds: Option<f64>,
     /// Largest |bank| while armed, deg.
     pub max_bank_deg: Option<f64>,
     /// Largest |pitch| while armed, deg.
@@ -261,6 +263,7 @@ pub fn figures_and_facts(
     }
     if let Some(m) = &s.mission {
         f.lifted_after_disarm = Some(s.lifted_after_disarm.is_some());
+        f.go_arounds = Some(go_arounds(samples) as f64);
         f.flight_time_s = finite(m.flight_time_s);
         f.energy_wh = finite(m.energy_wh);
         f.items = Some(m.nav_items.len() as f64);
@@ -355,6 +358,15 @@ pub fn fly_record(plan: &Plan, reproduce: String) -> (FlightRecord, Option<Fligh
         reproduce,
     };
     (record, flown.ok().map(|f| f.0))
+}
+
+/// Go-arounds in a flight's log: the armed frames where the navigator enters its go-around.
+fn go_arounds(samples: &[Sample]) -> usize {
+    let ga = common::navigation::Phase::GoAround as u8;
+    samples
+        .windows(2)
+        .filter(|w| w[1].armed && w[1].nav_phase == ga && w[0].nav_phase != ga)
+        .count()
 }
 
 #[cfg(test)]

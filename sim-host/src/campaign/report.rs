@@ -175,6 +175,8 @@ pub struct Report {
     pub causes: Vec<(String, u64)>,
     /// Flights the wind lifted off the runway after the disarm (not their landing).
     pub lifted_after_disarm: u64,
+    /// Flights that went around at least once, and how many of them passed.
+    pub went_around: (u64, u64),
     /// Every figure's distribution.
     pub figures: Vec<FigureStats>,
     /// Every dispersed quantity against the outcome, strongest relation first.
@@ -360,6 +362,16 @@ impl Report {
                 .iter()
                 .filter(|r| r.figures.lifted_after_disarm == Some(true))
                 .count() as u64,
+            went_around: {
+                let ga: Vec<_> = records
+                    .iter()
+                    .filter(|r| r.figures.go_arounds.is_some_and(|n| n > 0.0))
+                    .collect();
+                (
+                    ga.len() as u64,
+                    ga.iter().filter(|r| r.verdict.pass).count() as u64,
+                )
+            },
             figures: FIGURES.iter().map(|d| figure_stats(&records, d)).collect(),
             sensitivity: sens,
             failing: records
@@ -483,6 +495,13 @@ pub fn markdown(r: &Report, images: &Images) -> String {
          left on the runway for a second or more (a gust over about 11 m/s at the three-point \
          attitude), which is in each record (`lifted_after_disarm`) and not taken as its landing.",
         r.lifted_after_disarm, r.flights
+    );
+    let _ = writeln!(
+        md,
+        "\n{} flights went around (their flare floated or bounced over 20 m past the point in \
+         the air, or a gust lifted it out of the flare: `docs/NAVIGATION.md`) and were judged by \
+         the landing they made after it; {} of them pass.",
+        r.went_around.0, r.went_around.1
     );
     let _ = writeln!(
         md,

@@ -5,7 +5,10 @@
 use super::fly::{fly_report, mission_table, FlyOptions, LinkKind, NOTES_MARKER};
 use crate::aircraft::Aircraft;
 use crate::environment::wind::Turbulence;
-use crate::flight::missions::{default_mission, runway_mission};
+use crate::flight::landed::landed_state_honest;
+use crate::flight::missions::{
+    default_mission, other_runway_missions, runway_mission, RunwayMission,
+};
 use crate::flight::plots::ground_track_figure;
 use crate::flight::record::Sample;
 use crate::flight::runner::FlightOutcome;
@@ -32,6 +35,13 @@ pub const SEEDS: [u64; 20] = [
 pub const CHECK_SEEDS: [u64; 20] = [
     21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34, 35, 36, 37, 38, 39, 40,
 ];
+
+/// Windy seeds of the missions on other runways.
+pub const RUNWAY_SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
+
+/// Share of level cruise with the throttle on a stop under which the airspeed loop counts as
+/// holding the airspeed, %.
+pub const THROTTLE_AT_STOPS_MAX_PCT: f64 = 10.0;
 
 /// Targets of the windy flights on estimates, and of the calm one.
 pub const TARGETS: &str = "cross-track RMS on straight legs under 2 m (0.5 m in calm air), \
@@ -64,6 +74,59 @@ pub fn fly_default_on(
         ..runway_mission(default_mission(ModelParams::new(aircraft).home))
     };
     Ok(fly_report(aircraft, &cfg, opts)?.outcome)
+}
+
+/// The default case's wind turned with a runway of heading `runway_rad`: the same headwind and
+/// crosswind on its landing.
+pub fn wind_for_runway(runway_rad: f64) -> [f64; 3] {
+    let (s, c) = runway_rad.sin_cos();
+    let [n, e, d] = WIND_NED;
+    [n * c - e * s, n * s + e * c, d]
+}
+
+/// Flies a mission on another runway once (the aircraft standing on that runway), with the
+/// host build in this process or over the link of `opts`.
+pub fn fly_runway_mission(
+    aircraft: &Aircraft,
+    mission: &RunwayMission,
+    turbulence: Turbulence,
+    seed: u64,
+    opts: &FlyOptions,
+) -> anyhow::Result<FlightOutcome> {
+    let wind_ned = if turbulence == Turbulence::None {
+        [0.0; 3]
+    } else {
+        wind_for_runway(mission.runway_rad)
+    };
+    let cfg = crate::flight::config::FlightConfig {
+        wind_ned,
+        turbulence,
+        seed,
+        runway_heading: Some(mission.runway_rad),
+        ..runway_mission(mission.items.clone())
+    };
+    Ok(fly_report(aircraft, &cfg, opts)?.outcome)
+}
+
+/// What the issue of missions from elsewhere asks of each flight beyond [`meets_targets`]: no
+/// strike, the throttle off its stops in level cruise, and a landed state honest from the
+/// start to the stop. `Err` names what failed.
+pub fn flies_well(o: &FlightOutcome, calm: bool) -> Result<(), String> {
+    let m = o.summary.mission.as_ref().ok_or("no mission flown")?;
+    if !meets_targets(m, calm) {
+        return Err("a navigation target missed".into());
+    }
+    if let Some(s) = m.strikes.first() {
+        return Err(format!("{} strike at {:.1} s", s.point, s.t_s));
+    }
+    if !under(m.throttle_at_stops_pct, THROTTLE_AT_STOPS_MAX_PCT) {
+        return Err(format!(
+            "throttle on a stop {:.1} % of level cruise",
+            m.throttle_at_stops_pct
+        ));
+    }
+    let td = m.touchdown.as_ref().ok_or("no touchdown")?;
+    landed_state_honest(&o.summary.landed_states, td.time_s)
 }
 
 /// Flies the default mission in calm air at the cruise airspeed `airspeed_mps`, set as a
@@ -274,12 +337,7 @@ pub fn navigation_markdown(
                 &png,
             )?;
         }
-        let (d, sink) = m.touchdown.map_or(("none".into(), "-".into()), |t| {
-            (
-                format!("{:.1} ({:+.1})", t.distance_m, t.along_m),
-                format!("{:.2}", t.sink_rate_mps),
-            )
-        });
+        let (d, sink) = touchdown_cells(&m);
         let _ = writeln!(
             md,
             "| {seed} | {}/{} | {} ({}) | {} | {} | {} | {d} | {sink} | {:.0} | {:.2} | {} |",
@@ -318,11 +376,12 @@ pub fn navigation_markdown(
         SEEDS[0],
         rel(&img_dir.join("mission-wind.png"))
     );
+    let runways = runway_section(aircraft, img_dir, opts, &mut md)?;
     let notes = existing
         .and_then(|e| e.find(NOTES_MARKER).map(|i| &e[i..]))
         .unwrap_or("\n---\n\n*Everything above the line is written by the command named at the top; notes below it are kept.*\n");
     md.push_str(notes.trim_start_matches('\n'));
-    let results_section = results_summary(command, &calm_m, &windy, &check, img_dir);
+    let results_section = results_summary(command, &calm_m, &windy, &check, &runways, img_dir);
     Ok(NavigationDocs {
         navigation: md,
         results_section,
@@ -336,6 +395,7 @@ fn results_summary(
     calm: &MissionSummary,
     windy: &[MissionSummary],
     check: &[MissionSummary],
+    runways: &[(String, Vec<MissionSummary>)],
     img_dir: &Path,
 ) -> String {
     let calm_td = calm.touchdown.map_or("none".to_string(), |t| {
@@ -358,7 +418,7 @@ fn results_summary(
          | case | waypoints | straight-leg cross-track RMS (m) | altitude RMS (m) | airspeed RMS (m/s) | touchdown | sink (m/s) | meets targets |\n\
          |---|---|---|---|---|---|---|---|\n\
          | calm air | {}/{} | {} | {} | {} | {calm_td} | {calm_sink} | {yes} |\n\
-         {}\n{}\n\n\
+         {}\n{}\n{}\n\n\
          ![ground track, calm air]({}) ![ground track, wind and turbulence]({})\n",
         calm.reached.len(),
         calm.nav_items.len(),
@@ -373,9 +433,117 @@ fn results_summary(
             &format!("the same, seeds {}", seed_span(&CHECK_SEEDS)),
             check
         ),
+        runways
+            .iter()
+            .map(|(label, flights)| windy_row(label, flights))
+            .collect::<Vec<_>>()
+            .join("\n"),
         rel(&img_dir.join("mission-calm.png")),
         rel(&img_dir.join("mission-wind.png")),
     )
+}
+
+/// The missions on other runways, in calm air and on [`RUNWAY_SEEDS`] in the wind turned
+/// with each runway: a row per flight into `md`; the flights of each case for the results
+/// table.
+fn runway_section(
+    aircraft: &Aircraft,
+    img_dir: &Path,
+    opts: &FlyOptions,
+    md: &mut String,
+) -> anyhow::Result<Vec<(String, Vec<MissionSummary>)>> {
+    let missions = other_runway_missions(ModelParams::new(aircraft).home);
+    let plot =
+        |m: &RunwayMission| img_dir.join(format!("mission-{}.png", m.name.replace(' ', "-")));
+    let _ = writeln!(
+        md,
+        "## Missions from other runways\n\n\
+         Missions laid out as an outside planner laid them out (`sim_host::flight::missions::\
+         other_runway_missions`), flown from another runway than the default's with the same \
+         firmware defaults and the same station, in calm air (seed 1) and in the default \
+         case's wind turned with the runway (the same headwind and crosswind on the landing) \
+         with light turbulence, seeds {}. Beyond the targets above, each flight must strike \
+         nothing, keep the throttle off its stops in under {THROTTLE_AT_STOPS_MAX_PCT} % of \
+         level cruise and read an honest landed state from the start to the stop (TAKEOFF, \
+         IN_AIR, LANDING until the wheels touch, ON_GROUND within 15 s after).\n",
+        seed_span(&RUNWAY_SEEDS)
+    );
+    for m in &missions {
+        let _ = writeln!(md, "- `{}`: {}.", m.name, m.what);
+    }
+    let _ = writeln!(
+        md,
+        "\n| mission | air | seed | waypoints | cross-track RMS m | altitude RMS m | airspeed RMS m/s | throttle on a stop % | touchdown from the point (along) m | sink m/s | flies well |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    let mut cases = Vec::new();
+    for mission in &missions {
+        for calm in [true, false] {
+            let (turbulence, seeds) = if calm {
+                (Turbulence::None, &RUNWAY_SEEDS[..1])
+            } else {
+                (Turbulence::Light, &RUNWAY_SEEDS[..])
+            };
+            let mut flights = Vec::new();
+            for &seed in seeds {
+                let o = fly_runway_mission(aircraft, mission, turbulence, seed, opts)?;
+                if !calm && seed == seeds[0] {
+                    let title = format!("{}, 5 m/s wind, light turbulence", mission.name);
+                    ground_track(&o.samples, &title, &plot(mission))?;
+                }
+                let verdict = flies_well(&o, calm);
+                let m = o.summary.mission.context("no mission flown")?;
+                let (d, sink) = touchdown_cells(&m);
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {seed} | {}/{} | {} | {} | {} | {:.1} | {d} | {sink} | {} |",
+                    mission.name,
+                    if calm { "calm" } else { "wind" },
+                    m.reached.len(),
+                    m.nav_items.len(),
+                    sig(m.xtrack_rms_m, 3),
+                    sig(m.alt_rms_m, 3),
+                    sig(m.airspeed_rms_mps, 3),
+                    m.throttle_at_stops_pct,
+                    verdict.map_or_else(|e| format!("**no**: {e}"), |()| "yes".into()),
+                );
+                flights.push(m);
+            }
+            let air = if calm {
+                "calm air".to_string()
+            } else {
+                format!(
+                    "5 m/s wind, light turbulence, seeds {}",
+                    seed_span(&RUNWAY_SEEDS)
+                )
+            };
+            cases.push((format!("`{}`, {air}", mission.name), flights));
+        }
+    }
+    let plots: Vec<String> = missions
+        .iter()
+        .map(|m| {
+            format!(
+                "![{}, 5 m/s wind, light turbulence, seed {}]({})",
+                m.name,
+                RUNWAY_SEEDS[0],
+                rel(&plot(m))
+            )
+        })
+        .collect();
+    let _ = writeln!(md, "\n{}\n", plots.join(" "));
+    Ok(cases)
+}
+
+/// A flight's touchdown as table cells: distance from the point (along the runway), and the
+/// sink rate.
+fn touchdown_cells(m: &MissionSummary) -> (String, String) {
+    m.touchdown.map_or(("none".into(), "-".into()), |t| {
+        (
+            format!("{:.1} ({:+.1})", t.distance_m, t.along_m),
+            format!("{:.2}", t.sink_rate_mps),
+        )
+    })
 }
 
 /// "first-last" of a run of seeds.

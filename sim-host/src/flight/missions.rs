@@ -181,6 +181,169 @@ pub fn default_mission(home: GeoPoint) -> Vec<MISSION_ITEM_INT_DATA> {
         .build()
 }
 
+/// A mission on another runway than the default's, laid out as an outside planner laid out
+/// the missions this autopilot had never flown: the take-off item off the runway's heading,
+/// rectangles turned from it, speed changes, loiter turns and a circuit to the runway from
+/// either side.
+#[derive(Clone, Debug)]
+pub struct RunwayMission {
+    /// A short name for tables.
+    pub name: &'static str,
+    /// What the mission flies, for the documents.
+    pub what: &'static str,
+    /// The runway's heading, the way the aircraft stands on it (and lands), rad from north.
+    pub runway_rad: f64,
+    /// The items.
+    pub items: Vec<MISSION_ITEM_INT_DATA>,
+}
+
+/// Places points given along a runway and to its right (m) north and east of home.
+struct RunwayFrame {
+    sin: f64,
+    cos: f64,
+}
+
+impl RunwayFrame {
+    fn new(heading_rad: f64) -> Self {
+        let (sin, cos) = heading_rad.sin_cos();
+        Self { sin, cos }
+    }
+
+    /// A spot `along` the runway and `right` of it, `height_m` above home.
+    fn spot(&self, along: f64, right: f64, height_m: f64) -> Spot {
+        Spot {
+            north_m: along * self.cos - right * self.sin,
+            east_m: along * self.sin + right * self.cos,
+            height_m,
+        }
+    }
+
+    /// The corners of a `length` by `width` rectangle (m) about `centre` (along, right),
+    /// its length turned `turn_rad` right of the runway, clockwise seen from above from the
+    /// corner nearest the runway's start.
+    fn rectangle(
+        &self,
+        centre: (f64, f64),
+        length: f64,
+        width: f64,
+        turn_rad: f64,
+    ) -> [(f64, f64); 4] {
+        let (s, c) = turn_rad.sin_cos();
+        let (hl, hw) = (0.5 * length, 0.5 * width);
+        [(-hl, -hw), (hl, -hw), (hl, hw), (-hl, hw)]
+            .map(|(x, y)| (centre.0 + x * c - y * s, centre.1 + x * s + y * c))
+    }
+}
+
+/// Builds a mission in a runway's frame.
+struct RunwayBuilder {
+    frame: RunwayFrame,
+    b: MissionBuilder,
+}
+
+impl RunwayBuilder {
+    fn item(mut self, cmd: MavCmd, params: [f32; 4], at: Option<(f64, f64, f64)>) -> Self {
+        let at = at.map(|(a, r, h)| self.frame.spot(a, r, h));
+        self.b = self.b.item(cmd, params, at);
+        self
+    }
+
+    fn waypoint(self, along: f64, right: f64, height_m: f64) -> Self {
+        self.item(
+            MavCmd::MAV_CMD_NAV_WAYPOINT,
+            [0.0, 0.0, 0.0, f32::NAN],
+            Some((along, right, height_m)),
+        )
+    }
+
+    /// `DO_CHANGE_SPEED` to an airspeed of `mps`.
+    fn speed(self, mps: f32) -> Self {
+        self.item(MavCmd::MAV_CMD_DO_CHANGE_SPEED, [0.0, mps, -1.0, 0.0], None)
+    }
+
+    fn land_at_home(self) -> Vec<MISSION_ITEM_INT_DATA> {
+        self.item(
+            MavCmd::MAV_CMD_NAV_LAND,
+            [0.0, 0.0, 0.0, f32::NAN],
+            Some((0.0, 0.0, 0.0)),
+        )
+        .b
+        .build()
+    }
+}
+
+/// Two missions on other runways (120 and 250 deg), each landing at home on its runway:
+/// - `runway 120`: the take-off item 300 m out 30 deg right of the runway at 50 m, three
+///   sides of a 500 m x 300 m rectangle turned 30 deg right flown at 20 m/s
+///   (`DO_CHANGE_SPEED`), the fourth at 17 m/s, a right-hand circuit (downwind 200 m right of the runway at 40 m) and a
+///   450 m final;
+/// - `runway 250`: the take-off item 300 m out 75 deg left at 60 m, three sides of a
+///   500 m x 300 m rectangle turned 60 deg left flown anticlockwise, two anticlockwise turns
+///   of 70 m round its fourth corner, a left-hand circuit 200 m off the runway at 45 m and a
+///   350 m final.
+pub fn other_runway_missions(home: GeoPoint) -> Vec<RunwayMission> {
+    let build = |deg: f64| RunwayBuilder {
+        frame: RunwayFrame::new(deg.to_radians()),
+        b: MissionBuilder::new(home),
+    };
+    let takeoff = |off_deg: f64, h: f64| {
+        let (s, c) = off_deg.to_radians().sin_cos();
+        Some((300.0 * c, 300.0 * s, h))
+    };
+    let east = build(120.0);
+    let r = east
+        .frame
+        .rectangle((750.0, 400.0), 500.0, 300.0, 30f64.to_radians());
+    // Three sides at 20 m/s, the fourth at 17, then into the circuit: closing the rectangle
+    // at 20 m/s put a 135 deg corner downwind, which the 70 m fillets (`NAV_TURN_RAD`, laid
+    // out for 22 m/s over ground) overshot by up to 58 m in the 5 m/s wind.
+    let east = east
+        .item(MavCmd::MAV_CMD_NAV_TAKEOFF, [0.0; 4], takeoff(30.0, 50.0))
+        .speed(20.0)
+        .waypoint(r[0].0, r[0].1, 50.0)
+        .waypoint(r[1].0, r[1].1, 50.0)
+        .waypoint(r[2].0, r[2].1, 50.0)
+        .speed(17.0)
+        .waypoint(r[3].0, r[3].1, 50.0)
+        .waypoint(400.0, 200.0, 40.0)
+        .waypoint(-450.0, 200.0, 40.0)
+        .waypoint(-450.0, 0.0, 40.0)
+        .land_at_home();
+    let west = build(250.0);
+    let r = west
+        .frame
+        .rectangle((700.0, -450.0), 500.0, 300.0, -60f64.to_radians());
+    let mut b = west.item(MavCmd::MAV_CMD_NAV_TAKEOFF, [0.0; 4], takeoff(-75.0, 60.0));
+    // Anticlockwise: the corners in reverse, the loiter at the last.
+    for c in [r[0], r[3], r[2]] {
+        b = b.waypoint(c.0, c.1, 60.0);
+    }
+    let west = b
+        .item(
+            MavCmd::MAV_CMD_NAV_LOITER_TURNS,
+            [2.0, 0.0, -70.0, 0.0],
+            Some((r[1].0, r[1].1, 60.0)),
+        )
+        .waypoint(400.0, -200.0, 45.0)
+        .waypoint(-350.0, -200.0, 45.0)
+        .waypoint(-350.0, 0.0, 45.0)
+        .land_at_home();
+    vec![
+        RunwayMission {
+            name: "runway 120",
+            what: "take-off item 30 deg right of the runway, a rectangle turned 30 deg right flown clockwise, three sides at 20 m/s and the fourth at 17 m/s, right-hand circuit",
+            runway_rad: 120f64.to_radians(),
+            items: east,
+        },
+        RunwayMission {
+            name: "runway 250",
+            what: "take-off item 75 deg left of the runway, three sides of a rectangle turned 60 deg left anticlockwise, two anticlockwise turns, left-hand circuit",
+            runway_rad: 250f64.to_radians(),
+            items: west,
+        },
+    ]
+}
+
 /// A flight of `mission` from the runway at home (heading north, engine off), as a pilot
 /// with QGroundControl flies it: no parameter set (the firmware's defaults fly), the mission
 /// uploaded, the autopilot armed once its estimator has converged, the mission started a second later; the flight

@@ -27,6 +27,7 @@
 
 pub mod compare;
 pub mod config;
+pub mod landed;
 pub mod missions;
 pub mod onboard;
 pub mod plots;

@@ -115,6 +115,7 @@ pub fn phase_name(index: u8) -> String {
         (P::Landed, "roll-out"),
         (P::Hold, "hold"),
         (P::Complete, "complete"),
+        (P::GoAround, "go-around"),
     ];
     known
         .iter()

@@ -125,6 +125,8 @@ pub enum Phase {
     Hold,
     /// The mission is over; circling where it ended.
     Complete,
+    /// A landing given up: climbing away and flying a circuit to a new approach.
+    GoAround,
 }
 
 /// Result of one step.

@@ -1,4 +1,4 @@
-//! Landing: approach, flare, touchdown and roll-out onto a point.
+//! Landing: approach, flare, touchdown and roll-out onto a point, and the go-around.
 //!
 //! Landing flies the line from the previous waypoint (or from where the item began) to the
 //! land point, level until it meets the glide slope, then down it (`LonMode::Glide`: the
@@ -14,6 +14,14 @@
 //! updraft, and the flare goes on); a second on the ground (height under `NAV_LND_TD_M`, sinking slower
 //! than 0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
 //! stopped.
+//!
+//! A flare still in the air `NAV_LND_ABORT_M` past the point (floated, or bounced off the
+//! runway) or lifted out of itself by a gust goes around, as a pilot does after a bounce:
+//! full throttle in the take-off regime on the runway's line up to the approach's start
+//! height, a leg back parallel to the runway two loiter radii to its left (a left-hand
+//! circuit), and a new approach from far enough out to meet the glide slope from that
+//! height. A ground station asks for the same with `MAV_CMD_DO_GO_AROUND`. After
+//! [`GO_AROUNDS_MAX`] go-arounds the landing lands whatever its flare brings.
 
 use super::guide::{course_near_ground, follow, horizontal_dist, Flight};
 use super::io::{NavOutput, Phase};
@@ -86,11 +94,38 @@ fn rollout_pitch(airspeed: f32) -> f32 {
     TAIL_DOWN_PITCH * ((fast - airspeed) / (fast - slow)).clamp(0.0, 1.0)
 }
 
+/// Most go-arounds one landing flies; after them it lands whatever the flare brings.
+const GO_AROUNDS_MAX: u8 = 2;
+/// Height a flaring aircraft must climb back to, as a multiple of the flare height, for the
+/// flare to count as ballooned (a gust has lifted it out of the flare): it goes around.
+const BALLOON_FLARES: f32 = 2.0;
+/// Least airspeed at which a landing goes around by itself, m/s: at its three-point attitude
+/// the Ultra Stick's wing (C_L about 0.8) carries its 19 N from about 11 m/s, so it can climb
+/// away. Slower, it is rolling (an estimated height tenths of a metre off may say otherwise),
+/// and full throttle there put one aircraft of 1000 on its nose.
+const GO_AROUND_AIRSPEED: f32 = 11.0;
+/// Least height above the land point a go-around climbs to, m.
+const GO_AROUND_MIN_M: f32 = 15.0;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum LandPhase {
     Approach,
     Flare,
+    /// Climbing away on the runway's line after a go-around.
+    Climb,
+    /// Flying back, offset to the left of the runway, to a new approach.
+    Downwind,
     Landed,
+}
+
+/// The circuit a go-around flies back to the runway on: up to `height` (above home), along
+/// a leg parallel to the approach two loiter radii to its left, and round onto a new
+/// approach from `origin`, far enough out to meet the glide slope from that height.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Circuit {
+    height: f32,
+    downwind: Path,
+    origin: Vector3<f32>,
 }
 
 /// A landing in progress.
@@ -108,6 +143,8 @@ pub(super) struct Landing {
     touched: bool,
     /// Time since the touchdown, s.
     rollout_s: f32,
+    /// Go-arounds flown.
+    go_arounds: u8,
 }
 
 /// How far past the point where the glide slope meets the flare height the flare carries
@@ -143,6 +180,94 @@ impl Landing {
             slope_trim: 0.0,
             touched: false,
             rollout_s: 0.0,
+            go_arounds: 0,
+        }
+    }
+
+    /// Gives up this approach: climb away on the runway's line and fly a circuit to a new one.
+    /// Ignored once on the ground, or after [`GO_AROUNDS_MAX`] go-arounds; returns whether the
+    /// aircraft goes around.
+    pub fn go_around(&mut self) -> bool {
+        let can = matches!(self.phase, LandPhase::Approach | LandPhase::Flare)
+            && self.go_arounds < GO_AROUNDS_MAX;
+        if can {
+            self.go_arounds += 1;
+            self.phase = LandPhase::Climb;
+            self.touched = false;
+            self.ground_time = 0.0;
+            self.slope_trim = 0.0;
+        }
+        can
+    }
+
+    /// The circuit after a go-around, flown at `airspeed` (m/s).
+    fn circuit(&self, p: &NavParams, airspeed: f32) -> Circuit {
+        let d = Vector3::new(
+            self.point.x - self.origin.x,
+            self.point.y - self.origin.y,
+            0.0,
+        );
+        let d = if d.norm() > 0.01 {
+            d.normalize()
+        } else {
+            Vector3::x()
+        };
+        let left = Vector3::new(d.y, -d.x, 0.0);
+        let ground = -self.point.z;
+        let height = (-self.origin.z).max(ground + GO_AROUND_MIN_M);
+        let tan_slope = libm::tanf(p.glide_slope).max(0.01);
+        let turn = 2.0 * p.loiter_radius;
+        let length =
+            horizontal_dist(&self.origin, &self.point).max((height - ground) / tan_slope + turn);
+        let mut origin = self.point - d * length;
+        origin.z = -height;
+        let mut from = self.point + left * turn;
+        from.z = -height;
+        let downwind = Path::Line {
+            origin: from,
+            direction: -d,
+            airspeed,
+        };
+        Circuit {
+            height,
+            downwind,
+            origin,
+        }
+    }
+
+    /// One step of the go-around's climb or its circuit back to a new approach.
+    fn step_circuit(&mut self, f: &Flight, line: &Path, out: &mut NavOutput) {
+        let p = f.params;
+        let state = f.state;
+        let c = self.circuit(p, f.cruise);
+        out.phase = Phase::GoAround;
+        out.target = Some(c.origin);
+        if self.phase == LandPhase::Climb {
+            let g = f.guidance.step(line, &state.pos_ned, state.ground_speed());
+            out.guidance = Some(g);
+            let hagl = state.height() + self.point.z;
+            out.commands = Some(Commands {
+                roll: course_near_ground(g.course, hagl, p),
+                yaw: RUDDER,
+                lon: LonMode::TakeOff {
+                    altitude: c.height,
+                    airspeed: f.cruise.min(p.takeoff_airspeed),
+                    clear_altitude: -self.point.z + p.takeoff_clear,
+                },
+            });
+            if state.height() >= c.height - p.alt_accept {
+                self.phase = LandPhase::Downwind;
+            }
+            return;
+        }
+        f.emit(&c.downwind, Some(c.origin), Phase::GoAround, out);
+        // Abeam the new approach's start: turn onto it.
+        let back = self.origin - self.point;
+        if (state.pos_ned - c.origin).dot(&Vector3::new(back.x, back.y, 0.0)) >= 0.0 {
+            *self = Self {
+                go_arounds: self.go_arounds,
+                ..Self::new(c.origin, self.point)
+            };
         }
     }
 
@@ -176,6 +301,10 @@ impl Landing {
                 direction: Vector3::x(),
                 airspeed: p.land_airspeed,
             });
+        if matches!(self.phase, LandPhase::Climb | LandPhase::Downwind) {
+            self.step_circuit(f, &line, out);
+            return;
+        }
         let mut g = f.guidance.step(&line, &pos, state.ground_speed());
         // Level at the approach's start height until the glide slope, then down it, the
         // command moving at the slope's rate over the ground so the autopilot can fly the
@@ -233,6 +362,18 @@ impl Landing {
             }
             if self.ground_time >= TOUCHDOWN_S {
                 self.phase = LandPhase::Landed;
+            }
+            // Floated or bounced past the point by more than the landing may be long, or
+            // lifted by a gust out of the flare: go around.
+            let long = p.land_abort > 0.0 && -signed_to_go > p.land_abort;
+            let airborne = hagl > p.touchdown_alt;
+            let flying = state.airspeed >= GO_AROUND_AIRSPEED;
+            if flying
+                && (long && airborne || hagl > BALLOON_FLARES * p.flare_alt)
+                && self.go_around()
+            {
+                self.step_circuit(f, &line, out);
+                return;
             }
         }
         match self.phase {
@@ -309,6 +450,7 @@ impl Landing {
                     },
                 });
             }
+            LandPhase::Climb | LandPhase::Downwind => {}
             LandPhase::Landed => {
                 out.phase = Phase::Landed;
                 // Slow enough to be left to itself, or rolling for longer than any roll-out

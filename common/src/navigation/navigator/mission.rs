@@ -231,12 +231,23 @@ pub(super) struct Leg {
     airspeed: f32,
     /// Where the next leg goes, when the corner at `target` is rounded.
     next: Option<Vector3<f32>>,
+    /// The leg starts where the aircraft is (after a take-off or a loiter, no corner leads
+    /// onto it) and the aircraft is still turning towards the waypoint: the line is drawn
+    /// anew from the present position each step until the course is within
+    /// [`JOIN_ALIGNED`] of it. Drawn once from a position the aircraft is flying away from,
+    /// the line was overshot by up to two turn radii (36 m after a take-off whose item lay
+    /// 75 deg off the runway).
+    joining: bool,
 }
+
+/// Course error under which a leg that starts from the aircraft's position is fixed, rad.
+const JOIN_ALIGNED: f32 = 15.0 * crate::math::DEG;
 
 impl Leg {
     /// The leg of waypoint `item` from `origin` to `target` (NED from home), at `airspeed`
     /// (m/s), rounding the corner towards `next`; its acceptance radius is `param2`, or
-    /// `NAV_ACC_RAD` when not positive.
+    /// `NAV_ACC_RAD` when not positive. `joining`: the origin is the aircraft's position, not
+    /// a waypoint.
     pub fn item(
         item: &MissionItem,
         origin: Vector3<f32>,
@@ -244,6 +255,7 @@ impl Leg {
         next: Option<Vector3<f32>>,
         airspeed: f32,
         p: &NavParams,
+        joining: bool,
     ) -> Self {
         let accept = if item.param(1) > 0.0 {
             item.param(1)
@@ -256,6 +268,7 @@ impl Leg {
             accept,
             airspeed,
             next,
+            joining,
         }
     }
 
@@ -267,13 +280,24 @@ impl Leg {
     /// One step along the leg (the item `seq`): its commands into `out`. True when the
     /// waypoint is reached; this step's commands then already follow the next leg.
     pub fn step(
-        &self,
+        &mut self,
         f: &Flight,
         paths: &mut PathManager,
         seq: Option<u16>,
         out: &mut NavOutput,
     ) -> bool {
         let id = seq.unwrap_or(0);
+        let pos = f.state.pos_ned;
+        if self.joining {
+            let v = f.state.vel_ned;
+            let to = self.target - pos;
+            let err = wrap_pi(libm::atan2f(to.y, to.x) - libm::atan2f(v.y, v.x));
+            if libm::fabsf(err) > JOIN_ALIGNED && f.state.ground_speed() > 1.0 {
+                self.origin = pos;
+            } else {
+                self.joining = false;
+            }
+        }
         let mk = |ned, id| Waypoint {
             id,
             ned,
@@ -292,6 +316,8 @@ impl Leg {
             .map(|s| s.path)
             .unwrap_or(Orbit::loiter(self.target, f.params).path(self.airspeed));
         f.emit(&path, Some(self.target), Phase::Waypoint, out);
+        // Turning onto the leg is no straight flight.
+        out.straight &= !self.joining;
         reached
     }
 }

@@ -23,7 +23,7 @@
 //! After the last item (or when a walk falls off the end) the aircraft circles where it is
 //! ([`Phase::Complete`]).
 //!
-//! Not done here: go-around, abort altitude, hold times at waypoints, ground speed (a
+//! Not done here: hold times at waypoints, ground speed (a
 //! `DO_CHANGE_SPEED` of ground speed sets the airspeed), terrain, rally points.
 
 mod guide;
@@ -155,6 +155,16 @@ impl Navigator {
         self.request = Some(Request::LoiterAt(center));
     }
 
+    /// Gives up the landing being flown (a mission's or a return's) for a go-around and a new
+    /// approach; returns whether there was an approach or flare to give up.
+    pub fn go_around(&mut self) -> bool {
+        match &mut self.active {
+            Active::Land(l) => l.go_around(),
+            Active::Return(r) => r.go_around(),
+            _ => false,
+        }
+    }
+
     /// Stops: the next steps give no commands.
     pub fn stop(&mut self) {
         self.request = None;
@@ -269,7 +279,8 @@ impl Navigator {
             NAV_WAYPOINT => {
                 let next = self.mission.corner_after(items, seq, home, &target);
                 let airspeed = self.mission.cruise(p);
-                Active::Waypoint(Leg::item(item, origin, target, next, airspeed, p))
+                let joining = self.mission.prev_waypoint.is_none();
+                Active::Waypoint(Leg::item(item, origin, target, next, airspeed, p, joining))
             }
             NAV_LOITER_UNLIM | NAV_LOITER_TURNS | NAV_LOITER_TIME | NAV_LOITER_TO_ALT => {
                 Active::Loiter(Loiter::item(item, target, p))
@@ -331,8 +342,10 @@ impl Navigator {
             Active::Idle => {
                 out.phase = Phase::Idle;
             }
-            Active::Waypoint(leg) => {
-                if leg.step(&f, &mut self.paths, seq, out) {
+            Active::Waypoint(mut leg) => {
+                let reached = leg.step(&f, &mut self.paths, seq, out);
+                self.active = Active::Waypoint(leg);
+                if reached {
                     // The new item flies from the next step; this step's commands already
                     // follow the next leg.
                     self.mission.prev_waypoint = Some(leg.target());

@@ -228,6 +228,17 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_LND_ABORT_M",
+                20.0,
+                0.0,
+                500.0,
+                "m",
+                "Go around when the flare is still in the air, at 11 m/s or more, this far past the land point (0: never)",
+            ),
+            NavParams => land_abort
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_LND_DISARM_S",
                 30.0,
                 5.0,
@@ -357,6 +368,9 @@ pub struct NavParams {
     pub takeoff_clear: f32,
     /// `NAV_LND_DISARM_S`: longest roll-out before the disarm, s.
     pub land_disarm_s: f32,
+    /// `NAV_LND_ABORT_M`: distance past the land point at which a flare still in the air goes
+    /// around, m (0: never).
+    pub land_abort: f32,
     /// `NAV_TKO_RAMP_S`: time of the take-off roll's throttle ramp, s.
     pub takeoff_ramp: f32,
     /// Glide slope, rad.
@@ -407,6 +421,7 @@ const ZERO: NavParams = NavParams {
     takeoff_clear: 0.0,
     takeoff_ramp: 0.0,
     land_disarm_s: 0.0,
+    land_abort: 0.0,
     glide_slope: 0.0,
     land_airspeed: 0.0,
     flare_alt: 0.0,

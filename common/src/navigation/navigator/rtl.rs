@@ -46,6 +46,14 @@ impl Return {
         }
     }
 
+    /// Gives up the return's landing for a go-around, if it is landing.
+    pub fn go_around(&mut self) -> bool {
+        match &mut self.phase {
+            ReturnPhase::Land(l) => l.go_around(),
+            _ => false,
+        }
+    }
+
     /// One step of the return: its commands into `out`. `runway` is the course of the last
     /// take-off (the landing's final approach), `seq` the mission item reported reached on
     /// arriving home.
