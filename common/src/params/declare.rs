@@ -78,7 +78,7 @@ impl ParamError {
 /// description and labels. They reach a ground station in the parameter metadata file, which
 /// the firmware's build script writes on the host and the image serves compressed; nothing on
 /// board reads them, so the image carries neither the texts nor room for them (24 bytes of
-/// each of some 150 parameter definitions: 3.5 KB of flash).
+/// each of some 140 parameter definitions, and the lists of labels: 3.5 KB of flash).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HostOnly<T: Copy + 'static>(
     #[cfg(not(target_os = "none"))] T,

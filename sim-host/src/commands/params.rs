@@ -29,7 +29,8 @@ fn number(x: f32) -> String {
 fn labels(d: &ParamDef) -> Vec<(i32, &'static str)> {
     match d.kind {
         ParamKind::Bool => vec![(0, "off"), (1, "on")],
-        ParamKind::Enum(names) => names.get()
+        ParamKind::Enum(names) => names
+            .get()
             .iter()
             .enumerate()
             .map(|(i, n)| (i as i32, *n))
