@@ -351,7 +351,9 @@ fn parse_param(s: &str) -> Result<(String, f32), String> {
     def.check(v).map_err(|e| {
         format!(
             "`{s}`: {name} refuses {v} ({e:?}; bounds {} to {} {})",
-            def.min, def.max, def.unit
+            def.min,
+            def.max,
+            def.unit.get()
         )
     })?;
     Ok((name.to_string(), v))

@@ -7,6 +7,7 @@
 //! old plan. Home is not item 0: item 0 is the first thing to fly.
 
 use super::peer::Peer;
+use crate::link::mav_cmd::mav_cmd;
 use crate::navigation::fence::validate_fence;
 use crate::navigation::plan::{MissionItem, MissionStore, PlanKind, MISSION_CAPACITY};
 use crate::navigation::validate::{validate_mission, PlanRules, ValidationWarning};
@@ -117,7 +118,7 @@ pub fn item_to_mav(
         y: item.y,
         z: item.z_m(),
         seq,
-        command: MavCmd::from_u32(u32::from(item.command))?,
+        command: mav_cmd(u32::from(item.command))?,
         target_system: target.0,
         target_component: target.1,
         frame: MavFrame::from_u32(u32::from(item.frame))?,

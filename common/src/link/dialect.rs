@@ -11,6 +11,7 @@
 //! the common dialect does not know is to the host's tools: counted as an unknown id and
 //! dropped.
 
+use super::mav_cmd;
 use crate::crc::crc16_mcrf4xx;
 use mavlink::dialects::common::*;
 use mavlink::error::ParserError;
@@ -101,16 +102,21 @@ fn finish_v2(
     Some(())
 }
 
-/// Writes the autopilot's dialect from two lists of `MavMessage` variants and their data
-/// types: the messages it reads and the messages it writes.
+/// Writes the autopilot's dialect from three lists of `MavMessage` variants and their data
+/// types: the messages it reads with the crate's decoders, those it reads with a decoder of
+/// this crate's, and the messages it writes.
 // The autopilot still answers the deprecated messages ground stations send (SET_MODE,
 // MISSION_ITEM, ...), so the dialect names them.
 macro_rules! autopilot_dialect {
-    (reads: [$($r:ident($rd:ident)),* $(,)?], writes: [$($w:ident($wd:ident)),* $(,)?] $(,)?) => {
+    (
+        reads: [$($r:ident($rd:ident)),* $(,)?],
+        reads_by: [$($o:ident($od:ident) by $of:path),* $(,)?],
+        writes: [$($w:ident($wd:ident)),* $(,)?] $(,)?
+    ) => {
         #[allow(deprecated)]
         mod ids {
             use super::*;
-            pub(super) const READS: &[u32] = &[$($rd::ID),*];
+            pub(super) const READS: &[u32] = &[$($rd::ID,)* $($od::ID),*];
             pub(super) const WRITES: &[u32] = &[$($wd::ID),*];
         }
 
@@ -131,6 +137,7 @@ macro_rules! autopilot_dialect {
             fn extra_crc(id: u32) -> Option<u8> {
                 match id {
                     $($rd::ID => Some($rd::EXTRA_CRC),)*
+                    $($od::ID => Some($od::EXTRA_CRC),)*
                     _ => None,
                 }
             }
@@ -142,6 +149,7 @@ macro_rules! autopilot_dialect {
             ) -> Result<MavMessage, ParserError> {
                 match id {
                     $($rd::ID => $rd::deser(version, payload).map(MavMessage::$r),)*
+                    $($od::ID => $of(payload).map(MavMessage::$o),)*
                     _ => Err(ParserError::UnknownMessage { id }),
                 }
             }
@@ -169,12 +177,8 @@ autopilot_dialect! {
         PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA),
         PARAM_SET(PARAM_SET_DATA),
         MANUAL_CONTROL(MANUAL_CONTROL_DATA),
-        COMMAND_LONG(COMMAND_LONG_DATA),
-        COMMAND_INT(COMMAND_INT_DATA),
         SET_MODE(SET_MODE_DATA),
         MISSION_COUNT(MISSION_COUNT_DATA),
-        MISSION_ITEM_INT(MISSION_ITEM_INT_DATA),
-        MISSION_ITEM(MISSION_ITEM_DATA),
         MISSION_REQUEST_LIST(MISSION_REQUEST_LIST_DATA),
         MISSION_REQUEST_INT(MISSION_REQUEST_INT_DATA),
         MISSION_REQUEST(MISSION_REQUEST_DATA),
@@ -187,6 +191,14 @@ autopilot_dialect! {
         HIL_STATE_QUATERNION(HIL_STATE_QUATERNION_DATA),
         BATTERY_STATUS(BATTERY_STATUS_DATA),
         RC_CHANNELS(RC_CHANNELS_DATA),
+    ],
+    // Ground link: the messages that carry a MAV_CMD number, decoded without the crate's
+    // conversion of the number (`mav_cmd`).
+    reads_by: [
+        COMMAND_LONG(COMMAND_LONG_DATA) by mav_cmd::command_long,
+        COMMAND_INT(COMMAND_INT_DATA) by mav_cmd::command_int,
+        MISSION_ITEM_INT(MISSION_ITEM_INT_DATA) by mav_cmd::mission_item_int,
+        MISSION_ITEM(MISSION_ITEM_DATA) by mav_cmd::mission_item,
     ],
     writes: [
         // Ground link: telemetry (gcs::telemetry) ...

@@ -6,5 +6,6 @@
 
 pub mod dialect;
 pub mod framing;
+pub mod mav_cmd;
 pub mod signing;
 pub mod simlink;

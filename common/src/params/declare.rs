@@ -11,7 +11,7 @@ pub enum ParamKind {
     /// Off (0) or on (1) (`MAV_PARAM_TYPE_INT32`).
     Bool,
     /// One of named values 0, 1, ... (`MAV_PARAM_TYPE_INT32`); the labels in value order.
-    Enum(&'static [&'static str]),
+    Enum(HostOnly<&'static [&'static str]>),
 }
 
 impl ParamKind {
@@ -33,10 +33,10 @@ pub struct ParamDef {
     pub min: f32,
     /// Largest accepted value.
     pub max: f32,
-    /// Unit, empty when dimensionless (and on the MCU: see [`host_only`]).
-    pub unit: &'static str,
-    /// One line saying what the parameter does (empty on the MCU: see [`host_only`]).
-    pub description: &'static str,
+    /// Unit, empty when dimensionless.
+    pub unit: HostOnly<&'static str>,
+    /// One line saying what the parameter does.
+    pub description: HostOnly<&'static str>,
     /// What kind of value it is.
     pub kind: ParamKind,
 }
@@ -74,15 +74,35 @@ impl ParamError {
     }
 }
 
-/// `text` on the host, empty on the MCU. Units and descriptions reach a ground station in the
-/// parameter metadata file, which the firmware's build script writes on the host and the image
-/// serves compressed; nothing on board reads them, so the image does not carry them twice
-/// (some 7 KB of flash).
-const fn host_only(text: &'static str) -> &'static str {
-    if cfg!(target_os = "none") {
-        ""
-    } else {
-        text
+/// A value the host build keeps and the MCU image does not carry: a parameter's unit,
+/// description and labels. They reach a ground station in the parameter metadata file, which
+/// the firmware's build script writes on the host and the image serves compressed; nothing on
+/// board reads them, so the image carries neither the texts nor room for them (24 bytes of
+/// each of some 140 parameter definitions, and the lists of labels: 3.5 KB of flash).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HostOnly<T: Copy + 'static>(
+    #[cfg(not(target_os = "none"))] T,
+    #[cfg(target_os = "none")] core::marker::PhantomData<T>,
+);
+
+impl<T: Copy + Default + 'static> HostOnly<T> {
+    /// `value`, kept on the host only.
+    pub const fn new(value: T) -> Self {
+        #[cfg(not(target_os = "none"))]
+        return Self(value);
+        #[cfg(target_os = "none")]
+        {
+            let _ = value;
+            Self(core::marker::PhantomData)
+        }
+    }
+
+    /// The value on the host; on the MCU the type's default (an empty text or list).
+    pub fn get(self) -> T {
+        #[cfg(not(target_os = "none"))]
+        return self.0;
+        #[cfg(target_os = "none")]
+        T::default()
     }
 }
 
@@ -101,8 +121,8 @@ impl ParamDef {
             default,
             min,
             max,
-            unit: host_only(unit),
-            description: host_only(description),
+            unit: HostOnly::new(unit),
+            description: HostOnly::new(description),
             kind: ParamKind::Real,
         }
     }
@@ -121,8 +141,8 @@ impl ParamDef {
             default: default as f32,
             min: min as f32,
             max: max as f32,
-            unit: host_only(unit),
-            description: host_only(description),
+            unit: HostOnly::new(unit),
+            description: HostOnly::new(description),
             kind: ParamKind::Int,
         }
     }
@@ -134,8 +154,8 @@ impl ParamDef {
             default: if default { 1.0 } else { 0.0 },
             min: 0.0,
             max: 1.0,
-            unit: "",
-            description: host_only(description),
+            unit: HostOnly::new(""),
+            description: HostOnly::new(description),
             kind: ParamKind::Bool,
         }
     }
@@ -152,9 +172,9 @@ impl ParamDef {
             default: default as f32,
             min: 0.0,
             max: (labels.len() - 1) as f32,
-            unit: "",
-            description: host_only(description),
-            kind: ParamKind::Enum(labels),
+            unit: HostOnly::new(""),
+            description: HostOnly::new(description),
+            kind: ParamKind::Enum(HostOnly::new(labels)),
         }
     }
 

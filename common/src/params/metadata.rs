@@ -55,7 +55,7 @@ impl Write for Places {
 fn labels(d: &ParamDef) -> impl Iterator<Item = (usize, &'static str)> {
     let names: &'static [&'static str] = match d.kind {
         ParamKind::Bool => &["off", "on"],
-        ParamKind::Enum(names) => names,
+        ParamKind::Enum(names) => names.get(),
         ParamKind::Real | ParamKind::Int => &[],
     };
     names.iter().copied().enumerate()
@@ -102,10 +102,10 @@ pub fn write_json(registry: Registry, w: &mut impl Write) -> fmt::Result {
                 "Float"
             };
             write!(w, ",\"type\":\"{ty}\",\"shortDesc\":")?;
-            string(w, d.description)?;
-            if !d.unit.is_empty() {
+            string(w, d.description.get())?;
+            if !d.unit.get().is_empty() {
                 w.write_str(",\"units\":")?;
-                string(w, d.unit)?;
+                string(w, d.unit.get())?;
             }
             w.write_str(",\"default\":")?;
             number(w, d, d.default)?;

@@ -13,7 +13,7 @@ pub mod metadata;
 pub mod store;
 
 pub use declare::{
-    independent, validate_defs, Choice, Group, Param, ParamDef, ParamError, ParamKind, Stage,
-    MAX_NAME_LEN,
+    independent, validate_defs, Choice, Group, HostOnly, Param, ParamDef, ParamError, ParamKind,
+    Stage, MAX_NAME_LEN,
 };
 pub use store::{ParamStore, Registry, RegistryError};

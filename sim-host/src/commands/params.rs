@@ -30,6 +30,7 @@ fn labels(d: &ParamDef) -> Vec<(i32, &'static str)> {
     match d.kind {
         ParamKind::Bool => vec![(0, "off"), (1, "on")],
         ParamKind::Enum(names) => names
+            .get()
             .iter()
             .enumerate()
             .map(|(i, n)| (i as i32, *n))
@@ -65,7 +66,7 @@ pub fn tables(registry: Registry) -> Vec<Table> {
                 ],
             );
             for d in defs {
-                let mut description = d.description.to_string();
+                let mut description = d.description.get().to_string();
                 let l = labels(d);
                 if !l.is_empty() {
                     let values: Vec<String> = l.iter().map(|(v, n)| format!("{v} {n}")).collect();
@@ -76,7 +77,7 @@ pub fn tables(registry: Registry) -> Vec<Table> {
                     number(d.default),
                     number(d.min),
                     number(d.max),
-                    d.unit.to_string(),
+                    d.unit.get().to_string(),
                     kind_name(d.kind).to_string(),
                     description,
                 ]);
