@@ -293,7 +293,10 @@ impl Leg {
             let to = self.target - pos;
             let err = wrap_pi(libm::atan2f(to.y, to.x) - libm::atan2f(v.y, v.x));
             if libm::fabsf(err) > JOIN_ALIGNED && f.state.ground_speed() > 1.0 {
-                self.origin = pos;
+                // Over the ground only: the line's height profile still starts at the leg's
+                // own height (drawn from the aircraft's, a height lost in the turn was never
+                // climbed back).
+                self.origin = Vector3::new(pos.x, pos.y, self.origin.z);
             } else {
                 self.joining = false;
             }
