@@ -59,9 +59,16 @@ fn round_e7(x: f64) -> i32 {
     r as i32
 }
 
+/// Sine and cosine of latitudes: on the MCU (and with `bounded-trig`) without `libm`'s
+/// reduction of large arguments ([`super::latitude`]).
+#[cfg(any(target_os = "none", feature = "bounded-trig"))]
+use super::latitude::{cos as lat_cos, sin as lat_sin};
+#[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
+use libm::{cos as lat_cos, sin as lat_sin};
+
 /// Meridian and prime-vertical radii of curvature (m) at a latitude.
 fn radii(lat_rad: f64) -> (f64, f64) {
-    let s = libm::sin(lat_rad);
+    let s = lat_sin(lat_rad);
     let w2 = 1.0 - WGS84_E2 * s * s;
     let w = libm::sqrt(w2);
     (WGS84_A_M * (1.0 - WGS84_E2) / (w2 * w), WGS84_A_M / w)
@@ -93,7 +100,7 @@ pub fn ned_offset<T: RealField + Copy>(origin: GeoPoint, p: GeoPoint) -> (T, T) 
     let lat_mid = deg_e7_to_rad(i64::from(origin.lat_e7)) + 0.5 * deg_e7_to_rad(dlat);
     let (m, n) = radii(lat_mid);
     let north = deg_e7_to_rad(dlat) * m;
-    let east = deg_e7_to_rad(dlon) * n * libm::cos(lat_mid);
+    let east = deg_e7_to_rad(dlon) * n * lat_cos(lat_mid);
     (T::from_subset(&north), T::from_subset(&east))
 }
 
@@ -120,7 +127,7 @@ pub fn offset_point<T: RealField + Copy>(origin: GeoPoint, north: T, east: T) ->
     let lat_mid = lat0 + 0.5 * dlat_rad;
     let (_, n) = radii(lat_mid);
     let dlat = dlat_rad * to_e7;
-    let dlon = east / (n * libm::cos(lat_mid)) * to_e7;
+    let dlon = east / (n * lat_cos(lat_mid)) * to_e7;
     let lat = f64::from(origin.lat_e7) + dlat;
     let mut lon = f64::from(origin.lon_e7) + dlon;
     if lon > 1.8e9 {
@@ -160,7 +167,7 @@ impl LocalFrame {
         let h = 1e-3;
         let parallel = |lat: f64| {
             let (_, n) = radii(lat);
-            n * libm::cos(lat)
+            n * lat_cos(lat)
         };
         let meridian = |lat: f64| radii(lat).0;
         // Central differences over 1 mrad: the third-order terms they leave are far below

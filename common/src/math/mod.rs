@@ -12,6 +12,7 @@
 pub mod atmosphere;
 pub mod frames;
 pub mod geodetic;
+pub mod latitude;
 
 pub use frames::*;
 
