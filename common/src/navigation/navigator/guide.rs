@@ -59,8 +59,13 @@ pub(super) fn follow(g: &GuidanceOutput) -> Commands {
 /// once it is the smaller), so a wing tip cannot touch (the Ultra Stick's does at 17 deg of
 /// bank with its wheels on the ground, at 38 deg with them 0.2 m up, at none from 0.45 m).
 pub(super) fn course_near_ground(course: f32, height: f32, p: &NavParams) -> RollMode {
-    let frac = if p.ground_roll_height > 0.0 && height.is_finite() {
-        (height / p.ground_roll_height).clamp(0.0, 1.0)
+    course_widening(course, height, p.ground_roll_height, p)
+}
+
+/// As [`course_near_ground`], the bank allowed widening to 90 deg at `widen_m` (m) instead.
+pub(super) fn course_widening(course: f32, height: f32, widen_m: f32, p: &NavParams) -> RollMode {
+    let frac = if widen_m > 0.0 && height.is_finite() {
+        (height / widen_m).clamp(0.0, 1.0)
     } else {
         1.0
     };

@@ -23,7 +23,7 @@
 //! height. A ground station asks for the same with `MAV_CMD_DO_GO_AROUND`. After
 //! [`GO_AROUNDS_MAX`] go-arounds the landing lands whatever its flare brings.
 
-use super::guide::{course_near_ground, follow, horizontal_dist, Flight};
+use super::guide::{course_near_ground, course_widening, follow, horizontal_dist, Flight};
 use super::io::{NavOutput, Phase};
 use super::params::NavParams;
 use crate::control::autopilot::Commands;
@@ -93,6 +93,14 @@ fn rollout_pitch(airspeed: f32) -> f32 {
     }
     TAIL_DOWN_PITCH * ((fast - airspeed) / (fast - slow)).clamp(0.0, 1.0)
 }
+
+/// Height at which the bank the flare allows has widened to 90 deg, m (`NAV_GND_RLL_M` when
+/// larger): 17.75 deg at the 1.5 m flare's top, 7.5 deg at 0.3 m. The approach's bank widening
+/// to 90 deg at 3 m let the course loop answer a gust's 9 deg of course with 25 deg of bank at
+/// 0.85 m, and the wing tip met the runway (58 of 1000 dispersed flights in moderate
+/// turbulence, `docs/RESULTS-MONTECARLO.md`); widening to 10 m on the approach as well held
+/// its crosswind corrections too long (`docs/NAVIGATION.md`).
+const FLARE_BANK_M: f32 = 10.0;
 
 /// Most go-arounds one landing flies; after them it lands whatever the flare brings.
 const GO_AROUNDS_MAX: u8 = 2;
@@ -345,6 +353,16 @@ impl Landing {
         if self.phase == LandPhase::Approach && hagl < p.flare_alt {
             self.phase = LandPhase::Flare;
         }
+        // Lifted off the runway by a gust after the touchdown, the aircraft is flying again:
+        // the flare, not the roll-out's level pitch, brings it back down.
+        if self.phase == LandPhase::Landed
+            && hagl > p.touchdown_alt
+            && state.vel_ned.z < -BOUNCE_CLIMB
+        {
+            self.phase = LandPhase::Flare;
+            self.touched = false;
+            self.ground_time = 0.0;
+        }
         if self.phase == LandPhase::Flare {
             let sink = state.vel_ned.z;
             let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
@@ -369,6 +387,7 @@ impl Landing {
             let airborne = hagl > p.touchdown_alt;
             let flying = state.airspeed >= GO_AROUND_AIRSPEED;
             if flying
+                && self.rollout_s == 0.0
                 && (long && airborne || hagl > BALLOON_FLARES * p.flare_alt)
                 && self.go_around()
             {
@@ -442,7 +461,12 @@ impl Landing {
                     RUDDER
                 };
                 out.commands = Some(Commands {
-                    roll: course_near_ground(g.course, hagl, p),
+                    roll: course_widening(
+                        g.course,
+                        hagl,
+                        p.ground_roll_height.max(FLARE_BANK_M),
+                        p,
+                    ),
                     yaw,
                     lon: LonMode::Pitch {
                         pitch,
