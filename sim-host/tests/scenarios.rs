@@ -284,6 +284,29 @@ fn p_only_altitude_loop_settles_on_the_command() {
     assert!(flown.abs() < 0.1, "flown {flown} m");
 }
 
+/// The total energy control's height reference approaches a demand at `TECS_H_K` (0.4 1/s),
+/// the height loop's own rate, so a step that reaches no climb or sink limit is a first-order
+/// lag of time constant 1 / 0.4 = 2.5 s: 10-90 % rise ln 9 x 2.5 = 5.49 s, no overshoot. The
+/// 2 m step asks for 0.8 m/s at most (the limit is 3). Flown on the nonlinear plant with the
+/// servos and the delay, the rise is within 10 % of that and the overshoot under 2 %.
+#[test]
+fn the_energy_controls_small_altitude_step_is_the_first_order_lag_of_its_height_gain() {
+    use sim_host::commands::scenario::FLIGHT_TECS;
+    let g = gain_set(aircraft(), FLIGHT_TECS).unwrap();
+    let k = f64::from(g.tecs.height_k);
+    let predicted = 9f64.ln() / k;
+    assert!((predicted - 5.49).abs() < 0.01, "{predicted}");
+    let r = fly_sets("altitude_step_small", &[FLIGHT_TECS], &SimConfig::default());
+    let m = of(&r, FLIGHT_TECS).segments[0].metrics;
+    let rise = m.rise_time_s.unwrap();
+    assert!(
+        (rise / predicted - 1.0).abs() < 0.1,
+        "rise {rise} s, predicted {predicted} s"
+    );
+    let overshoot = m.overshoot_pct;
+    assert!(overshoot < 2.0, "overshoot {overshoot} %");
+}
+
 /// A gain file is checked gain by gain: a missing or non-finite gain is refused with its name.
 #[test]
 fn gain_files_name_the_missing_or_bad_gain() {

@@ -74,6 +74,38 @@ fn a_climb_demand_raises_throttle_by_the_energy_rate_over_a_v2() {
     assert!((o.pitch_cmd - want_pitch).abs() < 1e-4, "{}", o.pitch_cmd);
 }
 
+/// A 2 m step of the demand is filtered at `k_h`: the first climb-rate demand is `k_h` x 2 m
+/// = 0.8 m/s (the reference moved k_h x 2 m x dt), not the 3 m/s climb limit a slew would ask.
+#[test]
+fn a_small_altitude_step_asks_for_k_h_times_the_step_not_the_climb_limit() {
+    let t = ENGAGED_FOR_TEST;
+    let mut tecs = settled(&t, 100.0, 17.0);
+    tecs.observe(100.0, 17.0, DT);
+    let o = tecs.step(&demand(102.0, 17.0), &FLIGHT, DT).unwrap();
+    let moved = t.height_k * 2.0 * DT;
+    let want = t.height_k * 2.0 + t.height_k * moved;
+    assert!((want - 0.8).abs() < 0.01);
+    assert!((o.climb_rate_demand - want).abs() < 1e-4, "{o:?}");
+}
+
+/// A demand moving at 1 m/s (a leg between waypoints 20 m apart in height, flown for 20 s)
+/// is a ramp the aircraft can fly: the reference follows it without lag, so after a second
+/// with the aircraft held at 100 m the climb-rate demand is the ramp's 1 m/s plus `k_h` x the
+/// metre the reference has moved, 1.4 m/s (a first-order filter alone would lag 2.5 m).
+#[test]
+fn a_ramp_of_the_demand_is_followed_without_lag() {
+    let t = ENGAGED_FOR_TEST;
+    let mut tecs = settled(&t, 100.0, 17.0);
+    let mut o = TecsOutput::default();
+    for i in 1..=50 {
+        tecs.observe(100.0, 17.0, DT);
+        o = tecs
+            .step(&demand(100.0 + i as f32 * DT, 17.0), &FLIGHT, DT)
+            .unwrap();
+    }
+    assert!((o.climb_rate_demand - 1.4).abs() < 0.01, "{o:?}");
+}
+
 /// A far climb demand is limited to the climb limit and saturates the throttle; the
 /// integrator stops there (conditional integration), so on reaching the altitude there is
 /// nothing to unwind.
