@@ -14,6 +14,10 @@
 //! H(z, n) = { p : (p - z) . n >= 0 }  half-plane switching, robust to missing a radius
 //! ```
 //!
+//! The radius R is `NAV_TURN_RAD`, widened to the turn at 35 deg of bank over ground when the
+//! leg's airspeed and the estimated wind ask for more: `(V_a + W)^2 / (g tan 35 deg)`, laid out
+//! when the leg begins.
+//!
 //! Geometry is horizontal; the line's altitude runs from one waypoint's altitude to the next
 //! (the guidance interpolates it) and a fillet is flown at its corner waypoint's altitude.
 //!
@@ -35,7 +39,9 @@ use nalgebra::{Vector2, Vector3};
 /// ground with the wind behind it: 17 m/s of airspeed and 5 m/s of wind make 22 m/s, and at
 /// 35 degrees of bank (the 45-degree limit less room for gusts and the course loop)
 /// `22^2 / (g tan 35)` is 70 m. A 50 m fillet held the bank on its limit downwind and let one
-/// gust carry the aircraft 20 m outside the corner.
+/// gust carry the aircraft 20 m outside the corner. Faster, or in more wind, a corner is
+/// widened to that turn ([`PathManager::fillet_radius`]): a 135 deg corner flown at 20 m/s
+/// with 5 m/s behind was overshot by 58 m on the 70 m fillet.
 pub const PARAMS: Group<PathParams> = Group {
     name: "Path manager",
     params: &[param!(
@@ -45,7 +51,7 @@ pub const PARAMS: Group<PathParams> = Group {
         5.0,
         500.0,
         "m",
-        "Fillet radius at waypoint corners: the smallest turn radius over ground, wind included",
+        "Smallest fillet radius at waypoint corners; a corner is widened to the turn at 35 deg of bank over ground, (airspeed + wind)^2 / (g tan 35 deg), when that is wider",
     ),
         PathParams => turn_radius
     )],
@@ -72,6 +78,12 @@ pub const WINDOW: usize = 3;
 
 /// Turns under this angle are flown through without a fillet, rad (1 deg).
 const STRAIGHT_ON: f32 = 1.0 * core::f32::consts::PI / 180.0;
+
+/// Bank a fillet is laid out for, rad: the 45-degree limit less room for gusts and the course
+/// loop (`NAV_TURN_RAD`'s default is this turn at 22 m/s over ground).
+pub const TURN_BANK: f32 = 35.0 * core::f32::consts::PI / 180.0;
+/// Widest fillet the wind and airspeed may ask for, m (`NAV_TURN_RAD`'s own upper bound).
+pub const TURN_RADIUS_MAX: f32 = 500.0;
 
 /// One waypoint of the window.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +126,8 @@ pub struct PathManager {
     /// The leg being flown (its end's id and position), to notice when the caller changes it.
     leg: Option<(u16, Vector3<f32>)>,
     segment: Segment,
+    /// The fillet radius of the leg's corner, m, laid out when the leg began.
+    leg_radius: f32,
 }
 
 impl Default for PathManager {
@@ -139,10 +153,12 @@ fn in_half_plane(p: Vector2<f32>, z: Vector2<f32>, n: Vector2<f32>) -> bool {
 impl PathManager {
     /// A manager rounding corners with this radius, m (clamped to at least 1 m).
     pub fn new(turn_radius: f32) -> Self {
+        let turn_radius = sane_radius(turn_radius);
         Self {
-            turn_radius: sane_radius(turn_radius),
+            turn_radius,
             leg: None,
             segment: Segment::Straight,
+            leg_radius: turn_radius,
         }
     }
 
@@ -167,10 +183,29 @@ impl PathManager {
         self.segment
     }
 
+    /// The fillet radius for a corner flown at up to `airspeed` (m/s) in a wind of
+    /// `wind_speed` (m/s): `NAV_TURN_RAD`, or the turn over ground at [`TURN_BANK`] with the
+    /// wind behind, `(airspeed + wind)^2 / (g tan 35 deg)`, if that is wider (at most
+    /// [`TURN_RADIUS_MAX`]). A non-finite or negative speed counts as none.
+    pub fn fillet_radius(&self, airspeed: f32, wind_speed: f32) -> f32 {
+        let speed = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
+        let over_ground = speed(airspeed) + speed(wind_speed);
+        let needed = over_ground * over_ground / (crate::math::GRAVITY * libm::tanf(TURN_BANK));
+        self.turn_radius.max(needed.min(TURN_RADIUS_MAX))
+    }
+
     /// One step from the position `pos` (NED from home, m) along the window `[from, to,
-    /// next?]`; `None` when the window holds fewer than two waypoints. A leg shorter than 1 cm
-    /// is flown from `pos` straight to `to`.
-    pub fn step(&mut self, pos: &Vector3<f32>, window: &[Waypoint]) -> Option<PathStep> {
+    /// next?]`, with the estimated horizontal wind speed `wind_speed` (m/s; 0 when unknown);
+    /// `None` when the window holds fewer than two waypoints. A leg shorter than 1 cm is flown
+    /// from `pos` straight to `to`. The corner's fillet radius ([`PathManager::fillet_radius`],
+    /// at the faster of the two legs' airspeeds) is laid out when the leg begins and kept, so
+    /// that a gust does not move the arc under the aircraft.
+    pub fn step(
+        &mut self,
+        pos: &Vector3<f32>,
+        window: &[Waypoint],
+        wind_speed: f32,
+    ) -> Option<PathStep> {
         let (from, to) = match window {
             [a, b, ..] => (a, b),
             _ => return None,
@@ -179,6 +214,8 @@ impl PathManager {
         if self.leg != Some((to.id, to.ned)) {
             self.leg = Some((to.id, to.ned));
             self.segment = Segment::Straight;
+            let airspeed = next.map_or(to.airspeed, |n| to.airspeed.max(n.airspeed));
+            self.leg_radius = self.fillet_radius(airspeed, wind_speed);
         }
         let p = horizontal(pos);
         let w = horizontal(&to.ned);
@@ -204,7 +241,7 @@ impl PathManager {
             let half = 0.5 * rho;
             let tan_half = libm::tanf(half);
             let radius = self
-                .turn_radius
+                .leg_radius
                 .min(0.5 * len_prev.min(len_next) * tan_half)
                 .max(0.01);
             let (dq, _) = unit(q_prev - q_next)?;
@@ -305,11 +342,13 @@ mod tests {
     use crate::params::{validate_defs, ParamError};
     use approx::assert_abs_diff_eq;
 
+    /// A waypoint flown at 15 m/s, whose still-air turn at 35 deg (33 m) is inside every
+    /// fillet radius below: the geometry is the radius given.
     fn wp(id: u16, n: f32, e: f32, h: f32) -> Waypoint {
         Waypoint {
             id,
             ned: Vector3::new(n, e, -h),
-            airspeed: 17.0,
+            airspeed: 15.0,
             accept_radius: 10.0,
         }
     }
@@ -336,6 +375,49 @@ mod tests {
         assert_eq!(m.turn_radius(), 60.0);
     }
 
+    /// The fillet widens to the turn over ground at 35 deg of bank with the wind behind:
+    /// 17 m/s and 5 m/s of wind need 22^2 / (g tan 35) = 70.5 m (the 70 m default's own
+    /// design), 20 m/s and 5 m/s 25^2 / (g tan 35) = 91.0 m; 15 m/s in still air (32.8 m)
+    /// keeps the parameter's 70 m. A 90 deg corner laid out in that wind at 20 m/s leaves
+    /// its line 91 m before the corner, where in still air it keeps to it until 70 m.
+    #[test]
+    fn the_fillet_widens_with_airspeed_and_wind_to_a_35_degree_turn_over_ground() {
+        let m = PathManager::default();
+        assert_abs_diff_eq!(m.fillet_radius(17.0, 5.0), 70.5, epsilon = 0.1);
+        assert_abs_diff_eq!(m.fillet_radius(20.0, 5.0), 91.0, epsilon = 0.1);
+        assert_eq!(m.fillet_radius(15.0, 0.0), 70.0);
+        assert_eq!(m.fillet_radius(15.0, f32::NAN), 70.0);
+        assert_eq!(m.fillet_radius(f32::INFINITY, 5.0), 70.0);
+        assert_eq!(m.fillet_radius(200.0, 0.0), TURN_RADIUS_MAX);
+        let fast = |id| Waypoint {
+            airspeed: 20.0,
+            ..wp(id, 0.0, 0.0, 50.0)
+        };
+        let win = [
+            fast(0),
+            Waypoint {
+                ned: Vector3::new(300.0, 0.0, -50.0),
+                ..fast(1)
+            },
+            Waypoint {
+                ned: Vector3::new(300.0, 300.0, -50.0),
+                ..fast(2)
+            },
+        ];
+        let at = |wind: f32, n: f32| {
+            let mut m = PathManager::default();
+            m.step(&Vector3::new(100.0, 0.0, -50.0), &win, wind)
+                .unwrap();
+            m.step(&Vector3::new(n, 0.0, -50.0), &win, wind)
+                .unwrap()
+                .segment
+        };
+        assert_eq!(at(5.0, 205.0), Segment::Straight);
+        assert_eq!(at(5.0, 212.0), Segment::Fillet);
+        assert_eq!(at(0.0, 212.0), Segment::Straight);
+        assert_eq!(at(0.0, 232.0), Segment::Fillet);
+    }
+
     /// A 90-degree right turn: the fillet starts R before the corner, is centred R to the
     /// inside of both legs, turns clockwise, and the waypoint is reached R after the corner.
     #[test]
@@ -346,11 +428,11 @@ mod tests {
             wp(1, 300.0, 0.0, 60.0),
             wp(2, 300.0, 300.0, 60.0),
         ];
-        let s = m.step(&Vector3::new(200.0, 0.0, -55.0), &win).unwrap();
+        let s = m.step(&Vector3::new(200.0, 0.0, -55.0), &win, 0.0).unwrap();
         assert_eq!(s.segment, Segment::Straight);
         assert!(matches!(s.path, Path::Line { .. }));
         // Just past z1 = (260, 0).
-        let s = m.step(&Vector3::new(260.5, 0.0, -60.0), &win).unwrap();
+        let s = m.step(&Vector3::new(260.5, 0.0, -60.0), &win, 0.0).unwrap();
         assert_eq!(s.segment, Segment::Fillet);
         match s.path {
             Path::Orbit {
@@ -368,9 +450,13 @@ mod tests {
             p => panic!("{p:?}"),
         }
         // Before z2 = (300, 40): still turning; past it: reached, next leg.
-        let s = m.step(&Vector3::new(299.0, 39.0, -60.0), &win).unwrap();
+        let s = m
+            .step(&Vector3::new(299.0, 39.0, -60.0), &win, 0.0)
+            .unwrap();
         assert_eq!((s.reached, s.segment), (None, Segment::Fillet));
-        let s = m.step(&Vector3::new(300.0, 40.5, -60.0), &win).unwrap();
+        let s = m
+            .step(&Vector3::new(300.0, 40.5, -60.0), &win, 0.0)
+            .unwrap();
         assert_eq!(s.reached, Some(1));
         assert!(matches!(s.path, Path::Line { origin, .. } if origin == win[1].ned));
     }
@@ -383,7 +469,7 @@ mod tests {
             wp(1, 300.0, 0.0, 50.0),
             wp(2, 300.0, -30.0, 50.0),
         ];
-        let s = m.step(&Vector3::new(299.0, 0.0, -50.0), &win).unwrap();
+        let s = m.step(&Vector3::new(299.0, 0.0, -50.0), &win, 0.0).unwrap();
         match s.path {
             Path::Orbit {
                 radius, direction, ..
@@ -404,9 +490,9 @@ mod tests {
             wp(1, 300.0, 0.0, 50.0),
             wp(2, 0.0, 0.0, 50.0),
         ];
-        let s = m.step(&Vector3::new(250.0, 0.0, -50.0), &win).unwrap();
+        let s = m.step(&Vector3::new(250.0, 0.0, -50.0), &win, 0.0).unwrap();
         assert_eq!((s.reached, s.segment), (None, Segment::Straight));
-        let s = m.step(&Vector3::new(300.5, 0.0, -50.0), &win).unwrap();
+        let s = m.step(&Vector3::new(300.5, 0.0, -50.0), &win, 0.0).unwrap();
         assert_eq!(s.reached, Some(1));
         match s.path {
             Path::Line { direction, .. } => assert!(direction.x < -0.99),
@@ -418,14 +504,18 @@ mod tests {
     fn last_waypoint_reached_by_radius_or_by_passing_it() {
         let mut m = PathManager::new(40.0);
         let win = [wp(0, 0.0, 0.0, 50.0), wp(7, 300.0, 0.0, 50.0)];
-        let s = m.step(&Vector3::new(280.0, 30.0, -50.0), &win).unwrap();
+        let s = m
+            .step(&Vector3::new(280.0, 30.0, -50.0), &win, 0.0)
+            .unwrap();
         assert_eq!(s.reached, None);
-        let s = m.step(&Vector3::new(295.0, 5.0, -50.0), &win).unwrap();
+        let s = m.step(&Vector3::new(295.0, 5.0, -50.0), &win, 0.0).unwrap();
         assert_eq!(s.reached, Some(7));
         let mut m = PathManager::new(40.0);
-        let s = m.step(&Vector3::new(301.0, 80.0, -50.0), &win).unwrap();
+        let s = m
+            .step(&Vector3::new(301.0, 80.0, -50.0), &win, 0.0)
+            .unwrap();
         assert_eq!(s.reached, Some(7));
-        assert!(m.step(&Vector3::zeros(), &win[..1]).is_none());
+        assert!(m.step(&Vector3::zeros(), &win[..1], 0.0).is_none());
     }
 
     struct Lap {
@@ -459,7 +549,7 @@ mod tests {
         let mut t = 0.0;
         while cur < 4 * laps {
             let win: [Waypoint; 3] = core::array::from_fn(|j| wps[(cur + j) % 4]);
-            let s = m.step(&k.pos, &win).unwrap();
+            let s = m.step(&k.pos, &win, 0.0).unwrap();
             let o = g.step(&s.path, &k.pos, k.ground_velocity().xy().norm());
             if let Some(id) = s.reached {
                 lap.reached.push(id).unwrap();

@@ -81,6 +81,7 @@ impl Plane {
             heading: self.k.heading,
             airspeed: self.k.airspeed,
             yaw_rate: 0.0,
+            wind_speed: self.k.wind.xy().norm(),
         }
     }
 
@@ -829,6 +830,7 @@ fn garbage_items_and_state_do_not_panic() {
             heading: f32::NAN,
             airspeed: f32::NAN,
             yaw_rate: f32::NAN,
+            wind_speed: f32::NAN,
         };
         nav.set_current((next() % 14) as u16);
         let _ = nav.step(&items, &home(), &bad, f32::NAN);

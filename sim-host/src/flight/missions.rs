@@ -275,7 +275,7 @@ impl RunwayBuilder {
 /// Two missions on other runways (120 and 250 deg), each landing at home on its runway:
 /// - `runway 120`: the take-off item 300 m out 30 deg right of the runway at 50 m, three
 ///   sides of a 500 m x 300 m rectangle turned 30 deg right flown at 20 m/s
-///   (`DO_CHANGE_SPEED`), the fourth at 17 m/s, a right-hand circuit (downwind 200 m right of the runway at 40 m) and a
+///   (`DO_CHANGE_SPEED`), 17 m/s again for a right-hand circuit (downwind 200 m right of the runway at 40 m) and a
 ///   450 m final;
 /// - `runway 250`: the take-off item 300 m out 75 deg left at 60 m, three sides of a
 ///   500 m x 300 m rectangle turned 60 deg left flown anticlockwise, two anticlockwise turns
@@ -294,17 +294,18 @@ pub fn other_runway_missions(home: GeoPoint) -> Vec<RunwayMission> {
     let r = east
         .frame
         .rectangle((750.0, 400.0), 500.0, 300.0, 30f64.to_radians());
-    // Three sides at 20 m/s, the fourth at 17, then into the circuit: closing the rectangle
-    // at 20 m/s put a 135 deg corner downwind, which the 70 m fillets (`NAV_TURN_RAD`, laid
-    // out for 22 m/s over ground) overshot by up to 58 m in the 5 m/s wind.
+    // The rectangle at 20 m/s, back to 17 for the circuit: its last corner, 135 deg and
+    // downwind, needs a fillet wider than the 70 m default (`NAV_TURN_RAD`, laid out for
+    // 22 m/s over ground), which the path manager lays out from the wind (91 m in 5 m/s);
+    // on the 70 m fillet it was overshot by up to 58 m.
     let east = east
         .item(MavCmd::MAV_CMD_NAV_TAKEOFF, [0.0; 4], takeoff(30.0, 50.0))
         .speed(20.0)
         .waypoint(r[0].0, r[0].1, 50.0)
         .waypoint(r[1].0, r[1].1, 50.0)
         .waypoint(r[2].0, r[2].1, 50.0)
-        .speed(17.0)
         .waypoint(r[3].0, r[3].1, 50.0)
+        .speed(17.0)
         .waypoint(400.0, 200.0, 40.0)
         .waypoint(-450.0, 200.0, 40.0)
         .waypoint(-450.0, 0.0, 40.0)
@@ -331,7 +332,7 @@ pub fn other_runway_missions(home: GeoPoint) -> Vec<RunwayMission> {
     vec![
         RunwayMission {
             name: "runway 120",
-            what: "take-off item 30 deg right of the runway, a rectangle turned 30 deg right flown clockwise, three sides at 20 m/s and the fourth at 17 m/s, right-hand circuit",
+            what: "take-off item 30 deg right of the runway, a rectangle turned 30 deg right flown clockwise at 20 m/s, right-hand circuit at 17 m/s",
             runway_rad: 120f64.to_radians(),
             items: east,
         },

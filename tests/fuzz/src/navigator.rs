@@ -97,6 +97,7 @@ pub fn run(data: &[u8]) {
                         heading,
                         airspeed,
                         yaw_rate: 0.0,
+                        wind_speed: airspeed - 17.0,
                     };
                     let out = nav.step(&items, &home, &state, dt);
                     if let Some(g) = out.guidance {

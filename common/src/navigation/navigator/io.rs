@@ -19,6 +19,8 @@ pub struct NavState {
     pub airspeed: f32,
     /// Yaw rate about the body's z axis, rad/s (the heading's rate on the runway).
     pub yaw_rate: f32,
+    /// Horizontal wind speed, m/s (0 until the estimator has a wind).
+    pub wind_speed: f32,
 }
 
 impl NavState {
@@ -30,6 +32,11 @@ impl NavState {
             heading: s.euler.psi,
             airspeed: s.airspeed,
             yaw_rate: s.body_rates.z,
+            wind_speed: if s.wind_valid {
+                libm::hypotf(s.wind_ned.x, s.wind_ned.y)
+            } else {
+                0.0
+            },
         }
     }
 

@@ -313,7 +313,7 @@ impl Leg {
         if let Some(n) = self.next {
             let _ = window.push(mk(n, id.wrapping_add(1)));
         }
-        let step = paths.step(&f.state.pos_ned, &window);
+        let step = paths.step(&f.state.pos_ned, &window, f.state.wind_speed);
         let reached = step.as_ref().and_then(|s| s.reached).is_some();
         let path = step
             .map(|s| s.path)

@@ -118,7 +118,7 @@ impl Return {
                     accept_radius: p.accept_radius,
                 };
                 let window = [mk(0, origin), mk(1, gate), mk(2, Vector3::zeros())];
-                let step = paths.step(&pos, &window);
+                let step = paths.step(&pos, &window, f.state.wind_speed);
                 let reached = step.as_ref().and_then(|s| s.reached).is_some();
                 let path = step.map(|s| s.path).unwrap_or(circle.path(airspeed));
                 f.emit(&path, Some(gate), Phase::Return, out);
