@@ -49,7 +49,7 @@ pub const PARAMS: Group<PathParams> = Group {
         "NAV_TURN_RAD",
         70.0,
         5.0,
-        500.0,
+        TURN_RADIUS_MAX,
         "m",
         "Smallest fillet radius at waypoint corners; a corner is widened to the turn at 35 deg of bank over ground, (airspeed + wind)^2 / (g tan 35 deg), when that is wider",
     ),
@@ -82,7 +82,7 @@ const STRAIGHT_ON: f32 = 1.0 * core::f32::consts::PI / 180.0;
 /// Bank a fillet is laid out for, rad: the 45-degree limit less room for gusts and the course
 /// loop (`NAV_TURN_RAD`'s default is this turn at 22 m/s over ground).
 pub const TURN_BANK: f32 = 35.0 * core::f32::consts::PI / 180.0;
-/// Widest fillet the wind and airspeed may ask for, m (`NAV_TURN_RAD`'s own upper bound).
+/// Widest fillet, m: `NAV_TURN_RAD`'s upper bound, and the most the wind and airspeed may ask for.
 pub const TURN_RADIUS_MAX: f32 = 500.0;
 
 /// One waypoint of the window.
