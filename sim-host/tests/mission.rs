@@ -244,3 +244,22 @@ fn missions_from_other_runways_fly_well_in_calm_air_and_in_wind() {
         }
     }
 }
+
+/// A tailwind and a crosswind from the left on the take-off roll (5 m/s towards north and
+/// towards east, light turbulence): parked and rolling slowly, the aircraft sees its air from
+/// behind or from the side, far outside the Minnesota model's linear envelope. The plant's
+/// flat-plate aerodynamics there (`sim_host::plant::aero`) lift and roll it no more than a
+/// plate would, so nothing but the wheels touches the ground and every item is reached; with
+/// the linear coefficients carried to 180 deg, seed 1 put the right wing tip on the runway in
+/// both. (The landed state is not asserted here: in a tailwind the roll-out outlasts the land
+/// detector's 15 s allowance, `docs/NAVIGATION.md`.)
+#[test]
+fn a_tailwind_or_a_crosswind_on_the_take_off_roll_puts_no_wing_tip_on_the_runway() {
+    let a = Aircraft::ultrastick25e().expect("built-in aircraft");
+    for towards in [0, 90] {
+        let o = navigation::fly_default(&a, navigation::rose_wind(towards), Turbulence::Light, 1)
+            .expect("flight");
+        eprintln!("wind towards {towards} deg");
+        flown_as_planned(&o);
+    }
+}

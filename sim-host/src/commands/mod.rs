@@ -15,6 +15,7 @@ pub mod scenario;
 pub mod sim;
 pub mod trim;
 pub mod validation;
+pub mod wind_rose;
 
 use crate::report::table::Table;
 

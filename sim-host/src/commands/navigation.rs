@@ -3,6 +3,8 @@
 //! estimates; tables of the mission figures and ground-track plots for `docs/NAVIGATION.md`.
 
 use super::fly::{fly_report, mission_table, FlyOptions, LinkKind, NOTES_MARKER};
+use super::wind_rose::rose_section;
+pub use super::wind_rose::{rose_wind, ROSE_SEEDS, ROSE_SPEED_MPS, ROSE_TOWARDS_DEG};
 use crate::aircraft::Aircraft;
 use crate::environment::wind::Turbulence;
 use crate::flight::landed::landed_state_honest;
@@ -376,12 +378,29 @@ pub fn navigation_markdown(
         SEEDS[0],
         rel(&img_dir.join("mission-wind.png"))
     );
+    let rose = if opts.link == LinkKind::Qemu {
+        None
+    } else {
+        Some(rose_section(aircraft, opts, &mut md)?)
+    };
     let runways = runway_section(aircraft, img_dir, opts, &mut md)?;
     let notes = existing
         .and_then(|e| e.find(NOTES_MARKER).map(|i| &e[i..]))
         .unwrap_or("\n---\n\n*Everything above the line is written by the command named at the top; notes below it are kept.*\n");
     md.push_str(notes.trim_start_matches('\n'));
-    let results_section = results_summary(command, &calm_m, &windy, &check, &runways, img_dir);
+    let mut cases = Vec::with_capacity(runways.len() + 1);
+    if let Some(rose) = rose {
+        cases.push((
+            format!(
+                "{ROSE_SPEED_MPS} m/s wind towards each of {} directions, light turbulence, seeds {}",
+                ROSE_TOWARDS_DEG.len(),
+                seed_span(&ROSE_SEEDS)
+            ),
+            rose,
+        ));
+    }
+    cases.extend(runways);
+    let results_section = results_summary(command, &calm_m, &windy, &check, &cases, img_dir);
     Ok(NavigationDocs {
         navigation: md,
         results_section,
@@ -537,7 +556,7 @@ fn runway_section(
 
 /// A flight's touchdown as table cells: distance from the point (along the runway), and the
 /// sink rate.
-fn touchdown_cells(m: &MissionSummary) -> (String, String) {
+pub(super) fn touchdown_cells(m: &MissionSummary) -> (String, String) {
     m.touchdown.map_or(("none".into(), "-".into()), |t| {
         (
             format!("{:.1} ({:+.1})", t.distance_m, t.along_m),
@@ -547,7 +566,7 @@ fn touchdown_cells(m: &MissionSummary) -> (String, String) {
 }
 
 /// "first-last" of a run of seeds.
-fn seed_span(seeds: &[u64]) -> String {
+pub(super) fn seed_span(seeds: &[u64]) -> String {
     match (seeds.first(), seeds.last()) {
         (Some(a), Some(b)) => format!("{a}-{b}"),
         _ => "none".into(),
@@ -577,7 +596,7 @@ fn windy_row(label: &str, flights: &[MissionSummary]) -> String {
 }
 
 /// How many of the windy flights meet each target, and the spread of their touchdowns.
-fn spread_summary(flights: &[MissionSummary]) -> String {
+pub(super) fn spread_summary(flights: &[MissionSummary]) -> String {
     let s = Spread::of(flights);
     let n = s.n;
     let f = |x: Option<&f64>| x.map_or("-".to_string(), |x| format!("{x:+.1}"));
