@@ -9,6 +9,7 @@ pub mod fly;
 pub mod flying;
 pub mod laws;
 pub mod linearize;
+pub mod mission_tables;
 pub mod navigation;
 pub mod params;
 pub mod scenario;

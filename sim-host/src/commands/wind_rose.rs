@@ -1,10 +1,8 @@
 //! The default mission in a wind from every direction: the take-off and the landing meet a
 //! tailwind, a headwind and crosswinds from either side; a table for `docs/NAVIGATION.md`.
 
-use super::fly::FlyOptions;
-use super::navigation::{flies_well, fly_default_on, seed_span, spread_summary, touchdown_cells};
-use crate::aircraft::Aircraft;
-use crate::environment::wind::Turbulence;
+use super::mission_tables::{seed_span, spread_summary, touchdown_cells};
+use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::MissionSummary;
 use anyhow::Context;
 use std::fmt::Write as _;
@@ -26,10 +24,11 @@ pub fn rose_wind(towards_deg: u32) -> [f64; 3] {
 
 /// The default mission in [`ROSE_SPEED_MPS`] of wind towards each of [`ROSE_TOWARDS_DEG`] with
 /// light turbulence, on [`ROSE_SEEDS`]: a row per direction into `md`, each flight judged by
-/// [`flies_well`]; the flights for the results table.
+/// `judge` (the navigation command's `flies_well`); the flights for the results table. `fly`
+/// flies the default mission in a wind (NED, m/s) with light turbulence on a seed.
 pub(super) fn rose_section(
-    aircraft: &Aircraft,
-    opts: &FlyOptions,
+    mut fly: impl FnMut([f64; 3], u64) -> anyhow::Result<FlightOutcome>,
+    judge: fn(&FlightOutcome, bool) -> Result<(), String>,
     md: &mut String,
 ) -> anyhow::Result<Vec<MissionSummary>> {
     let _ = writeln!(
@@ -58,8 +57,8 @@ pub(super) fn rose_section(
         let wind = rose_wind(towards);
         let mut cells = Vec::with_capacity(ROSE_SEEDS.len());
         for &seed in &ROSE_SEEDS {
-            let o = fly_default_on(aircraft, wind, Turbulence::Light, seed, opts)?;
-            let verdict = flies_well(&o, false);
+            let o = fly(wind, seed)?;
+            let verdict = judge(&o, false);
             well += usize::from(verdict.is_ok());
             let m = o.summary.mission.context("no mission flown")?;
             let (_, sink) = touchdown_cells(&m);
