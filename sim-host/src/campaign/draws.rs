@@ -10,7 +10,7 @@
 
 use super::spec::CampaignSpec;
 use crate::aircraft::{Aero, Aircraft};
-use crate::environment::wind::Turbulence;
+use crate::environment::wind::{along_runway, Turbulence};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::de::{MapAccess, Visitor};
@@ -308,7 +308,7 @@ pub fn draw_day(s: &mut Sampler, spec: &CampaignSpec) -> Day {
     // Blowing from `from`: towards the opposite direction.
     let wind_ned = [-speed * from.cos(), -speed * from.sin(), 0.0];
     // A tailwind along the drawn heading: the pilot uses the runway's other end.
-    let tailwind = wind_ned[0] * runway.cos() + wind_ned[1] * runway.sin() > 0.0;
+    let tailwind = along_runway(wind_ned, runway).0 > 0.0;
     let reversed = spec.runway.into_wind && tailwind;
     if reversed {
         runway += std::f64::consts::PI;

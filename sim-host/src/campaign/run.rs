@@ -7,6 +7,7 @@ use super::record::{fly_record, FlightRecord, Plan};
 use super::spec::CampaignSpec;
 use super::verdict::Criterion;
 use crate::aircraft::Aircraft;
+use crate::environment::wind::along_runway;
 use crate::flight::config::FlightConfig;
 use crate::flight::missions::runway_mission;
 use crate::flight::runner::FlightOutcome;
@@ -191,15 +192,11 @@ impl Campaign {
             ["mass.cg_x_m", "mass.cg_y_m", "mass.cg_z_m"].map(|k| draws.get(k).unwrap_or(0.0));
         if let Some(l) = mission.landing {
             // The wind as the landing meets it: what a pilot reads off the windsock.
-            let (sin, cos) = l.direction_rad.sin_cos();
-            let [wn, we, _] = day.wind_ned;
+            let (along, across) = along_runway(day.wind_ned, l.direction_rad);
+            draws.0.push(("derived.headwind_mps".into(), -along));
             draws
                 .0
-                .push(("derived.headwind_mps".into(), -(wn * cos + we * sin)));
-            draws.0.push((
-                "derived.crosswind_from_right_mps".into(),
-                wn * sin - we * cos,
-            ));
+                .push(("derived.crosswind_from_right_mps".into(), -across));
         }
         let mut config = FlightConfig {
             wind_ned: day.wind_ned,

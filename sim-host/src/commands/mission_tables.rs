@@ -111,6 +111,13 @@ pub(super) fn touchdown_cells(m: &MissionSummary) -> (String, String) {
     })
 }
 
+/// A flight's verdict as a table cell: "yes", or "**no**" and what failed.
+pub(super) fn verdict_cell(verdict: &Result<(), String>) -> String {
+    verdict
+        .as_ref()
+        .map_or_else(|e| format!("**no**: {e}"), |()| "yes".into())
+}
+
 /// "first-last" of a run of seeds.
 pub(super) fn seed_span(seeds: &[u64]) -> String {
     match (seeds.first(), seeds.last()) {

@@ -4,7 +4,9 @@
 
 use super::fly::{fly_report, mission_table, FlyOptions, LinkKind, NOTES_MARKER};
 pub use super::mission_tables::meets_targets;
-use super::mission_tables::{seed_span, spread_summary, touchdown_cells, under, windy_row};
+use super::mission_tables::{
+    seed_span, spread_summary, touchdown_cells, under, verdict_cell, windy_row,
+};
 use super::wind_rose::rose_section;
 pub use super::wind_rose::{rose_wind, ROSE_SEEDS, ROSE_SPEED_MPS, ROSE_TOWARDS_DEG};
 use crate::aircraft::Aircraft;
@@ -435,7 +437,7 @@ fn runway_section(
                     sig(m.alt_rms_m, 3),
                     sig(m.airspeed_rms_mps, 3),
                     m.throttle_at_stops_pct,
-                    verdict.map_or_else(|e| format!("**no**: {e}"), |()| "yes".into()),
+                    verdict_cell(&verdict),
                 );
                 flights.push(m);
             }

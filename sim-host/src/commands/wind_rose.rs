@@ -1,7 +1,8 @@
 //! The default mission in a wind from every direction: the take-off and the landing meet a
 //! tailwind, a headwind and crosswinds from either side; a table for `docs/NAVIGATION.md`.
 
-use super::mission_tables::{seed_span, spread_summary, touchdown_cells};
+use super::mission_tables::{seed_span, spread_summary, touchdown_cells, verdict_cell};
+use crate::environment::wind::along_runway;
 use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::MissionSummary;
 use anyhow::Context;
@@ -65,20 +66,16 @@ pub(super) fn rose_section(
             let along = m
                 .touchdown
                 .map_or("none".to_string(), |t| format!("{:+.1}", t.along_m));
-            cells.push(format!(
-                "{}, {along}, {sink}",
-                verdict.map_or_else(|e| format!("**no**: {e}"), |()| "yes".into())
-            ));
+            cells.push(format!("{}, {along}, {sink}", verdict_cell(&verdict)));
             flights.push(m);
         }
-        // The runway heads north: the headwind is the wind's southward part, a crosswind
-        // from the left its eastward part.
+        // The default mission's runway heads north.
+        let (along, from_left) = along_runway(wind, 0.0);
         let _ = writeln!(
             md,
-            "| {towards} | {} | {:+.1} | {:+.1} | {} |",
+            "| {towards} | {} | {:+.1} | {from_left:+.1} | {} |",
             (towards + 180) % 360,
-            -wind[0],
-            wind[1],
+            -along,
             cells.join(" | ")
         );
     }

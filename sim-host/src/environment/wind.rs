@@ -81,6 +81,17 @@ struct Channel {
     x2: f64,
 }
 
+/// A steady wind (NED, m/s, the direction it blows towards) in a runway's axes, the runway
+/// heading `heading_rad`: its part along the runway (positive blowing towards the heading, a
+/// tailwind) and across it (positive blowing towards the heading's right, a crosswind from the
+/// left). The one definition of that frame change, for the campaign's windsock figures and
+/// the navigation tables.
+pub fn along_runway(wind_ned: [f64; 3], heading_rad: f64) -> (f64, f64) {
+    let (sin, cos) = heading_rad.sin_cos();
+    let [n, e, _] = wind_ned;
+    (n * cos + e * sin, -n * sin + e * cos)
+}
+
 /// The wind model: a steady NED wind plus body-axis turbulence.
 pub struct Wind {
     /// Steady wind, NED, m/s (the direction it blows towards).
@@ -181,6 +192,19 @@ fn second_order(c: &mut Channel, dt: f64, t: f64, k: f64, u: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_wind_towards_the_east_crosses_a_northbound_runway_from_the_left_and_heads_a_westbound_one()
+    {
+        let (along, across) = along_runway([0.0, 5.0, 0.0], 0.0);
+        assert!(along.abs() < 1e-12 && (across - 5.0).abs() < 1e-12);
+        // Runway heading west (270 deg): the wind blows against it.
+        let (along, across) = along_runway([0.0, 5.0, 0.0], 1.5 * std::f64::consts::PI);
+        assert!((along + 5.0).abs() < 1e-12 && across.abs() < 1e-12);
+        // Runway heading east: a tailwind of the whole 5 m/s.
+        let (along, _) = along_runway([0.0, 5.0, 0.0], 0.5 * std::f64::consts::PI);
+        assert!((along - 5.0).abs() < 1e-12);
+    }
 
     #[test]
     fn scales_match_mil_f_8785c_at_100m() {
