@@ -15,12 +15,15 @@
 //! is logged (the log has stopped growing), with the image idle at both ends: a window of
 //! `2 N` frames at 100 Hz is `N` whole 20 ms control periods.
 
+use nix::sys::stat::Mode;
 use object::{Object, ObjectSymbol, SymbolKind};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::io::{self, BufRead, Read, Write};
+use std::os::unix::fs::OpenOptionsExt;
 use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -131,37 +134,80 @@ impl McuProfile {
 /// The result of a window, shared between the link that records it and the flight's report.
 pub type ProfileSlot = Arc<Mutex<Option<Result<McuProfile, String>>>>;
 
-/// Switches QEMU's trace on and off around the window, then reads the trace.
+/// Switches QEMU's trace on and off around the window and counts it as it comes.
+///
+/// QEMU writes its log (`-D`) into a named pipe that a thread of this process reads and
+/// counts line by line: nothing of the trace is kept on disk (a window of 10 periods is
+/// gigabytes of log, most of it the idle loop between frames). A slow reader only slows
+/// QEMU's writes, which the lock-step link waits for.
 pub struct Profiler {
     window: ProfileWindow,
     monitor: PathBuf,
-    log: PathBuf,
-    elf: PathBuf,
+    fifo: PathBuf,
+    symbols: Result<Symbols, String>,
+    trace: Arc<Trace>,
     frames_sent: u64,
     slot: ProfileSlot,
 }
 
+/// What the reader of the pipe has counted so far.
+struct Trace {
+    /// Bytes read from the pipe: the trace has stopped when this stops growing.
+    bytes: AtomicU64,
+    counts: Mutex<Counts>,
+}
+
 impl Profiler {
-    /// A profiler of `window` for a QEMU started with `-monitor unix:MONITOR,server,nowait
-    /// -D LOG` (see [`Profiler::qemu_args`]) running `elf`.
+    /// A profiler of `window` for a QEMU running `elf` and started with
+    /// [`Profiler::qemu_args`]: creates the pipe in `dir` and starts its reader, which must
+    /// be there before QEMU starts (QEMU opens its log at start-up, waiting for a reader).
     pub fn new(window: ProfileWindow, dir: &Path, elf: &Path, slot: ProfileSlot) -> Self {
+        let (monitor, fifo) = Self::paths(dir);
+        let symbols = Symbols::of(elf);
+        let (start, end) = match &symbols {
+            Ok(s) => (
+                s.address_of(WORK_START).unwrap_or(u64::MAX),
+                s.address_of(WORK_END).unwrap_or(u64::MAX),
+            ),
+            Err(_) => (u64::MAX, u64::MAX),
+        };
+        let trace = Arc::new(Trace {
+            bytes: AtomicU64::new(0),
+            counts: Mutex::new(Counts::new(start, end)),
+        });
+        let _ = std::fs::remove_file(&fifo);
+        let symbols = match nix::unistd::mkfifo(&fifo, Mode::S_IRUSR | Mode::S_IWUSR) {
+            Ok(()) => {
+                let (fifo, trace) = (fifo.clone(), Arc::clone(&trace));
+                std::thread::spawn(move || read_trace(&fifo, &trace));
+                symbols
+            }
+            Err(e) => Err(format!("cannot create the pipe `{}`: {e}", fifo.display())),
+        };
         Self {
             window,
-            monitor: dir.join("qemu-monitor.sock"),
-            log: dir.join("qemu-trace.log"),
-            elf: elf.to_path_buf(),
+            monitor,
+            fifo,
+            symbols,
+            trace,
             frames_sent: 0,
             slot,
         }
     }
 
-    /// QEMU's arguments for the monitor socket and the trace file.
-    pub fn qemu_args(&self) -> Vec<String> {
+    /// The monitor's socket and the trace's pipe of a profile whose files go to `dir`.
+    fn paths(dir: &Path) -> (PathBuf, PathBuf) {
+        (dir.join("qemu-monitor.sock"), dir.join("qemu-trace.fifo"))
+    }
+
+    /// QEMU's arguments for the monitor socket and the trace of a profile in `dir`.
+    pub fn qemu_args(dir: &Path) -> Vec<String> {
+        let (monitor, fifo) = Self::paths(dir);
         vec![
             "-monitor".into(),
-            format!("unix:{},server,nowait", self.monitor.display()),
+            format!("unix:{},server,nowait", monitor.display()),
             "-D".into(),
-            self.log.display().to_string(),
+            fifo.display().to_string(),
         ]
     }
 
@@ -176,7 +222,7 @@ impl Profiler {
         } else if k == self.window.end_frame() {
             let r = self
                 .close()
-                .map_err(|e| format!("cannot read QEMU's trace: {e}"))
+                .map_err(|e| format!("cannot stop QEMU's trace: {e}"))
                 .and_then(|()| self.read());
             self.finish(r);
         }
@@ -184,8 +230,6 @@ impl Profiler {
 
     fn finish(&mut self, r: Result<McuProfile, String>) {
         *self.slot.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
-        // The trace is hundreds of megabytes: gone once read.
-        let _ = std::fs::remove_file(&self.log);
     }
 
     fn monitor(&self, commands: &[&str]) -> io::Result<()> {
@@ -216,57 +260,90 @@ impl Profiler {
 
     fn open(&mut self) -> io::Result<()> {
         // The image has answered the previous frame; let it finish that frame's work.
-        wait_quiet(&self.log, Duration::from_millis(100));
+        self.wait_quiet(Duration::from_millis(100));
         self.monitor(&["singlestep on", "log exec,nochain"])
     }
 
     fn close(&mut self) -> io::Result<()> {
         // The last frame's answer is in; its work goes on after the answer (telemetry):
         // closed once the trace has stopped growing.
-        wait_quiet(&self.log, Duration::from_millis(500));
-        self.monitor(&["log none", "singlestep off"])
+        self.wait_quiet(Duration::from_millis(500));
+        self.monitor(&["log none", "singlestep off"])?;
+        // What QEMU wrote before the switch is read to its end.
+        self.wait_quiet(Duration::from_millis(200));
+        Ok(())
     }
 
     fn read(&self) -> Result<McuProfile, String> {
-        let symbols = Symbols::of(&self.elf)?;
-        let f = std::fs::File::open(&self.log)
-            .map_err(|e| format!("cannot open `{}`: {e}", self.log.display()))?;
-        let (start, end) = (
-            symbols.address_of(WORK_START).ok_or_else(|| {
-                format!("the image has no `{WORK_START}`: it does not mark its work")
-            })?,
-            symbols
-                .address_of(WORK_END)
-                .ok_or_else(|| format!("no `{WORK_END}` in the image"))?,
-        );
-        let mut counts = Counts::new(start, end);
-        for line in io::BufReader::new(f).lines() {
-            let line = line.map_err(|e| format!("reading the trace: {e}"))?;
-            counts.line(&line);
+        let symbols = self.symbols.as_ref().map_err(String::clone)?;
+        for marker in [WORK_START, WORK_END] {
+            if symbols.address_of(marker).is_none() {
+                return Err(format!(
+                    "the image has no `{marker}`: it does not mark its work"
+                ));
+            }
         }
-        Ok(counts.profile(&symbols, self.window))
+        let mut counts = self.trace.counts.lock().unwrap_or_else(|p| p.into_inner());
+        let (start, end) = (counts.start, counts.end);
+        let counts = std::mem::replace(&mut *counts, Counts::new(start, end));
+        Ok(counts.profile(symbols, self.window))
+    }
+
+    /// Waits until the trace has not grown for `quiet` (at most a minute).
+    fn wait_quiet(&self, quiet: Duration) {
+        let size = || self.trace.bytes.load(Ordering::Relaxed);
+        let deadline = Instant::now() + Duration::from_secs(60);
+        let mut last = size();
+        let mut since = Instant::now();
+        while Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+            let s = size();
+            if s != last {
+                (last, since) = (s, Instant::now());
+            } else if since.elapsed() >= quiet {
+                return;
+            }
+        }
+    }
+}
+
+impl Drop for Profiler {
+    fn drop(&mut self) {
+        // A reader still waiting for QEMU to open the pipe (QEMU never started) is let go:
+        // a writer that opens and closes at once ends its read.
+        let _ = std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(nix::fcntl::OFlag::O_NONBLOCK.bits())
+            .open(&self.fifo);
+        let _ = std::fs::remove_file(&self.fifo);
+    }
+}
+
+/// Reads QEMU's trace from the pipe `fifo` until QEMU closes it, counting each line.
+fn read_trace(fifo: &Path, trace: &Trace) {
+    // Blocks until QEMU opens its end.
+    let Ok(f) = std::fs::File::open(fifo) else {
+        return;
+    };
+    let mut r = io::BufReader::with_capacity(1 << 16, f);
+    let mut line = Vec::with_capacity(256);
+    loop {
+        line.clear();
+        match r.read_until(b'\n', &mut line) {
+            Ok(0) | Err(_) => return,
+            Ok(n) => {
+                trace.bytes.fetch_add(n as u64, Ordering::Relaxed);
+                if let Ok(l) = std::str::from_utf8(&line) {
+                    let mut c = trace.counts.lock().unwrap_or_else(|p| p.into_inner());
+                    c.line(l.trim_end());
+                }
+            }
+        }
     }
 }
 
 fn count(hay: &[u8], needle: &[u8]) -> usize {
     hay.windows(needle.len()).filter(|w| *w == needle).count()
-}
-
-/// Waits until `path` has not grown for `quiet` (at most a minute).
-fn wait_quiet(path: &Path, quiet: Duration) {
-    let size = || std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    let deadline = Instant::now() + Duration::from_secs(60);
-    let mut last = size();
-    let mut since = Instant::now();
-    while Instant::now() < deadline {
-        std::thread::sleep(Duration::from_millis(20));
-        let s = size();
-        if s != last {
-            (last, since) = (s, Instant::now());
-        } else if since.elapsed() >= quiet {
-            return;
-        }
-    }
 }
 
 /// The image's functions by address.

@@ -140,9 +140,9 @@ impl QemuConfig {
         let mut c = Command::new(&self.program);
         c.args(["-machine", "netduinoplus2", "-cpu", "cortex-m4"])
             .arg("-nographic")
-            .args(self.profiler(None).map_or_else(
+            .args(self.profile.as_ref().map_or_else(
                 || vec!["-monitor".to_string(), "none".to_string()],
-                |p| p.qemu_args(),
+                |(_, dir)| Profiler::qemu_args(dir),
             ))
             .arg("-semihosting-config")
             .arg(semihosting_config(self.storage.as_deref()))
@@ -422,6 +422,8 @@ pub fn boot(
             "cannot open the ground link on udp {gcs_bind}: {e}"
         ))
     })?;
+    // The profiler's trace reader is there before QEMU, which opens its trace at start-up.
+    let profiler = cfg.profiler(profile);
     let mut process = QemuProcess::spawn(cfg, sim_l.local_addr()?, gcs_l.local_addr()?)?;
     let mut accept = |l: &TcpListener, what: &str, p: &mut QemuProcess| {
         TcpServer::accept(l, Some(CONNECT_WAIT), || {
@@ -456,7 +458,7 @@ pub fn boot(
             process,
             log: cfg.log.clone(),
             elf: cfg.elf.clone(),
-            profiler: cfg.profiler(profile),
+            profiler,
         },
         bridge,
     ))
