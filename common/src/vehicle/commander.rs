@@ -219,6 +219,10 @@ impl Commander {
             vel_down: e.vel_ned.z,
             airspeed: e.airspeed,
             specific_force,
+            // The navigator stays in its roll-out once it disarms the aircraft.
+            rolling_out: self.nav_for.is_some()
+                && self.flown_mode().needs_navigator()
+                && self.nav.phase == Phase::Landed,
         };
         self.land.update(p, &inputs, dt);
     }
@@ -229,8 +233,7 @@ impl Commander {
     /// rolling out fast enough to count as moving). In the air: airborne otherwise. On the
     /// ground: the detector's landed, outside a take-off.
     pub fn landed_state(&self) -> LandedState {
-        let phase = (self.armed && self.nav_for.is_some() && self.flown_mode().needs_navigator())
-            .then_some(self.nav.phase);
+        let phase = self.navigated_phase();
         let takeoff = matches!(phase, Some(Phase::TakeoffRoll | Phase::TakeoffClimb));
         let landing = matches!(phase, Some(Phase::Approach | Phase::Flare | Phase::Landed));
         match (self.land.landed(), takeoff, landing) {
@@ -239,6 +242,12 @@ impl Commander {
             (false, false, true) => LandedState::Landing,
             (false, false, false) => LandedState::InAir,
         }
+    }
+
+    /// The navigator's phase while it flies the armed aircraft.
+    fn navigated_phase(&self) -> Option<Phase> {
+        (self.armed && self.nav_for.is_some() && self.flown_mode().needs_navigator())
+            .then_some(self.nav.phase)
     }
 
     /// What a failsafe has the aircraft do instead of the chosen mode.

@@ -12,6 +12,12 @@
 //! evidence (wind over a parked aircraft) and the aircraft is on the ground as soon as it is
 //! at rest over the ground: a disarmed airframe with its motor stopped does not hover.
 //!
+//! Ground speed is no evidence of flight in the navigator's roll-out, armed or disarmed after
+//! it: the navigator has seen the wheels on the runway (a bounce back into the air returns it
+//! to the flare, and vertical speed still lifts the aircraft). A tailwind carries a landed aircraft along at 13 m/s over the ground
+//! with 8 m/s of air over its wings, far under any speed it could fly at; without this it
+//! read "landing" for the 20 s its wheels took to slow it under `LND_VXY_MAX`.
+//!
 //! The height over home is no input: an aircraft started in the air below home's altitude is
 //! flying, and one at 4 m on its final approach is too.
 //!
@@ -144,6 +150,9 @@ pub struct LandInputs {
     pub airspeed: f32,
     /// Magnitude of the accelerometer's specific force, m/s^2 (`None`: no sample yet).
     pub specific_force: Option<f32>,
+    /// In the navigator's roll-out, or disarmed at its end: the wheels have been seen on the
+    /// runway.
+    pub rolling_out: bool,
 }
 
 /// Low-passed inputs.
@@ -214,7 +223,8 @@ impl LandDetector {
             },
         };
         self.filtered = Some(f);
-        let moving = f.ground_speed > p.vel_xy_max || libm::fabsf(f.vel_down) > p.vel_z_max;
+        let moving = (f.ground_speed > p.vel_xy_max && !i.rolling_out)
+            || libm::fabsf(f.vel_down) > p.vel_z_max;
         // Landed, only an airspeed near flying speed is a take-off: wind and its gusts over
         // the stopped aircraft are not (hysteresis between the two thresholds).
         let airspeed_max = if self.landed {
@@ -263,6 +273,7 @@ mod tests {
             vel_down: 0.0,
             airspeed: 0.0,
             specific_force: Some(9.81),
+            rolling_out: false,
         }
     }
 
@@ -478,6 +489,88 @@ mod tests {
             ..at_rest(true)
         };
         assert!(run(&mut d, &run_up, 1.0).iter().any(|&l| !l));
+    }
+
+    #[test]
+    fn rolling_out_in_a_tailwind_it_is_landed_by_its_airspeed_not_its_ground_speed() {
+        let p = LandParams::default();
+        // Touched down at 13 m/s of air with 5 m/s of tailwind: 18 m/s over the ground, the
+        // wheels slowing it at 0.5 m/s^2 (mu_roll g), the air over the wings 5 m/s less.
+        let landed_at = |rolling_out: bool| {
+            let mut d = LandDetector::new();
+            run(
+                &mut d,
+                &LandInputs {
+                    ground_speed: 18.0,
+                    airspeed: 13.0,
+                    ..at_rest(true)
+                },
+                1.0,
+            );
+            let mut t = 0.0f32;
+            while t < 40.0 {
+                let v = (18.0 - 0.5 * t).max(0.0);
+                let i = LandInputs {
+                    ground_speed: v,
+                    airspeed: (v - 5.0).abs(),
+                    rolling_out,
+                    ..at_rest(true)
+                };
+                if d.update(&p, &i, DT) {
+                    return t;
+                }
+                t += DT;
+            }
+            f32::INFINITY
+        };
+        // In the roll-out: once the air is under LND_ASPD_MAX (13 - 10 = 3 m/s at 0.5 m/s^2:
+        // 6 s), then LND_TRIG_S. Without the navigator's word: once the ground speed is under
+        // LND_VXY_MAX (20 s), then LND_TRIG_S.
+        let rolling = landed_at(true);
+        assert!((6.0 + 1.5..6.0 + 1.5 + 1.0).contains(&rolling), "{rolling}");
+        let unknown = landed_at(false);
+        assert!(
+            (20.0 + 1.5..20.0 + 1.5 + 1.0).contains(&unknown),
+            "{unknown}"
+        );
+    }
+
+    #[test]
+    fn disarmed_on_the_runway_still_rolling_it_stays_landed_and_a_climb_still_lifts_it() {
+        let mut d = LandDetector::new();
+        let rolling = LandInputs {
+            ground_speed: 12.0,
+            airspeed: 4.0,
+            rolling_out: true,
+            ..at_rest(true)
+        };
+        assert!(run(&mut d, &rolling, 3.0).last() == Some(&true));
+        // Disarmed at 12 m/s over the ground (the navigator's roll-out time is up).
+        let disarmed = LandInputs {
+            armed: false,
+            ..rolling
+        };
+        assert!(run(&mut d, &disarmed, 3.0).iter().all(|&l| l));
+        // Lifted 2 m/s by a gust: not on the ground.
+        let lifted = LandInputs {
+            vel_down: -2.0,
+            ..disarmed
+        };
+        assert!(run(&mut d, &lifted, 1.0).iter().any(|&l| !l));
+        // A flight that ends disarmed (forced in the air) is not landed by it: the ground
+        // speed still says flight.
+        let mut d = LandDetector::new();
+        let fly = LandInputs {
+            ground_speed: 17.0,
+            airspeed: 17.0,
+            ..at_rest(true)
+        };
+        run(&mut d, &fly, 1.0);
+        let forced = LandInputs {
+            armed: false,
+            ..fly
+        };
+        assert!(run(&mut d, &forced, 3.0).iter().all(|&l| !l));
     }
 
     #[test]
