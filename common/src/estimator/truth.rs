@@ -18,7 +18,7 @@ use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
+use rand_distr::{Distribution, StandardNormal};
 use std::collections::VecDeque;
 use std::vec::Vec;
 
@@ -290,7 +290,6 @@ pub struct Samples {
 /// Noisy sensors on a trajectory.
 pub struct SensorSim {
     rng: ChaCha8Rng,
-    unit: Normal<f64>,
     /// Constant gyro bias, rad/s.
     pub gyro_bias: Vector3<f64>,
     /// GPS latency, s.
@@ -314,7 +313,6 @@ impl SensorSim {
     pub fn new(seed: u64) -> Self {
         Self {
             rng: ChaCha8Rng::seed_from_u64(seed),
-            unit: Normal::new(0.0, 1.0).unwrap(),
             gyro_bias: Vector3::new(0.02, -0.015, 0.01),
             gps_latency: 0.15,
             gps_period: 0.2,
@@ -328,7 +326,8 @@ impl SensorSim {
 
     fn n(&mut self, sigma: f64) -> f64 {
         if self.noisy {
-            sigma * self.unit.sample(&mut self.rng)
+            let unit: f64 = StandardNormal.sample(&mut self.rng);
+            sigma * unit
         } else {
             0.0
         }
