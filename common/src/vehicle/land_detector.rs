@@ -14,7 +14,8 @@
 //!
 //! Ground speed is no evidence of flight in the navigator's roll-out, armed or disarmed after
 //! it: the navigator has seen the wheels on the runway (a bounce back into the air returns it
-//! to the flare, and vertical speed still lifts the aircraft). A tailwind carries a landed aircraft along at 13 m/s over the ground
+//! to the flare, and vertical speed still lifts the aircraft); nor, once it reads landed there,
+//! is an airspeed over `LND_ASPD_TO` (a crosswind's gusts over a rolling aircraft). A tailwind carries a landed aircraft along at 13 m/s over the ground
 //! with 8 m/s of air over its wings, far under any speed it could fly at; without this it
 //! read "landing" for the 20 s its wheels took to slow it under `LND_VXY_MAX`.
 //!
@@ -232,7 +233,9 @@ impl LandDetector {
         } else {
             p.airspeed_max
         };
-        let flying_air = i.armed && f.airspeed > airspeed_max;
+        // Landed in the roll-out, a gust over the take-off airspeed is no take-off either: the
+        // navigator goes back to the flare if the wheels leave the runway, ending the roll-out.
+        let flying_air = i.armed && f.airspeed > airspeed_max && !(i.rolling_out && self.landed);
         if moving || flying_air {
             // Evidence of flight (or of a take-off run): not landed, at once.
             self.landed = false;
@@ -533,6 +536,55 @@ mod tests {
             (20.0 + 1.5..20.0 + 1.5 + 1.0).contains(&unknown),
             "{unknown}"
         );
+    }
+
+    #[test]
+    fn landed_in_the_roll_out_a_crosswind_gust_over_the_take_off_airspeed_does_not_launch_it() {
+        // Rolling at 8 m/s with 5 m/s of wind across: 9.4 m/s of air, landed after
+        // LND_TRIG_S; then a gust takes the air to 13.5 m/s (over LND_ASPD_TO) for 2 s.
+        let rolling = LandInputs {
+            ground_speed: 8.0,
+            airspeed: 9.4,
+            rolling_out: true,
+            ..at_rest(true)
+        };
+        let gust = LandInputs {
+            airspeed: 13.5,
+            ..rolling
+        };
+        // Coming in from the flare, flying.
+        let flying = LandInputs {
+            rolling_out: false,
+            ground_speed: 13.0,
+            airspeed: 13.5,
+            ..rolling
+        };
+        let mut d = LandDetector::new();
+        run(&mut d, &flying, 1.0);
+        assert!(!d.landed());
+        assert!(run(&mut d, &rolling, 3.0).last() == Some(&true));
+        assert!(run(&mut d, &gust, 2.0).iter().all(|&l| l));
+        // Outside the roll-out (the navigator back in the flare), the same gust is flight.
+        let flare = LandInputs {
+            rolling_out: false,
+            ground_speed: 0.0,
+            ..gust
+        };
+        assert!(run(&mut d, &flare, 2.0).iter().any(|&l| !l));
+        // Not yet landed in the roll-out, the airspeed over LND_ASPD_MAX still keeps it
+        // "flying": the wheels are down, the wings could still lift it off.
+        let mut d = LandDetector::new();
+        run(&mut d, &flying, 1.0);
+        assert!(run(
+            &mut d,
+            &LandInputs {
+                airspeed: 11.0,
+                ..rolling
+            },
+            5.0
+        )
+        .iter()
+        .all(|&l| !l));
     }
 
     #[test]
