@@ -92,7 +92,7 @@ pub fn check(frame: &[u8], key: &Key) -> Option<Signed> {
 /// frame that is not a whole MAVLink 2 frame.
 ///
 /// The checksum is updated, not recomputed, so signing needs no dialect (no `CRC_EXTRA` of
-/// the message): see [`crc_change_of_signed_flag`].
+/// the message): see `crc_change_of_signed_flag`.
 pub fn sign(
     frame: &[u8],
     key: &Key,

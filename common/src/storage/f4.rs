@@ -2,9 +2,9 @@
 //!
 //! The driver talks to the controller through [`FlashRegs`], so the same code runs on the
 //! MCU (volatile accesses to `FLASH` at `0x4002_3C00` and to the memory-mapped array) and on
-//! the host against [`model::F4Model`], a register-level model that enforces the rules the
-//! silicon enforces (the unlock sequence, `PSIZE` against the access width, alignment,
-//! programming only with `PG` set, write protection) and sets the same error flags.
+//! the host (in its tests) against `model::F4Model`, a register-level model that enforces the
+//! rules the silicon enforces (the unlock sequence, `PSIZE` against the access width,
+//! alignment, programming only with `PG` set, write protection) and sets the same error flags.
 //!
 //! Each operation: wait for `BSY` to clear, clear stale error flags, unlock with the two
 //! keys, set the operation (`SER` + `SNB` for a sector erase, `PG` for programming) with

@@ -15,7 +15,7 @@ pub struct ArmRequest {
 }
 
 /// What the ground station asked the vehicle to do, after the link's checks. The vehicle takes
-/// these with [`GroundLink::take_requests`] and acts on them.
+/// these with [`crate::gcs::GroundLink::take_requests`] and acts on them.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct VehicleRequests {

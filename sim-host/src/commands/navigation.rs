@@ -65,7 +65,7 @@ pub fn fly_default(
 }
 
 /// Flies the default mission once over the link of `opts` (the MCU image with
-/// [`LinkKind::Qemu`](super::fly::LinkKind::Qemu)).
+/// [`super::fly::LinkKind::Qemu`]).
 pub fn fly_default_on(
     aircraft: &Aircraft,
     wind_ned: [f64; 3],

@@ -2,9 +2,9 @@
 //! guidance asked for, the throttle's time on its stops, the touchdown, and the verdict on
 //! them a campaign names.
 
+use super::measures::{rms, HomeDatum};
 use super::record::Sample;
 use super::strikes::{StrikeEvent, Survey};
-use super::summary::{rms, HomeDatum};
 use crate::campaign::verdict::Criterion;
 use crate::plant::Touchdown;
 use common::navigation::Phase;

@@ -28,6 +28,7 @@
 pub mod compare;
 pub mod config;
 pub mod landed;
+pub mod measures;
 pub mod mission_summary;
 pub mod missions;
 pub mod onboard;

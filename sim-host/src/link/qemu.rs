@@ -273,7 +273,7 @@ impl QemuProcess {
         }
     }
 
-    /// "QEMU exited with status 1: <what it printed>".
+    /// `QEMU exited with status 1: <what it printed>`.
     pub fn exit_message(&self, status: ExitStatus) -> String {
         use std::os::unix::process::ExitStatusExt;
         let how = match (status.code(), status.signal()) {

@@ -21,7 +21,7 @@
 //! height, a leg back parallel to the runway two loiter radii to its left (a left-hand
 //! circuit), and a new approach from far enough out to meet the glide slope from that
 //! height. A ground station asks for the same with `MAV_CMD_DO_GO_AROUND`. After
-//! [`GO_AROUNDS_MAX`] go-arounds the landing lands whatever its flare brings.
+//! `GO_AROUNDS_MAX` go-arounds the landing lands whatever its flare brings.
 
 use super::guide::{course_near_ground, course_widening, follow, horizontal_dist, Flight};
 use super::io::{NavOutput, Phase};
