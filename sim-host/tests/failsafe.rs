@@ -149,11 +149,12 @@ fn lands_on_the_runway(o: &FlightOutcome, calm: bool) {
 /// The landed state the scripted station read (EXTENDED_SYS_STATE, 1 Hz and on change) was
 /// honest about the landing (`sim_host::flight::landed::landed_state_honest`): TAKEOFF then
 /// IN_AIR after arming, never ON_GROUND from lift-off until the plant's wheels touched at
-/// `touchdown_s`, LANDING on the approach, and ON_GROUND for good within 15 s of the touchdown.
+/// `touchdown_s`, LANDING on the approach, and ON_GROUND for good within 15 s of the touchdown
+/// (or 5 s after the air over the wings has slowed under flying speed, when that is later).
 fn the_station_saw_the_landing_honestly(o: &FlightOutcome, touchdown_s: f64) {
     let states = &o.summary.landed_states;
     eprintln!("landed states {states:?}, touchdown at {touchdown_s:.2} s");
-    if let Err(e) = sim_host::flight::landed::landed_state_honest(states, touchdown_s) {
+    if let Err(e) = sim_host::flight::landed::landed_state_honest(states, touchdown_s, &o.samples) {
         panic!("{e}");
     }
 }

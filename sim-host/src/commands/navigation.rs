@@ -11,7 +11,7 @@ use super::wind_rose::rose_section;
 pub use super::wind_rose::{rose_wind, ROSE_SEEDS, ROSE_SPEED_MPS, ROSE_TOWARDS_DEG};
 use crate::aircraft::Aircraft;
 use crate::environment::wind::Turbulence;
-use crate::flight::landed::landed_state_honest;
+use crate::flight::landed::{landed_state_honest, ON_GROUND_AFTER_SLOW_S, ON_GROUND_WITHIN_S};
 use crate::flight::missions::{
     default_mission, other_runway_missions, runway_mission, RunwayMission,
 };
@@ -132,7 +132,7 @@ pub fn flies_well(o: &FlightOutcome, calm: bool) -> Result<(), String> {
         ));
     }
     let td = m.touchdown.as_ref().ok_or("no touchdown")?;
-    landed_state_honest(&o.summary.landed_states, td.time_s)
+    landed_state_honest(&o.summary.landed_states, td.time_s, &o.samples)
 }
 
 /// Flies the default mission in calm air at the cruise airspeed `airspeed_mps`, set as a
@@ -397,7 +397,10 @@ fn runway_section(
          with light turbulence, seeds {}. Beyond the targets above, each flight must strike \
          nothing, keep the throttle off its stops in under {THROTTLE_AT_STOPS_MAX_PCT} % of \
          level cruise and read an honest landed state from the start to the stop (TAKEOFF, \
-         IN_AIR, LANDING until the wheels touch, ON_GROUND within 15 s after).\n",
+         IN_AIR, LANDING until the wheels touch, ON_GROUND within {ON_GROUND_WITHIN_S} s \
+         after, or within {ON_GROUND_AFTER_SLOW_S} s of the air over the wings slowing under \
+         the land detector's `LND_ASPD_MAX` when a roll-out keeps flying speed longer: \
+         `sim_host::flight::landed`).\n",
         seed_span(&RUNWAY_SEEDS)
     );
     for m in &missions {
