@@ -316,6 +316,8 @@ impl Drop for Profiler {
             .custom_flags(nix::fcntl::OFlag::O_NONBLOCK.bits())
             .open(&self.fifo);
         let _ = std::fs::remove_file(&self.fifo);
+        // QEMU's monitor socket is its to create and nobody's to reuse.
+        let _ = std::fs::remove_file(&self.monitor);
     }
 }
 
