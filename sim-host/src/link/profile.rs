@@ -216,8 +216,16 @@ impl Profiler {
         let k = self.frames_sent;
         self.frames_sent += 1;
         if k == self.window.start_frame {
-            if let Err(e) = self.open() {
-                self.finish(Err(format!("cannot start QEMU's trace: {e}")));
+            // Without its reader (no pipe) or its symbols, the trace is not switched on: QEMU
+            // would write gigabytes into a plain file that nobody reads.
+            let r = match &self.symbols {
+                Err(e) => Err(e.clone()),
+                Ok(_) => self
+                    .open()
+                    .map_err(|e| format!("cannot start QEMU's trace: {e}")),
+            };
+            if let Err(e) = r {
+                self.finish(Err(e));
             }
         } else if k == self.window.end_frame() {
             let r = self
@@ -497,6 +505,20 @@ mod tests {
         for bad in ["", "x", "-1", "5:0", "5:x", "inf"] {
             assert!(ProfileWindow::parse(bad).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn without_its_pipe_the_window_reports_why_and_never_switches_the_trace_on() {
+        let slot = ProfileSlot::default();
+        let dir = std::path::Path::new("/nonexistent/profile-dir");
+        let window = ProfileWindow::parse("0:1").expect("window");
+        let mut p = Profiler::new(window, dir, Path::new("/nonexistent/elf"), slot.clone());
+        // The window's first frame: no monitor is asked (there is no QEMU here), the slot
+        // says why.
+        p.before_frame();
+        let r = slot.lock().expect("slot").clone().expect("a result");
+        let e = r.expect_err("no profile without a pipe");
+        assert!(e.contains("cannot create the pipe"), "{e}");
     }
 
     #[test]
