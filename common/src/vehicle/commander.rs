@@ -220,9 +220,7 @@ impl Commander {
             airspeed: e.airspeed,
             specific_force,
             // The navigator stays in its roll-out once it disarms the aircraft.
-            rolling_out: self.nav_for.is_some()
-                && self.flown_mode().needs_navigator()
-                && self.nav.phase == Phase::Landed,
+            rolling_out: self.navigator_flies() && self.nav.phase == Phase::Landed,
         };
         self.land.update(p, &inputs, dt);
     }
@@ -244,10 +242,14 @@ impl Commander {
         }
     }
 
+    /// The navigator has a plan and the flown mode is one it flies (armed or not).
+    fn navigator_flies(&self) -> bool {
+        self.nav_for.is_some() && self.flown_mode().needs_navigator()
+    }
+
     /// The navigator's phase while it flies the armed aircraft.
     fn navigated_phase(&self) -> Option<Phase> {
-        (self.armed && self.nav_for.is_some() && self.flown_mode().needs_navigator())
-            .then_some(self.nav.phase)
+        (self.armed && self.navigator_flies()).then_some(self.nav.phase)
     }
 
     /// What a failsafe has the aircraft do instead of the chosen mode.

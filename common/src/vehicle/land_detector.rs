@@ -15,9 +15,10 @@
 //! Ground speed is no evidence of flight in the navigator's roll-out, armed or disarmed after
 //! it: the navigator has seen the wheels on the runway (a bounce back into the air returns it
 //! to the flare, and vertical speed still lifts the aircraft); nor, once it reads landed there,
-//! is an airspeed over `LND_ASPD_TO` (a crosswind's gusts over a rolling aircraft). A tailwind carries a landed aircraft along at 13 m/s over the ground
-//! with 8 m/s of air over its wings, far under any speed it could fly at; without this it
-//! read "landing" for the 20 s its wheels took to slow it under `LND_VXY_MAX`.
+//! is an airspeed over `LND_ASPD_TO` (a crosswind's gusts over a rolling aircraft). A tailwind
+//! carries a landed aircraft along at 13 m/s over the ground with 8 m/s of air over its wings,
+//! far under any speed it could fly at; without this it read "landing" for the 20 s its wheels
+//! took to slow it under `LND_VXY_MAX`.
 //!
 //! The height over home is no input: an aircraft started in the air below home's altitude is
 //! flying, and one at 4 m on its final approach is too.

@@ -12,7 +12,8 @@ use std::fmt::Write as _;
 /// every 30 degrees, so that the take-off and the landing (both northbound) meet a tailwind, a
 /// headwind and crosswinds from either side.
 pub const ROSE_TOWARDS_DEG: [u32; 12] = [0, 30, 60, 90, 120, 150, 180, 210, 240, 270, 300, 330];
-/// Wind speed of the wind-rose flights, m/s: the 5 m/s.
+/// Wind speed of the wind-rose flights, m/s: the wind the default mission's windy case and the
+/// missions from other runways fly in.
 pub const ROSE_SPEED_MPS: f64 = 5.0;
 /// Seeds of the wind-rose flights (turbulence and sensor noise).
 pub const ROSE_SEEDS: [u64; 3] = [1, 2, 3];

@@ -144,7 +144,9 @@ pub struct Profiler {
     window: ProfileWindow,
     monitor: PathBuf,
     fifo: PathBuf,
-    symbols: Result<Symbols, String>,
+    /// The image's symbols, or why the window cannot be profiled (no pipe, no symbols, no
+    /// work markers): then the trace is never switched on.
+    ready: Result<Symbols, String>,
     trace: Arc<Trace>,
     frames_sent: u64,
     slot: ProfileSlot,
@@ -163,24 +165,27 @@ impl Profiler {
     /// be there before QEMU starts (QEMU opens its log at start-up, waiting for a reader).
     pub fn new(window: ProfileWindow, dir: &Path, elf: &Path, slot: ProfileSlot) -> Self {
         let (monitor, fifo) = Self::paths(dir);
-        let symbols = Symbols::of(elf);
-        let (start, end) = match &symbols {
-            Ok(s) => (
-                s.address_of(WORK_START).unwrap_or(u64::MAX),
-                s.address_of(WORK_END).unwrap_or(u64::MAX),
-            ),
-            Err(_) => (u64::MAX, u64::MAX),
-        };
+        let marked = Symbols::of(elf).and_then(|s| {
+            let at = |marker: &str| {
+                s.address_of(marker).ok_or_else(|| {
+                    format!("the image has no `{marker}`: it does not mark its work")
+                })
+            };
+            let markers = (at(WORK_START)?, at(WORK_END)?);
+            Ok((s, markers))
+        });
+        let (start, end) = marked.as_ref().map_or((u64::MAX, u64::MAX), |(_, m)| *m);
         let trace = Arc::new(Trace {
             bytes: AtomicU64::new(0),
             counts: Mutex::new(Counts::new(start, end)),
         });
         let _ = std::fs::remove_file(&fifo);
-        let symbols = match nix::unistd::mkfifo(&fifo, Mode::S_IRUSR | Mode::S_IWUSR) {
+        // The reader starts whatever the image: QEMU waits at start-up for one to open the pipe.
+        let ready = match nix::unistd::mkfifo(&fifo, Mode::S_IRUSR | Mode::S_IWUSR) {
             Ok(()) => {
                 let (fifo, trace) = (fifo.clone(), Arc::clone(&trace));
                 std::thread::spawn(move || read_trace(&fifo, &trace));
-                symbols
+                marked.map(|(s, _)| s)
             }
             Err(e) => Err(format!("cannot create the pipe `{}`: {e}", fifo.display())),
         };
@@ -188,7 +193,7 @@ impl Profiler {
             window,
             monitor,
             fifo,
-            symbols,
+            ready,
             trace,
             frames_sent: 0,
             slot,
@@ -216,9 +221,9 @@ impl Profiler {
         let k = self.frames_sent;
         self.frames_sent += 1;
         if k == self.window.start_frame {
-            // Without its reader (no pipe) or its symbols, the trace is not switched on: QEMU
-            // would write gigabytes into a plain file that nobody reads.
-            let r = match &self.symbols {
+            // Not ready, the trace is not switched on: without its reader QEMU would write
+            // gigabytes into a plain file that nobody reads.
+            let r = match &self.ready {
                 Err(e) => Err(e.clone()),
                 Ok(_) => self
                     .open()
@@ -283,14 +288,7 @@ impl Profiler {
     }
 
     fn read(&self) -> Result<McuProfile, String> {
-        let symbols = self.symbols.as_ref().map_err(String::clone)?;
-        for marker in [WORK_START, WORK_END] {
-            if symbols.address_of(marker).is_none() {
-                return Err(format!(
-                    "the image has no `{marker}`: it does not mark its work"
-                ));
-            }
-        }
+        let symbols = self.ready.as_ref().map_err(String::clone)?;
         let mut counts = self.trace.counts.lock().unwrap_or_else(|p| p.into_inner());
         let (start, end) = (counts.start, counts.end);
         let counts = std::mem::replace(&mut *counts, Counts::new(start, end));
