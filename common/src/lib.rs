@@ -62,4 +62,5 @@ pub mod navigation;
 pub mod params;
 pub mod sensors;
 pub mod storage;
+pub mod ulog;
 pub mod vehicle;
