@@ -503,6 +503,7 @@ fn self_spend(budget: &mut Option<usize>, ops: &mut usize) -> Result<bool, RamFl
 }
 
 pub mod f4;
+pub mod flight_log;
 pub mod stream;
 
 #[cfg(test)]
