@@ -57,6 +57,7 @@ pub mod failsafe;
 pub mod gcs;
 pub mod guidance;
 pub mod link;
+pub mod logger;
 pub mod math;
 pub mod navigation;
 pub mod params;

@@ -134,3 +134,90 @@ impl Format {
         }
     }
 }
+
+/// A value a topic's field holds: its ULog type and how it is written.
+pub trait Value {
+    /// The element type.
+    const TY: Ty;
+    /// `None` for a scalar, `Some(n)` for an array of `n`.
+    const COUNT: Option<u16>;
+    /// Appends the value, little-endian.
+    fn put(&self, c: &mut Cursor<'_>);
+}
+
+macro_rules! scalar_value {
+    ($($t:ty => $ty:ident, $put:ident);* $(;)?) => {$(
+        impl Value for $t {
+            const TY: Ty = Ty::$ty;
+            const COUNT: Option<u16> = None;
+            fn put(&self, c: &mut Cursor<'_>) {
+                c.$put(*self);
+            }
+        }
+    )*};
+}
+
+scalar_value! {
+    u8 => U8, u8;
+    i8 => I8, i8;
+    u16 => U16, u16;
+    i16 => I16, i16;
+    u32 => U32, u32;
+    i32 => I32, i32;
+    u64 => U64, u64;
+    f32 => F32, f32;
+    f64 => F64, f64;
+    bool => Bool, bool;
+}
+
+impl<T: Value, const N: usize> Value for [T; N] {
+    const TY: Ty = T::TY;
+    // Topics hold short arrays (quaternions, outputs): N < 2^16 by construction.
+    #[allow(clippy::cast_possible_truncation)]
+    const COUNT: Option<u16> = Some(N as u16);
+    fn put(&self, c: &mut Cursor<'_>) {
+        for v in self {
+            v.put(c);
+        }
+    }
+}
+
+/// A logged topic: a plain struct whose fields are its format's, in order.
+pub trait Topic {
+    /// Its format.
+    const FORMAT: Format;
+    /// Appends its fields (not the timestamp), in the format's order.
+    fn encode(&self, c: &mut Cursor<'_>);
+}
+
+/// Declares a topic: the struct and its [`Topic`] implementation from one list of fields, so
+/// the format a reader is told and the bytes written cannot disagree.
+#[macro_export]
+macro_rules! ulog_topic {
+    (
+        $(#[$m:meta])*
+        $name:ident = $topic:literal {
+            $($(#[$fm:meta])* $field:ident : $ty:ty),* $(,)?
+        }
+    ) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq)]
+        pub struct $name {
+            $($(#[$fm])* pub $field: $ty,)*
+        }
+
+        impl $crate::ulog::topic::Topic for $name {
+            const FORMAT: $crate::ulog::topic::Format = $crate::ulog::topic::Format {
+                name: $topic,
+                fields: &[$($crate::ulog::topic::Field {
+                    name: stringify!($field),
+                    ty: <$ty as $crate::ulog::topic::Value>::TY,
+                    count: <$ty as $crate::ulog::topic::Value>::COUNT,
+                }),*],
+            };
+            fn encode(&self, c: &mut $crate::ulog::Cursor<'_>) {
+                $($crate::ulog::topic::Value::put(&self.$field, c);)*
+            }
+        }
+    };
+}
