@@ -1,6 +1,322 @@
 //! The flight log: what the autopilot records of each flight, at what rate, as ULog.
+//!
+//! The logger never writes storage itself. Each control period it encodes what is due into a
+//! RAM ring ([`RING_LEN`] bytes), whole messages only; the board drains the ring into its
+//! storage (a file in SITL, a flash region on the MCU) outside the control period, at its own
+//! pace. A sample that finds the ring full is dropped, counted, and the gap is written as a
+//! ULog dropout once there is room again, so a slow storage costs log data, never a control
+//! period.
+//!
+//! A log starts with its definitions (header, flag bits, information, every parameter, the
+//! formats and subscriptions). They go out a few messages a period as the ring has room,
+//! before the first sample; a flight's samples start once they are out, a few periods
+//! after arming.
 
+pub mod ring;
 pub mod topics;
+
+use crate::params::ParamStore;
+use crate::ulog::topic::{Format, Topic};
+use crate::ulog::{self, Level, TooLong};
+use ring::ByteRing;
+use topics::*;
+
+/// Bytes of the ring between the logger and the storage.
+pub const RING_LEN: usize = 4096;
+/// The longest message the logger encodes (a format's text is the longest).
+pub const MESSAGE_MAX: usize = 512;
+/// Every how many microseconds a sync message is written.
+pub const SYNC_PERIOD_US: u64 = 1_000_000;
+
+/// A topic of this log: its message id is its place in [`TOPICS`].
+pub trait Logged: Topic {
+    /// Its message id.
+    const ID: u16;
+}
+
+macro_rules! logged {
+    ($($t:ident => $rate:literal),* $(,)?) => {
+        /// Every topic of the log with its rate in Hz, in message-id order.
+        pub const TOPICS: &[(Format, u16)] = &[$(($t::FORMAT, $rate)),*];
+        logged!(@ids 0u16, $($t),*);
+    };
+    (@ids $n:expr, $t:ident $(, $rest:ident)*) => {
+        impl Logged for $t {
+            const ID: u16 = $n;
+        }
+        logged!(@ids $n + 1, $($rest),*);
+    };
+    (@ids $n:expr,) => {};
+}
+
+// Rates: the estimate and the loops fast enough to see a 1-2 Hz oscillation of the attitude
+// loops sharply, the slow states at a few Hz; about 2.3 KB a second in all (docs/LOGGING.md).
+logged! {
+    VehicleAttitude => 25,
+    SensorCombined => 25,
+    ControlLoops => 25,
+    ActuatorOutputs => 25,
+    VehicleAttitudeSetpoint => 10,
+    VehicleLocalPosition => 10,
+    AirspeedValidated => 10,
+    VehicleAirData => 5,
+    DifferentialPressure => 5,
+    VehicleMagnetometer => 5,
+    VehicleGlobalPosition => 5,
+    VehicleGpsPosition => 5,
+    Wind => 2,
+    EstimatorStates => 2,
+    VehicleStatus => 2,
+    VehicleLandDetected => 2,
+    BatteryStatus => 1,
+    MissionResult => 1,
+    TelemetryStatus => 1,
+}
+
+/// What identifies the log's system (ULog information messages).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SystemInfo {
+    /// `sys_name`: the autopilot.
+    pub sys_name: &'static str,
+    /// `ver_sw`: the software version.
+    pub ver_sw: &'static str,
+    /// `ver_hw`: the board.
+    pub ver_hw: &'static str,
+}
+
+/// Where the log's definitions stand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    Header,
+    Flags,
+    Info(u8),
+    Param(u16),
+    Format(u16),
+    Subscribe(u16),
+    Data,
+}
+
+/// Counters of what the log lost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LogStats {
+    /// Samples and texts dropped for want of room in the ring.
+    pub dropped: u32,
+    /// Bytes taken into the ring.
+    pub bytes: u32,
+}
+
+/// The logger of one flight at a time.
+pub struct Logger {
+    ring: ByteRing<RING_LEN>,
+    stage: Option<Stage>,
+    start_us: u64,
+    next_due_us: [u64; TOPICS.len()],
+    next_sync_us: u64,
+    dropout_since_us: Option<u64>,
+    stats: LogStats,
+    info: SystemInfo,
+}
+
+impl Logger {
+    /// A logger recording nothing yet.
+    pub fn new(info: SystemInfo) -> Self {
+        Self {
+            ring: ByteRing::new(),
+            stage: None,
+            start_us: 0,
+            next_due_us: [0; TOPICS.len()],
+            next_sync_us: 0,
+            dropout_since_us: None,
+            stats: LogStats::default(),
+            info,
+        }
+    }
+
+    /// Whether a log is being recorded.
+    pub fn recording(&self) -> bool {
+        self.stage.is_some()
+    }
+
+    /// What this log lost and took.
+    pub fn stats(&self) -> LogStats {
+        self.stats
+    }
+
+    /// Starts a new log at `now_us` (what is still in the ring of the last one stays ahead
+    /// of it: drain it into the last log's storage first).
+    pub fn start(&mut self, now_us: u64) {
+        self.stage = Some(Stage::Header);
+        self.start_us = now_us;
+        self.next_due_us = [now_us; TOPICS.len()];
+        self.next_sync_us = now_us.saturating_add(SYNC_PERIOD_US);
+        self.dropout_since_us = None;
+        self.stats = LogStats::default();
+    }
+
+    /// Ends the log: nothing more is taken; what is in the ring is still to be drained.
+    pub fn stop(&mut self) {
+        self.stage = None;
+    }
+
+    /// Moves the definitions on as far as the ring has room, then writes a sync marker when
+    /// one is due. Call once a control period, before the samples.
+    pub fn step(&mut self, now_us: u64, params: &ParamStore) {
+        while let Some(stage) = self.stage.filter(|s| *s != Stage::Data) {
+            let mut b = [0u8; MESSAGE_MAX];
+            let Some((n, next)) = self.definition(stage, params, &mut b) else {
+                // An oversized definition is skipped, not allowed to stall the log.
+                self.stage = Some(self.after(stage));
+                continue;
+            };
+            if !self.ring.push(b.get(..n).unwrap_or(&[])) {
+                return;
+            }
+            self.stats.bytes = self.stats.bytes.saturating_add(n as u32);
+            self.stage = Some(next);
+        }
+        if self.stage == Some(Stage::Data) && now_us >= self.next_sync_us {
+            let mut b = [0u8; 16];
+            if let Ok(n) = ulog::sync(&mut b) {
+                if self.ring.push(b.get(..n).unwrap_or(&[])) {
+                    self.next_sync_us = now_us.saturating_add(SYNC_PERIOD_US);
+                }
+            }
+        }
+    }
+
+    /// Whether topic `T` is due at `now_us` (the caller builds the sample only then).
+    pub fn due<T: Logged>(&self, now_us: u64) -> bool {
+        self.stage == Some(Stage::Data)
+            && self
+                .next_due_us
+                .get(usize::from(T::ID))
+                .is_some_and(|&t| now_us >= t)
+    }
+
+    /// Writes one sample of `T` stamped `now_us`, and schedules the next at its rate.
+    pub fn write<T: Logged>(&mut self, now_us: u64, sample: &T) {
+        if self.stage != Some(Stage::Data) {
+            return;
+        }
+        let id = usize::from(T::ID);
+        if let (Some(due), Some((_, rate))) = (self.next_due_us.get_mut(id), TOPICS.get(id)) {
+            let period = 1_000_000 / u64::from((*rate).max(1));
+            // Keep the phase while on time; after a gap, start again from now.
+            let next = due.saturating_add(period);
+            *due = if next > now_us {
+                next
+            } else {
+                now_us.saturating_add(period)
+            };
+        }
+        let mut b = [0u8; MESSAGE_MAX];
+        let n = ulog::data(&mut b, T::ID, now_us, |c| sample.encode(c));
+        self.push_or_drop(now_us, n, &b);
+    }
+
+    /// Writes a text (a status text, a failsafe or land-detector event) stamped `now_us`.
+    pub fn text(&mut self, now_us: u64, level: Level, text: &str) {
+        if self.stage != Some(Stage::Data) {
+            return;
+        }
+        let mut b = [0u8; MESSAGE_MAX];
+        let n = ulog::logging(&mut b, level, now_us, text);
+        self.push_or_drop(now_us, n, &b);
+    }
+
+    /// The oldest bytes waiting for the storage (a contiguous run; more may follow).
+    pub fn pending(&self) -> &[u8] {
+        self.ring.front()
+    }
+
+    /// Bytes waiting for the storage in all.
+    pub fn pending_len(&self) -> usize {
+        self.ring.len()
+    }
+
+    /// The storage took the first `n` bytes of [`Logger::pending`].
+    pub fn consume(&mut self, n: usize) {
+        self.ring.consume(n);
+    }
+
+    fn push_or_drop(&mut self, now_us: u64, n: Result<usize, TooLong>, b: &[u8]) {
+        if let Some(since) = self.dropout_since_us {
+            let mut d = [0u8; 8];
+            let ms = now_us.saturating_sub(since) / 1000;
+            let room = n.map_or(0, |n| n).saturating_add(5);
+            match ulog::dropout(&mut d, u32::try_from(ms).unwrap_or(u32::MAX)) {
+                Ok(k) if self.ring.free() >= room => {
+                    self.ring.push(d.get(..k).unwrap_or(&[]));
+                    self.dropout_since_us = None;
+                }
+                _ => {}
+            }
+        }
+        let pushed = match n {
+            Ok(n) if self.dropout_since_us.is_none() => self.ring.push(b.get(..n).unwrap_or(&[])),
+            _ => false,
+        };
+        match (pushed, n) {
+            (true, Ok(n)) => self.stats.bytes = self.stats.bytes.saturating_add(n as u32),
+            _ => {
+                self.stats.dropped = self.stats.dropped.saturating_add(1);
+                self.dropout_since_us.get_or_insert(now_us);
+            }
+        }
+    }
+
+    /// The message of definition `stage`, and the stage after it; `None` if it cannot be
+    /// encoded.
+    fn definition(
+        &self,
+        stage: Stage,
+        params: &ParamStore,
+        b: &mut [u8],
+    ) -> Option<(usize, Stage)> {
+        let next = self.after(stage);
+        let n = match stage {
+            Stage::Header => ulog::header(b, self.start_us),
+            Stage::Flags => ulog::flag_bits(b),
+            Stage::Info(0) => ulog::info_str(b, "sys_name", self.info.sys_name),
+            Stage::Info(1) => ulog::info_str(b, "ver_sw", self.info.ver_sw),
+            Stage::Info(_) => ulog::info_str(b, "ver_hw", self.info.ver_hw),
+            Stage::Param(i) => {
+                let i = usize::from(i);
+                let (Some(def), Some(v)) = (params.def(i), params.value(i)) else {
+                    // Past the last parameter: on to the formats.
+                    return Some((0, Stage::Format(0)));
+                };
+                if def.kind.is_integer() {
+                    ulog::parameter_i32(b, def.name, v as i32)
+                } else {
+                    ulog::parameter_f32(b, def.name, v)
+                }
+            }
+            Stage::Format(i) => ulog::format(b, &TOPICS.get(usize::from(i))?.0),
+            Stage::Subscribe(i) => {
+                let name = TOPICS.get(usize::from(i))?.0.name;
+                ulog::add_logged(b, 0, i, name)
+            }
+            Stage::Data => return None,
+        };
+        n.ok().map(|n| (n, next))
+    }
+
+    fn after(&self, stage: Stage) -> Stage {
+        let topics = TOPICS.len() as u16;
+        match stage {
+            Stage::Header => Stage::Flags,
+            Stage::Flags => Stage::Info(0),
+            Stage::Info(i) if i < 2 => Stage::Info(i + 1),
+            Stage::Info(_) => Stage::Param(0),
+            Stage::Param(i) => Stage::Param(i.saturating_add(1)),
+            Stage::Format(i) if i.saturating_add(1) < topics => Stage::Format(i + 1),
+            Stage::Format(_) => Stage::Subscribe(0),
+            Stage::Subscribe(i) if i.saturating_add(1) < topics => Stage::Subscribe(i + 1),
+            Stage::Subscribe(_) | Stage::Data => Stage::Data,
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests;

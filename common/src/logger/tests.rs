@@ -1,10 +1,14 @@
-//! The topics' formats against what their encoders write.
+//! The topics' formats against what their encoders write, and the logger's stream walked
+//! message by message as a ULog reader walks it.
 
 extern crate std;
 
-use super::topics::*;
+use std::vec::Vec;
+
+use super::*;
 use crate::ulog::topic::Topic;
 use crate::ulog::{self, Cursor};
+use crate::vehicle::params::REGISTRY;
 
 fn encoded_len<T: Topic + Default>() -> usize {
     let mut b = [0u8; 512];
@@ -15,12 +19,11 @@ fn encoded_len<T: Topic + Default>() -> usize {
 
 macro_rules! check_all {
     ($($t:ty),*) => {{
-        let mut names = std::vec::Vec::new();
+        let mut names = Vec::new();
         $(
             // The timestamp (8 bytes) comes from the data message, the rest from the encoder.
             assert_eq!(encoded_len::<$t>() + 8, <$t>::FORMAT.size(), "{}", <$t>::FORMAT.name);
-            let mut b = [0u8; 1024];
-            assert!(ulog::format(&mut b, &<$t>::FORMAT).is_ok());
+            assert_eq!(TOPICS[<$t as Logged>::ID as usize].0.name, <$t>::FORMAT.name);
             names.push(<$t>::FORMAT.name);
         )*
         names
@@ -28,7 +31,7 @@ macro_rules! check_all {
 }
 
 #[test]
-fn every_topic_writes_exactly_the_bytes_its_format_declares() {
+fn every_topic_writes_exactly_the_bytes_its_format_declares_under_its_own_id() {
     let mut names = check_all!(
         VehicleAttitude,
         VehicleLocalPosition,
@@ -50,10 +53,10 @@ fn every_topic_writes_exactly_the_bytes_its_format_declares() {
         MissionResult,
         TelemetryStatus
     );
-    let n = names.len();
+    assert_eq!(names.len(), TOPICS.len());
     names.sort_unstable();
     names.dedup();
-    assert_eq!(names.len(), n, "topic names are unique");
+    assert_eq!(names.len(), TOPICS.len(), "topic names are unique");
 }
 
 #[test]
@@ -85,4 +88,156 @@ fn fields_are_written_in_order_little_endian_without_padding() {
     assert_eq!(b[..4], [0xff; 4]);
     assert_eq!(b[8..12], [4, 3, 2, 1]);
     assert_eq!(b[n - 2..n], [3, 9]);
+}
+
+const INFO: SystemInfo = SystemInfo {
+    sys_name: "test",
+    ver_sw: "0.1.0",
+    ver_hw: "host",
+};
+
+/// One message of the stream: its type and payload.
+fn messages(bytes: &[u8]) -> Vec<(u8, Vec<u8>)> {
+    assert_eq!(&bytes[..7], &ulog::MAGIC);
+    let mut out = Vec::new();
+    let mut at = ulog::HEADER_LEN;
+    while at + 3 <= bytes.len() {
+        let size = u16::from_le_bytes([bytes[at], bytes[at + 1]]) as usize;
+        out.push((bytes[at + 2], bytes[at + 3..at + 3 + size].to_vec()));
+        at += 3 + size;
+    }
+    assert_eq!(at, bytes.len(), "the stream ends on a message boundary");
+    out
+}
+
+/// Flies the logger for `periods` control periods of 20 ms from t = 0, writing every topic
+/// when due, and draining `drain` bytes a period (all with `None`).
+fn fly(periods: u64, drain: Option<usize>) -> (Vec<u8>, LogStats) {
+    let params = crate::params::ParamStore::new(REGISTRY);
+    let mut log = Logger::new(INFO);
+    log.start(0);
+    let mut out = Vec::new();
+    for k in 0..periods {
+        let t = k * 20_000;
+        log.step(t, &params);
+        if log.due::<VehicleAttitude>(t) {
+            log.write(
+                t,
+                &VehicleAttitude {
+                    q: [1.0, 0.0, 0.0, 0.0],
+                },
+            );
+        }
+        if log.due::<BatteryStatus>(t) {
+            log.write(
+                t,
+                &BatteryStatus {
+                    voltage_v: 12.0,
+                    ..Default::default()
+                },
+            );
+        }
+        if log.due::<EstimatorStates>(t) {
+            log.write(t, &EstimatorStates::default());
+        }
+        if k == 300 {
+            log.text(t, Level::Warning, "geofence breached");
+        }
+        let mut left = drain.unwrap_or(usize::MAX);
+        while left > 0 && log.pending_len() > 0 {
+            let n = log.pending().len().min(left);
+            out.extend_from_slice(&log.pending()[..n]);
+            log.consume(n);
+            left -= n;
+        }
+    }
+    (out, log.stats())
+}
+
+#[test]
+fn a_log_opens_with_its_definitions_in_the_order_ulog_requires() {
+    let (bytes, stats) = fly(100, None);
+    assert_eq!(stats.dropped, 0);
+    let m = messages(&bytes);
+    let params = crate::params::ParamStore::new(REGISTRY).len();
+    let kinds: Vec<u8> = m.iter().map(|(k, _)| *k).collect();
+    assert_eq!(kinds[0], b'B');
+    assert_eq!(&kinds[1..4], b"III");
+    assert!(kinds[4..4 + params].iter().all(|&k| k == b'P'));
+    let f = 4 + params;
+    assert!(kinds[f..f + TOPICS.len()].iter().all(|&k| k == b'F'));
+    let a = f + TOPICS.len();
+    assert!(kinds[a..a + TOPICS.len()].iter().all(|&k| k == b'A'));
+    assert!(kinds[a + TOPICS.len()..]
+        .iter()
+        .all(|&k| matches!(k, b'D' | b'S')));
+    // Each subscription names its format, with its place as the message id.
+    for (i, (_, p)) in m[a..a + TOPICS.len()].iter().enumerate() {
+        assert_eq!(u16::from_le_bytes([p[1], p[2]]) as usize, i);
+        assert_eq!(&p[3..], TOPICS[i].0.name.as_bytes());
+    }
+}
+
+#[test]
+fn each_topic_is_written_at_its_rate() {
+    let (bytes, _) = fly(500, None); // 10 s
+    let m = messages(&bytes);
+    let count = |id: u16| {
+        m.iter()
+            .filter(|(k, p)| *k == b'D' && u16::from_le_bytes([p[0], p[1]]) == id)
+            .count()
+    };
+    // The definitions take the first periods; every rate is met from then on.
+    let att = count(VehicleAttitude::ID);
+    assert!((245..=250).contains(&att), "{att}");
+    let bat = count(BatteryStatus::ID);
+    assert!((9..=10).contains(&bat), "{bat}");
+    let est = count(EstimatorStates::ID);
+    assert!((19..=20).contains(&est), "{est}");
+    let syncs = m.iter().filter(|(k, _)| *k == b'S').count();
+    assert!((9..=10).contains(&syncs), "{syncs}");
+    let text = m.iter().find(|(k, _)| *k == b'L').unwrap();
+    assert_eq!(text.1[0], b'4');
+    assert_eq!(
+        u64::from_le_bytes(text.1[1..9].try_into().unwrap()),
+        6_000_000
+    );
+    assert_eq!(&text.1[9..], b"geofence breached");
+}
+
+#[test]
+fn a_storage_too_slow_costs_samples_and_the_log_says_for_how_long() {
+    // 200 bytes a period is less than the definitions and samples need at first.
+    let (bytes, stats) = fly(500, Some(200));
+    assert!(stats.dropped > 0);
+    let m = messages(&bytes);
+    let dropouts: Vec<u16> = m
+        .iter()
+        .filter(|(k, _)| *k == b'O')
+        .map(|(_, p)| u16::from_le_bytes([p[0], p[1]]))
+        .collect();
+    assert!(!dropouts.is_empty());
+    assert!(
+        dropouts.iter().all(|&ms| ms > 0 && ms < 10_000),
+        "{dropouts:?}"
+    );
+}
+
+#[test]
+fn nothing_is_taken_before_the_start_or_after_the_stop() {
+    let params = crate::params::ParamStore::new(REGISTRY);
+    let mut log = Logger::new(INFO);
+    log.step(0, &params);
+    assert!(!log.due::<VehicleAttitude>(0));
+    log.write(0, &VehicleAttitude::default());
+    assert_eq!(log.pending_len(), 0);
+    log.start(0);
+    log.step(0, &params);
+    assert!(log.pending_len() > 0);
+    log.stop();
+    let n = log.pending_len();
+    log.step(20_000, &params);
+    log.text(20_000, Level::Info, "x");
+    assert_eq!(log.pending_len(), n);
+    assert!(!log.recording());
 }
