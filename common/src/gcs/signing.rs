@@ -43,6 +43,17 @@ pub enum Refusal {
     Replay,
 }
 
+impl core::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Refusal::Unsigned => "not signed with the key",
+            Refusal::Replay => "signature timestamp too old (a replay)",
+        })
+    }
+}
+
+impl core::error::Error for Refusal {}
+
 /// The signing state of a ground link.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Signing {
@@ -217,6 +228,20 @@ impl Signing {
         self.streams.clear();
         self.changes = self.changes.wrapping_add(1);
         true
+    }
+
+    /// `SETUP_SIGNING` as a station sent it (`signed`: its signature block, if it had one):
+    /// the setup taken or refused as [`Signing::setup`] does, and the status text that tells
+    /// the station which.
+    pub fn on_setup(&mut self, d: &SETUP_SIGNING_DATA, signed: Option<Signed>) -> &'static str {
+        let with_key = signed.is_some_and(|s| s.valid);
+        if !self.setup(d, with_key) {
+            "Signing setup refused: not signed with the key"
+        } else if self.key.is_some() {
+            "Signing on: unsigned writes are refused"
+        } else {
+            "Signing off"
+        }
     }
 }
 

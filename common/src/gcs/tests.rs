@@ -11,10 +11,10 @@ use mavlink::MavHeader;
 
 use super::mission::{UPLOAD_MAX_RETRIES, UPLOAD_RETRY_US};
 use super::*;
-use crate::navigation::plan::MISSION_CAPACITY;
+use crate::navigation::plan::{MissionStore, PlanKind, MISSION_CAPACITY};
 use crate::navigation::validate::PlanRules;
 use crate::param;
-use crate::params::store::Registry;
+use crate::params::store::{ParamStore, Registry};
 use crate::params::{Group, ParamDef};
 use crate::vehicle::modes::{FlightMode, ModeSet};
 use crate::vehicle::requests::ArmRequest;
