@@ -521,11 +521,11 @@ fn unknown_mode(custom_mode: u32, out: &mut Outbox) -> MavResult {
     MavResult::MAV_RESULT_FAILED
 }
 
-#[allow(deprecated)]
-// PARAM_FLOAT is deprecated in favour of the encoding flags, yet
-// the design names it and older ground stations look for it.
 /// `AUTOPILOT_VERSION`: what this autopilot speaks (FTP when it serves files, `ftp`) and
 /// the board's unique id.
+// PARAM_FLOAT is deprecated in favour of the encoding flags, yet the design names it and
+// older ground stations look for it.
+#[allow(deprecated)]
 pub(crate) fn autopilot_version(uid: u64, ftp: bool) -> MavMessage {
     type C = MavProtocolCapability;
     let mut capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2

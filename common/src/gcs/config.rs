@@ -20,9 +20,8 @@ pub struct LinkConfig {
     pub system_id: u8,
     /// Our component id.
     pub component_id: u8,
-    /// `PARAM_VALUE`s sent per [`GroundLink::poll`](super::GroundLink::poll) while streaming
-    /// the list: paces a full download to the link's bandwidth (a 50 Hz loop with 4 per poll
-    /// sends 200 per second).
+    /// `PARAM_VALUE`s sent per poll of the link while streaming the list: paces a full
+    /// download to the link's bandwidth (a 50 Hz loop with 4 per poll sends 200 per second).
     pub params_per_poll: u8,
     /// Hardware unique id reported in `AUTOPILOT_VERSION` (0 when unknown).
     pub uid: u64,

@@ -13,7 +13,7 @@
 //! (the parameter protocol), [`commands`] (commands and their acknowledgements, and the
 //! vehicle's requests), [`ftp`] (files), [`texts`] (status texts), [`telemetry`] and
 //! [`streams`] (what is sent unasked, and how often). This file routes each message to one
-//! of them and orders what they have to send at each poll ([`output`] builds it). The
+//! of them and orders what they have to send at each poll (`output.rs` builds it). The
 //! services never call each other: what one has to send is written to the outbox handed to
 //! it, and what one needs of another is handed to it as an argument.
 //!
@@ -292,8 +292,7 @@ impl GroundLink {
             MavMessage::MISSION_ITEM_INT(d) => {
                 let plan = &mut *stores.plan;
                 let r = self.missions.on_item(plan, &stores.rules, d, from, now_us);
-                // Said after the answer is queued: they are no part of it.
-                for w in self.missions.take_warnings().iter().copied() {
+                for w in self.missions.take_warnings().iter() {
                     out.textf(MavSeverity::MAV_SEVERITY_WARNING, format_args!("{w}"));
                 }
                 r

@@ -375,4 +375,17 @@ mod tests {
         assert_eq!(s.timestamp(), MAX_TIMESTAMP);
         assert_eq!(s.next_timestamp(), MAX_TIMESTAMP);
     }
+
+    #[test]
+    fn refusals_read_as_a_plain_reason_and_are_errors() {
+        extern crate std;
+        use std::string::ToString;
+        assert_eq!(Refusal::Unsigned.to_string(), "not signed with the key");
+        assert_eq!(
+            Refusal::Replay.to_string(),
+            "signature timestamp too old (a replay)"
+        );
+        let e: &dyn core::error::Error = &Refusal::Replay;
+        assert!(e.source().is_none());
+    }
 }
