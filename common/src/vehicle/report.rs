@@ -3,7 +3,7 @@
 
 use super::commander::Commander;
 use super::modes::{FlightMode, ModeSet};
-use super::snapshot::{GpsRaw, Home, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot};
+use super::snapshot::{GpsRaw, HomeReport, NavReport, SensorHealthReport, VehicleSnapshot};
 use crate::battery::Battery;
 use crate::estimator::EstimatedState;
 use crate::math::{course_and_speed, wrap_two_pi};
@@ -47,7 +47,7 @@ pub fn available_modes(e: &EstimatedState) -> ModeSet {
 /// The snapshot of a vehicle.
 pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapshot {
     let h = &e.health;
-    let health = SensorHealth {
+    let health = SensorHealthReport {
         gyro_ok: h.imu.healthy,
         accel_ok: h.imu.healthy,
         mag_ok: h.mag.healthy,
@@ -57,7 +57,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         attitude_converged: e.converged,
         position_valid: e.position_valid,
     };
-    let home = e.home.map_or(Home::default(), |h| Home {
+    let home = e.home.map_or(HomeReport::default(), |h| HomeReport {
         valid: true,
         lat_e7: h.point.lat_e7,
         lon_e7: h.point.lon_e7,
@@ -119,14 +119,14 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
 }
 
 /// NAV_CONTROLLER_OUTPUT from the navigator's last step (zeros outside navigation modes).
-fn nav_telemetry(e: &EstimatedState, c: &Commander) -> NavTelemetry {
+fn nav_telemetry(e: &EstimatedState, c: &Commander) -> NavReport {
     if !c.flown_mode().needs_navigator() {
-        return NavTelemetry::default();
+        return NavReport::default();
     }
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
     let nav = c.navigation();
     let g = nav.guidance;
-    NavTelemetry {
+    NavReport {
         roll_cmd: 0.0,
         pitch_cmd: 0.0,
         course_cmd: g.map_or(0.0, |g| wrap_two_pi(g.course)),
