@@ -734,6 +734,7 @@ fn a_disarm_asked_in_flight_below_5_m_is_refused_unless_forced() {
             ..Default::default()
         },
         &e,
+        &mut crate::navigation::navigator::Navigator::default(),
     );
     for _ in 0..100 {
         c.detect_landing(&LandParams::default(), &e, Some(9.81), 0.02);
