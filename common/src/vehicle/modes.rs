@@ -115,7 +115,7 @@ pub enum Commanded {
 /// Everything a mode is, in one row: how the link names it, what it needs, what it flies.
 #[derive(Clone, Copy, Debug)]
 pub struct ModeFacts {
-    /// The mode the row describes (its position in [`MODES`] is `mode as usize`).
+    /// The mode the row describes (rows are in [`FlightMode::ALL`]'s order).
     pub mode: FlightMode,
     /// Name shown by ground stations (`AVAILABLE_MODES.mode_name`, STATUSTEXT).
     pub name: &'static str,
@@ -221,14 +221,24 @@ pub const MODES: [ModeFacts; 9] = [
     },
 ];
 
-// Each row sits at its mode's index, so `facts` needs no search and cannot pick the wrong row.
-const _: () = {
-    let mut i = 0;
-    while i < MODES.len() {
-        assert!(MODES[i].mode as usize == i && FlightMode::ALL[i] as usize == i);
-        i += 1;
+/// Whether each mode's row describes that mode (checked as the crate compiles).
+const fn rows_in_place(modes: &[FlightMode]) -> bool {
+    match modes.split_first() {
+        Some((m, rest)) => m.facts().mode as u8 == *m as u8 && rows_in_place(rest),
+        None => true,
     }
-};
+}
+
+const _: () = assert!(rows_in_place(&FlightMode::ALL));
+
+/// The modes of `modes` that need no position estimate.
+const fn without_position(modes: &[FlightMode]) -> ModeSet {
+    match modes.split_first() {
+        Some((m, rest)) if m.needs_position() => without_position(rest),
+        Some((m, rest)) => without_position(rest).with(*m),
+        None => ModeSet::EMPTY,
+    }
+}
 
 impl FlightMode {
     /// Every mode, in the order `AVAILABLE_MODES` lists them (its `mode_index` is this
@@ -247,7 +257,18 @@ impl FlightMode {
 
     /// This mode's row of [`MODES`].
     pub const fn facts(self) -> &'static ModeFacts {
-        &MODES[self as usize]
+        let [manual, stabilized, altitude, hold, mission, loiter, ret, takeoff, land] = &MODES;
+        match self {
+            FlightMode::Manual => manual,
+            FlightMode::Stabilized => stabilized,
+            FlightMode::Altitude => altitude,
+            FlightMode::Hold => hold,
+            FlightMode::Mission => mission,
+            FlightMode::Loiter => loiter,
+            FlightMode::Return => ret,
+            FlightMode::Takeoff => takeoff,
+            FlightMode::Land => land,
+        }
     }
 
     /// Name shown by ground stations (`AVAILABLE_MODES.mode_name`, STATUSTEXT).
@@ -384,17 +405,7 @@ impl ModeSet {
     /// Every mode.
     pub const ALL: ModeSet = ModeSet((1 << FlightMode::ALL.len()) - 1);
     /// Modes that need no position estimate.
-    pub const WITHOUT_POSITION: ModeSet = {
-        let mut set = ModeSet::EMPTY;
-        let mut i = 0;
-        while i < MODES.len() {
-            if !MODES[i].mode.needs_position() {
-                set = set.with(MODES[i].mode);
-            }
-            i += 1;
-        }
-        set
-    };
+    pub const WITHOUT_POSITION: ModeSet = without_position(&FlightMode::ALL);
 
     /// Whether `mode` is in the set.
     pub const fn contains(self, mode: FlightMode) -> bool {
