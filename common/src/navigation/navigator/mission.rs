@@ -21,7 +21,7 @@ use super::guide::{horizontal_dist, Flight, Orbit};
 use super::io::{HomeRequest, NavOutput, NavState, NavWarning, Phase};
 use super::params::NavParams;
 use crate::estimator::Home;
-use crate::math::wrap_pi;
+use crate::math::{wrap_pi, MIN_COURSE_SPEED_MPS};
 use crate::navigation::item::{
     HomeChange, JumpRepeat, NavCommand, NavItem, Route, SpeedChange,
 };
@@ -221,7 +221,7 @@ impl MissionWalk {
         };
         let t = next.ned(home, &pos);
         let vg = state.ground_speed();
-        if vg < 3.0 || horizontal_dist(&t, &orbit.center) < 1.5 * orbit.radius {
+        if vg < MIN_COURSE_SPEED_MPS || horizontal_dist(&t, &orbit.center) < 1.5 * orbit.radius {
             return true;
         }
         let bearing = libm::atan2f(t.y - pos.y, t.x - pos.x);
