@@ -30,7 +30,9 @@ use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
 use crate::navigation::fence::{breached, FenceParams};
 use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
 use crate::navigation::navigator::Navigator;
-use crate::navigation::plan::{MissionItem, MissionStore, PlanKind};
+use crate::navigation::item::{NavCommand, NavItem, Route};
+use crate::navigation::items::{Altitude, Place};
+use crate::navigation::plan::{MissionStore, PlanKind};
 use crate::sensors::ManualInput;
 
 /// Sticks older than this are ignored (the ground station or the radio stopped sending), us.
@@ -192,15 +194,15 @@ pub fn trim_surfaces(g: &GainSet) -> Surfaces {
 }
 
 /// The Takeoff mode's one item: climb out along the present heading to the return altitude.
-fn takeoff_item(height_m: f32) -> MissionItem {
-    use mavlink::dialects::common::{MavCmd, MavFrame};
-    MissionItem {
-        params: [0, 0, 0, f32::NAN.to_bits()],
-        x: 0,
-        y: 0,
-        z: height_m.to_bits(),
-        command: MavCmd::MAV_CMD_NAV_TAKEOFF as u16,
-        frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT as u8,
+fn takeoff_item(height_m: f32) -> NavItem {
+    NavItem {
+        command: NavCommand::Takeoff {
+            place: Place {
+                point: None,
+                alt: height_m.is_finite().then_some(Altitude::AboveHome(height_m)),
+            },
+            yaw: None,
+        },
         autocontinue: true,
     }
 }
@@ -637,13 +639,13 @@ impl Commander {
                 NavTask::Takeoff => navigator.start_mission(0),
             }
         }
-        let takeoff = [takeoff_item(navigator.params().rtl_alt)];
-        let items: &[MissionItem] = match task {
-            NavTask::Mission => plan.items(PlanKind::Mission),
-            NavTask::Takeoff => &takeoff,
-            NavTask::Loiter | NavTask::Return | NavTask::Land => &[],
+        let takeoff = takeoff_item(navigator.params().rtl_alt);
+        let items = match task {
+            NavTask::Mission => Route::Plan(plan.items(PlanKind::Mission)),
+            NavTask::Takeoff => Route::Item(&takeoff),
+            NavTask::Loiter | NavTask::Return | NavTask::Land => Route::Plan(&[]),
         };
-        let out = navigator.step(items, &home, &NavState::from_estimate(e), dt);
+        let out = navigator.step_route(items, &home, &NavState::from_estimate(e), dt);
         if task == NavTask::Mission {
             let current = out.current_seq.filter(|&c| c != self.mission_seq);
             if let Some(c) = out.current_seq {

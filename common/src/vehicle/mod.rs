@@ -414,7 +414,7 @@ impl Vehicle {
             roll: e.euler.phi,
             pitch: e.euler.theta,
             // Course needs ground speed; on the ground or in a hover-like crawl use heading.
-            course: if e.ground_speed > 3.0 {
+            course: if e.ground_speed > crate::math::MIN_COURSE_SPEED_MPS {
                 e.course
             } else {
                 e.euler.psi
