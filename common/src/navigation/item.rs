@@ -339,8 +339,7 @@ mod tests {
         };
         assert_eq!(circle.radius_m, None);
         assert_eq!(until, LoiterEnd::Altitude);
-        let NavCommand::Loiter { until, .. } =
-            decode(NAV_LOITER_TIME, [f32::NAN, 0.0, 0.0, 0.0])
+        let NavCommand::Loiter { until, .. } = decode(NAV_LOITER_TIME, [f32::NAN, 0.0, 0.0, 0.0])
         else {
             panic!("not a loiter");
         };
@@ -349,8 +348,7 @@ mod tests {
 
     #[test]
     fn a_takeoff_yaw_is_read_in_degrees_only_when_finite() {
-        let NavCommand::Takeoff { yaw, place } = decode(NAV_TAKEOFF, [0.0, 0.0, 0.0, 90.0])
-        else {
+        let NavCommand::Takeoff { yaw, place } = decode(NAV_TAKEOFF, [0.0, 0.0, 0.0, 90.0]) else {
             panic!("not a take-off");
         };
         assert!((yaw.unwrap() - core::f32::consts::FRAC_PI_2).abs() < 1e-6);
@@ -390,8 +388,14 @@ mod tests {
     #[test]
     fn speed_changes_of_an_unknown_type_are_unsupported() {
         let speed = |k, v| decode(DO_CHANGE_SPEED, [k, v, 0.0, 0.0]);
-        assert_eq!(speed(0.0, 18.0), NavCommand::ChangeSpeed(SpeedChange::To(18.0)));
-        assert_eq!(speed(1.0, -2.0), NavCommand::ChangeSpeed(SpeedChange::Cruise));
+        assert_eq!(
+            speed(0.0, 18.0),
+            NavCommand::ChangeSpeed(SpeedChange::To(18.0))
+        );
+        assert_eq!(
+            speed(1.0, -2.0),
+            NavCommand::ChangeSpeed(SpeedChange::Cruise)
+        );
         assert_eq!(speed(1.0, -1.0), NavCommand::ChangeSpeed(SpeedChange::Keep));
         assert_eq!(
             speed(2.0, 18.0),

@@ -28,10 +28,10 @@ use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
 use crate::navigation::fence::{breached, FenceParams};
-use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
-use crate::navigation::navigator::Navigator;
 use crate::navigation::item::{NavCommand, NavItem, Route};
 use crate::navigation::items::{Altitude, Place};
+use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
+use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::{MissionStore, PlanKind};
 use crate::sensors::ManualInput;
 
@@ -199,7 +199,9 @@ fn takeoff_item(height_m: f32) -> NavItem {
         command: NavCommand::Takeoff {
             place: Place {
                 point: None,
-                alt: height_m.is_finite().then_some(Altitude::AboveHome(height_m)),
+                alt: height_m
+                    .is_finite()
+                    .then_some(Altitude::AboveHome(height_m)),
             },
             yaw: None,
         },

@@ -48,10 +48,7 @@ impl Loiter {
                 swept: 0.0,
                 last: None,
             },
-            LoiterEnd::Time(goal) => LoiterGoal::Time {
-                goal,
-                elapsed: 0.0,
-            },
+            LoiterEnd::Time(goal) => LoiterGoal::Time { goal, elapsed: 0.0 },
             LoiterEnd::Altitude => LoiterGoal::Altitude,
             LoiterEnd::Unlimited => LoiterGoal::Unlimited,
         };

@@ -22,9 +22,7 @@ use super::io::{HomeRequest, NavOutput, NavState, NavWarning, Phase};
 use super::params::NavParams;
 use crate::estimator::Home;
 use crate::math::{wrap_pi, MIN_COURSE_SPEED_MPS};
-use crate::navigation::item::{
-    HomeChange, JumpRepeat, NavCommand, NavItem, Route, SpeedChange,
-};
+use crate::navigation::item::{HomeChange, JumpRepeat, NavCommand, NavItem, Route, SpeedChange};
 use crate::navigation::path_manager::{PathManager, Waypoint};
 use crate::navigation::plan::MISSION_CAPACITY;
 use nalgebra::Vector3;
@@ -95,24 +93,21 @@ impl MissionWalk {
             }
             budget -= 1;
             match item.command {
-                NavCommand::Jump { target, repeat } => match jump_step(
-                    target,
-                    repeat,
-                    items.len(),
-                    self.jumps.get(seq).copied(),
-                ) {
-                    JumpStep::Jump(t) => {
-                        if let Some(c) = self.jumps.get_mut(seq) {
-                            *c = c.saturating_add(1);
+                NavCommand::Jump { target, repeat } => {
+                    match jump_step(target, repeat, items.len(), self.jumps.get(seq).copied()) {
+                        JumpStep::Jump(t) => {
+                            if let Some(c) = self.jumps.get_mut(seq) {
+                                *c = c.saturating_add(1);
+                            }
+                            seq = t;
                         }
-                        seq = t;
+                        JumpStep::Next => seq += 1,
+                        JumpStep::Bad => {
+                            out.warn(NavWarning::BadJump { seq: s16 });
+                            seq += 1;
+                        }
                     }
-                    JumpStep::Next => seq += 1,
-                    JumpStep::Bad => {
-                        out.warn(NavWarning::BadJump { seq: s16 });
-                        seq += 1;
-                    }
-                },
+                }
                 NavCommand::ChangeSpeed(change) => {
                     match change {
                         SpeedChange::To(v) => {
@@ -160,20 +155,17 @@ impl MissionWalk {
         for _ in 0..4 * items.len() + 8 {
             let item = items.get(s)?;
             match item.command {
-                NavCommand::Jump { target, repeat } => match jump_step(
-                    target,
-                    repeat,
-                    items.len(),
-                    jumps.get(s).copied(),
-                ) {
-                    JumpStep::Jump(t) => {
-                        if let Some(c) = jumps.get_mut(s) {
-                            *c = c.saturating_add(1);
+                NavCommand::Jump { target, repeat } => {
+                    match jump_step(target, repeat, items.len(), jumps.get(s).copied()) {
+                        JumpStep::Jump(t) => {
+                            if let Some(c) = jumps.get_mut(s) {
+                                *c = c.saturating_add(1);
+                            }
+                            s = t;
                         }
-                        s = t;
+                        _ => s += 1,
                     }
-                    _ => s += 1,
-                },
+                }
                 c if c.is_nav() => return Some(item),
                 _ => s += 1,
             }
@@ -339,12 +331,7 @@ enum JumpStep {
 
 /// What a `DO_JUMP` to `target`, `repeat` times, does in a mission of `len` items given the
 /// jumps it has done (`None`: its counter cannot be kept).
-fn jump_step(
-    target: Option<usize>,
-    repeat: JumpRepeat,
-    len: usize,
-    done: Option<u16>,
-) -> JumpStep {
+fn jump_step(target: Option<usize>, repeat: JumpRepeat, len: usize, done: Option<u16>) -> JumpStep {
     let Some(target) = target.filter(|&t| t < len) else {
         return JumpStep::Bad;
     };
