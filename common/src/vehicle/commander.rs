@@ -170,9 +170,10 @@ pub fn in_air(e: &EstimatedState) -> bool {
 }
 
 /// An altitude above mean sea level from a height above `home`, m; `None` without a home.
-/// Every height above home the vehicle turns into an altitude passes here.
+/// The commander's heights take the navigator's one conversion ([`Altitude::amsl_m`]), so
+/// home's altitude is added in one place.
 pub fn above_home(home: Option<Home>, height_m: f32) -> Option<f32> {
-    home.map(|h| h.alt_amsl_m + height_m)
+    home.map(|h| Altitude::AboveHome(height_m).amsl_m(&h))
 }
 
 /// A home at the aircraft's estimated position and altitude.
