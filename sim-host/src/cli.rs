@@ -281,6 +281,34 @@ pub(crate) struct FlyArgs {
     pub(crate) params: Vec<(String, f32)>,
 }
 
+impl FlyArgs {
+    /// The command these options ask for.
+    pub(crate) fn command(self) -> commands::fly::command::FlyCommand {
+        commands::fly::command::FlyCommand {
+            link: self.link,
+            bind: self.bind,
+            realtime: self.realtime,
+            speed: self.speed,
+            wind_ned: self.env.wind,
+            turbulence: self.env.turbulence,
+            seed: self.env.seed,
+            dt_s: self.env.dt,
+            faults: self.env.faults,
+            qemu: self.mcu.config(),
+            duration_s: self.duration,
+            out: self.out,
+            gains: self.gains,
+            truth: self.truth,
+            report: self.report,
+            compare_host: self.compare_host,
+            profile: self.profile,
+            json: self.json,
+            mission: self.mission,
+            params: self.params,
+        }
+    }
+}
+
 #[derive(clap::Args)]
 pub(crate) struct SimArgs {
     /// Simulator link: tcp (the autopilot connects to --bind, PX4's convention), udp (the

@@ -5,12 +5,11 @@ mod cli_campaign;
 
 use anyhow::Context;
 use clap::Parser;
-use cli::{Cli, Command, FlyArgs, SimArgs};
+use cli::{Cli, Command, SimArgs};
 use sim_host::aircraft::Aircraft;
 use sim_host::analysis::doublet::DoubletConfig;
 use sim_host::commands::{self, render, Format};
 use sim_host::report::to_json;
-use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -27,7 +26,10 @@ fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     let aircraft = Aircraft::load(cli.aircraft.as_deref())?;
     match cli.command {
-        None => default_run(&aircraft),
+        None => {
+            commands::fly::command::default_flight(&aircraft, emit)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Trim { out }) => {
             let r = commands::trim::trim_report(&aircraft);
             if out.json {
@@ -153,7 +155,10 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Some(Command::Fly(args)) => fly_command(&aircraft, args),
+        Some(Command::Fly(args)) => {
+            commands::fly::command::fly_command(&aircraft, args.command(), emit)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Sim(args)) => sim_command(&aircraft, args),
         Some(Command::Campaign(c)) => {
             cli_campaign::campaign_command(&aircraft, cli.aircraft.as_deref(), c, emit)
@@ -281,182 +286,6 @@ fn emit(text: &str) -> anyhow::Result<()> {
     }
 }
 
-/// The flight configuration of `--mission`: the built-in default mission or a mission file.
-fn mission_config(
-    aircraft: &Aircraft,
-    which: &Path,
-) -> anyhow::Result<sim_host::flight::FlightConfig> {
-    use sim_host::flight::missions::{default_mission, other_runway_missions, runway_mission};
-    let home = sim_host::plant::ModelParams::new(aircraft).home;
-    if which == Path::new("default") {
-        return Ok(runway_mission(default_mission(home)));
-    }
-    // `runway-120` and `runway-250`: the built-in missions on other runways, standing on them.
-    if let Some(m) = other_runway_missions(home)
-        .into_iter()
-        .find(|m| which == Path::new(&m.name.replace(' ', "-")))
-    {
-        return Ok(sim_host::flight::FlightConfig {
-            runway_heading: Some(m.runway_rad),
-            ..runway_mission(m.items)
-        });
-    }
-    let file = sim_host::mission_file::read_mission_file(which)?;
-    anyhow::ensure!(
-        !file.mission.is_empty(),
-        "`{}`: the mission has no items",
-        which.display()
-    );
-    let mut cfg = runway_mission(file.mission);
-    cfg.script.fence = file.fence;
-    Ok(cfg)
-}
-
-fn fly_command(aircraft: &Aircraft, a: FlyArgs) -> anyhow::Result<ExitCode> {
-    use sim_host::flight::FlightConfig;
-    let base = match &a.mission {
-        Some(m) => mission_config(aircraft, m)?,
-        None => FlightConfig::default(),
-    };
-    let mut cfg = FlightConfig {
-        wind_ned: a.env.wind,
-        turbulence: a.env.turbulence,
-        seed: a.env.seed,
-        realtime: a.realtime,
-        speed: a.speed,
-        progress: true,
-        dt_s: a.env.dt,
-        // With --realtime, QGroundControl can watch: telemetry to 14550, as from PX4 SITL.
-        ground_link: a
-            .realtime
-            .then(|| ("127.0.0.1:18570".into(), "127.0.0.1:14550".into())),
-        // Ctrl-C ends the flight as flown so far (and QEMU with it).
-        stop: Some(commands::sim::stop_on_ctrl_c()),
-        ..base
-    };
-    cfg.faults.extend(a.env.faults.iter().copied());
-    if let Some(d) = a.duration {
-        cfg.duration_s = d;
-    }
-    cfg.script.params.extend(a.params.iter().cloned());
-    if let Some(g) = a.gains {
-        let names: Vec<&str> = common::control::gains::NAMED
-            .iter()
-            .map(|(n, _, _)| *n)
-            .collect();
-        anyhow::ensure!(
-            (g as usize) < names.len(),
-            "--gains {g}: no such gain set (0..={}: {})",
-            names.len() - 1,
-            names.join(", ")
-        );
-    }
-    let opts = commands::fly::FlyOptions {
-        link: a.link,
-        bind: a.bind,
-        out: Some(a.out.clone()),
-        plots: true,
-        gain_set: a.gains,
-        // The thesis's scripted flight flies the gains designed here; a mission flies the
-        // firmware's defaults, as `sim-host navigation` and a fresh autopilot do.
-        upload_gains: match (a.gains, &a.mission) {
-            (None, None) => Some(sim_host::analysis::design::computed_gain_set(aircraft)?),
-            _ => None,
-        },
-        use_truth: a.truth,
-        qemu: sim_host::link::qemu::QemuConfig {
-            profile: a.profile.map(|w| (w, a.out.clone())),
-            ..a.mcu.config()
-        },
-    };
-    if a.profile.is_some() && a.link != commands::fly::LinkKind::Qemu {
-        anyhow::bail!("--profile profiles the MCU image: it needs --link qemu");
-    }
-    let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
-    if let Some(p) = &r.mcu_profile {
-        let path = a.out.join("profile.md");
-        std::fs::write(&path, p.markdown(usize::MAX))
-            .with_context(|| format!("cannot write `{}`", path.display()))?;
-    }
-    let compared = if a.compare_host {
-        Some(commands::compare::compare_with_host(aircraft, &cfg, &opts)?)
-    } else {
-        None
-    };
-    if a.json {
-        match (&compared, &r.mcu) {
-            (Some(c), mcu) => emit(&to_json(&serde_json::json!({
-                "flight": r.outcome.summary,
-                "host": c.host.summary,
-                "answers": c.answers,
-                "mcu": mcu,
-            }))?)?,
-            // The MCU image's figures of itself (--link qemu): flash, RAM, instructions.
-            (None, Some(m)) => {
-                let mut doc = serde_json::to_value(&r.outcome.summary)?;
-                if let Some(o) = doc.as_object_mut() {
-                    let mut mcu = serde_json::to_value(m)?;
-                    if let (Some(p), Some(mo)) = (&r.mcu_profile, mcu.as_object_mut()) {
-                        mo.insert("profile".into(), serde_json::to_value(p)?);
-                    }
-                    o.insert("mcu".into(), mcu);
-                }
-                emit(&to_json(&doc)?)?
-            }
-            (None, None) => emit(&to_json(&r.outcome.summary)?)?,
-        }
-    } else {
-        emit(&render(
-            &commands::fly::summary_tables(&r.outcome),
-            Format::Text,
-        ))?;
-        if let Some(c) = &compared {
-            emit(&render(&[c.table(&r.outcome, opts.link)], Format::Text))?;
-        }
-        if let Some(p) = &r.mcu_profile {
-            emit(&p.markdown(25))?;
-        }
-        for f in &r.files {
-            emit(&format!("wrote {}", f.display()))?;
-        }
-    }
-    for (t, text) in &r.outcome.summary.texts {
-        // Arming refusals while the estimator converges are expected (the script retries).
-        if text.contains("refused") {
-            eprintln!("autopilot at {t:.1} s: {text}");
-        }
-    }
-    if let Some(path) = a.report {
-        let truth_opts = commands::fly::FlyOptions {
-            use_truth: true,
-            out: Some(a.out.join("truth")),
-            ..opts
-        };
-        let t = commands::fly::fly_report(aircraft, &cfg, &truth_opts)?;
-        let md = commands::fly::results_markdown(
-            &cfg,
-            &r.outcome,
-            &t.outcome,
-            &format!(
-                "cargo run --release -p sim-host -- {}",
-                std::env::args().skip(1).collect::<Vec<_>>().join(" ")
-            ),
-        );
-        // Notes written by hand below the generated part survive a new run.
-        let notes = std::fs::read_to_string(&path)
-            .ok()
-            .and_then(|old| {
-                old.find(commands::fly::NOTES_MARKER)
-                    .map(|i| old[i..].to_string())
-            })
-            .unwrap_or_default();
-        std::fs::write(&path, md + &notes)
-            .with_context(|| format!("cannot write `{}`", path.display()))?;
-        emit(&format!("wrote {}", path.display()))?;
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
 fn sim_command(aircraft: &Aircraft, a: SimArgs) -> anyhow::Result<ExitCode> {
     use sim_host::flight::FlightConfig;
     let secs = |what: &str, s: f64| {
@@ -511,26 +340,5 @@ fn sim_command(aircraft: &Aircraft, a: SimArgs) -> anyhow::Result<ExitCode> {
             emit(&format!("wrote {}", f.display()))?;
         }
     }
-    Ok(ExitCode::SUCCESS)
-}
-
-/// With no subcommand: fly the scripted flight in-process and print a short summary.
-fn default_run(aircraft: &Aircraft) -> anyhow::Result<ExitCode> {
-    let cfg = sim_host::flight::FlightConfig {
-        progress: true,
-        ..mission_config(aircraft, Path::new("default"))?
-    };
-    let opts = commands::fly::FlyOptions {
-        out: Some(PathBuf::from("out/fly")),
-        ..Default::default()
-    };
-    emit("Flying the firmware in-process, on its own estimates: upload the default mission, arm, take off from the runway, a 600 m x 400 m rectangle, two turns around a corner, approach and landing")?;
-    let r = commands::fly::fly_report(aircraft, &cfg, &opts)?;
-    emit(&render(
-        &commands::fly::summary_tables(&r.outcome),
-        Format::Text,
-    ))?;
-    emit("\nfiles in out/fly (flight.csv, flight.tlog of the ground link, simlink.tlog, PNG plots, summary.json)")?;
-    emit("(see `sim-host --help` for fly, trim, linearize, doublet, design and validation)")?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,5 +1,6 @@
-//! The shape of the source tree, checked: no import circle between the files of any crate, and
-//! no file that does several jobs (more than [`MAX_LOGIC_LINES`] lines of logic).
+//! The shape of the source tree, checked: no import circle between the files of any crate, no
+//! file that names an item of a layer above its own ([`LAYERS`]), and no file that does several
+//! jobs (more than [`MAX_LOGIC_LINES`] lines of logic).
 //!
 //! A file depends on another when it names an item of it: a `use crate::...`, `use super::...`
 //! or `use self::...` path, or an inline `crate::a::b` path in its code. Each path is resolved
@@ -15,6 +16,70 @@ const MAX_LOGIC_LINES: usize = 600;
 
 const CRATES: [&str; 3] = ["common", "firmware", "sim-host"];
 
+/// The crate root's name in the graph and in [`LAYERS`] (`lib.rs`, or `main.rs` in a crate
+/// without a library); a binary's `main.rs` beside a `lib.rs` is the module `main`.
+const ROOT: &str = "(crate root)";
+
+/// Each crate's layers, lowest first: groups of top-level modules. A file may name items of
+/// its own layer and of the layers below it, never of a layer above. Every top-level module
+/// is placed, so a new one is placed on purpose.
+const LAYERS: [(&str, &[&[&str]]); 3] = [
+    (
+        "common",
+        &[
+            // What every stage is written in; the root holds the exported macros (`param!`).
+            &[ROOT, "math", "crc", "decimal"],
+            // Each stage declares its parameters.
+            &["params"],
+            // The two ends of the tick: typed sensor samples in, surfaces out.
+            &["sensors", "actuators"],
+            // The stages, and the wire formats of the two links (HIL frames carry samples
+            // and surfaces).
+            &["estimator", "guidance", "control", "battery", "link"],
+            // The navigator drives guidance and control from the estimate; the failsafes
+            // read the battery.
+            &["navigation", "failsafe"],
+            // The vehicle wires the stages: commander, modes, snapshot, requests.
+            &["vehicle"],
+            // The vehicle's stores and snapshot brought out: the ground link and the flash.
+            &["gcs", "storage"],
+        ],
+    ),
+    (
+        "firmware",
+        &[
+            &[ROOT],
+            // The application: the vehicle between its two ports.
+            &["app"],
+            // The boards that move its bytes (`mcu` is the binary's).
+            &["sitl", "mcu"],
+            &["main"],
+        ],
+    ),
+    (
+        "sim-host",
+        &[
+            // Output forms, the air, sensor models and mission files: nothing of sim-host.
+            &[ROOT, "report", "environment", "sensors", "mission_file"],
+            // The aircraft file, its sensors' configuration included.
+            &["aircraft"],
+            &["plant"],
+            // The simulator end of the link: transports, lock-step, .tlog, QEMU.
+            &["link"],
+            // The linear tools and the chapter-4 scenarios on the nonlinear plant.
+            &["analysis", "scenario"],
+            // Firmware in the loop: a flight, its log and figures.
+            &["flight"],
+            // Campaigns of flights.
+            &["campaign"],
+            // The command-line front as library functions.
+            &["commands"],
+            // The binary: parsing and dispatch.
+            &["main", "cli", "cli_campaign"],
+        ],
+    ),
+];
+
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -23,7 +88,8 @@ fn workspace() -> PathBuf {
 }
 
 /// The `.rs` files of a crate's `src/` that are not test code, by module path
-/// (`["navigation", "executor"]` for `src/navigation/executor.rs`; `[]` for the crate root).
+/// (`["navigation", "executor"]` for `src/navigation/executor.rs`; `[]` for the crate root,
+/// `["main"]` for a binary's `main.rs` beside a `lib.rs`).
 fn modules(src: &Path) -> BTreeMap<Vec<String>, PathBuf> {
     let mut out = BTreeMap::new();
     let mut stack = vec![src.to_path_buf()];
@@ -50,7 +116,10 @@ fn modules(src: &Path) -> BTreeMap<Vec<String>, PathBuf> {
                 .flat_map(|p| p.components())
                 .map(|c| c.as_os_str().to_string_lossy().into_owned())
                 .collect();
-            if !matches!(stem, "mod" | "lib" | "main") {
+            // A binary's root beside the library's is a module of its own, not the root.
+            let binary_beside_lib =
+                stem == "main" && module.is_empty() && src.join("lib.rs").is_file();
+            if binary_beside_lib || !matches!(stem, "mod" | "lib" | "main") {
                 module.push(stem.to_owned());
             }
             out.insert(module, path);
@@ -300,6 +369,62 @@ fn circles(g: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<Vec<String>>
     t.out
 }
 
+/// The name of a module's top-level module, as [`LAYERS`] lists it.
+fn top(module: &[String]) -> &str {
+    module.first().map_or(ROOT, String::as_str)
+}
+
+/// The layer of a module: the index in `layers` of the group holding its top-level module.
+fn layer_of(module: &[String], layers: &[&[&str]]) -> Option<usize> {
+    layers.iter().position(|l| l.contains(&top(module)))
+}
+
+/// The top-level modules of a crate that no layer holds, and the names a layer holds that are
+/// no top-level module of the crate.
+fn unplaced(src: &Path, layers: &[&[&str]]) -> (BTreeSet<String>, BTreeSet<String>) {
+    let tops: BTreeSet<String> = modules(src).keys().map(|m| top(m).to_owned()).collect();
+    let placed: BTreeSet<String> = layers
+        .iter()
+        .flat_map(|l| l.iter())
+        .map(|s| s.to_string())
+        .collect();
+    (
+        tops.difference(&placed).cloned().collect(),
+        placed.difference(&tops).cloned().collect(),
+    )
+}
+
+/// Every file that names an item of a layer above its own: the file, what it names and both
+/// layers, paths relative to `src`.
+fn upward_imports(src: &Path, layers: &[&[&str]]) -> Vec<String> {
+    let mods = modules(src);
+    let file = |m: &Vec<String>| {
+        mods.get(m)
+            .and_then(|p| p.strip_prefix(src).ok())
+            .map_or_else(|| m.join("::"), |p| p.display().to_string())
+    };
+    let name = |i: usize| layers.get(i).map_or("?".to_owned(), |l| l.join("/"));
+    let mut found = Vec::new();
+    for (m, deps) in graph(src) {
+        let Some(own) = layer_of(&m, layers) else {
+            continue;
+        };
+        for d in deps {
+            match layer_of(&d, layers) {
+                Some(l) if l > own => found.push(format!(
+                    "{} (layer {own}: {}) names {} (layer {l}: {})",
+                    file(&m),
+                    name(own),
+                    file(&d),
+                    name(l)
+                )),
+                _ => {}
+            }
+        }
+    }
+    found
+}
+
 #[test]
 fn no_crate_has_an_import_circle_between_its_files() {
     let mut found = Vec::new();
@@ -356,4 +481,68 @@ fn the_circle_finder_sees_a_circle_through_a_re_export() {
     // Importing from the defining file breaks it.
     std::fs::write(src.join("m/b.rs"), "pub struct B;\n").expect("write");
     assert!(circles(&graph(src)).is_empty());
+}
+
+#[test]
+fn every_top_level_module_is_placed_in_exactly_one_layer() {
+    let mut wrong = Vec::new();
+    for (krate, layers) in LAYERS {
+        let (missing, stale) = unplaced(&workspace().join(krate).join("src"), layers);
+        for m in missing {
+            wrong.push(format!("{krate}: `{m}` is in no layer: place it in LAYERS"));
+        }
+        for m in stale {
+            wrong.push(format!("{krate}: LAYERS names `{m}`, no top-level module"));
+        }
+        let mut seen = BTreeSet::new();
+        for m in layers.iter().flat_map(|l| l.iter()) {
+            if !seen.insert(m) {
+                wrong.push(format!("{krate}: `{m}` is in two layers"));
+            }
+        }
+    }
+    assert_eq!(LAYERS.map(|(k, _)| k), CRATES, "every crate has its layers");
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn no_file_imports_from_a_layer_above_its_own() {
+    let mut found = Vec::new();
+    for (krate, layers) in LAYERS {
+        for u in upward_imports(&workspace().join(krate).join("src"), layers) {
+            found.push(format!("{krate}: {u}"));
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "imports from a layer above:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_layer_check_sees_an_upward_import_through_a_re_export_and_an_unplaced_module() {
+    // low/a.rs names a type that high/mod.rs re-exports from high/h.rs: it depends on high.
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let src = dir.path();
+    for d in ["low", "high"] {
+        std::fs::create_dir(src.join(d)).expect("folder");
+    }
+    std::fs::write(src.join("lib.rs"), "pub mod high;\npub mod low;\n").expect("write");
+    std::fs::write(src.join("low/mod.rs"), "pub mod a;\n").expect("write");
+    std::fs::write(src.join("low/a.rs"), "pub fn f(_: crate::high::H) {}\n").expect("write");
+    std::fs::write(src.join("high/mod.rs"), "pub mod h;\npub use h::H;\n").expect("write");
+    std::fs::write(src.join("high/h.rs"), "pub struct H;\n").expect("write");
+    let layers: &[&[&str]] = &[&[ROOT, "low"], &["high"]];
+    assert_eq!(
+        upward_imports(src, layers),
+        ["low/a.rs (layer 0: (crate root)/low) names high/mod.rs (layer 1: high)"]
+    );
+    // Nothing runs down the other way, and with the layers swapped nothing runs up.
+    assert!(upward_imports(src, &[&[ROOT, "high"], &["low"]]).is_empty());
+    // A new top-level module is in no layer until it is placed.
+    std::fs::write(src.join("extra.rs"), "pub struct E;\n").expect("write");
+    let (missing, stale) = unplaced(src, layers);
+    assert_eq!(missing, BTreeSet::from(["extra".to_owned()]));
+    assert!(stale.is_empty());
 }

@@ -107,6 +107,8 @@ impl core::fmt::Display for GainError {
     }
 }
 
+impl core::error::Error for GainError {}
+
 impl GainSet {
     /// The thesis's designed set (chapter 3), every stage's own designed gains.
     pub const THESIS: GainSet = GainSet {

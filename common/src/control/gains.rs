@@ -154,6 +154,8 @@ impl core::fmt::Display for UnknownSet {
     }
 }
 
+impl core::error::Error for UnknownSet {}
+
 impl GainSet {
     /// The named set, or the list of valid names.
     pub fn named(name: &str) -> Result<GainSet, UnknownSet> {

@@ -19,6 +19,17 @@ pub enum Refused {
     Degenerate,
 }
 
+impl core::fmt::Display for Refused {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Refused::Gated => "innovation beyond the gate",
+            Refused::Degenerate => "innovation variance not positive and finite",
+        })
+    }
+}
+
+impl core::error::Error for Refused {}
+
 /// The outcome of one fused component.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Fused<const N: usize> {

@@ -9,6 +9,9 @@
 //! - [`air::AirspeedFilter`]: true airspeed from the pitot and the barometer's density;
 //! - [`air::WindFilter`]: horizontal wind from airspeed and zero sideslip.
 //!
+//! Home and the NED origin's rules (the provisional home of the first fix, the home held once
+//! set) are in `origin`; [`Home`] is re-exported here.
+//!
 //! The clock is the sum of the IMU time steps; every other sensor is stamped with it when it
 //! arrives. Each input is checked before use: a non-finite or physically absurd sample is
 //! counted and dropped, and the state stays as it was.
@@ -18,6 +21,7 @@ pub mod config;
 pub mod health;
 pub mod ins;
 pub mod kalman;
+mod origin;
 
 #[cfg(test)]
 mod tests;
@@ -26,14 +30,16 @@ pub(crate) mod truth;
 
 pub use config::{EstimatorConfig, PARAMS};
 pub use health::{SensorHealth, SensorStatus};
+pub use origin::Home;
 
 use crate::math::atmosphere::pressure_altitude;
 use crate::math::frames::{course_and_speed, AirData, Euler};
-use crate::math::geodetic::{ned_offset, offset_point, GeoPoint, LocalFrame};
-use crate::sensors::{limits, BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use crate::math::geodetic::{offset_point, GeoPoint};
+use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
 use ins::{Fusion, GpsNoise, Ins, Motion, ProcessNoise};
 use nalgebra::{UnitQuaternion, Vector3};
+use origin::Origin;
 
 /// Largest accepted IMU time step, s (a longer gap is a stalled loop, not a time step).
 pub const MAX_IMU_DT_S: f32 = 0.2;
@@ -56,16 +62,6 @@ const GPS_NIS_WEIGHT: f32 = 0.1;
 /// long enough for a tilt error to show in the velocity innovations, which it does at
 /// `g * tilt` per second.
 pub const CONV_MIN_FIXES: u32 = 25;
-
-/// The reference of the local NED frame, set at the first good 3D fix.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Home {
-    /// Horizontal position of the NED origin.
-    pub point: GeoPoint,
-    /// Altitude of the NED origin above mean sea level, m.
-    pub alt_amsl_m: f32,
-}
 
 /// Everything the estimator knows, as the rest of the autopilot reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -139,14 +135,8 @@ pub struct Estimator {
     last_mag: Option<Vector3<f32>>,
     baro_alt: Option<f32>,
     density: f32,
-    home: Option<Home>,
-    /// The local frame about home's point, worked out when home moves (see [`LocalFrame`]).
-    frame: Option<LocalFrame>,
-    /// The barometer offset when home was set: heights above home follow the barometer.
-    home_baro_offset: f32,
-    /// Home as set by arming or `DO_SET_HOME`, held as reported from then on; `None` while
-    /// the first fix's provisional home follows what the estimator learns.
-    home_held: Option<Home>,
+    /// Home and the NED origin.
+    origin: Origin,
     mag_nis: f32,
     vel_nis: f32,
     aided_fixes: u32,
@@ -179,10 +169,7 @@ impl Estimator {
             last_mag: None,
             baro_alt: None,
             density: DEFAULT_DENSITY,
-            home: None,
-            frame: None,
-            home_baro_offset: 0.0,
-            home_held: None,
+            origin: Origin::new(),
             mag_nis: 0.0,
             vel_nis: 0.0,
             aided_fixes: 0,
@@ -412,7 +399,7 @@ impl Estimator {
         self.refresh_health();
         self.baro_alt = Some(alt);
         self.density = rho;
-        if let Some(home) = self.home {
+        if let Some(home) = self.origin.datum() {
             let c = self.cfg;
             let f =
                 self.ins
@@ -426,7 +413,7 @@ impl Estimator {
                 // where they were.
                 let before = self.ins.baro_offset();
                 self.ins.reset_baro_offset(home.alt_amsl_m - alt);
-                self.home_baro_offset += self.ins.baro_offset() - before;
+                self.origin.shift_baro(self.ins.baro_offset() - before);
             }
         }
     }
@@ -508,7 +495,7 @@ impl Estimator {
         }
         let c = self.cfg;
         let noise = self.gps_noise();
-        let Some(home) = self.home else {
+        let Some(home) = self.origin.datum() else {
             // Home is the datum of every altitude and position after it: only a good fix.
             let hdop_ok = fix.hdop.is_finite() && fix.hdop <= c.home_max_hdop;
             if u32::from(fix.satellites) < c.home_min_sats || !hdop_ok {
@@ -518,8 +505,7 @@ impl Estimator {
                 point: fix.position,
                 alt_amsl_m: fix.alt_amsl_m,
             };
-            self.home = Some(home);
-            self.frame = Some(LocalFrame::new(home.point));
+            self.origin.set_first(home);
             let baro_offset = self.baro_alt.map_or(0.0, |b| b - fix.alt_amsl_m);
             self.ins.start_nav(
                 self.t_us,
@@ -529,13 +515,13 @@ impl Estimator {
                 baro_offset,
                 &noise,
             );
-            self.home_baro_offset = self.ins.baro_offset();
+            self.origin.anchor_baro(self.ins.baro_offset());
             self.ins.reopen_attitude(c.gyro_bias_init);
             self.restart_gps_monitor();
             return;
         };
 
-        let (n, e) = self.ned_of(home.point, fix.position);
+        let (n, e) = self.origin.ned_of(home.point, fix.position);
         let pos = Vector3::new(n, e, home.alt_amsl_m - fix.alt_amsl_m);
         let t_fix = self.t_us.saturating_sub(micros(c.gps_delay));
         let (fp, fv) = self
@@ -599,33 +585,13 @@ impl Estimator {
     /// [`EstimatedState::home`]). Refused (false) for an invalid point or altitude, or before
     /// the first fix has set a provisional home.
     pub fn set_home(&mut self, home: Home) -> bool {
-        let Some(old) = self.home else {
-            return false;
-        };
-        if !home.point.is_valid() || !limits::in_range(home.alt_amsl_m, limits::GPS_ALT_M) {
-            return false;
-        }
-        let reported = self
-            .home_held
-            .map_or(old.alt_amsl_m - self.baro_drift_m(), |h| h.alt_amsl_m);
-        // The origin and the altitude it is fused at move together, so the barometer's
-        // offset, and with it the height above home, carry on from where they were.
-        let up = home.alt_amsl_m - reported;
-        let (n, e): (f32, f32) = ned_offset(home.point, old.point);
-        self.ins.shift_origin(&Vector3::new(n, e, up));
-        self.home = Some(Home {
-            point: home.point,
-            alt_amsl_m: old.alt_amsl_m + up,
-        });
-        self.frame = Some(LocalFrame::new(home.point));
-        self.home_held = Some(home);
-        true
+        self.origin.set_home(&mut self.ins, home)
     }
 
     /// What the estimator has learnt of the barometer's offset since the first fix set home,
     /// m: how far heights above home and the GPS-aided altitude have come apart.
     pub fn baro_drift_m(&self) -> f32 {
-        self.ins.baro_offset() - self.home_baro_offset
+        self.origin.baro_drift_m(&self.ins)
     }
 
     /// Averaged normalised GPS velocity innovation (about 1 when the estimate agrees with GPS).
@@ -642,26 +608,9 @@ impl Estimator {
         self.ins.bias_sigma()
     }
 
-    /// North and east of `p` from `origin`, m: through the cached frame when it is about
-    /// `origin`.
-    fn ned_of(&self, origin: GeoPoint, p: GeoPoint) -> (f32, f32) {
-        match self.frame.filter(|f| f.origin() == origin) {
-            Some(f) => f.ned_offset(p),
-            None => ned_offset(origin, p),
-        }
-    }
-
     /// Home as [`EstimatedState::home`] gives it, without forming the whole estimate.
     pub fn home(&self) -> Option<Home> {
-        let drift = self.baro_drift_m();
-        match (self.home_held, self.home) {
-            (Some(held), _) => Some(held),
-            (None, Some(h)) if drift.is_finite() => Some(Home {
-                alt_amsl_m: h.alt_amsl_m - drift,
-                ..h
-            }),
-            (None, h) => h,
-        }
+        self.origin.home(self.baro_drift_m())
     }
 
     /// The current estimate.
@@ -693,14 +642,14 @@ impl Estimator {
         // its datum, home's altitude plus the height above it, so that what a ground station
         // shows of home and of the aircraft never drifts apart in flight.
         let drift = self.baro_drift_m();
-        let pos = if self.home.is_some() && drift.is_finite() {
+        let pos = if self.origin.datum().is_some() && drift.is_finite() {
             Vector3::new(pos.x, pos.y, pos.z - drift)
         } else {
             pos
         };
         let home = self.home();
         let (position, alt_amsl_m) = match home {
-            Some(h) => match self.frame.filter(|f| f.origin() == h.point) {
+            Some(h) => match self.origin.frame_about(h.point) {
                 Some(f) => (f.offset_point(pos.x, pos.y), h.alt_amsl_m - pos.z),
                 None => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
             },

@@ -2,7 +2,7 @@
 //! workspace (the simulator's scripted one, the system tests' clients, the link's own tests):
 //! its heartbeat and a `COMMAND_LONG`.
 
-use super::{COMPONENT_ID, SYSTEM_ID};
+use super::config::{COMPONENT_ID, SYSTEM_ID};
 use mavlink::dialects::common::{
     MavAutopilot, MavCmd, MavMessage, MavModeFlag, MavState, MavType, COMMAND_LONG_DATA,
     HEARTBEAT_DATA,

@@ -1,54 +1,188 @@
 //! The command service: `COMMAND_LONG` / `COMMAND_INT` checked against the vehicle's
-//! snapshot, answered with `COMMAND_ACK`, accepted ones queued as requests.
+//! snapshot, answered with `COMMAND_ACK`, accepted ones queued as requests for the vehicle;
+//! the other messages that ask the vehicle for something (`SET_MODE`, `MISSION_SET_CURRENT`,
+//! `MANUAL_CONTROL`) land in the same requests. Saves and reboots are the board's: the
+//! service keeps them until the board takes them.
 
-use super::outbox::{After, Command, Pending};
+use super::config::{Stores, HEARTBEAT_INTERVAL_US};
+use super::manual::manual_input;
+use super::outbox::{After, Command, Outbox, Pending};
 use super::peer::Peer;
-use super::streams::Stream;
-use super::{telemetry, GroundLink, Stores, FORCE_ARM_MAGIC, HEARTBEAT_INTERVAL_US};
+use super::streams::{Scheduler, Stream};
+use super::telemetry;
 use crate::decimal::trimmed;
 use crate::navigation::plan::MissionStore;
 use crate::vehicle::modes::FlightMode;
-use crate::vehicle::requests::{AltitudeSetpoint, ArmRequest, CourseSetpoint};
+use crate::vehicle::requests::{AltitudeSetpoint, ArmRequest, CourseSetpoint, VehicleRequests};
 use crate::vehicle::snapshot::{LandedState, VehicleSnapshot};
 use mavlink::dialects::common::*;
 use mavlink::MessageData;
 use num_traits::FromPrimitive;
 
-impl GroundLink {
+/// `param2` of `MAV_CMD_COMPONENT_ARM_DISARM` that skips the checks (MAVLink's magic number).
+pub const FORCE_ARM_MAGIC: f32 = 21196.0;
+
+/// What a command reads and writes besides the service's own state.
+pub(crate) struct CommandContext<'a, 'b> {
+    /// When the command arrived, µs.
+    pub now_us: u64,
+    /// The vehicle as it is.
+    pub vehicle: &'a VehicleSnapshot,
+    /// The parameters (reset by a storage command) and the plan (checked by mode changes).
+    pub stores: &'a mut Stores<'b>,
+    /// The telemetry streams' rates (`MAV_CMD_SET_MESSAGE_INTERVAL`).
+    pub streams: &'a mut Scheduler,
+    /// Whether the link serves a `general.json`, so `COMPONENT_METADATA` can be asked for.
+    pub metadata: bool,
+    /// Where the answers go.
+    pub out: &'a mut Outbox,
+}
+
+/// The command service's state: the requests accepted for the vehicle, and the save and
+/// reboot the board owes.
+#[derive(Clone, Debug, Default)]
+pub struct CommandService {
+    requests: VehicleRequests,
+    /// A `MAV_CMD_PREFLIGHT_STORAGE` save the board owes, and who asked.
+    storage_request: Option<Peer>,
+    /// A `MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN` reboot the board owes.
+    reboot_request: bool,
+}
+
+impl CommandService {
+    /// Nothing requested, nothing owed.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Takes the requests accepted since the last call.
+    pub fn take_requests(&mut self) -> VehicleRequests {
+        core::mem::take(&mut self.requests)
+    }
+
+    /// The mode the vehicle will fly: the one requested, when a request waits, else the one
+    /// it flies.
+    pub fn intended_mode(&self, v: &VehicleSnapshot) -> FlightMode {
+        self.requests.mode.unwrap_or(v.mode)
+    }
+
+    /// `COMMAND_LONG`.
+    pub(crate) fn on_command_long(
+        &mut self,
+        d: &COMMAND_LONG_DATA,
+        from: Peer,
+        cx: CommandContext<'_, '_>,
+    ) {
+        let c = Command {
+            cmd: d.command,
+            p: [
+                d.param1, d.param2, d.param3, d.param4, d.param5, d.param6, d.param7,
+            ],
+        };
+        self.on_command(c, from, cx);
+    }
+
+    /// `COMMAND_INT`: its integer x and y as floats, as `COMMAND_LONG` carries them.
+    pub(crate) fn on_command_int(
+        &mut self,
+        d: &COMMAND_INT_DATA,
+        from: Peer,
+        cx: CommandContext<'_, '_>,
+    ) {
+        let c = Command {
+            cmd: d.command,
+            p: [
+                d.param1, d.param2, d.param3, d.param4, d.x as f32, d.y as f32, d.z,
+            ],
+        };
+        self.on_command(c, from, cx);
+    }
+
+    /// `MANUAL_CONTROL`: the sticks, for the vehicle to take with the other requests.
+    pub fn on_manual_control(&mut self, d: &MANUAL_CONTROL_DATA, now_us: u64) {
+        self.requests.manual = Some(manual_input(d, now_us));
+    }
+
+    /// `SET_MODE`: PX4 treats it as `MAV_CMD_DO_SET_MODE` and acknowledges it as such.
+    // SET_MODE is deprecated but still sent by pymavlink and older ground stations.
+    #[allow(deprecated)]
+    pub(crate) fn on_set_mode(
+        &mut self,
+        d: &SET_MODE_DATA,
+        from: Peer,
+        v: &VehicleSnapshot,
+        plan: &MissionStore,
+        out: &mut Outbox,
+    ) {
+        let result = if d
+            .base_mode
+            .contains(MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
+        {
+            match FlightMode::from_custom_mode(d.custom_mode) {
+                Some(m) => self.request_mode(m, v, plan, out),
+                None => unknown_mode(d.custom_mode, out),
+            }
+        } else {
+            out.textf(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                format_args!("Mode refused: only custom modes"),
+            );
+            MavResult::MAV_RESULT_DENIED
+        };
+        out.ack(MavCmd::MAV_CMD_DO_SET_MODE, result, from);
+    }
+
+    /// `MISSION_SET_CURRENT`: the message has no ACK, so a bad index gets a STATUSTEXT and the
+    /// current item.
+    // MISSION_SET_CURRENT is deprecated but still sent by pymavlink and older ground stations.
+    #[allow(deprecated)]
+    pub(crate) fn on_mission_set_current(
+        &mut self,
+        d: &MISSION_SET_CURRENT_DATA,
+        from: Peer,
+        plan: &MissionStore,
+        out: &mut Outbox,
+    ) {
+        if !self.set_mission_current(d.seq, plan, out) {
+            out.push_to(Pending::MissionCurrent(None), from.dest());
+        }
+    }
+
     // GET_MESSAGE_INTERVAL and REQUEST_AUTOPILOT_CAPABILITIES are superseded by
     // REQUEST_MESSAGE but QGC and MAVSDK versions in use still send them.
     #[allow(deprecated)]
-    pub(super) fn on_command(
-        &mut self,
-        c: Command,
-        from: Peer,
-        now_us: u64,
-        v: &VehicleSnapshot,
-        stores: &mut Stores,
-    ) {
+    fn on_command(&mut self, c: Command, from: Peer, cx: CommandContext<'_, '_>) {
+        let CommandContext {
+            now_us,
+            vehicle: v,
+            stores,
+            streams,
+            metadata,
+            out,
+        } = cx;
         let mut after = After::new();
         let result = match c.cmd {
-            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => self.arm_disarm(&c, v),
+            MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => self.arm_disarm(&c, v, out),
             MavCmd::MAV_CMD_DO_SET_MODE => {
                 let base = c.p[0] as u32;
                 if base & MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as u32 == 0 {
-                    self.textf(
+                    out.textf(
                         MavSeverity::MAV_SEVERITY_WARNING,
                         format_args!("Mode refused: only custom modes"),
                     );
                     MavResult::MAV_RESULT_DENIED
                 } else {
                     match FlightMode::from_set_mode_params(c.p[1], c.p[2]) {
-                        Ok(m) => self.request_mode(m, v, stores.plan),
-                        Err(word) => self.unknown_mode(word),
+                        Ok(m) => self.request_mode(m, v, stores.plan, out),
+                        Err(word) => unknown_mode(word, out),
                     }
                 }
             }
             MavCmd::MAV_CMD_DO_SET_STANDARD_MODE => {
                 match MavStandardMode::from_u32(c.p[0] as u32).and_then(FlightMode::from_standard) {
-                    Some(m) => self.request_mode(m, v, stores.plan),
+                    Some(m) => self.request_mode(m, v, stores.plan, out),
                     None => {
-                        self.textf(
+                        out.textf(
                             MavSeverity::MAV_SEVERITY_WARNING,
                             format_args!("Standard mode {} not supported", c.p[0] as u32),
                         );
@@ -57,7 +191,7 @@ impl GroundLink {
                 }
             }
             MavCmd::MAV_CMD_MISSION_START => {
-                let r = self.request_mode(FlightMode::Mission, v, stores.plan);
+                let r = self.request_mode(FlightMode::Mission, v, stores.plan, out);
                 let first = c.p[0];
                 if r == MavResult::MAV_RESULT_ACCEPTED
                     && first >= 1.0
@@ -68,10 +202,12 @@ impl GroundLink {
                 r
             }
             MavCmd::MAV_CMD_NAV_RETURN_TO_LAUNCH => {
-                self.request_mode(FlightMode::Return, v, stores.plan)
+                self.request_mode(FlightMode::Return, v, stores.plan, out)
             }
-            MavCmd::MAV_CMD_NAV_TAKEOFF => self.request_mode(FlightMode::Takeoff, v, stores.plan),
-            MavCmd::MAV_CMD_NAV_LAND => self.request_mode(FlightMode::Land, v, stores.plan),
+            MavCmd::MAV_CMD_NAV_TAKEOFF => {
+                self.request_mode(FlightMode::Takeoff, v, stores.plan, out)
+            }
+            MavCmd::MAV_CMD_NAV_LAND => self.request_mode(FlightMode::Land, v, stores.plan, out),
             MavCmd::MAV_CMD_DO_GO_AROUND => {
                 // Only a landing can be given up (param1, the altitude, is not used: the
                 // go-around climbs to its circuit's height). A landing already rolling out is
@@ -86,7 +222,7 @@ impl GroundLink {
             MavCmd::MAV_CMD_DO_SET_MISSION_CURRENT => {
                 let seq = c.p[0];
                 if (0.0..65536.0).contains(&seq)
-                    && self.set_mission_current(seq as u16, stores.plan)
+                    && self.set_mission_current(seq as u16, stores.plan, out)
                 {
                     MavResult::MAV_RESULT_ACCEPTED
                 } else {
@@ -116,7 +252,7 @@ impl GroundLink {
                 } else if c.p[0] as i32 > 1 {
                     MavResult::MAV_RESULT_UNSUPPORTED
                 } else if !(lo..=hi).contains(&c.p[1]) {
-                    self.textf(
+                    out.textf(
                         MavSeverity::MAV_SEVERITY_WARNING,
                         format_args!(
                             "Airspeed {} refused: outside [{}, {}] m/s",
@@ -151,7 +287,7 @@ impl GroundLink {
                     Some(HEARTBEAT_DATA::ID) => MavResult::MAV_RESULT_DENIED,
                     Some(id) => match Stream::from_message_id(id) {
                         // A NaN interval asks for nothing: refused, the rate kept.
-                        Some(s) if self.streams.set_interval(s, c.p[1], now_us) => {
+                        Some(s) if streams.set_interval(s, c.p[1], now_us) => {
                             MavResult::MAV_RESULT_ACCEPTED
                         }
                         Some(_) => MavResult::MAV_RESULT_DENIED,
@@ -166,8 +302,7 @@ impl GroundLink {
                         HEARTBEAT_INTERVAL_US as i32
                     } else {
                         match Stream::from_message_id(id) {
-                            Some(s) => self
-                                .streams
+                            Some(s) => streams
                                 .interval_us(s)
                                 .map_or(-1, |i| i.min(i32::MAX as u32) as i32),
                             None => 0,
@@ -182,7 +317,7 @@ impl GroundLink {
                 None => MavResult::MAV_RESULT_DENIED,
             },
             MavCmd::MAV_CMD_REQUEST_MESSAGE => {
-                let (r, p) = self.request_message(&c, v);
+                let (r, p) = request_message(&c, v, metadata);
                 after = p;
                 r
             }
@@ -197,7 +332,7 @@ impl GroundLink {
                 MavResult::MAV_RESULT_ACCEPTED
             }
             // The save is the board's: IN_PROGRESS now, ACCEPTED or FAILED once it is done
-            // (GroundLink::storage_done). Erasing flash stalls the processor, so never armed.
+            // (CommandService::storage_done). Erasing flash stalls the processor, so never armed.
             MavCmd::MAV_CMD_PREFLIGHT_STORAGE => match c.p[0] as i32 {
                 1 if v.armed => MavResult::MAV_RESULT_TEMPORARILY_REJECTED,
                 1 => {
@@ -225,59 +360,14 @@ impl GroundLink {
             },
             _ => MavResult::MAV_RESULT_UNSUPPORTED,
         };
-        self.ack(c.cmd, result, from);
+        out.ack(c.cmd, result, from);
         // By reference: a heapless vector's by-value iterator checks a slice bound on drop.
         for p in after.iter().copied() {
-            self.push_to(p, from.dest());
+            out.push_to(p, from.dest());
         }
     }
 
-    /// `MAV_CMD_REQUEST_MESSAGE`: the result and, when accepted, what to send after the ACK.
-    // PROTOCOL_VERSION is deprecated in the dialect, yet QGroundControl 4 asks for it.
-    #[allow(deprecated)]
-    fn request_message(&mut self, c: &Command, v: &VehicleSnapshot) -> (MavResult, After) {
-        let mut after = After::new();
-        let Some(id) = message_id(c.p[0]) else {
-            return (MavResult::MAV_RESULT_DENIED, after);
-        };
-        let one = match id {
-            HEARTBEAT_DATA::ID => Some(Pending::Heartbeat),
-            AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
-            CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
-            PROTOCOL_VERSION_DATA::ID => Some(Pending::ProtocolVersion),
-            COMPONENT_METADATA_DATA::ID if self.ftp.general().is_some() => {
-                Some(Pending::ComponentMetadata)
-            }
-            AVAILABLE_MODES_DATA::ID => {
-                let n = FlightMode::ALL.len();
-                let index = c.p[1];
-                if index == 0.0 {
-                    // 0 asks for every mode.
-                    for i in 0..n {
-                        let _ = after.push(Pending::AvailableMode(i as u8));
-                    }
-                    return (MavResult::MAV_RESULT_ACCEPTED, after);
-                } else if index >= 1.0 && index <= n as f32 && libm::truncf(index) == index {
-                    Some(Pending::AvailableMode((index as u8).saturating_sub(1)))
-                } else {
-                    return (MavResult::MAV_RESULT_DENIED, after);
-                }
-            }
-            _ => match Stream::from_message_id(id) {
-                Some(Stream::HomePosition) if !v.home.valid => {
-                    return (MavResult::MAV_RESULT_TEMPORARILY_REJECTED, after)
-                }
-                Some(s) => Some(Pending::Stream(s)),
-                None => return (MavResult::MAV_RESULT_UNSUPPORTED, after),
-            },
-        };
-        if let Some(p) = one {
-            let _ = after.push(p);
-        }
-        (MavResult::MAV_RESULT_ACCEPTED, after)
-    }
-
-    fn arm_disarm(&mut self, c: &Command, v: &VehicleSnapshot) -> MavResult {
+    fn arm_disarm(&mut self, c: &Command, v: &VehicleSnapshot, out: &mut Outbox) -> MavResult {
         let arm = c.p[0] > 0.5;
         let forced = (c.p[1] - FORCE_ARM_MAGIC).abs() < 0.5;
         if arm {
@@ -286,14 +376,14 @@ impl GroundLink {
             }
             if !forced {
                 if !v.boot_complete {
-                    self.textf(
+                    out.textf(
                         MavSeverity::MAV_SEVERITY_CRITICAL,
                         format_args!("Arming denied: system still starting"),
                     );
                     return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
                 }
                 if let Some(why) = telemetry::prearm_failure(v) {
-                    self.textf(
+                    out.textf(
                         MavSeverity::MAV_SEVERITY_CRITICAL,
                         format_args!("Arming denied: {}", why),
                     );
@@ -309,7 +399,7 @@ impl GroundLink {
                 LandedState::InAir | LandedState::Takeoff | LandedState::Landing
             );
             if flying && !forced {
-                self.textf(
+                out.textf(
                     MavSeverity::MAV_SEVERITY_CRITICAL,
                     format_args!("Disarming denied: not landed"),
                 );
@@ -320,34 +410,23 @@ impl GroundLink {
         MavResult::MAV_RESULT_ACCEPTED
     }
 
-    pub(super) fn unknown_mode(&mut self, custom_mode: u32) -> MavResult {
-        self.textf(
-            MavSeverity::MAV_SEVERITY_WARNING,
-            format_args!(
-                "Mode {}.{} not supported",
-                (custom_mode >> 16) & 0xff,
-                custom_mode >> 24
-            ),
-        );
-        MavResult::MAV_RESULT_FAILED
-    }
-
     /// Checks a mode change and, when possible, queues it for the vehicle.
-    pub(super) fn request_mode(
+    fn request_mode(
         &mut self,
         mode: FlightMode,
         v: &VehicleSnapshot,
         plan: &MissionStore,
+        out: &mut Outbox,
     ) -> MavResult {
         if mode == FlightMode::Mission && plan.mission.is_empty() {
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Mode Mission refused: no mission"),
             );
             return MavResult::MAV_RESULT_DENIED;
         }
         if mode == FlightMode::Return && !v.home.valid {
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Mode Return refused: no home position"),
             );
@@ -359,7 +438,7 @@ impl GroundLink {
             } else {
                 "not available now"
             };
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Mode {} refused: {}", mode.name(), why),
             );
@@ -371,49 +450,108 @@ impl GroundLink {
 
     /// Asks the vehicle to make `seq` current and confirms with MISSION_CURRENT; false (and a
     /// STATUSTEXT) when there is no such item.
-    pub(super) fn set_mission_current(&mut self, seq: u16, plan: &MissionStore) -> bool {
+    fn set_mission_current(&mut self, seq: u16, plan: &MissionStore, out: &mut Outbox) -> bool {
         let n = plan.mission.len();
         if usize::from(seq) >= n {
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Mission item {} does not exist ({} items)", seq, n),
             );
             return false;
         }
         self.requests.mission_seq = Some(seq);
-        self.push(Pending::MissionCurrent(Some(seq)));
+        out.push(Pending::MissionCurrent(Some(seq)));
         true
     }
+}
 
-    #[allow(deprecated)] // PARAM_FLOAT is deprecated in favour of the encoding flags, yet
-                         // the design names it and older ground stations look for it.
-    pub(super) fn autopilot_version(&self) -> MavMessage {
-        type C = MavProtocolCapability;
-        let mut capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
-            | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
-            | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
-            | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
-            | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
-            | C::MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
-            | C::MAV_PROTOCOL_CAPABILITY_MISSION_RALLY;
-        if !self.ftp.files().is_empty() {
-            capabilities |= C::MAV_PROTOCOL_CAPABILITY_FTP;
+/// `MAV_CMD_REQUEST_MESSAGE`: the result and, when accepted, what to send after the ACK.
+// PROTOCOL_VERSION is deprecated in the dialect, yet QGroundControl 4 asks for it.
+#[allow(deprecated)]
+fn request_message(c: &Command, v: &VehicleSnapshot, metadata: bool) -> (MavResult, After) {
+    let mut after = After::new();
+    let Some(id) = message_id(c.p[0]) else {
+        return (MavResult::MAV_RESULT_DENIED, after);
+    };
+    let one = match id {
+        HEARTBEAT_DATA::ID => Some(Pending::Heartbeat),
+        AUTOPILOT_VERSION_DATA::ID => Some(Pending::AutopilotVersion),
+        CURRENT_MODE_DATA::ID => Some(Pending::CurrentMode),
+        PROTOCOL_VERSION_DATA::ID => Some(Pending::ProtocolVersion),
+        COMPONENT_METADATA_DATA::ID if metadata => Some(Pending::ComponentMetadata),
+        AVAILABLE_MODES_DATA::ID => {
+            let n = FlightMode::ALL.len();
+            let index = c.p[1];
+            if index == 0.0 {
+                // 0 asks for every mode.
+                for i in 0..n {
+                    let _ = after.push(Pending::AvailableMode(i as u8));
+                }
+                return (MavResult::MAV_RESULT_ACCEPTED, after);
+            } else if index >= 1.0 && index <= n as f32 && libm::truncf(index) == index {
+                Some(Pending::AvailableMode((index as u8).saturating_sub(1)))
+            } else {
+                return (MavResult::MAV_RESULT_DENIED, after);
+            }
         }
-        MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
-            capabilities,
-            uid: self.cfg.uid,
-            flight_sw_version: FLIGHT_SW_VERSION,
-            middleware_sw_version: 0,
-            os_sw_version: 0,
-            board_version: 0,
-            vendor_id: 0,
-            product_id: 0,
-            flight_custom_version: [0; 8],
-            middleware_custom_version: [0; 8],
-            os_custom_version: [0; 8],
-            uid2: [0; 18],
-        })
+        _ => match Stream::from_message_id(id) {
+            Some(Stream::HomePosition) if !v.home.valid => {
+                return (MavResult::MAV_RESULT_TEMPORARILY_REJECTED, after)
+            }
+            Some(s) => Some(Pending::Stream(s)),
+            None => return (MavResult::MAV_RESULT_UNSUPPORTED, after),
+        },
+    };
+    if let Some(p) = one {
+        let _ = after.push(p);
     }
+    (MavResult::MAV_RESULT_ACCEPTED, after)
+}
+
+/// A mode this autopilot does not fly: FAILED, and a status text naming PX4's numbers.
+fn unknown_mode(custom_mode: u32, out: &mut Outbox) -> MavResult {
+    out.textf(
+        MavSeverity::MAV_SEVERITY_WARNING,
+        format_args!(
+            "Mode {}.{} not supported",
+            (custom_mode >> 16) & 0xff,
+            custom_mode >> 24
+        ),
+    );
+    MavResult::MAV_RESULT_FAILED
+}
+
+/// `AUTOPILOT_VERSION`: what this autopilot speaks (FTP when it serves files, `ftp`) and
+/// the board's unique id.
+// PARAM_FLOAT is deprecated in favour of the encoding flags, yet the design names it and
+// older ground stations look for it.
+#[allow(deprecated)]
+pub(crate) fn autopilot_version(uid: u64, ftp: bool) -> MavMessage {
+    type C = MavProtocolCapability;
+    let mut capabilities = C::MAV_PROTOCOL_CAPABILITY_MAVLINK2
+        | C::MAV_PROTOCOL_CAPABILITY_MISSION_INT
+        | C::MAV_PROTOCOL_CAPABILITY_COMMAND_INT
+        | C::MAV_PROTOCOL_CAPABILITY_PARAM_FLOAT
+        | C::MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE
+        | C::MAV_PROTOCOL_CAPABILITY_MISSION_FENCE
+        | C::MAV_PROTOCOL_CAPABILITY_MISSION_RALLY;
+    if ftp {
+        capabilities |= C::MAV_PROTOCOL_CAPABILITY_FTP;
+    }
+    MavMessage::AUTOPILOT_VERSION(AUTOPILOT_VERSION_DATA {
+        capabilities,
+        uid,
+        flight_sw_version: FLIGHT_SW_VERSION,
+        middleware_sw_version: 0,
+        os_sw_version: 0,
+        board_version: 0,
+        vendor_id: 0,
+        product_id: 0,
+        flight_custom_version: [0; 8],
+        middleware_custom_version: [0; 8],
+        os_custom_version: [0; 8],
+        uid2: [0; 18],
+    })
 }
 
 /// A message id carried in a float command parameter.
@@ -446,26 +584,26 @@ pub const FLIGHT_SW_VERSION: u32 = (parse_u8(env!("CARGO_PKG_VERSION_MAJOR")) <<
     | 255;
 
 /// What the board owes a station after a storage or reboot command.
-impl GroundLink {
+impl CommandService {
     /// The station whose `MAV_CMD_PREFLIGHT_STORAGE` waits for the board's save (answered
-    /// `IN_PROGRESS` so far); the board saves and answers with [`GroundLink::storage_done`].
+    /// `IN_PROGRESS` so far); the board saves, and the link answers once it is done.
     pub fn take_storage_request(&mut self) -> Option<Peer> {
         self.storage_request.take()
     }
 
     /// The final answer to a `MAV_CMD_PREFLIGHT_STORAGE`: ACCEPTED once the save is done,
     /// FAILED (with a status text) when the flash refused it.
-    pub fn storage_done(&mut self, to: Peer, saved: bool) {
+    pub(crate) fn storage_done(&self, to: Peer, saved: bool, out: &mut Outbox) {
         let result = if saved {
             MavResult::MAV_RESULT_ACCEPTED
         } else {
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_ERROR,
                 format_args!("Parameters not saved: flash error"),
             );
             MavResult::MAV_RESULT_FAILED
         };
-        self.ack(MavCmd::MAV_CMD_PREFLIGHT_STORAGE, result, to);
+        out.ack(MavCmd::MAV_CMD_PREFLIGHT_STORAGE, result, to);
     }
 
     /// Whether a reboot was asked for (and accepted: disarmed) since the last call.

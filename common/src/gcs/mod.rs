@@ -9,9 +9,13 @@
 //! the stored plan are the vehicle's ([`Stores`]): the link reads them and writes what the
 //! protocols accept, through the store's own checks.
 //!
-//! One file per service: [`mission`] (the mission protocol), [`params`] (the parameter
-//! protocol), [`commands`] (commands and their acknowledgements), [`telemetry`] and
-//! [`streams`] (what is sent unasked, and how often); this file routes messages to them.
+//! One type per service, each in its file: [`mission`] (the mission protocol), [`params`]
+//! (the parameter protocol), [`commands`] (commands and their acknowledgements, and the
+//! vehicle's requests), [`ftp`] (files), [`texts`] (status texts), [`telemetry`] and
+//! [`streams`] (what is sent unasked, and how often). This file routes each message to one
+//! of them and orders what they have to send at each poll (`output.rs` builds it). The
+//! services never call each other: what one has to send is written to the outbox handed to
+//! it, and what one needs of another is handed to it as an argument.
 //!
 //! Identity: system 1, component 1, `MAV_TYPE_FIXED_WING`, `MAV_AUTOPILOT_GENERIC`; modes in
 //! PX4's `custom_mode` encoding (see [`modes`]). `docs/GROUND-STATION.md` describes the
@@ -22,118 +26,57 @@
 
 pub mod client;
 pub mod commands;
+pub mod config;
 pub mod ftp;
+pub mod manual;
 pub mod mission;
 pub mod modes;
 pub mod outbox;
+mod output;
 pub mod params;
 pub mod peer;
 pub mod signing;
 pub mod streams;
 pub mod telemetry;
+pub mod texts;
 
 #[cfg(test)]
 mod tests;
 
-use core::fmt::Write;
-
-use heapless::{Deque, String};
 use mavlink::dialects::common::*;
 use mavlink::{MavHeader, Message};
 
-use crate::navigation::plan::{MissionStore, PlanKind};
-use crate::navigation::validate::PlanRules;
-use crate::navigation::validate::ValidationWarning;
-use crate::params::store::ParamStore;
-use crate::sensors::ManualInput;
 use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::VehicleRequests;
 use crate::vehicle::snapshot::VehicleSnapshot;
-use mission::{mission_message, MissionManager, MissionReply};
-use outbox::{Command, Pending, Text, TEXT_MAX};
-
-pub use outbox::{CommandAck, Outgoing};
-pub use peer::{Dest, Origin, Peer};
-
-pub use outbox::STATUSTEXT_LEN;
+use commands::{CommandContext, CommandService};
+use mission::{MissionManager, MissionReply};
+use outbox::{Outbox, Pending};
+use output::{emit, stream_message, Sources};
+use params::ParamService;
 use signing::Signing;
 use streams::{Scheduler, Stream};
 
-/// Our MAVLink system id.
-pub const SYSTEM_ID: u8 = 1;
-/// Our MAVLink component id (`MAV_COMP_ID_AUTOPILOT1`).
-pub const COMPONENT_ID: u8 = 1;
-/// `param2` of `MAV_CMD_COMPONENT_ARM_DISARM` that skips the checks (MAVLink's magic number).
-pub const FORCE_ARM_MAGIC: f32 = 21196.0;
-/// Heartbeat interval, µs (1 Hz; QGC drops a vehicle after 3.5 s of silence).
-pub const HEARTBEAT_INTERVAL_US: u64 = 1_000_000;
+pub use commands::FORCE_ARM_MAGIC;
+pub use config::{LinkConfig, Stores, COMPONENT_ID, HEARTBEAT_INTERVAL_US, SYSTEM_ID};
+pub use outbox::{CommandAck, Outgoing};
+pub use peer::{Dest, Origin, Peer};
+pub use texts::STATUSTEXT_LEN;
 
-const PENDING_CAPACITY: usize = 32;
-const TEXT_CAPACITY: usize = 8;
-
-/// Settings of a link.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LinkConfig {
-    /// Our system id.
-    pub system_id: u8,
-    /// Our component id.
-    pub component_id: u8,
-    /// `PARAM_VALUE`s sent per [`GroundLink::poll`] while streaming the list: paces a full
-    /// download to the link's bandwidth (a 50 Hz loop with 4 per poll sends 200 per second).
-    pub params_per_poll: u8,
-    /// Hardware unique id reported in `AUTOPILOT_VERSION` (0 when unknown).
-    pub uid: u64,
-    /// The files served over MAVLink FTP; with a `general.json` among them, the link answers
-    /// requests for `COMPONENT_METADATA` with its URI.
-    pub files: &'static [ftp::File],
-}
-
-impl Default for LinkConfig {
-    fn default() -> Self {
-        Self {
-            system_id: SYSTEM_ID,
-            component_id: COMPONENT_ID,
-            params_per_poll: 4,
-            uid: 0,
-            files: &[],
-        }
-    }
-}
-
-/// What the link reads and writes besides the vehicle's snapshot: the parameter values, the
-/// stored plan, and what a finished upload is checked against.
-pub struct Stores<'a> {
-    /// Every parameter of the vehicle.
-    pub params: &'a mut ParamStore,
-    /// The mission, geofence and rally lists.
-    pub plan: &'a mut MissionStore,
-    /// Home and the navigator's limits, for the upload checks.
-    pub rules: PlanRules,
-}
-
-/// The ground-station link state machine.
+/// The ground-station link: the services, and the router between them and the stations.
 #[derive(Clone, Debug)]
 pub struct GroundLink {
     cfg: LinkConfig,
     missions: MissionManager,
     streams: Scheduler,
-    pending: Deque<(Pending, Dest), PENDING_CAPACITY>,
-    texts: Deque<Text, TEXT_CAPACITY>,
-    requests: VehicleRequests,
-    /// A `MAV_CMD_PREFLIGHT_STORAGE` save the board owes, and who asked.
-    storage_request: Option<Peer>,
-    /// A `MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN` reboot the board owes.
-    reboot_request: bool,
-    /// The next index of a parameter list download, and the channel that asked for it.
-    param_next: Option<(u16, u8)>,
+    commands: CommandService,
+    params: ParamService,
+    outbox: Outbox,
     next_heartbeat_us: u64,
     gcs_last_seen_us: Option<u64>,
     last_mode: Option<FlightMode>,
-    dropped: u32,
     rx_errors: u16,
     signing: Signing,
-    /// The `id` of the last status text sent in chunks.
-    text_id: u16,
     ftp: ftp::Ftp,
 }
 
@@ -152,19 +95,14 @@ impl GroundLink {
             cfg,
             missions: MissionManager::new(),
             streams: Scheduler::new(),
-            pending: Deque::new(),
-            texts: Deque::new(),
-            requests: VehicleRequests::default(),
-            storage_request: None,
-            reboot_request: false,
-            param_next: None,
+            commands: CommandService::new(),
+            params: ParamService::new(cfg.params_per_poll),
+            outbox: Outbox::default(),
             next_heartbeat_us: 0,
             gcs_last_seen_us: None,
             last_mode: None,
-            dropped: 0,
             rx_errors: 0,
             signing: Signing::default(),
-            text_id: 0,
             ftp: ftp::Ftp::new(cfg.files),
         }
     }
@@ -191,7 +129,7 @@ impl GroundLink {
 
     /// Takes the requests accepted since the last call.
     pub fn take_requests(&mut self) -> VehicleRequests {
-        core::mem::take(&mut self.requests)
+        self.commands.take_requests()
     }
 
     /// Time the last ground-station heartbeat arrived, µs (for a link-loss failsafe).
@@ -201,7 +139,7 @@ impl GroundLink {
 
     /// Outgoing messages dropped because the output queues were full.
     pub fn dropped(&self) -> u32 {
-        self.dropped
+        self.outbox.dropped()
     }
 
     /// Counts a frame the transport could not decode (reported in `SYS_STATUS.errors_comm`).
@@ -214,42 +152,24 @@ impl GroundLink {
     /// `chunk_seq`), up to 150 bytes; when the queue is full the text is dropped and counted in
     /// [`GroundLink::dropped`].
     pub fn send_statustext(&mut self, severity: MavSeverity, text: &str) {
-        let mut s = String::new();
-        for c in text.chars() {
-            if s.push(c).is_err() {
-                break;
-            }
-        }
-        self.queue_text(severity, s);
+        self.outbox.texts_mut().push_str(severity, text);
     }
 
-    fn queue_text(&mut self, severity: MavSeverity, text: String<TEXT_MAX>) {
-        if self.texts.push_back(Text { severity, text }).is_err() {
-            self.dropped = self.dropped.wrapping_add(1);
-        }
+    /// The station whose `MAV_CMD_PREFLIGHT_STORAGE` waits for the board's save (answered
+    /// `IN_PROGRESS` so far); the board saves and answers with [`GroundLink::storage_done`].
+    pub fn take_storage_request(&mut self) -> Option<Peer> {
+        self.commands.take_storage_request()
     }
 
-    /// Says what an accepted mission will do differently from what its reader may expect.
-    fn mission_warning(&mut self, w: ValidationWarning) {
-        self.textf(MavSeverity::MAV_SEVERITY_WARNING, format_args!("{w}"));
+    /// The final answer to a `MAV_CMD_PREFLIGHT_STORAGE`: ACCEPTED once the save is done,
+    /// FAILED (with a status text) when the flash refused it.
+    pub fn storage_done(&mut self, to: Peer, saved: bool) {
+        self.commands.storage_done(to, saved, &mut self.outbox);
     }
 
-    fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
-        let mut s: String<TEXT_MAX> = String::new();
-        // A text that does not fit is cut, never refused.
-        let _ = s.write_fmt(args);
-        self.queue_text(severity, s);
-    }
-
-    /// Queues a message for every station.
-    fn push(&mut self, p: Pending) {
-        self.push_to(p, Dest::All);
-    }
-
-    fn push_to(&mut self, p: Pending, dest: Dest) {
-        if self.pending.push_back((p, dest)).is_err() {
-            self.dropped = self.dropped.wrapping_add(1);
-        }
+    /// Whether a reboot was asked for (and accepted: disarmed) since the last call.
+    pub fn take_reboot_request(&mut self) -> bool {
+        self.commands.take_reboot_request()
     }
 
     /// Consumes one message from a ground station, received on the board's `channel` (with
@@ -297,141 +217,124 @@ impl GroundLink {
             component: header.component_id,
             channel,
         };
-        match msg {
+        let out = &mut self.outbox;
+        let reply = match msg {
             MavMessage::SETUP_SIGNING(d) => {
-                let with_key = signed.is_some_and(|s| s.valid);
-                let text = if !self.signing.setup(d, with_key) {
-                    "Signing setup refused: not signed with the key"
-                } else if self.signing.key().is_some() {
-                    "Signing on: unsigned writes are refused"
-                } else {
-                    "Signing off"
-                };
-                self.send_statustext(MavSeverity::MAV_SEVERITY_INFO, text);
+                let text = self.signing.on_setup(d, signed);
+                out.texts_mut()
+                    .push_str(MavSeverity::MAV_SEVERITY_INFO, text);
+                None
             }
             MavMessage::FILE_TRANSFER_PROTOCOL(d) if d.target_network == 0 => {
                 self.ftp.handle(d, from, now_us);
+                None
             }
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
                 self.gcs_last_seen_us = Some(now_us);
+                None
             }
             MavMessage::PARAM_REQUEST_LIST(_) => {
-                // A new request restarts the stream: every index once, in order, to the
-                // channel that asked.
-                self.param_next = Some((0, channel));
+                self.params.on_request_list(channel);
+                None
             }
             MavMessage::PARAM_REQUEST_READ(d) => {
-                self.on_param_read(d, stores.params, from);
+                self.params.on_read(d, stores.params, from, out);
+                None
             }
-            MavMessage::PARAM_SET(d) => self.on_param_set(d, stores.params, from),
+            MavMessage::PARAM_SET(d) => {
+                self.params.on_set(d, stores.params, from, out);
+                None
+            }
             MavMessage::MANUAL_CONTROL(d) => {
-                // Axes are -1000..1000 (throttle 0..1000); INT16_MAX marks an axis as unused.
-                let axis = |v: i16| {
-                    if v == i16::MAX {
-                        0.0
-                    } else {
-                        (f32::from(v) / 1000.0).clamp(-1.0, 1.0)
-                    }
-                };
-                self.requests.manual = Some(ManualInput {
-                    roll: axis(d.y),
-                    pitch: -axis(d.x),
-                    yaw: axis(d.r),
-                    throttle: axis(d.z).clamp(0.0, 1.0),
-                    time_us: now_us,
-                });
+                self.commands.on_manual_control(d, now_us);
+                None
             }
             MavMessage::COMMAND_LONG(d) => {
-                let c = Command {
-                    cmd: d.command,
-                    p: [
-                        d.param1, d.param2, d.param3, d.param4, d.param5, d.param6, d.param7,
-                    ],
+                let cx = CommandContext {
+                    now_us,
+                    vehicle,
+                    stores,
+                    streams: &mut self.streams,
+                    metadata: self.ftp.general().is_some(),
+                    out: &mut *out,
                 };
-                self.on_command(c, from, now_us, vehicle, stores);
+                self.commands.on_command_long(d, from, cx);
+                None
             }
             MavMessage::COMMAND_INT(d) => {
-                let c = Command {
-                    cmd: d.command,
-                    p: [
-                        d.param1, d.param2, d.param3, d.param4, d.x as f32, d.y as f32, d.z,
-                    ],
+                let cx = CommandContext {
+                    now_us,
+                    vehicle,
+                    stores,
+                    streams: &mut self.streams,
+                    metadata: self.ftp.general().is_some(),
+                    out: &mut *out,
                 };
-                self.on_command(c, from, now_us, vehicle, stores);
+                self.commands.on_command_int(d, from, cx);
+                None
             }
             MavMessage::SET_MODE(d) => {
-                // PX4 treats SET_MODE as MAV_CMD_DO_SET_MODE and acknowledges it as such.
-                let result = if d
-                    .base_mode
-                    .contains(MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED)
-                {
-                    match FlightMode::from_custom_mode(d.custom_mode) {
-                        Some(m) => self.request_mode(m, vehicle, stores.plan),
-                        None => self.unknown_mode(d.custom_mode),
-                    }
-                } else {
-                    self.textf(
-                        MavSeverity::MAV_SEVERITY_WARNING,
-                        format_args!("Mode refused: only custom modes"),
-                    );
-                    MavResult::MAV_RESULT_DENIED
-                };
-                self.ack(MavCmd::MAV_CMD_DO_SET_MODE, result, from);
+                self.commands
+                    .on_set_mode(d, from, vehicle, stores.plan, out);
+                None
+            }
+            MavMessage::MISSION_SET_CURRENT(d) => {
+                self.commands
+                    .on_mission_set_current(d, from, stores.plan, out);
+                None
             }
             MavMessage::MISSION_COUNT(d) => {
-                let r = self
-                    .missions
-                    .on_count(stores.plan, d.mission_type, d.count, from, now_us);
-                self.push_to(Pending::Mission(r, from), from.dest());
+                Some(
+                    self.missions
+                        .on_count(stores.plan, d.mission_type, d.count, from, now_us),
+                )
             }
             MavMessage::MISSION_ITEM_INT(d) => {
                 let plan = &mut *stores.plan;
-                if let Some(r) = self.missions.on_item(plan, &stores.rules, d, from, now_us) {
-                    self.push_to(Pending::Mission(r, from), from.dest());
+                let r = self.missions.on_item(plan, &stores.rules, d, from, now_us);
+                for w in self.missions.take_warnings().iter() {
+                    out.textf(MavSeverity::MAV_SEVERITY_WARNING, format_args!("{w}"));
                 }
-                for w in self.missions.take_warnings().iter().copied() {
-                    self.mission_warning(w);
-                }
+                r
             }
             // Float items lose precision; this autopilot asks for MISSION_ITEM_INT only.
             MavMessage::MISSION_ITEM(d) if self.missions.busy() => {
                 self.missions.on_ack(d.mission_type, from);
-                let nack =
-                    MissionReply::Ack(d.mission_type, MavMissionResult::MAV_MISSION_UNSUPPORTED);
-                self.push_to(Pending::Mission(nack, from), from.dest());
+                Some(MissionReply::Ack(
+                    d.mission_type,
+                    MavMissionResult::MAV_MISSION_UNSUPPORTED,
+                ))
             }
             MavMessage::MISSION_REQUEST_LIST(d) => {
-                let r = self
-                    .missions
-                    .on_request_list(stores.plan, d.mission_type, from, now_us);
-                self.push_to(Pending::Mission(r, from), from.dest());
+                Some(
+                    self.missions
+                        .on_request_list(stores.plan, d.mission_type, from, now_us),
+                )
             }
             MavMessage::MISSION_REQUEST_INT(d) => {
-                let r = self
-                    .missions
-                    .on_request(stores.plan, d.mission_type, d.seq, from, now_us);
-                self.push_to(Pending::Mission(r, from), from.dest());
+                Some(
+                    self.missions
+                        .on_request(stores.plan, d.mission_type, d.seq, from, now_us),
+                )
             }
+            // Legacy request: answered with MISSION_ITEM_INT all the same.
             MavMessage::MISSION_REQUEST(d) => {
-                // Legacy request: answered with MISSION_ITEM_INT all the same.
-                let r = self
-                    .missions
-                    .on_request(stores.plan, d.mission_type, d.seq, from, now_us);
-                self.push_to(Pending::Mission(r, from), from.dest());
+                Some(
+                    self.missions
+                        .on_request(stores.plan, d.mission_type, d.seq, from, now_us),
+                )
             }
-            MavMessage::MISSION_ACK(d) => self.missions.on_ack(d.mission_type, from),
+            MavMessage::MISSION_ACK(d) => {
+                self.missions.on_ack(d.mission_type, from);
+                None
+            }
             MavMessage::MISSION_CLEAR_ALL(d) => {
-                let r = self.missions.on_clear(stores.plan, d.mission_type);
-                self.push_to(Pending::Mission(r, from), from.dest());
+                Some(self.missions.on_clear(stores.plan, d.mission_type))
             }
-            MavMessage::MISSION_SET_CURRENT(d) => {
-                // The message has no ACK: a bad index gets a STATUSTEXT and the current item.
-                let ok = self.set_mission_current(d.seq, stores.plan);
-                if !ok {
-                    self.push_to(Pending::MissionCurrent(None), from.dest());
-                }
-            }
-            _ => {}
+            _ => None,
+        };
+        if let Some(r) = reply {
+            out.push_to(Pending::Mission(r, from), from.dest());
         }
     }
 
@@ -460,28 +363,18 @@ impl GroundLink {
             component: header.component_id,
             channel,
         };
-        self.push_to(Pending::Unsupported { command, to }, to.dest());
-    }
-
-    fn ack(&mut self, command: MavCmd, result: MavResult, to: Peer) {
-        self.push_to(
-            Pending::Ack {
-                command,
-                result,
-                to,
-            },
-            to.dest(),
-        );
+        self.outbox
+            .push_to(Pending::Unsupported { command, to }, to.dest());
     }
 
     /// The vehicle's mission progress: a new current item (MISSION_CURRENT at once, besides
     /// the 1 Hz stream) and an item finished (MISSION_ITEM_REACHED), as PX4 reports them.
     pub fn mission_progress(&mut self, current: Option<u16>, reached: Option<u16>) {
         if let Some(seq) = reached {
-            self.push(Pending::ItemReached(seq));
+            self.outbox.push(Pending::ItemReached(seq));
         }
         if let Some(seq) = current {
-            self.push(Pending::MissionCurrent(Some(seq)));
+            self.outbox.push(Pending::MissionCurrent(Some(seq)));
         }
     }
 
@@ -496,7 +389,8 @@ impl GroundLink {
         mut out_raw: F,
     ) {
         self.signing.tick(now_us);
-        while let Some((p, dest)) = self.pending.pop_front() {
+        let intended = self.commands.intended_mode(v);
+        while let Some((p, dest)) = self.outbox.pop() {
             if let Pending::Unsupported { command, to } = p {
                 let ack = CommandAck {
                     command,
@@ -506,9 +400,8 @@ impl GroundLink {
                 out_raw(dest, Outgoing::Ack(ack));
                 continue;
             }
-            self.emit(p, dest, now_us, v, stores, &mut |d, m| {
-                out_raw(d, Outgoing::Message(m))
-            });
+            let src = self.sources(now_us, v, stores, intended);
+            emit(p, dest, &src, &mut |d, m| out_raw(d, Outgoing::Message(m)));
         }
         let mut out_msg = |d, m| out_raw(d, Outgoing::Message(m));
         let out = &mut out_msg;
@@ -523,200 +416,46 @@ impl GroundLink {
                 self.next_heartbeat_us = now_us.saturating_add(HEARTBEAT_INTERVAL_US);
             }
         }
-        while let Some(t) = self.texts.pop_front() {
-            let bytes = t.text.as_bytes();
-            if bytes.len() <= STATUSTEXT_LEN {
-                let text = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
-                    severity: t.severity,
-                    text: t.text.as_str().into(),
-                    id: 0,
-                    chunk_seq: 0,
-                });
-                out(Dest::All, text);
-                continue;
-            }
-            // Chunks of one text share a non-zero id; the last is shorter than 50 bytes (its
-            // NUL ends the text), an empty one when the text fills its chunks exactly.
-            self.text_id = self.text_id.wrapping_add(1).max(1);
-            let chunks = (bytes.len() / STATUSTEXT_LEN).saturating_add(1);
-            for (seq, start) in (0..chunks).map(|i| (i, i.saturating_mul(STATUSTEXT_LEN))) {
-                let part = bytes.get(start..).unwrap_or(&[]);
-                let part = part.get(..STATUSTEXT_LEN).unwrap_or(part);
-                let mut text = [0u8; STATUSTEXT_LEN];
-                for (d, b) in text.iter_mut().zip(part) {
-                    *d = *b;
-                }
-                let chunk = MavMessage::STATUSTEXT(STATUSTEXT_DATA {
-                    severity: t.severity,
-                    text: text.into(),
-                    id: self.text_id,
-                    chunk_seq: seq as u8,
-                });
-                out(Dest::All, chunk);
-            }
-        }
+        self.outbox.texts_mut().drain(out);
         if let Some((reply, to)) = self.missions.poll(now_us) {
-            self.emit(
-                Pending::Mission(reply, to),
-                to.dest(),
-                now_us,
-                v,
-                stores,
-                out,
-            );
+            let src = self.sources(now_us, v, stores, intended);
+            emit(Pending::Mission(reply, to), to.dest(), &src, out);
         }
         if self.last_mode != Some(v.mode) {
             if self.last_mode.is_some() {
-                out(Dest::All, telemetry::current_mode(v, self.intended_mode(v)));
+                out(Dest::All, telemetry::current_mode(v, intended));
             }
             self.last_mode = Some(v.mode);
         }
-        self.stream_params(stores.params, out);
+        self.params.stream(stores.params, out);
         let mut due: heapless::Vec<Stream, { streams::STREAM_COUNT }> = heapless::Vec::new();
         self.streams.run(now_us, |s| {
             let _ = due.push(s);
         });
+        let src = self.sources(now_us, v, stores, intended);
         for s in due {
-            if let Some(m) = self.stream_message(s, now_us, v, stores.plan) {
+            if let Some(m) = stream_message(s, &src) {
                 out(Dest::All, m);
             }
         }
     }
 
-    fn intended_mode(&self, v: &VehicleSnapshot) -> FlightMode {
-        self.requests.mode.unwrap_or(v.mode)
-    }
-
-    fn mission_ids(s: &MissionStore) -> (u32, u32, u32) {
-        (
-            s.opaque_id(PlanKind::Mission),
-            s.opaque_id(PlanKind::Fence),
-            s.opaque_id(PlanKind::Rally),
-        )
-    }
-
-    fn stream_message(
-        &self,
-        s: Stream,
+    /// What the queued answers and the streams are built from at this poll.
+    fn sources<'a, 'b>(
+        &'a self,
         now_us: u64,
-        v: &VehicleSnapshot,
-        plan: &MissionStore,
-    ) -> Option<MavMessage> {
-        Some(match s {
-            Stream::SysStatus => telemetry::sys_status(v, self.rx_errors),
-            Stream::GpsRawInt => telemetry::gps_raw_int(v),
-            Stream::Attitude => telemetry::attitude(v, now_us),
-            Stream::GlobalPositionInt => telemetry::global_position_int(v, now_us),
-            Stream::MissionCurrent => telemetry::mission_current(
-                v,
-                v.mission_seq,
-                plan.mission.len() as u16,
-                Self::mission_ids(plan),
-            ),
-            Stream::NavControllerOutput => telemetry::nav_controller_output(v),
-            Stream::VfrHud => telemetry::vfr_hud(v),
-            Stream::BatteryStatus => telemetry::battery_status(v),
-            Stream::HomePosition => telemetry::home_position(v, now_us)?,
-            Stream::ExtendedSysState => telemetry::extended_sys_state(v),
-            Stream::CurrentMode => telemetry::current_mode(v, self.intended_mode(v)),
-        })
-    }
-
-    fn emit<F: FnMut(Dest, MavMessage)>(
-        &self,
-        p: Pending,
-        dest: Dest,
-        now_us: u64,
-        v: &VehicleSnapshot,
-        stores: &Stores,
-        out: &mut F,
-    ) {
-        let mut out = |m| out(dest, m);
-        match p {
-            // Sent as raw data by `poll`.
-            Pending::Unsupported { .. } => {}
-            Pending::ParamError {
-                index,
-                name,
-                error,
-                to,
-            } => out(MavMessage::PARAM_ERROR(PARAM_ERROR_DATA {
-                param_index: index,
-                target_system: to.system,
-                target_component: to.component,
-                param_id: name.into(),
-                error,
-            })),
-            // Deprecated in the dialect since 2025, but QGroundControl 4 still asks for it.
-            #[allow(deprecated)]
-            Pending::ProtocolVersion => out(MavMessage::PROTOCOL_VERSION(PROTOCOL_VERSION_DATA {
-                // MAVLink 2 spoken (and sent); MAVLink 1 frames still read.
-                version: 200,
-                min_version: 100,
-                max_version: 200,
-                spec_version_hash: [0; 8],
-                library_version_hash: [0; 8],
-            })),
-            Pending::ComponentMetadata => {
-                if let Some(f) = self.ftp.general() {
-                    out(MavMessage::COMPONENT_METADATA(COMPONENT_METADATA_DATA {
-                        time_boot_ms: (now_us / 1000) as u32,
-                        file_crc: ftp::file_crc(f.bytes),
-                        uri: ftp::uri(f).as_str().into(),
-                    }));
-                }
-            }
-            Pending::Ack {
-                command,
-                result,
-                to,
-            } => out(MavMessage::COMMAND_ACK(COMMAND_ACK_DATA {
-                command,
-                result,
-                progress: 0,
-                result_param2: 0,
-                target_system: to.system,
-                target_component: to.component,
-            })),
-            Pending::ParamValue(i) => {
-                if let Some(m) = params::param_value(stores.params, usize::from(i)) {
-                    out(m);
-                }
-            }
-            Pending::Mission(reply, to) => {
-                if let Some(m) = mission_message(reply, to.address(), stores.plan, v.mission_seq) {
-                    out(m);
-                }
-            }
-            Pending::MissionCurrent(seq) => out(telemetry::mission_current(
-                v,
-                seq.unwrap_or(v.mission_seq),
-                stores.plan.mission.len() as u16,
-                Self::mission_ids(stores.plan),
-            )),
-            Pending::ItemReached(seq) => out(MavMessage::MISSION_ITEM_REACHED(
-                MISSION_ITEM_REACHED_DATA { seq },
-            )),
-            Pending::AutopilotVersion => out(self.autopilot_version()),
-            Pending::AvailableMode(i) => {
-                if let Some(m) = FlightMode::ALL.get(usize::from(i)) {
-                    out(telemetry::available_mode(usize::from(i), *m));
-                }
-            }
-            Pending::CurrentMode => out(telemetry::current_mode(v, self.intended_mode(v))),
-            Pending::Heartbeat => out(telemetry::heartbeat(v)),
-            Pending::Stream(s) => {
-                let m = self.stream_message(s, now_us, v, stores.plan);
-                if let Some(m) = m {
-                    out(m);
-                }
-            }
-            Pending::MessageInterval { id, interval_us } => {
-                out(MavMessage::MESSAGE_INTERVAL(MESSAGE_INTERVAL_DATA {
-                    interval_us,
-                    message_id: id,
-                }))
-            }
+        vehicle: &'a VehicleSnapshot,
+        stores: &'a Stores<'b>,
+        intended: FlightMode,
+    ) -> Sources<'a, 'b> {
+        Sources {
+            now_us,
+            vehicle,
+            stores,
+            ftp: &self.ftp,
+            intended,
+            rx_errors: self.rx_errors,
+            uid: self.cfg.uid,
         }
     }
 }

@@ -1,27 +1,19 @@
-//! What the link has to send: answers waiting for the next poll, and status texts.
+//! What the link has to send: answers waiting for the next poll, and the status texts beside
+//! them.
 
 use super::mission::MissionReply;
-use super::peer::Peer;
+use super::peer::{Dest, Peer};
 use super::streams::Stream;
+use super::texts::TextQueue;
 use crate::vehicle::modes::FlightMode;
-use heapless::String;
+use heapless::Deque;
 use mavlink::dialects::common::{
     MavCmd, MavMessage, MavParamError, MavResult, MavSeverity, COMMAND_ACK_DATA, COMMAND_INT_DATA,
     COMMAND_LONG_DATA,
 };
 use mavlink::{MavlinkVersion, MessageData};
 
-/// Longest text one STATUSTEXT carries; a longer one goes out in chunks.
-pub const STATUSTEXT_LEN: usize = 50;
-/// Longest status text the link keeps (three chunks).
-pub const TEXT_MAX: usize = 3 * STATUSTEXT_LEN;
-
-/// A STATUSTEXT waiting to be sent.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Text {
-    pub severity: MavSeverity,
-    pub text: String<TEXT_MAX>,
-}
+const PENDING_CAPACITY: usize = 32;
 
 /// Something to send at the next poll.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,6 +61,61 @@ pub(crate) type After = heapless::Vec<Pending, { FlightMode::ALL.len() }>;
 pub(crate) struct Command {
     pub cmd: MavCmd,
     pub p: [f32; 7],
+}
+
+/// Answers and status texts waiting for the next poll: what every service writes and the
+/// link's poll sends.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Outbox {
+    pending: Deque<(Pending, Dest), PENDING_CAPACITY>,
+    texts: TextQueue,
+    dropped: u32,
+}
+
+impl Outbox {
+    /// Queues a message for every station.
+    pub fn push(&mut self, p: Pending) {
+        self.push_to(p, Dest::All);
+    }
+
+    /// Queues a message for `dest`; dropped (and counted) when the queue is full.
+    pub fn push_to(&mut self, p: Pending, dest: Dest) {
+        if self.pending.push_back((p, dest)).is_err() {
+            self.dropped = self.dropped.wrapping_add(1);
+        }
+    }
+
+    /// Queues a `COMMAND_ACK` to the station that sent the command.
+    pub fn ack(&mut self, command: MavCmd, result: MavResult, to: Peer) {
+        self.push_to(
+            Pending::Ack {
+                command,
+                result,
+                to,
+            },
+            to.dest(),
+        );
+    }
+
+    /// Queues a formatted status text for every station.
+    pub fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
+        self.texts.pushf(severity, args);
+    }
+
+    /// The status-text queue.
+    pub fn texts_mut(&mut self) -> &mut TextQueue {
+        &mut self.texts
+    }
+
+    /// The oldest answer waiting, with where it goes.
+    pub fn pop(&mut self) -> Option<(Pending, Dest)> {
+        self.pending.pop_front()
+    }
+
+    /// Answers and texts dropped because their queue was full.
+    pub fn dropped(&self) -> u32 {
+        self.dropped.wrapping_add(self.texts.dropped())
+    }
 }
 
 /// What the link hands its owner to send (for the moment it takes to encode it: the size of

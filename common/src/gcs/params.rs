@@ -1,21 +1,44 @@
 //! The parameter service: the list streamed at the link's pace, single reads, and writes
 //! checked by the parameter store (refused values are answered with the value kept).
 
-use super::outbox::Pending;
+use super::outbox::{Outbox, Pending};
 use super::peer::{Dest, Peer};
-use super::GroundLink;
 use crate::decimal::trimmed;
 use crate::params::store::{encode_wire, param_id_str, ParamStore};
 use crate::params::ParamKind;
 use mavlink::dialects::common::*;
 
-impl GroundLink {
+/// The parameter protocol's state: the list download in progress and its pace.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParamService {
+    /// The next index of a parameter list download, and the channel that asked for it.
+    next: Option<(u16, u8)>,
+    /// `PARAM_VALUE`s sent per poll while streaming the list.
+    per_poll: u8,
+}
+
+impl ParamService {
+    /// No download running; a list goes out `per_poll` values at a time.
+    pub fn new(per_poll: u8) -> Self {
+        Self {
+            next: None,
+            per_poll,
+        }
+    }
+
+    /// `PARAM_REQUEST_LIST` on `channel`: a new request restarts the stream, every index
+    /// once, in order, to the channel that asked.
+    pub fn on_request_list(&mut self, channel: u8) {
+        self.next = Some((0, channel));
+    }
+
     /// `PARAM_REQUEST_READ`: by index, or by name when the index is -1.
-    pub(super) fn on_param_read(
-        &mut self,
+    pub(crate) fn on_read(
+        &self,
         d: &PARAM_REQUEST_READ_DATA,
         params: &ParamStore,
         from: Peer,
+        out: &mut Outbox,
     ) {
         let index = if d.param_index < 0 {
             param_id_str(&d.param_id[..]).and_then(|n| params.index_of(n))
@@ -23,45 +46,26 @@ impl GroundLink {
             Some(d.param_index as usize).filter(|&i| i < params.len())
         };
         match index {
-            Some(i) => self.push_to(Pending::ParamValue(i as u16), from.dest()),
-            None => self.param_error(
+            Some(i) => out.push_to(Pending::ParamValue(i as u16), from.dest()),
+            None => param_error(
                 &d.param_id[..],
                 d.param_index,
                 MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST,
                 from,
+                out,
             ),
         }
     }
 
-    /// `PARAM_ERROR` to the station that asked (the parameter protocol's answer to an unknown
-    /// name and to a refused value; QGroundControl counts it as the end of its retries).
-    fn param_error(&mut self, id: &[u8], index: i16, error: MavParamError, to: Peer) {
-        let mut name = [0u8; 16];
-        for (d, b) in name.iter_mut().zip(id) {
-            *d = *b;
-        }
-        let p = Pending::ParamError {
-            index,
-            name,
-            error,
-            to,
-        };
-        self.push_to(p, to.dest());
-    }
-
-    /// The next `params_per_poll` values of a list download, if one runs, to the channel that
-    /// asked for it.
-    pub(super) fn stream_params<F: FnMut(Dest, MavMessage)>(
-        &mut self,
-        params: &ParamStore,
-        out: &mut F,
-    ) {
-        let Some((next, channel)) = self.param_next else {
+    /// The next `per_poll` values of a list download, if one runs, to the channel that asked
+    /// for it.
+    pub fn stream<F: FnMut(Dest, MavMessage)>(&mut self, params: &ParamStore, out: &mut F) {
+        let Some((next, channel)) = self.next else {
             return;
         };
         let n = params.len();
         let mut i = usize::from(next);
-        for _ in 0..self.cfg.params_per_poll.max(1) {
+        for _ in 0..self.per_poll.max(1) {
             if i >= n {
                 break;
             }
@@ -70,7 +74,7 @@ impl GroundLink {
             }
             i = i.saturating_add(1);
         }
-        self.param_next = if i >= n {
+        self.next = if i >= n {
             None
         } else {
             Some((i as u16, channel))
@@ -78,20 +82,27 @@ impl GroundLink {
     }
 
     /// `PARAM_SET`: the store checks the value; the echo carries the value it now holds.
-    pub(super) fn on_param_set(&mut self, d: &PARAM_SET_DATA, params: &mut ParamStore, from: Peer) {
+    pub(crate) fn on_set(
+        &self,
+        d: &PARAM_SET_DATA,
+        params: &mut ParamStore,
+        from: Peer,
+        out: &mut Outbox,
+    ) {
         let Some(name) = param_id_str(&d.param_id[..]) else {
             return;
         };
         let Some(index) = params.index_of(name) else {
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!("Param {}: unknown", name),
             );
-            self.param_error(
+            param_error(
                 &d.param_id[..],
                 -1,
                 MavParamError::MAV_PARAM_ERROR_DOES_NOT_EXIST,
                 from,
+                out,
             );
             return;
         };
@@ -122,7 +133,7 @@ impl GroundLink {
                 .map_err(|e| (e.text(), MavParamError::MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE))
         });
         if let Err((why, error)) = result {
-            self.textf(
+            out.textf(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 format_args!(
                     "Param {} refused: {} [{}, {}]",
@@ -132,15 +143,31 @@ impl GroundLink {
                     trimmed(def.max, 6)
                 ),
             );
-            self.param_error(&d.param_id[..], index as i16, error, from);
+            param_error(&d.param_id[..], index as i16, error, from, out);
         }
         // The echo carries the value now stored, changed or not.
-        self.push(Pending::ParamValue(index as u16));
+        out.push(Pending::ParamValue(index as u16));
     }
 }
 
+/// `PARAM_ERROR` to the station that asked (the parameter protocol's answer to an unknown
+/// name and to a refused value; QGroundControl counts it as the end of its retries).
+fn param_error(id: &[u8], index: i16, error: MavParamError, to: Peer, out: &mut Outbox) {
+    let mut name = [0u8; 16];
+    for (d, b) in name.iter_mut().zip(id) {
+        *d = *b;
+    }
+    let p = Pending::ParamError {
+        index,
+        name,
+        error,
+        to,
+    };
+    out.push_to(p, to.dest());
+}
+
 /// `PARAM_VALUE` of the parameter at `index`.
-pub(super) fn param_value(params: &ParamStore, index: usize) -> Option<MavMessage> {
+pub(crate) fn param_value(params: &ParamStore, index: usize) -> Option<MavMessage> {
     let def = params.def(index)?;
     let value = params.value(index)?;
     Some(MavMessage::PARAM_VALUE(PARAM_VALUE_DATA {

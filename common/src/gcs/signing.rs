@@ -43,6 +43,17 @@ pub enum Refusal {
     Replay,
 }
 
+impl core::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Refusal::Unsigned => "not signed with the key",
+            Refusal::Replay => "signature timestamp too old (a replay)",
+        })
+    }
+}
+
+impl core::error::Error for Refusal {}
+
 /// The signing state of a ground link.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Signing {
@@ -218,6 +229,20 @@ impl Signing {
         self.changes = self.changes.wrapping_add(1);
         true
     }
+
+    /// `SETUP_SIGNING` as a station sent it (`signed`: its signature block, if it had one):
+    /// the setup taken or refused as [`Signing::setup`] does, and the status text that tells
+    /// the station which.
+    pub fn on_setup(&mut self, d: &SETUP_SIGNING_DATA, signed: Option<Signed>) -> &'static str {
+        let with_key = signed.is_some_and(|s| s.valid);
+        if !self.setup(d, with_key) {
+            "Signing setup refused: not signed with the key"
+        } else if self.key.is_some() {
+            "Signing on: unsigned writes are refused"
+        } else {
+            "Signing off"
+        }
+    }
 }
 
 #[cfg(test)]
@@ -349,5 +374,18 @@ mod tests {
         s.tick(10_000_000);
         assert_eq!(s.timestamp(), MAX_TIMESTAMP);
         assert_eq!(s.next_timestamp(), MAX_TIMESTAMP);
+    }
+
+    #[test]
+    fn refusals_read_as_a_plain_reason_and_are_errors() {
+        extern crate std;
+        use std::string::ToString;
+        assert_eq!(Refusal::Unsigned.to_string(), "not signed with the key");
+        assert_eq!(
+            Refusal::Replay.to_string(),
+            "signature timestamp too old (a replay)"
+        );
+        let e: &dyn core::error::Error = &Refusal::Replay;
+        assert!(e.source().is_none());
     }
 }

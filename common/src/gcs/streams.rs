@@ -3,6 +3,13 @@
 //! Defaults follow PX4's "normal" MAVLink mode on a ground-station link; `MAV_CMD_SET_MESSAGE_INTERVAL`
 //! changes one stream (interval > 0), restores its default (0) or stops it (-1).
 
+use mavlink::dialects::common::{
+    ATTITUDE_DATA, BATTERY_STATUS_DATA, CURRENT_MODE_DATA, EXTENDED_SYS_STATE_DATA,
+    GLOBAL_POSITION_INT_DATA, GPS_RAW_INT_DATA, HOME_POSITION_DATA, MISSION_CURRENT_DATA,
+    NAV_CONTROLLER_OUTPUT_DATA, SYS_STATUS_DATA, VFR_HUD_DATA,
+};
+use mavlink::MessageData;
+
 /// A message the link can stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -53,17 +60,17 @@ impl Stream {
     /// MAVLink message id.
     pub const fn message_id(self) -> u32 {
         match self {
-            Stream::SysStatus => 1,
-            Stream::GpsRawInt => 24,
-            Stream::Attitude => 30,
-            Stream::GlobalPositionInt => 33,
-            Stream::MissionCurrent => 42,
-            Stream::NavControllerOutput => 62,
-            Stream::VfrHud => 74,
-            Stream::BatteryStatus => 147,
-            Stream::HomePosition => 242,
-            Stream::ExtendedSysState => 245,
-            Stream::CurrentMode => 436,
+            Stream::SysStatus => SYS_STATUS_DATA::ID,
+            Stream::GpsRawInt => GPS_RAW_INT_DATA::ID,
+            Stream::Attitude => ATTITUDE_DATA::ID,
+            Stream::GlobalPositionInt => GLOBAL_POSITION_INT_DATA::ID,
+            Stream::MissionCurrent => MISSION_CURRENT_DATA::ID,
+            Stream::NavControllerOutput => NAV_CONTROLLER_OUTPUT_DATA::ID,
+            Stream::VfrHud => VFR_HUD_DATA::ID,
+            Stream::BatteryStatus => BATTERY_STATUS_DATA::ID,
+            Stream::HomePosition => HOME_POSITION_DATA::ID,
+            Stream::ExtendedSysState => EXTENDED_SYS_STATE_DATA::ID,
+            Stream::CurrentMode => CURRENT_MODE_DATA::ID,
         }
     }
 

@@ -11,10 +11,10 @@ use mavlink::MavHeader;
 
 use super::mission::{UPLOAD_MAX_RETRIES, UPLOAD_RETRY_US};
 use super::*;
-use crate::navigation::plan::MISSION_CAPACITY;
+use crate::navigation::plan::{MissionStore, PlanKind, MISSION_CAPACITY};
 use crate::navigation::validate::PlanRules;
 use crate::param;
-use crate::params::store::Registry;
+use crate::params::store::{ParamStore, Registry};
 use crate::params::{Group, ParamDef};
 use crate::vehicle::modes::{FlightMode, ModeSet};
 use crate::vehicle::requests::ArmRequest;
@@ -153,7 +153,7 @@ fn healthy() -> VehicleSnapshot {
         airspeed_range_m_s: (13.0, 25.0),
         modes_available: ModeSet::ALL,
         landed: LandedState::OnGround,
-        health: SensorHealth {
+        health: SensorHealthReport {
             gyro_ok: true,
             accel_ok: true,
             mag_ok: true,
@@ -168,7 +168,7 @@ fn healthy() -> VehicleSnapshot {
             satellites: 10,
             ..Default::default()
         },
-        home: Home {
+        home: HomeReport {
             valid: true,
             lat_e7: 449_000_000,
             lon_e7: -932_000_000,
@@ -734,6 +734,7 @@ fn a_disarm_asked_in_flight_below_5_m_is_refused_unless_forced() {
             ..Default::default()
         },
         &e,
+        &mut crate::navigation::navigator::Navigator::default(),
     );
     for _ in 0..100 {
         c.detect_landing(&LandParams::default(), &e, Some(9.81), 0.02);

@@ -14,7 +14,7 @@ pub const LAPSE_K_PER_M: f64 = 0.0065;
 /// Specific gas constant of dry air, J/(kg K) (US1976: R* / M0).
 pub const R_AIR: f64 = 287.052_87;
 /// Standard gravity of the atmosphere model, m/s^2 (not the plant's local g).
-pub const G0: f64 = 9.806_65;
+pub const G0: f64 = super::STANDARD_GRAVITY;
 /// Top of the troposphere, m.
 pub const TROPOPAUSE_M: f64 = 11_000.0;
 

@@ -176,6 +176,10 @@ pub fn wrap_two_pi<T: RealField + Copy>(angle: T) -> T {
     }
 }
 
+/// Ground speed above which the course over ground is trusted, m/s: slower, GPS velocity
+/// noise of a few dm/s swings the course by tens of degrees, and the heading stands in for it.
+pub const MIN_COURSE_SPEED_MPS: f32 = 3.0;
+
 /// Course over ground and ground speed from a NED velocity (course in (-pi, pi]).
 pub fn course_and_speed<T: RealField + Copy>(v_ned: &Vector3<T>) -> (T, T) {
     let vg = (v_ned.x * v_ned.x + v_ned.y * v_ned.y).sqrt();

@@ -1,4 +1,4 @@
-//! Mission items as the navigator reads them: command numbers, frames, positions and altitudes.
+//! MAVLink mission items' command numbers, frames, positions and altitudes.
 
 use super::plan::MissionItem;
 use crate::estimator::Home;
@@ -85,34 +85,95 @@ pub fn point(item: &MissionItem) -> Option<GeoPoint> {
     (is_global(item) && !(item.x == 0 && item.y == 0) && p.is_valid()).then_some(p)
 }
 
-/// The item's altitude as height above home, m; `None` when it gives none (not a global frame,
-/// or a non-finite `z`).
-pub fn height(item: &MissionItem, home: &Home) -> Option<f32> {
+/// An altitude with its datum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Altitude {
+    /// Height above home, m (the `*_RELATIVE_ALT` frames).
+    AboveHome(f32),
+    /// Above mean sea level, m (the plain global frames).
+    Amsl(f32),
+}
+
+impl Altitude {
+    /// As height above `home`, m.
+    pub fn above_home_m(self, home: &Home) -> f32 {
+        match self {
+            Altitude::AboveHome(h) => h,
+            Altitude::Amsl(a) => a - home.alt_amsl_m,
+        }
+    }
+
+    /// Above mean sea level, m, by way of the height above `home` (so an AMSL altitude comes
+    /// back rounded through home's datum, as the navigator has always flown it).
+    pub fn amsl_m(self, home: &Home) -> f32 {
+        self.above_home_m(home) + home.alt_amsl_m
+    }
+}
+
+/// The item's altitude with its datum; `None` when it gives none (not a global frame, or a
+/// non-finite `z`).
+pub fn altitude(item: &MissionItem) -> Option<Altitude> {
     let z = item.z_m();
     if !z.is_finite() {
-        return None;
-    }
-    if is_relative(item) {
-        Some(z)
+        None
+    } else if is_relative(item) {
+        Some(Altitude::AboveHome(z))
     } else if GLOBAL_ABS.contains(&item.frame) {
-        Some(z - home.alt_amsl_m)
+        Some(Altitude::Amsl(z))
     } else {
         None
     }
 }
 
+/// Where an item flies to: a point and an altitude, each absent when the item leaves it to
+/// the aircraft's present one.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Place {
+    /// The horizontal position, when the item names one ([`point`]).
+    pub point: Option<GeoPoint>,
+    /// The altitude, when the item gives one ([`altitude`]).
+    pub alt: Option<Altitude>,
+}
+
+impl Place {
+    /// The place `item` names.
+    pub fn of(item: &MissionItem) -> Self {
+        Self {
+            point: point(item),
+            alt: altitude(item),
+        }
+    }
+
+    /// Height above `home`, m, when the place gives an altitude.
+    pub fn height(&self, home: &Home) -> Option<f32> {
+        self.alt.map(|a| a.above_home_m(home))
+    }
+
+    /// NED from `home`: the place's point (or `here`'s when it names none) at its height (or
+    /// `here`'s when it gives none).
+    pub fn ned(&self, home: &Home, here: &Vector3<f32>) -> Vector3<f32> {
+        let (n, e) = match self.point {
+            Some(p) => ned_offset::<f32>(home.point, p),
+            None => (here.x, here.y),
+        };
+        let h = self.height(home).unwrap_or(-here.z);
+        Vector3::new(n, e, -h)
+    }
+}
+
+/// The item's altitude as height above home, m; `None` when it gives none (not a global frame,
+/// or a non-finite `z`).
+pub fn height(item: &MissionItem, home: &Home) -> Option<f32> {
+    altitude(item).map(|a| a.above_home_m(home))
+}
+
 /// The item's altitude above mean sea level, m, when it gives one.
 pub fn alt_amsl(item: &MissionItem, home: &Home) -> Option<f32> {
-    height(item, home).map(|h| h + home.alt_amsl_m)
+    altitude(item).map(|a| a.amsl_m(home))
 }
 
 /// The item's target NED from home: its position (or `here`'s when it names none) at its
 /// height (or `here`'s when it gives none).
 pub fn target_ned(item: &MissionItem, home: &Home, here: &Vector3<f32>) -> Vector3<f32> {
-    let (n, e) = match point(item) {
-        Some(p) => ned_offset::<f32>(home.point, p),
-        None => (here.x, here.y),
-    };
-    let h = height(item, home).unwrap_or(-here.z);
-    Vector3::new(n, e, -h)
+    Place::of(item).ned(home, here)
 }

@@ -4,11 +4,13 @@
 //!   take-off, loiter, landing, return and loiter-here behaviours.
 //! - [`path_manager`]: waypoint switching with fillets (Beard & McLain 11.2).
 //! - [`plan`]: the stored mission, geofence and rally lists, and their capacities.
-//! - [`items`]: mission items as the navigator reads them (commands, frames, altitudes).
+//! - [`items`]: MAVLink mission items' commands, frames, positions and altitudes.
+//! - [`item`]: each item decoded once into a [`NavItem`], as the navigator flies it.
 //! - [`validate`]: mission checks at upload, with the `MAV_MISSION_RESULT` of the first fault.
 //! - [`fence`]: the geofence (inclusion/exclusion polygons and circles, maximum height).
 
 pub mod fence;
+pub mod item;
 pub mod items;
 pub mod navigator;
 pub mod path_manager;
@@ -21,6 +23,7 @@ pub(crate) mod sim;
 mod tests;
 
 pub use fence::{breached, validate_fence, Breach, FenceParams};
+pub use item::{NavCommand, NavItem, Route};
 pub use navigator::io::{HomeRequest, NavOutput, NavState, NavWarning, Phase};
 pub use navigator::params::NavParams;
 pub use navigator::Navigator;

@@ -78,6 +78,14 @@ impl MissionItem {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct NoSpace;
 
+impl core::fmt::Display for NoSpace {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("list too long for its storage")
+    }
+}
+
+impl core::error::Error for NoSpace {}
+
 /// The three stored lists.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct MissionStore {

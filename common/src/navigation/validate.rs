@@ -87,6 +87,14 @@ pub struct Rejection {
     pub result: MavMissionResult,
 }
 
+impl core::fmt::Display for Rejection {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "mission item {} refused: {:?}", self.seq, self.result)
+    }
+}
+
+impl core::error::Error for Rejection {}
+
 /// Something that will be flown differently from what a reader might expect.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

@@ -74,6 +74,14 @@ impl ParamError {
     }
 }
 
+impl core::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.text())
+    }
+}
+
+impl core::error::Error for ParamError {}
+
 /// A value the host build keeps and the MCU image does not carry: a parameter's unit,
 /// description and labels. They reach a ground station in the parameter metadata file, which
 /// the firmware's build script writes on the host and the image serves compressed; nothing on

@@ -31,6 +31,17 @@ pub enum RegistryError {
     BadDef(&'static str),
 }
 
+impl core::fmt::Display for RegistryError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            RegistryError::TooMany => write!(f, "more than {MAX_PARAMS} parameters"),
+            RegistryError::BadDef(name) => write!(f, "bad parameter definition: {name}"),
+        }
+    }
+}
+
+impl core::error::Error for RegistryError {}
+
 /// One persisted value, keyed by name so a reordered or extended table still loads.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParamRecord {

@@ -133,6 +133,20 @@ pub enum F4Error {
     Verify,
 }
 
+impl core::fmt::Display for F4Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            F4Error::Address => f.write_str("address outside the allowed sectors"),
+            F4Error::Locked => f.write_str("flash control register stayed locked"),
+            F4Error::Status(sr) => write!(f, "flash controller error flags {sr:#x}"),
+            F4Error::Timeout => f.write_str("flash controller stayed busy"),
+            F4Error::Verify => f.write_str("flash does not read back what was programmed"),
+        }
+    }
+}
+
+impl core::error::Error for F4Error {}
+
 /// Polls of `SR` before an operation is given up (a sector erase is about 2 million polls at
 /// 168 MHz; this is far more).
 const BUSY_POLLS: u32 = 200_000_000;

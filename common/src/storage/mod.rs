@@ -89,6 +89,25 @@ pub enum StorageError<E> {
     Decode,
 }
 
+impl<E: core::fmt::Display> core::fmt::Display for StorageError<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            StorageError::Flash(e) => write!(f, "flash failed: {e}"),
+            StorageError::TooLarge => f.write_str("record too large for its slot"),
+            StorageError::Decode => f.write_str("record does not decode (format changed)"),
+        }
+    }
+}
+
+impl<E: core::error::Error + 'static> core::error::Error for StorageError<E> {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            StorageError::Flash(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
 /// A record loaded from flash.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Loaded<T> {
@@ -370,6 +389,17 @@ pub enum RamFlashError {
     /// The simulated power is off.
     PowerLost,
 }
+
+impl core::fmt::Display for RamFlashError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            RamFlashError::Address => "address outside the device or not a sector start",
+            RamFlashError::PowerLost => "power lost",
+        })
+    }
+}
+
+impl core::error::Error for RamFlashError {}
 
 /// Flash in RAM with NOR semantics (erase to 0xFF, writes clear bits), for SITL and tests.
 /// It can lose power after a given number of operations (each erase and each byte written is

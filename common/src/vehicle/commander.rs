@@ -1,15 +1,23 @@
 //! The commander: what the vehicle is doing and what it asks of the control stages.
 //!
 //! It keeps the armed state and the chosen mode, takes the requests a ground link accepted
-//! (arming, mode entry, set points, the current mission item), reacts to the failsafes (the
-//! mode actually flown), hands the navigation modes to the navigator and turns the flown mode
-//! into [`Commands`] for the autopilot, or into surfaces directly in Manual. Everything it
-//! has to say goes out as [`Notice`]s.
+//! (arming, mode entry, set points, the current mission item: [`Commander::apply`], as they
+//! arrive), and once a control tick ([`Commander::step`]) watches for a landing, reacts to the
+//! failsafes (the mode actually flown), hands the navigation modes to the navigator and turns
+//! the flown mode into [`Commands`] for the autopilot, or into surfaces directly in Manual.
+//! What each mode commands is its row of the table of mode facts
+//! ([`super::modes::MODES`]). Everything it has to say goes out as [`Notice`]s.
+//!
+//! The [`Navigator`] is the vehicle's, lent to the commander by `&mut` for a request or a
+//! step: the vehicle configures it from the parameters and the plan's checks and the reports
+//! read its settings, none of which is the commander's business, while what it flies, when it
+//! starts and what becomes of its output (mission progress, a new home, the disarm after a
+//! landing) is decided within the commander's step, in the same order as it is flown.
 
 use heapless::Deque;
 
 use super::land_detector::{LandDetector, LandInputs, LandParams};
-use super::modes::FlightMode;
+use super::modes::{Commanded, FlightMode, NavTask};
 use super::requests::VehicleRequests;
 use super::snapshot::{LandedState, MissionRunState};
 use crate::actuators::Surfaces;
@@ -20,9 +28,11 @@ use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
 use crate::navigation::fence::{breached, FenceParams};
+use crate::navigation::item::{NavCommand, NavItem, Route};
+use crate::navigation::items::{Altitude, Place};
 use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
 use crate::navigation::navigator::Navigator;
-use crate::navigation::plan::{MissionItem, MissionStore, PlanKind};
+use crate::navigation::plan::{MissionStore, PlanKind};
 use crate::sensors::ManualInput;
 
 /// Sticks older than this are ignored (the ground station or the radio stopped sending), us.
@@ -87,6 +97,42 @@ pub struct Watch {
     pub fence: FenceParams,
 }
 
+/// What the commander is handed for one control tick.
+#[derive(Debug)]
+pub struct CommanderInputs<'a> {
+    /// The vehicle's clock, us.
+    pub now_us: u64,
+    /// Time since the last control tick, s.
+    pub dt: f32,
+    /// The estimate for the whole tick.
+    pub estimate: &'a EstimatedState,
+    /// The vehicle's navigator, flown in the navigation modes.
+    pub navigator: &'a mut Navigator,
+    /// The stored mission and geofence.
+    pub plan: &'a MissionStore,
+    /// The autopilot's gains (its trims and limits).
+    pub gains: &'a GainSet,
+    /// The failsafes' settings and the fence.
+    pub watch: &'a Watch,
+    /// The land detector's settings.
+    pub land: &'a LandParams,
+    /// Magnitude of the last accelerometer sample, m/s^2.
+    pub specific_force: Option<f32>,
+    /// When a ground station was last heard, us (the link-loss failsafe).
+    pub gcs_heard_us: Option<u64>,
+    /// The battery monitor's warning, `None` when no battery is monitored.
+    pub battery: Option<Warning>,
+}
+
+/// What one control tick of the commander decided.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommanderOutput {
+    /// What the flown mode asks of the actuators.
+    pub demand: Demand,
+    /// A new home, for the vehicle to hand to the estimator (a mission item's DO_SET_HOME).
+    pub home: Option<Home>,
+}
+
 /// The commander's state.
 #[derive(Clone, Debug)]
 pub struct Commander {
@@ -97,7 +143,7 @@ pub struct Commander {
     reaction: Reaction,
     /// Altitude (AMSL, m) held while a GPS failsafe flies wings level.
     wings_level: Option<f32>,
-    navigator: Navigator,
+    /// The navigator's last output.
     nav: NavOutput,
     /// The mode the navigator was last started for.
     nav_for: Option<FlightMode>,
@@ -123,6 +169,21 @@ pub fn in_air(e: &EstimatedState) -> bool {
     e.airspeed > 8.0 && height > 5.0
 }
 
+/// An altitude above mean sea level from a height above `home`, m; `None` without a home.
+/// The commander's heights take the navigator's one conversion ([`Altitude::amsl_m`]), so
+/// home's altitude is added in one place.
+pub fn above_home(home: Option<Home>, height_m: f32) -> Option<f32> {
+    home.map(|h| Altitude::AboveHome(height_m).amsl_m(&h))
+}
+
+/// A home at the aircraft's estimated position and altitude.
+fn here(e: &EstimatedState) -> Home {
+    Home {
+        point: e.position,
+        alt_amsl_m: e.alt_amsl_m,
+    }
+}
+
 /// The trims of a gain set as surface positions.
 pub fn trim_surfaces(g: &GainSet) -> Surfaces {
     Surfaces {
@@ -134,15 +195,17 @@ pub fn trim_surfaces(g: &GainSet) -> Surfaces {
 }
 
 /// The Takeoff mode's one item: climb out along the present heading to the return altitude.
-fn takeoff_item(height_m: f32) -> MissionItem {
-    use mavlink::dialects::common::{MavCmd, MavFrame};
-    MissionItem {
-        params: [0, 0, 0, f32::NAN.to_bits()],
-        x: 0,
-        y: 0,
-        z: height_m.to_bits(),
-        command: MavCmd::MAV_CMD_NAV_TAKEOFF as u16,
-        frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT as u8,
+fn takeoff_item(height_m: f32) -> NavItem {
+    NavItem {
+        command: NavCommand::Takeoff {
+            place: Place {
+                point: None,
+                alt: height_m
+                    .is_finite()
+                    .then_some(Altitude::AboveHome(height_m)),
+            },
+            yaw: None,
+        },
         autocontinue: true,
     }
 }
@@ -161,7 +224,6 @@ impl Commander {
             sticks: None,
             reaction: Reaction::None,
             wings_level: None,
-            navigator: Navigator::default(),
             nav: NavOutput::default(),
             nav_for: None,
             mission_seq: 0,
@@ -206,7 +268,7 @@ impl Commander {
 
     /// Steps the land detector at the control rate: `specific_force` is the magnitude of the
     /// last accelerometer sample, m/s^2.
-    pub fn detect_landing(
+    pub(crate) fn detect_landing(
         &mut self,
         p: &LandParams,
         e: &EstimatedState,
@@ -272,16 +334,6 @@ impl Commander {
         &self.nav
     }
 
-    /// The navigator (its parameters).
-    pub fn navigator(&self) -> &Navigator {
-        &self.navigator
-    }
-
-    /// The navigator, to configure.
-    pub fn navigator_mut(&mut self) -> &mut Navigator {
-        &mut self.navigator
-    }
-
     /// The current mission item and how far the mission has come.
     pub fn mission(&self) -> (u16, MissionRunState) {
         (self.mission_seq, self.mission_state)
@@ -318,9 +370,14 @@ impl Commander {
         self.notify(Notice::Text(s, t));
     }
 
-    /// Acts on what the ground station asked for. Returns a new home when arming on the
-    /// ground moves it.
-    pub fn apply(&mut self, r: &VehicleRequests, e: &EstimatedState) -> Option<Home> {
+    /// Acts on what the ground station asked for, as it arrives (between control ticks too).
+    /// Returns a new home when arming on the ground moves it.
+    pub fn apply(
+        &mut self,
+        r: &VehicleRequests,
+        e: &EstimatedState,
+        navigator: &mut Navigator,
+    ) -> Option<Home> {
         let mut rehome = None;
         if let Some(a) = r.arm {
             if a.arm && !self.armed && !in_air(e) {
@@ -329,10 +386,7 @@ impl Commander {
                 // GPS and barometer for as long as the estimator took to converge, and the
                 // landing aims at this height.
                 if let Some(h) = e.home {
-                    let here = Home {
-                        point: e.position,
-                        alt_amsl_m: e.alt_amsl_m,
-                    };
+                    let here = here(e);
                     if here != h {
                         rehome = Some(here);
                     }
@@ -343,7 +397,7 @@ impl Commander {
                 if a.arm {
                     self.failsafes.new_flight();
                 } else {
-                    self.navigator.stop();
+                    navigator.stop();
                     self.nav_for = None;
                     self.failsafes.acknowledge();
                 }
@@ -353,9 +407,7 @@ impl Commander {
         if let Some(mode) = r.mode {
             if mode != self.mode {
                 // Entering a guided mode holds where the aircraft is.
-                if matches!(mode, FlightMode::Hold | FlightMode::Altitude)
-                    && !matches!(self.mode, FlightMode::Hold | FlightMode::Altitude)
-                {
+                if mode.holds_setpoints() && !self.mode.holds_setpoints() {
                     self.setpoints.course = e.course;
                     self.setpoints.alt_amsl_m = e.alt_amsl_m;
                 }
@@ -371,17 +423,17 @@ impl Commander {
         if let Some(seq) = r.mission_seq {
             self.mission_seq = seq;
             if self.nav_for == Some(FlightMode::Mission) {
-                self.navigator.set_current(seq);
+                navigator.set_current(seq);
             }
         }
         if let Some(alt) = r.altitude {
-            let base = if alt.relative_to_home {
-                e.home.map(|h| h.alt_amsl_m)
+            let target = if alt.relative_to_home {
+                above_home(e.home, alt.alt_m)
             } else {
-                Some(0.0)
+                Some(0.0 + alt.alt_m)
             };
-            match base {
-                Some(b) => self.setpoints.alt_amsl_m = b + alt.alt_m,
+            match target {
+                Some(a) => self.setpoints.alt_amsl_m = a,
                 None => self.text(
                     Severity::Warning,
                     "Altitude above home refused: no home yet",
@@ -392,7 +444,7 @@ impl Commander {
             self.setpoints.airspeed = v;
         }
         if r.go_around {
-            if self.navigator.go_around() {
+            if navigator.go_around() {
                 self.text(Severity::Info, "Going around");
             } else {
                 self.text(
@@ -415,9 +467,25 @@ impl Commander {
         rehome
     }
 
+    /// One control tick: the land detector, the failsafes and their reaction, then what the
+    /// flown mode asks of the actuators (stepping the navigator in its modes), in that order.
+    pub fn step(&mut self, i: CommanderInputs<'_>) -> CommanderOutput {
+        self.detect_landing(i.land, i.estimate, i.specific_force, i.dt);
+        self.check_failsafes(
+            i.now_us,
+            i.estimate,
+            i.watch,
+            i.plan,
+            i.gcs_heard_us,
+            i.battery,
+        );
+        let (demand, home) = self.demand(i.now_us, i.dt, i.estimate, i.navigator, i.plan, i.gains);
+        CommanderOutput { demand, home }
+    }
+
     /// Watches the failsafes at the control rate and acts on their reaction. `battery` is the
     /// battery monitor's warning, `None` when no battery is monitored.
-    pub fn check_failsafes(
+    pub(crate) fn check_failsafes(
         &mut self,
         now_us: u64,
         e: &EstimatedState,
@@ -462,11 +530,12 @@ impl Commander {
 
     /// What the flown mode asks of the actuators this tick, at `now_us`, `dt` after the last
     /// one. The second value is a home a mission item moved (DO_SET_HOME).
-    pub fn demand(
+    pub(crate) fn demand(
         &mut self,
         now_us: u64,
         dt: f32,
         e: &EstimatedState,
+        navigator: &mut Navigator,
         plan: &MissionStore,
         gains: &GainSet,
     ) -> (Demand, Option<Home>) {
@@ -483,7 +552,7 @@ impl Commander {
             throttle: 0.0,
             ..trim_surfaces(gains)
         };
-        if self.mode == FlightMode::Manual {
+        if self.mode.commands() == Commanded::Surfaces {
             // Pass-through: sticks straight to the surfaces (PX4's normalised sense), trim
             // when no stick is live (idle on the ground).
             let s = match sticks {
@@ -511,22 +580,22 @@ impl Commander {
         if !self.armed && self.nav.phase == Phase::Landed && flown.needs_navigator() {
             return (Demand::Surfaces(idle), None);
         }
-        if flown.needs_navigator() {
-            let (commands, home) = self.navigate(flown, dt, e, plan);
+        if let Some(task) = flown.nav_task() {
+            let (commands, home) = self.navigate(flown, task, dt, e, navigator, plan);
             // No home yet (refused before, so only after a reset): hold what we have.
             let c = commands.unwrap_or(hold(sp.alt_amsl_m));
             return (Demand::Commands(c), home);
         }
-        let unflown = match flown {
-            FlightMode::Altitude | FlightMode::Hold => true,
-            FlightMode::Stabilized => sticks.is_none(),
-            _ => false,
+        let unflown = match flown.commands() {
+            Commanded::Altitude | Commanded::Course => true,
+            Commanded::Attitude => sticks.is_none(),
+            Commanded::Surfaces | Commanded::Navigator(_) => false,
         };
         if self.land.landed() && unflown {
             return (Demand::Surfaces(idle), None);
         }
-        let commands = match flown {
-            FlightMode::Stabilized => Commands {
+        let commands = match flown.commands() {
+            Commanded::Attitude => Commands {
                 // Sticks command attitude within the loops' limits; centred: wings level.
                 roll: RollMode::Roll(sticks.map_or(0.0, |s| s.roll * gains.lateral.roll_max)),
                 yaw: RUDDER,
@@ -535,12 +604,13 @@ impl Commander {
                     throttle: sticks.map_or(level.trim_throttle, |s| s.throttle),
                 },
             },
-            FlightMode::Altitude => hold(sp.alt_amsl_m),
-            FlightMode::Hold => Commands {
+            Commanded::Altitude => hold(sp.alt_amsl_m),
+            Commanded::Course => Commands {
                 roll: RollMode::Course(sp.course),
                 ..hold(sp.alt_amsl_m)
             },
-            _ => Commands::OFF,
+            // Flown only when chosen, pass-through answered above; the navigator's above too.
+            Commanded::Surfaces | Commanded::Navigator(_) => Commands::OFF,
         };
         (Demand::Commands(commands), None)
     }
@@ -550,8 +620,10 @@ impl Commander {
     fn navigate(
         &mut self,
         flown: FlightMode,
+        task: NavTask,
         dt: f32,
         e: &EstimatedState,
+        navigator: &mut Navigator,
         plan: &MissionStore,
     ) -> (Option<Commands>, Option<Home>) {
         let Some(home) = e.home else {
@@ -559,29 +631,25 @@ impl Commander {
         };
         if self.nav_for != Some(flown) {
             self.nav_for = Some(flown);
-            match flown {
-                FlightMode::Mission => {
-                    self.navigator.set_current(self.mission_seq);
+            match task {
+                NavTask::Mission => {
+                    navigator.set_current(self.mission_seq);
                     self.mission_state = MissionRunState::Active;
                 }
-                FlightMode::Loiter => self.navigator.start_loiter(None),
-                FlightMode::Return => self
-                    .navigator
-                    .start_return(self.navigator.params().rtl_land),
-                FlightMode::Land => self.navigator.start_return(true),
-                _ => self.navigator.start_mission(0),
+                NavTask::Loiter => navigator.start_loiter(None),
+                NavTask::Return => navigator.start_return(navigator.params().rtl_land),
+                NavTask::Land => navigator.start_return(true),
+                NavTask::Takeoff => navigator.start_mission(0),
             }
         }
-        let takeoff = [takeoff_item(self.navigator.params().rtl_alt)];
-        let items: &[MissionItem] = match flown {
-            FlightMode::Mission => plan.items(PlanKind::Mission),
-            FlightMode::Takeoff => &takeoff,
-            _ => &[],
+        let takeoff = takeoff_item(navigator.params().rtl_alt);
+        let items = match task {
+            NavTask::Mission => Route::Plan(plan.items(PlanKind::Mission)),
+            NavTask::Takeoff => Route::Item(&takeoff),
+            NavTask::Loiter | NavTask::Return | NavTask::Land => Route::Plan(&[]),
         };
-        let out = self
-            .navigator
-            .step(items, &home, &NavState::from_estimate(e), dt);
-        if flown == FlightMode::Mission {
+        let out = navigator.step_route(items, &home, &NavState::from_estimate(e), dt);
+        if task == NavTask::Mission {
             let current = out.current_seq.filter(|&c| c != self.mission_seq);
             if let Some(c) = out.current_seq {
                 self.mission_seq = c;
@@ -600,10 +668,7 @@ impl Commander {
             self.text(Severity::Warning, w.text());
         }
         let rehome = out.set_home.map(|req| match req {
-            HomeRequest::Here => Home {
-                point: e.position,
-                alt_amsl_m: e.alt_amsl_m,
-            },
+            HomeRequest::Here => here(e),
             HomeRequest::At(h) => h,
         });
         if out.landed && self.armed {

@@ -32,7 +32,7 @@ use crate::params::{Group, ParamDef};
 pub const FILTER_TAU_S: f32 = 0.3;
 
 /// Standard gravity, m/s^2: the specific force at rest.
-const G: f32 = 9.806_65;
+const G: f32 = crate::math::GRAVITY;
 
 /// Parameters of the land detector.
 pub const PARAMS: Group<LandParams> = Group {
@@ -276,7 +276,7 @@ mod tests {
             ground_speed: 0.0,
             vel_down: 0.0,
             airspeed: 0.0,
-            specific_force: Some(9.81),
+            specific_force: Some(G),
             rolling_out: false,
         }
     }
@@ -322,7 +322,7 @@ mod tests {
             let i = LandInputs {
                 ground_speed: v,
                 airspeed: v,
-                specific_force: Some(libm::hypotf(9.81, 2.0)),
+                specific_force: Some(libm::hypotf(G, 2.0)),
                 ..at_rest(true)
             };
             if !d.update(&p, &i, DT) && left_ground_at.is_none() {
@@ -339,7 +339,7 @@ mod tests {
             ground_speed: 17.0,
             vel_down: -2.0,
             airspeed: 17.0,
-            specific_force: Some(1.2 * 9.81),
+            specific_force: Some(1.2 * G),
             ..at_rest(true)
         };
         assert!(run(&mut d, &climb, 10.0).iter().all(|&l| !l));
@@ -400,7 +400,7 @@ mod tests {
                 ground_speed: v,
                 airspeed: v,
                 vel_down: 0.0,
-                specific_force: Some(libm::hypotf(9.81, 1.5)),
+                specific_force: Some(libm::hypotf(G, 1.5)),
                 ..at_rest(true)
             };
             if d.update(&p, &i, DT) && landed_at.is_none() {
@@ -434,7 +434,7 @@ mod tests {
         // Rolling slowly for 1 s, then a bump (2 g for 0.3 s) restarts the wait.
         run(&mut d, &slow, 1.0);
         let bump = LandInputs {
-            specific_force: Some(2.0 * 9.81),
+            specific_force: Some(2.0 * G),
             ..slow
         };
         assert!(run(&mut d, &bump, 0.3).iter().all(|&l| !l));

@@ -40,7 +40,8 @@ use crate::battery::{self, BatteryMonitor};
 use crate::control::autopilot::{Autopilot, GainSet};
 use crate::control::gains::NAMED;
 use crate::control::inputs::Measurements;
-use crate::estimator::{config as estimator_config, EstimatedState, Estimator};
+use crate::estimator::{self, config as estimator_config, EstimatedState, Estimator};
+use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::MissionStore;
 use crate::navigation::validate::{MissionLimits, PlanRules};
 use crate::navigation::{fence, navigator, path_manager, validate};
@@ -48,7 +49,9 @@ use crate::params::ParamStore;
 use crate::sensors::{BatterySample, GpsFix, ManualInput, SensorFrame};
 use crate::{failsafe, guidance};
 use clock::{Clock, ClockStats, Step};
-use commander::{trim_surfaces, Commander, Demand, Setpoints, Severity, Watch};
+use commander::{
+    above_home, trim_surfaces, Commander, CommanderInputs, Demand, Setpoints, Severity, Watch,
+};
 use modes::FlightMode;
 use requests::VehicleRequests;
 
@@ -74,6 +77,8 @@ pub struct Vehicle {
     estimator: Estimator,
     autopilot: Autopilot,
     commander: Commander,
+    /// The navigator, lent to the commander for each request and control tick.
+    navigator: Navigator,
     battery: BatteryMonitor,
     watch: Watch,
     land: land_detector::LandParams,
@@ -120,6 +125,7 @@ impl Vehicle {
             estimator: Estimator::default(),
             autopilot: Autopilot::default(),
             commander: Commander::new(),
+            navigator: Navigator::default(),
             battery: BatteryMonitor::default(),
             watch: Watch::default(),
             land: land_detector::LandParams::default(),
@@ -164,7 +170,7 @@ impl Vehicle {
         let rules = PlanRules {
             home: self.estimator.home(),
             limits: self.limits,
-            nav: *self.commander.navigator().params(),
+            nav: *self.navigator.params(),
         };
         (&mut self.params, &mut self.plan, rules)
     }
@@ -174,9 +180,14 @@ impl Vehicle {
         self.estimator.state()
     }
 
-    /// The commander (mode, arming, failsafes, navigator).
+    /// The commander (mode, arming, failsafes, the navigator's last output).
     pub fn commander(&self) -> &Commander {
         &self.commander
+    }
+
+    /// The navigator (its parameters).
+    pub fn navigator(&self) -> &Navigator {
+        &self.navigator
     }
 
     /// The vehicle's clock, us (see [`clock`]); `None` before the first sensor frame.
@@ -216,11 +227,10 @@ impl Vehicle {
         if !self.commander.flown_mode().needs_navigator() {
             return sp;
         }
-        let home_alt = self.estimator.home().map_or(0.0, |h| h.alt_amsl_m);
         match self.commander.navigation().guidance {
             Some(g) => Setpoints {
                 course: g.course,
-                alt_amsl_m: g.altitude + home_alt,
+                alt_amsl_m: above_home(self.estimator.home(), g.altitude).unwrap_or(g.altitude),
                 airspeed: g.airspeed,
             },
             None => sp,
@@ -235,6 +245,10 @@ impl Vehicle {
             throttle: self.surfaces.throttle,
             clock: self.clock.stats(),
             battery: self.battery.report(self.clock.now_us()),
+            airspeed_range_m_s: {
+                let p = self.navigator.params();
+                (p.airspeed_min, p.airspeed_max)
+            },
         };
         report::snapshot(&self.estimator.state(), &self.commander, &extras)
     }
@@ -332,8 +346,15 @@ impl Vehicle {
             return;
         }
         let e = self.estimator.state();
-        if let Some(home) = self.commander.apply(r, &e) {
-            self.estimator.set_home(home);
+        let home = self.commander.apply(r, &e, &mut self.navigator);
+        self.move_home(home);
+    }
+
+    /// Hands a home the commander decided to the estimator, which holds it (the one place
+    /// home is written after the first fix set it).
+    fn move_home(&mut self, home: Option<estimator::Home>) {
+        if let Some(h) = home {
+            self.estimator.set_home(h);
         }
     }
 
@@ -357,24 +378,23 @@ impl Vehicle {
         // One estimate for the whole control step.
         let e = self.estimator.state();
         let b = self.battery.report(Some(now_us));
-        self.commander
-            .detect_landing(&self.land, &e, self.specific_force, dt);
-        self.commander.check_failsafes(
-            now_us,
-            &e,
-            &self.watch,
-            &self.plan,
-            ground.heard_us,
-            b.present.then_some(b.warning),
-        );
-        let m = self.measurements(&e);
         let gains = *self.autopilot.gains();
-        let clock = self.clock.now_us().unwrap_or(0);
-        let (demand, home) = self.commander.demand(clock, dt, &e, &self.plan, &gains);
-        if let Some(h) = home {
-            self.estimator.set_home(h);
-        }
-        match demand {
+        let out = self.commander.step(CommanderInputs {
+            now_us,
+            dt,
+            estimate: &e,
+            navigator: &mut self.navigator,
+            plan: &self.plan,
+            gains: &gains,
+            watch: &self.watch,
+            land: &self.land,
+            specific_force: self.specific_force,
+            gcs_heard_us: ground.heard_us,
+            battery: b.present.then_some(b.warning),
+        });
+        self.move_home(out.home);
+        let m = self.measurements(&e);
+        match out.demand {
             Demand::Surfaces(s) => {
                 self.surfaces = s;
                 // The loops start from these positions when a stabilised mode engages.
@@ -394,7 +414,7 @@ impl Vehicle {
             roll: e.euler.phi,
             pitch: e.euler.theta,
             // Course needs ground speed; on the ground or in a hover-like crawl use heading.
-            course: if e.ground_speed > 3.0 {
+            course: if e.ground_speed > crate::math::MIN_COURSE_SPEED_MPS {
                 e.course
             } else {
                 e.euler.psi
@@ -435,7 +455,7 @@ impl Vehicle {
         }
         let p = &self.params;
         self.estimator.set_config(p.load(&estimator_config::PARAMS));
-        self.commander.navigator_mut().configure(
+        self.navigator.configure(
             &p.load(&navigator::params::PARAMS),
             &p.load(&path_manager::PARAMS),
             &p.load(&guidance::PARAMS),
@@ -450,7 +470,7 @@ impl Vehicle {
         self.use_truth = sys.use_truth;
         // The cruise airspeed is the altitude-holding modes' until a ground station changes it.
         if count == 0 || self.commander.chosen_mode() == FlightMode::Manual {
-            let cruise = self.commander.navigator().params().airspeed;
+            let cruise = self.navigator.params().airspeed;
             self.commander.set_cruise_airspeed(cruise);
         }
     }

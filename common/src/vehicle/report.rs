@@ -2,8 +2,8 @@
 //! commander's state, which the ground link turns into telemetry and checks commands against.
 
 use super::commander::Commander;
-use super::modes::{FlightMode, ModeSet};
-use super::snapshot::{GpsRaw, Home, NavOutput as NavTelemetry, SensorHealth, VehicleSnapshot};
+use super::modes::{ModeSet, Needs, MODES};
+use super::snapshot::{GpsRaw, HomeReport, NavReport, SensorHealthReport, VehicleSnapshot};
 use crate::battery::Battery;
 use crate::estimator::EstimatedState;
 use crate::math::{course_and_speed, wrap_two_pi};
@@ -22,23 +22,24 @@ pub struct Extras {
     pub clock: super::clock::ClockStats,
     /// The battery monitor's report.
     pub battery: Battery,
+    /// Airspeeds the vehicle may be asked to hold, m/s (the navigator's settings).
+    pub airspeed_range_m_s: (f32, f32),
 }
 
-/// The modes the vehicle can fly with this estimate: attitude for the altitude hold, a
-/// position for Hold, a position and a home for the navigator's modes.
+/// The modes the vehicle can fly with this estimate: each mode's [`Needs`] from the table of
+/// mode facts (attitude for the altitude hold, a position for Hold, a position and a home
+/// for the navigator's modes).
 pub fn available_modes(e: &EstimatedState) -> ModeSet {
-    let mut modes = ModeSet::EMPTY
-        .with(FlightMode::Manual)
-        .with(FlightMode::Stabilized);
-    if e.converged || e.attitude_valid {
-        modes = modes.with(FlightMode::Altitude);
-    }
-    if e.position_valid {
-        modes = modes.with(FlightMode::Hold);
-        if e.home.is_some() {
-            for m in FlightMode::ALL.iter().filter(|m| m.needs_navigator()) {
-                modes = modes.with(*m);
-            }
+    let mut modes = ModeSet::EMPTY;
+    for f in &MODES {
+        let met = match f.needs {
+            Needs::Nothing => true,
+            Needs::Attitude => e.converged || e.attitude_valid,
+            Needs::Position => e.position_valid,
+            Needs::PositionAndHome => e.position_valid && e.home.is_some(),
+        };
+        if met {
+            modes = modes.with(f.mode);
         }
     }
     modes
@@ -47,7 +48,7 @@ pub fn available_modes(e: &EstimatedState) -> ModeSet {
 /// The snapshot of a vehicle.
 pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapshot {
     let h = &e.health;
-    let health = SensorHealth {
+    let health = SensorHealthReport {
         gyro_ok: h.imu.healthy,
         accel_ok: h.imu.healthy,
         mag_ok: h.mag.healthy,
@@ -57,7 +58,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         attitude_converged: e.converged,
         position_valid: e.position_valid,
     };
-    let home = e.home.map_or(Home::default(), |h| Home {
+    let home = e.home.map_or(HomeReport::default(), |h| HomeReport {
         valid: true,
         lat_e7: h.point.lat_e7,
         lon_e7: h.point.lon_e7,
@@ -102,10 +103,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         vel_e: e.vel_ned.y,
         vel_d: e.vel_ned.z,
         airspeed: e.airspeed,
-        airspeed_range_m_s: {
-            let p = c.navigator().params();
-            (p.airspeed_min, p.airspeed_max)
-        },
+        airspeed_range_m_s: x.airspeed_range_m_s,
         throttle: if c.armed() { x.throttle } else { 0.0 },
         home,
         gps,
@@ -119,14 +117,14 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
 }
 
 /// NAV_CONTROLLER_OUTPUT from the navigator's last step (zeros outside navigation modes).
-fn nav_telemetry(e: &EstimatedState, c: &Commander) -> NavTelemetry {
+fn nav_telemetry(e: &EstimatedState, c: &Commander) -> NavReport {
     if !c.flown_mode().needs_navigator() {
-        return NavTelemetry::default();
+        return NavReport::default();
     }
     let finite = |x: f32| if x.is_finite() { x } else { 0.0 };
     let nav = c.navigation();
     let g = nav.guidance;
-    NavTelemetry {
+    NavReport {
         roll_cmd: 0.0,
         pitch_cmd: 0.0,
         course_cmd: g.map_or(0.0, |g| wrap_two_pi(g.course)),

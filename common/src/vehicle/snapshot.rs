@@ -38,7 +38,7 @@ pub enum MissionRunState {
 /// Health of each sensor and of the estimator. `true` means present and working.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct SensorHealth {
+pub struct SensorHealthReport {
     /// Rate gyros.
     pub gyro_ok: bool,
     /// Accelerometers.
@@ -57,10 +57,10 @@ pub struct SensorHealth {
     pub position_valid: bool,
 }
 
-/// The home position.
+/// The home position as reported (`HOME_POSITION`, the altitude above home).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Home {
+pub struct HomeReport {
     /// Whether home has been set.
     pub valid: bool,
     /// Latitude, degrees * 1e7.
@@ -103,7 +103,7 @@ pub use crate::battery::Battery;
 /// What the navigator and guidance are doing (`NAV_CONTROLLER_OUTPUT`).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct NavOutput {
+pub struct NavReport {
     /// Commanded roll, rad.
     pub roll_cmd: f32,
     /// Commanded pitch, rad.
@@ -144,7 +144,7 @@ pub struct VehicleSnapshot {
     /// On the ground, in the air, ...
     pub landed: LandedState,
     /// Sensor and estimator health.
-    pub health: SensorHealth,
+    pub health: SensorHealthReport,
     /// Roll, rad.
     pub roll: f32,
     /// Pitch, rad.
@@ -178,13 +178,13 @@ pub struct VehicleSnapshot {
     /// Throttle command, 0..1.
     pub throttle: f32,
     /// Home position.
-    pub home: Home,
+    pub home: HomeReport,
     /// GPS receiver solution.
     pub gps: GpsRaw,
     /// Battery.
     pub battery: Battery,
     /// Navigator and guidance outputs.
-    pub nav: NavOutput,
+    pub nav: NavReport,
     /// Index of the mission item being flown (or next to fly).
     pub mission_seq: u16,
     /// Progress through the mission.

@@ -14,6 +14,7 @@ use crate::control::longitudinal::LonMode;
 use crate::estimator::Home;
 use crate::failsafe::Reaction;
 use crate::math::geodetic::GeoPoint;
+use crate::navigation::navigator::Navigator;
 use nalgebra::Vector3;
 
 /// Flying level at 17 m/s, 60 m above a home at 300 m, course 90 deg, every sensor healthy.
@@ -76,6 +77,7 @@ fn texts(c: &mut Commander) -> std::vec::Vec<&'static str> {
 #[test]
 fn arming_on_the_ground_sets_home_where_the_aircraft_stands_and_says_so() {
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let mut e = on_ground();
     // The estimate moved 2 m north and 0.4 m up since the first fix set home.
     e.position = GeoPoint {
@@ -83,7 +85,7 @@ fn arming_on_the_ground_sets_home_where_the_aircraft_stands_and_says_so() {
         lon_e7: -932_000_000,
     };
     e.alt_amsl_m = 300.4;
-    let home = c.apply(&arm(), &e);
+    let home = c.apply(&arm(), &e, &mut n);
     assert_eq!(
         home,
         Some(Home {
@@ -94,27 +96,29 @@ fn arming_on_the_ground_sets_home_where_the_aircraft_stands_and_says_so() {
     assert!(c.armed());
     assert_eq!(texts(&mut c), ["Armed"]);
     // Arming again changes nothing and says nothing.
-    assert_eq!(c.apply(&arm(), &e), None);
+    assert_eq!(c.apply(&arm(), &e, &mut n), None);
     assert!(texts(&mut c).is_empty());
 }
 
 #[test]
 fn arming_in_the_air_keeps_home() {
     let mut c = Commander::new();
-    assert_eq!(c.apply(&arm(), &flying()), None);
+    let mut n = Navigator::default();
+    assert_eq!(c.apply(&arm(), &flying(), &mut n), None);
     assert!(c.armed());
 }
 
 #[test]
 fn entering_hold_holds_the_present_course_and_altitude() {
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let e = flying();
     detect(&mut c, &e, 0.1);
-    c.apply(&mode(FlightMode::Hold), &e);
+    c.apply(&mode(FlightMode::Hold), &e, &mut n);
     let sp = c.setpoints();
     assert_eq!((sp.course, sp.alt_amsl_m), (e.course, 360.0));
     // Hold flies the outer loops on those set points.
-    let (d, _) = c.demand(0, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let (d, _) = c.demand(0, 0.02, &e, &mut n, &MissionStore::default(), &DESIGNED);
     match d {
         Demand::Commands(cmd) => {
             assert_eq!(cmd.roll, RollMode::Course(e.course));
@@ -133,6 +137,7 @@ fn entering_hold_holds_the_present_course_and_altitude() {
 #[test]
 fn an_altitude_above_home_needs_a_home() {
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let mut e = flying();
     let up = VehicleRequests {
         altitude: Some(AltitudeSetpoint {
@@ -141,20 +146,28 @@ fn an_altitude_above_home_needs_a_home() {
         }),
         ..Default::default()
     };
-    c.apply(&up, &e);
+    c.apply(&up, &e, &mut n);
     assert_eq!(c.setpoints().alt_amsl_m, 380.0);
     e.home = None;
-    c.apply(&up, &e);
+    c.apply(&up, &e, &mut n);
     assert_eq!(texts(&mut c), ["Altitude above home refused: no home yet"]);
 }
 
 #[test]
 fn manual_passes_the_sticks_and_falls_back_to_the_thesis_trim_without_them() {
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let e = flying();
     // In the air (on the ground the motor idles without sticks).
     detect(&mut c, &e, 0.1);
-    let (d, _) = c.demand(1_000_000, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let (d, _) = c.demand(
+        1_000_000,
+        0.02,
+        &e,
+        &mut n,
+        &MissionStore::default(),
+        &DESIGNED,
+    );
     let trim = Surfaces {
         elevator: -0.0963,
         aileron: 0.01,
@@ -170,7 +183,14 @@ fn manual_passes_the_sticks_and_falls_back_to_the_thesis_trim_without_them() {
         throttle: 0.5,
         time_us: 1_000_000,
     });
-    let (d, _) = c.demand(1_100_000, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let (d, _) = c.demand(
+        1_100_000,
+        0.02,
+        &e,
+        &mut n,
+        &MissionStore::default(),
+        &DESIGNED,
+    );
     let Demand::Surfaces(s) = d else {
         panic!("Manual sets the surfaces")
     };
@@ -178,16 +198,17 @@ fn manual_passes_the_sticks_and_falls_back_to_the_thesis_trim_without_them() {
     assert_eq!(s.throttle, 0.5);
     // Sticks older than the timeout no longer count.
     let later = 1_000_000 + STICK_TIMEOUT_US + 1;
-    let (d, _) = c.demand(later, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    let (d, _) = c.demand(later, 0.02, &e, &mut n, &MissionStore::default(), &DESIGNED);
     assert_eq!(d, Demand::Surfaces(trim));
 }
 
 #[test]
 fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() {
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let e = flying();
-    c.apply(&arm(), &e);
-    c.apply(&mode(FlightMode::Hold), &e);
+    c.apply(&arm(), &e, &mut n);
+    c.apply(&mode(FlightMode::Hold), &e, &mut n);
     // The land detector has seen the flight.
     detect(&mut c, &e, 0.1);
     texts(&mut c);
@@ -202,7 +223,7 @@ fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() 
     assert_eq!(c.chosen_mode(), FlightMode::Hold);
     assert!(!texts(&mut c).is_empty(), "the failsafe is reported");
     // Choosing a mode, even the same one, takes over from the return.
-    c.apply(&mode(FlightMode::Hold), &e);
+    c.apply(&mode(FlightMode::Hold), &e, &mut n);
     c.check_failsafes(5_200_000, &e, &watch, &plan, Some(5_150_000), None);
     assert_eq!(c.flown_mode(), FlightMode::Hold);
 }
@@ -210,10 +231,11 @@ fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() 
 #[test]
 fn a_navigation_mode_without_home_holds_altitude_wings_level() {
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let mut e = flying();
     e.home = None;
-    c.apply(&mode(FlightMode::Loiter), &e);
-    let (d, _) = c.demand(0, 0.02, &e, &MissionStore::default(), &DESIGNED);
+    c.apply(&mode(FlightMode::Loiter), &e, &mut n);
+    let (d, _) = c.demand(0, 0.02, &e, &mut n, &MissionStore::default(), &DESIGNED);
     let Demand::Commands(cmd) = d else {
         panic!("Loiter flies the loops")
     };
@@ -277,6 +299,7 @@ fn detect(c: &mut Commander, e: &EstimatedState, seconds: f32) {
 fn standing_still_on_the_ground_the_vehicle_reports_on_ground_armed_or_not() {
     use super::snapshot::LandedState;
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let e = {
         let mut e = on_ground();
         e.ground_speed = 0.0;
@@ -284,8 +307,8 @@ fn standing_still_on_the_ground_the_vehicle_reports_on_ground_armed_or_not() {
     };
     detect(&mut c, &e, 2.0);
     assert_eq!(c.landed_state(), LandedState::OnGround);
-    c.apply(&arm(), &e);
-    c.apply(&mode(FlightMode::Hold), &e);
+    c.apply(&arm(), &e, &mut n);
+    c.apply(&mode(FlightMode::Hold), &e, &mut n);
     detect(&mut c, &e, 2.0);
     assert_eq!(c.landed_state(), LandedState::OnGround);
     assert!(!c.flying());
@@ -295,16 +318,17 @@ fn standing_still_on_the_ground_the_vehicle_reports_on_ground_armed_or_not() {
 fn a_take_off_reports_takeoff_from_the_roll_to_its_altitude_then_in_air() {
     use super::snapshot::LandedState;
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let mut e = on_ground();
     e.ground_speed = 0.0;
-    c.apply(&arm(), &e);
-    c.apply(&mode(FlightMode::Takeoff), &e);
+    c.apply(&arm(), &e, &mut n);
+    c.apply(&mode(FlightMode::Takeoff), &e, &mut n);
     let plan = MissionStore::default();
-    let tick = |c: &mut Commander, e: &EstimatedState| {
+    let tick = |c: &mut Commander, n: &mut Navigator, e: &EstimatedState| {
         c.detect_landing(&land_detector::LandParams::default(), e, Some(9.81), 0.02);
-        c.demand(0, 0.02, e, &plan, &DESIGNED);
+        c.demand(0, 0.02, e, n, &plan, &DESIGNED);
     };
-    tick(&mut c, &e);
+    tick(&mut c, &mut n, &e);
     assert_eq!(
         c.navigation().phase,
         crate::navigation::navigator::io::Phase::TakeoffRoll
@@ -315,7 +339,7 @@ fn a_take_off_reports_takeoff_from_the_roll_to_its_altitude_then_in_air() {
     e.airspeed = 10.0;
     e.vel_ned = Vector3::new(0.0, 10.0, 0.0);
     for _ in 0..50 {
-        tick(&mut c, &e);
+        tick(&mut c, &mut n, &e);
     }
     assert_eq!(c.landed_state(), LandedState::Takeoff);
     // Airborne at 3 m, climbing: the take-off until its altitude.
@@ -325,7 +349,7 @@ fn a_take_off_reports_takeoff_from_the_roll_to_its_altitude_then_in_air() {
     e.pos_ned.z = -3.0;
     e.alt_amsl_m = 303.0;
     for _ in 0..50 {
-        tick(&mut c, &e);
+        tick(&mut c, &mut n, &e);
     }
     assert_eq!(
         c.navigation().phase,
@@ -334,12 +358,12 @@ fn a_take_off_reports_takeoff_from_the_roll_to_its_altitude_then_in_air() {
     assert_eq!(c.landed_state(), LandedState::Takeoff);
     assert!(c.flying(), "airborne at 3 m: the failsafes watch");
     // At the take-off altitude it circles: in the air.
-    let top = c.navigator().params().rtl_alt;
+    let top = n.params().rtl_alt;
     e.pos_ned.z = -top;
     e.alt_amsl_m = 300.0 + top;
     e.vel_ned.z = 0.0;
     for _ in 0..50 {
-        tick(&mut c, &e);
+        tick(&mut c, &mut n, &e);
     }
     assert_ne!(
         c.navigation().phase,
@@ -352,6 +376,7 @@ fn a_take_off_reports_takeoff_from_the_roll_to_its_altitude_then_in_air() {
 fn at_4_5_m_over_home_sinking_at_approach_speed_it_is_flying_and_the_failsafes_watch() {
     use super::snapshot::LandedState;
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     // 4.5 m above home, 14 m/s, sinking 1.5 m/s.
     let mut e = flying();
     e.pos_ned = Vector3::new(-30.0, 0.0, -4.5);
@@ -359,8 +384,8 @@ fn at_4_5_m_over_home_sinking_at_approach_speed_it_is_flying_and_the_failsafes_w
     e.airspeed = 14.0;
     e.ground_speed = 14.0;
     e.vel_ned = Vector3::new(14.0, 0.0, 1.5);
-    c.apply(&arm(), &e);
-    c.apply(&mode(FlightMode::Hold), &e);
+    c.apply(&arm(), &e, &mut n);
+    c.apply(&mode(FlightMode::Hold), &e, &mut n);
     detect(&mut c, &e, 3.0);
     // Below 5 m over home and still flying: not on the ground.
     assert_eq!(c.landed_state(), LandedState::InAir);
@@ -381,6 +406,7 @@ fn at_4_5_m_over_home_sinking_at_approach_speed_it_is_flying_and_the_failsafes_w
 fn an_air_start_below_home_altitude_at_cruise_speed_is_in_air() {
     use super::snapshot::LandedState;
     let mut c = Commander::new();
+    let mut n = Navigator::default();
     let mut e = flying();
     // 40 m below home, cruising.
     e.alt_amsl_m = 260.0;
@@ -388,7 +414,7 @@ fn an_air_start_below_home_altitude_at_cruise_speed_is_in_air() {
     e.vel_ned = Vector3::new(0.0, 17.0, 0.0);
     detect(&mut c, &e, 0.02);
     assert_eq!(c.landed_state(), LandedState::InAir);
-    let _ = c.apply(&arm(), &e);
+    let _ = c.apply(&arm(), &e, &mut n);
     detect(&mut c, &e, 2.0);
     assert_eq!(c.landed_state(), LandedState::InAir);
     assert!(c.flying());
@@ -408,11 +434,12 @@ fn armed_on_the_ground_without_sticks_the_motor_idles() {
         FlightMode::Hold,
     ] {
         let mut c = Commander::new();
+        let mut n = Navigator::default();
         detect(&mut c, &e, 2.0);
-        c.apply(&arm(), &e);
-        c.apply(&mode(m), &e);
+        c.apply(&arm(), &e, &mut n);
+        c.apply(&mode(m), &e, &mut n);
         detect(&mut c, &e, 0.1);
-        let (d, _) = c.demand(0, 0.02, &e, &MissionStore::default(), &DESIGNED);
+        let (d, _) = c.demand(0, 0.02, &e, &mut n, &MissionStore::default(), &DESIGNED);
         match d {
             Demand::Surfaces(s) => {
                 assert_eq!(s.throttle, 0.0, "{m:?}");
@@ -422,9 +449,45 @@ fn armed_on_the_ground_without_sticks_the_motor_idles() {
         }
     }
     let mut c = Commander::new();
-    c.apply(&arm(), &flying());
-    c.apply(&mode(FlightMode::Stabilized), &flying());
+    let mut n = Navigator::default();
+    c.apply(&arm(), &flying(), &mut n);
+    c.apply(&mode(FlightMode::Stabilized), &flying(), &mut n);
     detect(&mut c, &flying(), 0.1);
-    let (d, _) = c.demand(0, 0.02, &flying(), &MissionStore::default(), &DESIGNED);
+    let (d, _) = c.demand(
+        0,
+        0.02,
+        &flying(),
+        &mut n,
+        &MissionStore::default(),
+        &DESIGNED,
+    );
     assert!(matches!(d, Demand::Commands(_)), "in the air: {d:?}");
+}
+
+/// Each row of the table of mode facts names its own mode back: through its PX4 pair, through
+/// the whole `custom_mode` word, and through its standard mode where the standard names it;
+/// a non-standard mode is not reached by the standard's NON_STANDARD.
+#[test]
+fn every_mode_round_trips_through_its_px4_numbers_and_its_standard_mode() {
+    use super::modes::MODES;
+    use mavlink::dialects::common::{MavModeProperty, MavStandardMode};
+    assert_eq!(MODES.len(), FlightMode::ALL.len());
+    for (f, m) in MODES.iter().zip(FlightMode::ALL) {
+        assert_eq!(f.mode, m);
+        assert_eq!(m.facts().name, m.name());
+        let (main, sub) = f.px4;
+        assert_eq!(FlightMode::from_px4(main, sub), Some(m));
+        assert_eq!(FlightMode::from_custom_mode(m.custom_mode()), Some(m));
+        if f.standard == MavStandardMode::MAV_STANDARD_MODE_NON_STANDARD {
+            assert_eq!(FlightMode::from_standard(f.standard), None);
+        } else {
+            assert_eq!(FlightMode::from_standard(f.standard), Some(m));
+        }
+        // The AUTO_MODE property and the heartbeat's AUTO flag are the navigator's modes.
+        assert_eq!(
+            f.properties
+                .contains(MavModeProperty::MAV_MODE_PROPERTY_AUTO_MODE),
+            m.needs_navigator()
+        );
+    }
 }

@@ -286,7 +286,7 @@ mod tests {
         let f = SensorFrame {
             time_us,
             imu: Some(ImuSample {
-                accel: nalgebra::Vector3::new(0.0, 0.0, -9.8),
+                accel: nalgebra::Vector3::new(0.0, 0.0, -common::math::GRAVITY),
                 gyro: nalgebra::Vector3::zeros(),
             }),
             ..Default::default()

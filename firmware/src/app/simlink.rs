@@ -204,7 +204,11 @@ fn truth_measurements(d: &HIL_STATE_QUATERNION_DATA) -> Option<Measurements> {
     let e = common::math::Euler::from_quaternion(&uq);
     let v = nalgebra::Vector3::new(f32::from(d.vx), f32::from(d.vy), f32::from(d.vz)) / 100.0;
     let (chi, vg) = common::math::course_and_speed(&v);
-    let course = if vg > 3.0 { chi } else { e.psi };
+    let course = if vg > common::math::MIN_COURSE_SPEED_MPS {
+        chi
+    } else {
+        e.psi
+    };
     Some(Measurements {
         roll: e.phi,
         pitch: e.theta,

@@ -72,6 +72,17 @@ pub enum HostError {
     Io,
 }
 
+impl core::fmt::Display for HostError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            HostError::Address => "address outside the reserved sectors",
+            HostError::Io => "semihosting call failed",
+        })
+    }
+}
+
+impl core::error::Error for HostError {}
+
 impl HostFile {
     /// The file named by the `storage=PATH` semihosting argument, created erased when
     /// missing; `None` without the argument or when it cannot be opened.
@@ -183,6 +194,24 @@ pub enum BoardFlashError {
     Host(HostError),
     /// The controller.
     Chip(F4Error),
+}
+
+impl core::fmt::Display for BoardFlashError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            BoardFlashError::Host(e) => write!(f, "host file: {e}"),
+            BoardFlashError::Chip(e) => write!(f, "flash controller: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for BoardFlashError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            BoardFlashError::Host(e) => Some(e),
+            BoardFlashError::Chip(e) => Some(e),
+        }
+    }
 }
 
 impl BoardFlash {

@@ -8,7 +8,7 @@
 //! - [`mission`]: the default mission, a mission file or one generated per flight, turned
 //!   with the runway;
 //! - [`record`]: one flight flown in-process, its figures and facts;
-//! - [`verdict`]: the criteria, in one place;
+//! - [`verdict`]: the verdict by the criteria ([`crate::flight::criteria`]), in one place;
 //! - [`run`]: the campaign, its shards, its flights flown on every core;
 //! - [`output`]: its directory, the merge of shards, the document;
 //! - [`report`], [`plots`], [`stats`]: the report made from the records.

@@ -17,6 +17,7 @@ use super::plots;
 use super::record::FlightRecord;
 use super::report::{markdown, Images, Report};
 use super::run::{CampaignMeta, Shard, FORMAT};
+use crate::report::NOTES_MARKER;
 use anyhow::{bail, Context};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -247,9 +248,6 @@ fn summarise(v: &[u64]) -> String {
         s
     }
 }
-
-/// Marker below which a document's notes are written by hand and kept.
-pub const NOTES_MARKER: &str = crate::commands::fly::NOTES_MARKER;
 
 /// Writes the report as a document at `doc`, its images beside it in `img/montecarlo-*.png`,
 /// keeping the notes below [`NOTES_MARKER`] of the document already there.

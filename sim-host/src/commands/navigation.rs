@@ -2,7 +2,7 @@
 //! and in a 5 m/s wind with light turbulence over several seeds, on the autopilot's own
 //! estimates; tables of the mission figures and ground-track plots for `docs/NAVIGATION.md`.
 
-use super::fly::{fly_report, mission_table, FlyOptions, LinkKind, NOTES_MARKER};
+use super::fly::{fly_report, mission_table, FlyOptions, LinkKind};
 pub use super::mission_tables::meets_targets;
 use super::mission_tables::{
     seed_span, spread_summary, touchdown_cells, under, verdict_cell, windy_row,
@@ -20,7 +20,7 @@ use crate::flight::record::Sample;
 use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::MissionSummary;
 use crate::plant::params::ModelParams;
-use crate::report::sig;
+use crate::report::{sig, NOTES_MARKER};
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -2,6 +2,7 @@
 //! (the MCU image in QEMU against the host build, for the same seed), bit for bit.
 
 use crate::link::tlog::read_tlog;
+use common::gcs::{COMPONENT_ID, SYSTEM_ID};
 use common::link::framing::FrameParser;
 use mavlink::dialects::common::MavMessage;
 use serde::Serialize;
@@ -22,14 +23,17 @@ pub struct Answer {
     pub flags: u64,
 }
 
-/// The autopilot's answers in a `.tlog`, in order (frames of system 1, component 1).
+/// The autopilot's answers in a `.tlog`, in order (frames of the autopilot's system and
+/// component, [`SYSTEM_ID`] and [`COMPONENT_ID`]).
 pub fn answers(tlog: &[u8]) -> Vec<Answer> {
     let mut parser = FrameParser::new();
     let mut out = Vec::new();
     for (_, frame) in read_tlog(tlog) {
         parser.push(&frame, |f| {
             if let MavMessage::HIL_ACTUATOR_CONTROLS(d) = f.message {
-                if (f.header.system_id, f.header.component_id) == (1, 1) {
+                if (f.header.system_id, f.header.component_id)
+                    == (u32::from(SYSTEM_ID), COMPONENT_ID)
+                {
                     let mut controls = [0.0; CONTROLS];
                     controls.copy_from_slice(&d.controls[..CONTROLS]);
                     out.push(Answer {

@@ -2,10 +2,10 @@
 //! guidance asked for, the throttle's time on its stops, the touchdown, and the verdict on
 //! them a campaign names.
 
+use super::criteria::Criterion;
 use super::measures::{rms, HomeDatum};
 use super::record::Sample;
 use super::strikes::{StrikeEvent, Survey};
-use crate::campaign::verdict::Criterion;
 use crate::plant::Touchdown;
 use common::navigation::Phase;
 use serde::Serialize;

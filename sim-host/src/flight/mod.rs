@@ -27,6 +27,7 @@
 
 pub mod compare;
 pub mod config;
+pub mod criteria;
 pub mod landed;
 pub mod measures;
 pub mod mission_summary;

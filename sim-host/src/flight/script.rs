@@ -15,6 +15,7 @@ use crate::link::transport::Transport;
 use common::gcs::client::{command_long, gcs_heartbeat};
 use common::gcs::Dest;
 use common::link::framing::{FrameParser, Sender};
+use common::vehicle::modes::FlightMode;
 use mavlink::dialects::common::{
     MavCmd, MavLandedState, MavMessage, MavMissionResult, MavMissionType, MavParamType, MavResult,
     MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
@@ -30,13 +31,13 @@ pub const GCS_SYSTEM_ID: u8 = 255;
 /// Component id of the ground station (MAV_COMP_ID_MISSIONPLANNER, what QGC uses).
 pub const GCS_COMPONENT_ID: u8 = 190;
 /// PX4 main mode ALTCTL (the autopilot's "Altitude").
-pub const PX4_ALTCTL: u8 = 2;
+pub const PX4_ALTCTL: u8 = FlightMode::Altitude.px4().0;
 /// PX4 main mode POSCTL (the autopilot's "Hold": course, altitude and airspeed hold).
-pub const PX4_POSCTL: u8 = 3;
-/// PX4 main mode AUTO.
-pub const PX4_AUTO: u8 = 4;
+pub const PX4_POSCTL: u8 = FlightMode::Hold.px4().0;
+/// PX4 main mode AUTO (the navigator's modes).
+pub const PX4_AUTO: u8 = FlightMode::Loiter.px4().0;
 /// PX4 AUTO sub-mode LOITER.
-pub const PX4_AUTO_LOITER: u8 = 3;
+pub const PX4_AUTO_LOITER: u8 = FlightMode::Loiter.px4().1;
 
 /// One ground-station command.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -353,10 +354,10 @@ impl GroundStation {
             ),
             Action::Loiter => (
                 "mode Loiter".into(),
-                command(
-                    MavCmd::MAV_CMD_DO_SET_MODE,
-                    [1.0, f32::from(PX4_AUTO), f32::from(PX4_AUTO_LOITER), 0.0],
-                ),
+                command(MavCmd::MAV_CMD_DO_SET_MODE, {
+                    let (main, sub) = FlightMode::Loiter.px4();
+                    [1.0, f32::from(main), f32::from(sub), 0.0]
+                }),
             ),
             Action::Silence | Action::Resume => return None,
         })
@@ -498,11 +499,21 @@ impl GroundStation {
     }
 }
 
+/// The name a command's record gives a PX4 main mode: the two the scripts fly by name, every
+/// other "other" (the records of flights already made say so).
 fn mode_name(main: u8) -> &'static str {
-    match main {
-        PX4_ALTCTL => "Altitude",
-        PX4_POSCTL => "Hold",
-        _ => "other",
+    match FlightMode::from_px4(main, 0) {
+        Some(m @ (FlightMode::Altitude | FlightMode::Hold)) => m.name(),
+        Some(
+            FlightMode::Manual
+            | FlightMode::Stabilized
+            | FlightMode::Mission
+            | FlightMode::Loiter
+            | FlightMode::Return
+            | FlightMode::Takeoff
+            | FlightMode::Land,
+        )
+        | None => "other",
     }
 }
 

@@ -231,7 +231,7 @@ mod tests {
         assert_eq!(got, hello.raw_bytes());
 
         // Three frames from the autopilot, cut anywhere, with noise between two of them.
-        let mut ap = Sender::new(1, 1);
+        let mut ap = Sender::new(common::gcs::SYSTEM_ID, common::gcs::COMPONENT_ID);
         let frames: Vec<Vec<u8>> = ["one", "two", "three"]
             .iter()
             .map(|t| {

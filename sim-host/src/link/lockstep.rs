@@ -2,16 +2,16 @@
 
 use super::tlog::TlogWriter;
 use super::transport::Transport;
+use common::gcs::SYSTEM_ID;
 use common::link::framing::{encode_v2, Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame};
 use mavlink::dialects::common::MavMessage;
 use std::io;
 use std::time::{Duration, Instant};
 
-/// The simulator speaks for the vehicle's sensors: system 1 (the autopilot's own system, so
-/// it accepts the frames), and a component id of its own.
-pub const SIM_SYSTEM_ID: u8 = 1;
 /// Component id of the simulator (MAV_COMP_ID_USER27, unused by real vehicles' components).
+/// The simulator speaks for the vehicle's sensors, so its system is the autopilot's own
+/// ([`SYSTEM_ID`]: the autopilot takes simulator frames from its own system only).
 pub const SIM_COMPONENT_ID: u8 = 51;
 
 /// Why an exchange failed.
@@ -53,7 +53,7 @@ impl<T: Transport> Lockstep<T> {
         Self {
             transport,
             parser: FrameParser::new(),
-            sender: Sender::new(SIM_SYSTEM_ID, SIM_COMPONENT_ID),
+            sender: Sender::new(SYSTEM_ID, SIM_COMPONENT_ID),
             tlog: None,
             timeout,
             answered: 0,
@@ -107,7 +107,7 @@ impl<T: Transport> Lockstep<T> {
             return Ok(());
         }
         self.await_frame(0, timeout, |f| {
-            (f.header.system_id == u32::from(SIM_SYSTEM_ID)).then_some(())
+            (f.header.system_id == u32::from(SYSTEM_ID)).then_some(())
         })?;
         self.heard = true;
         Ok(())

@@ -35,6 +35,11 @@ pub fn sig(x: f64, digits: usize) -> String {
     format!("{:.*}", decimals, x)
 }
 
+/// Where the hand-written notes of a generated document begin: a command that rewrites the
+/// document keeps everything from here on (`sim-host fly --report`, `navigation`, `campaign
+/// --doc`).
+pub const NOTES_MARKER: &str = "\n---\n";
+
 /// The opening marker of a section `name` that a command writes into a document another
 /// command owns (`docs/RESULTS.md` carries the missions of `sim-host navigation`).
 fn section_markers(name: &str) -> (String, String) {

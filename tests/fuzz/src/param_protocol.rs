@@ -184,7 +184,7 @@ impl Harness {
             self.check();
             let v = self.app.vehicle();
             assert_eq!(
-                *v.commander().navigator().params(),
+                *v.navigator().params(),
                 v.params().load(&navigator::params::PARAMS),
                 "the navigator flies other settings than the store holds"
             );

@@ -1,7 +1,7 @@
 //! Loiter items: circling a point until the item's goal is met.
 //!
-//! Loiters orbit their point (radius `param3`, `param2` for `LOITER_TO_ALT`, or `NAV_LOIT_RAD`
-//! when 0; a negative radius turns counter-clockwise). `LOITER_TURNS` counts the angle swept
+//! Loiters orbit their point (the item's radius, or `NAV_LOIT_RAD` when it gives none; see
+//! [`crate::navigation::item`]). `LOITER_TURNS` counts the angle swept
 //! round the centre once on the circle; `LOITER_TIME` the time on the circle;
 //! `LOITER_TO_ALT` waits for the altitude. `LOITER_UNLIM` is reported reached on arrival and
 //! never ends.
@@ -9,10 +9,8 @@
 use super::guide::{Flight, Orbit};
 use super::io::{NavOutput, Phase};
 use super::params::NavParams;
-use crate::guidance::OrbitDirection;
 use crate::math::wrap_pi;
-use crate::navigation::items::{NAV_LOITER_TIME, NAV_LOITER_TO_ALT, NAV_LOITER_TURNS};
-use crate::navigation::plan::MissionItem;
+use crate::navigation::item::{Circle, LoiterEnd};
 use core::f32::consts::TAU;
 use nalgebra::Vector3;
 
@@ -42,37 +40,23 @@ pub(super) struct Loiter {
 }
 
 impl Loiter {
-    /// The loiter of `item` (one of the `NAV_LOITER_*` commands) round `center` (NED from
-    /// home).
-    pub fn item(item: &MissionItem, center: Vector3<f32>, p: &NavParams) -> Self {
-        let r = if item.command == NAV_LOITER_TO_ALT {
-            item.param(1)
-        } else {
-            item.param(2)
-        };
-        let radius = if r.is_finite() && r.abs() >= 1.0 {
-            r.abs()
-        } else {
-            p.loiter_radius
-        };
-        let goal = match item.command {
-            NAV_LOITER_TURNS => LoiterGoal::Turns {
-                goal: item.param(0).max(0.0) * TAU,
+    /// The loiter item's `circle` round `center` (NED from home), ended `until`.
+    pub fn item(circle: Circle, until: LoiterEnd, center: Vector3<f32>, p: &NavParams) -> Self {
+        let goal = match until {
+            LoiterEnd::Turns(turns) => LoiterGoal::Turns {
+                goal: turns * TAU,
                 swept: 0.0,
                 last: None,
             },
-            NAV_LOITER_TIME => LoiterGoal::Time {
-                goal: item.param(0).max(0.0),
-                elapsed: 0.0,
-            },
-            NAV_LOITER_TO_ALT => LoiterGoal::Altitude,
-            _ => LoiterGoal::Unlimited,
+            LoiterEnd::Time(goal) => LoiterGoal::Time { goal, elapsed: 0.0 },
+            LoiterEnd::Altitude => LoiterGoal::Altitude,
+            LoiterEnd::Unlimited => LoiterGoal::Unlimited,
         };
         Self {
             orbit: Orbit {
                 center,
-                radius,
-                direction: OrbitDirection::from_signed_radius(r),
+                radius: circle.radius_m.unwrap_or(p.loiter_radius),
+                direction: circle.direction,
             },
             goal,
             arrived: false,

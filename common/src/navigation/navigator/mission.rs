@@ -21,12 +21,10 @@ use super::guide::{horizontal_dist, Flight, Orbit};
 use super::io::{HomeRequest, NavOutput, NavState, NavWarning, Phase};
 use super::params::NavParams;
 use crate::estimator::Home;
-use crate::math::wrap_pi;
-use crate::navigation::items::{
-    self, is_nav, DO_CHANGE_SPEED, DO_JUMP, DO_SET_HOME, NAV_LAND, NAV_WAYPOINT,
-};
+use crate::math::{wrap_pi, MIN_COURSE_SPEED_MPS};
+use crate::navigation::item::{HomeChange, JumpRepeat, NavCommand, NavItem, Route, SpeedChange};
 use crate::navigation::path_manager::{PathManager, Waypoint};
-use crate::navigation::plan::{MissionItem, MISSION_CAPACITY};
+use crate::navigation::plan::MISSION_CAPACITY;
 use nalgebra::Vector3;
 
 /// How closely the course must point at the next item before a finished loiter is left,
@@ -72,14 +70,14 @@ impl MissionWalk {
     /// Walks from item `seq` to the next navigation item, running `DO_*` items on the way, and
     /// makes it current. `None` when there is none to fly: the mission is empty (then nothing
     /// is current), a jump loop has nothing in it, or the walk fell off the end.
-    pub fn walk<'a>(
+    pub fn walk(
         &mut self,
-        items: &'a [MissionItem],
+        items: Route<'_>,
         mut seq: usize,
         home: &Home,
         p: &NavParams,
         out: &mut NavOutput,
-    ) -> Option<(usize, &'a MissionItem)> {
+    ) -> Option<(usize, NavItem)> {
         if items.is_empty() {
             out.warn(NavWarning::NoMission);
             self.seq = None;
@@ -95,55 +93,53 @@ impl MissionWalk {
             }
             budget -= 1;
             match item.command {
-                DO_JUMP => match jump_target(item, items.len(), self.jumps.get(seq).copied()) {
-                    JumpStep::Jump(t) => {
-                        if let Some(c) = self.jumps.get_mut(seq) {
-                            *c = c.saturating_add(1);
+                NavCommand::Jump { target, repeat } => {
+                    match jump_step(target, repeat, items.len(), self.jumps.get(seq).copied()) {
+                        JumpStep::Jump(t) => {
+                            if let Some(c) = self.jumps.get_mut(seq) {
+                                *c = c.saturating_add(1);
+                            }
+                            seq = t;
                         }
-                        seq = t;
+                        JumpStep::Next => seq += 1,
+                        JumpStep::Bad => {
+                            out.warn(NavWarning::BadJump { seq: s16 });
+                            seq += 1;
+                        }
                     }
-                    JumpStep::Next => seq += 1,
-                    JumpStep::Bad => {
-                        out.warn(NavWarning::BadJump { seq: s16 });
-                        seq += 1;
-                    }
-                },
-                DO_CHANGE_SPEED => {
-                    let kind = item.param(0);
-                    let v = item.param(1);
-                    if kind == 0.0 || kind == 1.0 {
-                        if v > 0.0 {
+                }
+                NavCommand::ChangeSpeed(change) => {
+                    match change {
+                        SpeedChange::To(v) => {
                             self.airspeed = Some(v.max(p.airspeed_min).min(p.airspeed_max));
-                        } else if v == -2.0 {
-                            self.airspeed = None;
                         }
-                    } else {
-                        out.warn(NavWarning::UnsupportedSpeed { seq: s16 });
+                        SpeedChange::Cruise => self.airspeed = None,
+                        SpeedChange::Keep => {}
+                        SpeedChange::Unsupported => {
+                            out.warn(NavWarning::UnsupportedSpeed { seq: s16 });
+                        }
                     }
                     seq += 1;
                 }
-                DO_SET_HOME => {
-                    out.set_home = Some(if item.param(0) == 1.0 {
-                        HomeRequest::Here
-                    } else {
-                        match (items::point(item), items::alt_amsl(item, home)) {
-                            (Some(point), Some(alt_amsl_m)) => {
-                                HomeRequest::At(Home { point, alt_amsl_m })
-                            }
-                            (Some(point), None) => HomeRequest::At(Home {
-                                point,
-                                alt_amsl_m: home.alt_amsl_m,
-                            }),
-                            _ => HomeRequest::Here,
-                        }
+                NavCommand::SetHome(change) => {
+                    out.set_home = Some(match change {
+                        HomeChange::Here => HomeRequest::Here,
+                        HomeChange::At { point, alt } => HomeRequest::At(Home {
+                            point,
+                            alt_amsl_m: alt.map_or(home.alt_amsl_m, |a| a.amsl_m(home)),
+                        }),
                     });
                     seq += 1;
                 }
-                c if is_nav(c) => {
+                NavCommand::Waypoint { .. }
+                | NavCommand::Loiter { .. }
+                | NavCommand::Takeoff { .. }
+                | NavCommand::Land { .. }
+                | NavCommand::ReturnToLaunch { .. } => {
                     self.seq = Some(s16);
                     return Some((seq, item));
                 }
-                command => {
+                NavCommand::Unsupported { command } => {
                     out.warn(NavWarning::UnknownCommand { seq: s16, command });
                     seq += 1;
                 }
@@ -153,22 +149,24 @@ impl MissionWalk {
 
     /// The next navigation item after `seq` as the walk would find it (jumps followed, counts
     /// not spent).
-    fn peek_nav<'a>(&self, items: &'a [MissionItem], seq: usize) -> Option<&'a MissionItem> {
+    fn peek_nav(&self, items: Route<'_>, seq: usize) -> Option<NavItem> {
         let mut jumps = self.jumps;
         let mut s = seq + 1;
         for _ in 0..4 * items.len() + 8 {
             let item = items.get(s)?;
             match item.command {
-                DO_JUMP => match jump_target(item, items.len(), jumps.get(s).copied()) {
-                    JumpStep::Jump(t) => {
-                        if let Some(c) = jumps.get_mut(s) {
-                            *c = c.saturating_add(1);
+                NavCommand::Jump { target, repeat } => {
+                    match jump_step(target, repeat, items.len(), jumps.get(s).copied()) {
+                        JumpStep::Jump(t) => {
+                            if let Some(c) = jumps.get_mut(s) {
+                                *c = c.saturating_add(1);
+                            }
+                            s = t;
                         }
-                        s = t;
+                        _ => s += 1,
                     }
-                    _ => s += 1,
-                },
-                c if is_nav(c) => return Some(item),
+                }
+                c if c.is_nav() => return Some(item),
                 _ => s += 1,
             }
         }
@@ -179,14 +177,17 @@ impl MissionWalk {
     /// rounded: a waypoint or the final approach of a landing follows.
     pub fn corner_after(
         &self,
-        items: &[MissionItem],
+        items: Route<'_>,
         seq: usize,
         home: &Home,
         target: &Vector3<f32>,
     ) -> Option<Vector3<f32>> {
-        self.peek_nav(items, seq)
-            .filter(|n| matches!(n.command, NAV_WAYPOINT | NAV_LAND))
-            .map(|n| items::target_ned(n, home, target))
+        match self.peek_nav(items, seq)?.command {
+            NavCommand::Waypoint { place, .. } | NavCommand::Land { place } => {
+                Some(place.ned(home, target))
+            }
+            _ => None,
+        }
     }
 
     /// True when the course over ground points within [`EXIT_COURSE_TOL`] of the next
@@ -194,7 +195,7 @@ impl MissionWalk {
     /// and a half radii of the circle's centre, or with no ground speed to tell).
     pub fn heading_for_next(
         &self,
-        items: &[MissionItem],
+        items: Route<'_>,
         home: &Home,
         state: &NavState,
         orbit: &Orbit,
@@ -205,13 +206,14 @@ impl MissionWalk {
         let pos = state.pos_ned;
         let Some(next) = self
             .peek_nav(items, usize::from(seq))
-            .filter(|n| items::point(n).is_some())
+            .and_then(|n| n.command.place())
+            .filter(|n| n.point.is_some())
         else {
             return true;
         };
-        let t = items::target_ned(next, home, &pos);
+        let t = next.ned(home, &pos);
         let vg = state.ground_speed();
-        if vg < 3.0 || horizontal_dist(&t, &orbit.center) < 1.5 * orbit.radius {
+        if vg < MIN_COURSE_SPEED_MPS || horizontal_dist(&t, &orbit.center) < 1.5 * orbit.radius {
             return true;
         }
         let bearing = libm::atan2f(t.y - pos.y, t.x - pos.x);
@@ -244,12 +246,12 @@ pub(super) struct Leg {
 const JOIN_ALIGNED: f32 = 15.0 * crate::math::DEG;
 
 impl Leg {
-    /// The leg of waypoint `item` from `origin` to `target` (NED from home), at `airspeed`
-    /// (m/s), rounding the corner towards `next`; its acceptance radius is `param2`, or
-    /// `NAV_ACC_RAD` when not positive. `joining`: the origin is the aircraft's position, not
-    /// a waypoint.
+    /// The leg of a waypoint item from `origin` to `target` (NED from home), at `airspeed`
+    /// (m/s), rounding the corner towards `next`; its acceptance radius is the item's
+    /// `accept_radius_m`, or `NAV_ACC_RAD` when it gives none. `joining`: the origin is the
+    /// aircraft's position, not a waypoint.
     pub fn item(
-        item: &MissionItem,
+        accept_radius_m: Option<f32>,
         origin: Vector3<f32>,
         target: Vector3<f32>,
         next: Option<Vector3<f32>>,
@@ -257,11 +259,7 @@ impl Leg {
         p: &NavParams,
         joining: bool,
     ) -> Self {
-        let accept = if item.param(1) > 0.0 {
-            item.param(1)
-        } else {
-            p.accept_radius
-        };
+        let accept = accept_radius_m.unwrap_or(p.accept_radius);
         Self {
             origin,
             target,
@@ -331,28 +329,21 @@ enum JumpStep {
     Bad,
 }
 
-/// What a `DO_JUMP` does given the jumps it has done (`None`: its counter cannot be kept).
-fn jump_target(item: &MissionItem, len: usize, done: Option<u16>) -> JumpStep {
-    let target = item.param(0);
-    let repeat = item.param(1);
-    if !(target.is_finite()
-        && target >= 0.0
-        && target < len as f32
-        && libm::truncf(target) == target)
-    {
+/// What a `DO_JUMP` to `target`, `repeat` times, does in a mission of `len` items given the
+/// jumps it has done (`None`: its counter cannot be kept).
+fn jump_step(target: Option<usize>, repeat: JumpRepeat, len: usize, done: Option<u16>) -> JumpStep {
+    let Some(target) = target.filter(|&t| t < len) else {
         return JumpStep::Bad;
-    }
+    };
     let Some(done) = done else {
         return JumpStep::Bad;
     };
-    // -1: for ever; otherwise a whole number of repeats.
-    let again = if repeat == -1.0 {
-        true
-    } else {
-        repeat.is_finite() && repeat >= 0.0 && f32::from(done) < libm::truncf(repeat)
+    let again = match repeat {
+        JumpRepeat::Forever => true,
+        JumpRepeat::Times(n) => u32::from(done) < n,
     };
     if again {
-        JumpStep::Jump(target as usize)
+        JumpStep::Jump(target)
     } else {
         JumpStep::Next
     }

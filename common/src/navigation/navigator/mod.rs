@@ -46,10 +46,7 @@ use self::takeoff::Takeoff;
 use crate::control::autopilot::Commands;
 use crate::estimator::Home;
 use crate::guidance::{Guidance, GuidanceParams};
-use crate::navigation::items::{
-    self, NAV_LAND, NAV_LOITER_TIME, NAV_LOITER_TO_ALT, NAV_LOITER_TURNS, NAV_LOITER_UNLIM,
-    NAV_TAKEOFF, NAV_WAYPOINT,
-};
+use crate::navigation::item::{NavCommand, NavItem, Route};
 use crate::navigation::path_manager::{PathManager, PathParams};
 use crate::navigation::plan::MissionItem;
 use nalgebra::Vector3;
@@ -188,6 +185,18 @@ impl Navigator {
         state: &NavState,
         dt: f32,
     ) -> NavOutput {
+        self.step_route(Route::Plan(items), home, state, dt)
+    }
+
+    /// One step along `items`, the stored mission or an item built on board; otherwise as
+    /// [`Navigator::step`].
+    pub fn step_route(
+        &mut self,
+        items: Route<'_>,
+        home: &Home,
+        state: &NavState,
+        dt: f32,
+    ) -> NavOutput {
         let mut out = NavOutput {
             wp_dist_m: f32::NAN,
             target_bearing: f32::NAN,
@@ -249,7 +258,7 @@ impl Navigator {
     /// mission when there is none.
     fn walk(
         &mut self,
-        items: &[MissionItem],
+        items: Route<'_>,
         seq: usize,
         home: &Home,
         state: &NavState,
@@ -257,7 +266,7 @@ impl Navigator {
     ) {
         self.paths.reset();
         match self.mission.walk(items, seq, home, &self.params, out) {
-            Some((seq, item)) => self.activate(items, seq, item, home, state),
+            Some((seq, item)) => self.activate(items, seq, &item, home, state),
             None => self.complete(&state.pos_ned),
         }
     }
@@ -265,32 +274,35 @@ impl Navigator {
     /// Starts the behaviour that flies navigation item `seq`.
     fn activate(
         &mut self,
-        items: &[MissionItem],
+        items: Route<'_>,
         seq: usize,
-        item: &MissionItem,
+        item: &NavItem,
         home: &Home,
         state: &NavState,
     ) {
         let p = &self.params;
         let pos = state.pos_ned;
-        let target = items::target_ned(item, home, &pos);
+        let target = item.command.place().unwrap_or_default().ned(home, &pos);
         let origin = self.mission.prev_waypoint.unwrap_or(pos);
         self.active = match item.command {
-            NAV_WAYPOINT => {
+            NavCommand::Waypoint {
+                accept_radius_m, ..
+            } => {
                 let next = self.mission.corner_after(items, seq, home, &target);
                 let airspeed = self.mission.cruise(p);
                 let joining = self.mission.prev_waypoint.is_none();
-                Active::Waypoint(Leg::item(item, origin, target, next, airspeed, p, joining))
+                let leg = Leg::item(accept_radius_m, origin, target, next, airspeed, p, joining);
+                Active::Waypoint(leg)
             }
-            NAV_LOITER_UNLIM | NAV_LOITER_TURNS | NAV_LOITER_TIME | NAV_LOITER_TO_ALT => {
-                Active::Loiter(Loiter::item(item, target, p))
+            NavCommand::Loiter { circle, until, .. } => {
+                Active::Loiter(Loiter::item(circle, until, target, p))
             }
-            NAV_TAKEOFF => {
-                let t = Takeoff::item(item, target, home, state, p);
+            NavCommand::Takeoff { place, yaw } => {
+                let t = Takeoff::item(&place, yaw, target, home, state, p);
                 self.runway = Some(t.runway());
                 Active::Takeoff(t)
             }
-            NAV_LAND => Active::Land(Landing::item(origin, target, pos)),
+            NavCommand::Land { .. } => Active::Land(Landing::item(origin, target, pos)),
             // NAV_RETURN_TO_LAUNCH (the only navigation command left).
             _ => Active::Return(Return::new(pos, p.rtl_land)),
         };
@@ -302,7 +314,7 @@ impl Navigator {
     /// The current item is done: report it and walk on (or hold, without autocontinue).
     fn item_done(
         &mut self,
-        items: &[MissionItem],
+        items: Route<'_>,
         home: &Home,
         state: &NavState,
         hold: Orbit,
@@ -324,7 +336,7 @@ impl Navigator {
     /// Flies the active behaviour one step.
     fn fly(
         &mut self,
-        items: &[MissionItem],
+        items: Route<'_>,
         home: &Home,
         state: &NavState,
         dt: f32,

@@ -17,9 +17,7 @@ use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::Home;
 use crate::guidance::Path;
-use crate::math::{wrap_pi, DEG};
-use crate::navigation::items;
-use crate::navigation::plan::MissionItem;
+use crate::navigation::items::Place;
 use nalgebra::Vector3;
 
 /// A take-off in progress.
@@ -38,11 +36,13 @@ pub(super) struct Takeoff {
 }
 
 impl Takeoff {
-    /// The take-off of `item`, whose position is `target` (NED from home): along the present
+    /// The take-off of an item whose position is `target` (NED from home): along the present
     /// heading; with `NAV_TKO_TO_ITEM`, along the line to that point when it lies more than
-    /// 20 m away, else on the item's yaw (`param4`), else on the present heading.
+    /// 20 m away, else on the item's `yaw` (rad), else on the present heading; `place` is
+    /// the item's.
     pub fn item(
-        item: &MissionItem,
+        place: &Place,
+        yaw: Option<f32>,
         target: Vector3<f32>,
         home: &Home,
         state: &NavState,
@@ -51,17 +51,17 @@ impl Takeoff {
         let pos = state.pos_ned;
         let course = if !p.takeoff_to_item {
             state.heading
-        } else if items::point(item).is_some() && horizontal_dist(&target, &pos) > 20.0 {
+        } else if place.point.is_some() && horizontal_dist(&target, &pos) > 20.0 {
             libm::atan2f(target.y - pos.y, target.x - pos.x)
-        } else if item.param(3).is_finite() {
-            wrap_pi(item.param(3) * DEG)
+        } else if let Some(yaw) = yaw {
+            yaw
         } else {
             state.heading
         };
         Self {
             start: pos,
             course,
-            height: items::height(item, home).unwrap_or(p.rtl_alt),
+            height: place.height(home).unwrap_or(p.rtl_alt),
             rolling: state.airspeed.is_nan() || state.airspeed < p.takeoff_vr,
             roll_s: 0.0,
         }

@@ -144,7 +144,7 @@ impl Discrete {
 /// `(g / a_V2 + PI) E_d - PI E` and pitch command `(1 + PI) B_d - PI B` from the height and
 /// airspeed (`common::control::longitudinal::tecs`).
 fn tecs_controller(g: &GainSet, d: &Discrete, va: f64, ky: &mut CMat, kr: &mut CMat) {
-    const G: f64 = 9.81;
+    const G: f64 = common::math::STANDARD_GRAVITY;
     let t = &g.tecs;
     let (x, r) = d.rate_estimator(t.rate_pole);
     let w = f64::from(t.speed_weight);

@@ -22,11 +22,8 @@ pub mod gains;
 use super::gains::LongitudinalGains;
 use crate::control::filters::RateEstimator;
 use crate::control::pid::{Bumpless, Derivative, Pid, PidGains};
-use crate::math::clamp;
+use crate::math::{clamp, GRAVITY};
 pub use gains::{TecsGains, UNDERSPEED_BAND_MPS};
-
-/// Standard gravity, m/s^2.
-const G_MPS2: f32 = 9.81;
 
 /// Airspeed below which the rates are not divided by it, m/s: on the ground roll and in a
 /// stall the flight-path angle `h_dot / V` means nothing.
@@ -212,12 +209,12 @@ impl Tecs {
         let (w_h, w_v) = ((2.0 - w).min(1.0), w.min(1.0));
 
         let inv_v = 1.0 / v.max(MIN_DIVISOR_MPS);
-        let total_d = climb_d * inv_v + accel_d / G_MPS2;
-        let total = h_dot * inv_v + v_dot / G_MPS2;
-        let bal_d = w_h * climb_d * inv_v - w_v * accel_d / G_MPS2;
-        let bal = w_h * h_dot * inv_v - w_v * v_dot / G_MPS2;
+        let total_d = climb_d * inv_v + accel_d / GRAVITY;
+        let total = h_dot * inv_v + v_dot / GRAVITY;
+        let bal_d = w_h * climb_d * inv_v - w_v * accel_d / GRAVITY;
+        let bal = w_h * h_dot * inv_v - w_v * v_dot / GRAVITY;
 
-        let thr_ff = g.trim_throttle + total_d * G_MPS2 / t.thr_accel;
+        let thr_ff = g.trim_throttle + total_d * GRAVITY / t.thr_accel;
         let thr = self.thr.step(total_d - total, Derivative::None, thr_ff, dt);
         let throttle = thr + under * (g.throttle_max - thr);
         let pitch_cmd = self

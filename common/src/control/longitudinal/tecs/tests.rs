@@ -65,7 +65,7 @@ fn a_climb_demand_raises_throttle_by_the_energy_rate_over_a_v2() {
     let o = tecs.step(&glide, &FLIGHT, DT).unwrap();
     assert_eq!(o.climb_rate_demand, 1.0);
     let gamma = 1.0 / 17.0;
-    let ff = gamma * G_MPS2 / t.thr_accel;
+    let ff = gamma * GRAVITY / t.thr_accel;
     assert!((ff - 0.108).abs() < 1e-3);
     // One step of integration on top.
     let want = FLIGHT.trim_throttle + ff + t.thr_kp * gamma + t.thr_ki * gamma * DT;
@@ -125,7 +125,7 @@ fn a_far_climb_is_rate_limited_and_the_throttle_integrator_does_not_wind_up() {
     // The integrator holds just what brings the output to full, 1 - trim - ff - p = 0.054,
     // where a plain one would hold 0.18 rad * 2.75/s * 10 s = 4.9 of throttle to unwind.
     let gamma = t.climb_max / 17.0;
-    let room = 1.0 - FLIGHT.trim_throttle - gamma * G_MPS2 / t.thr_accel - t.thr_kp * gamma;
+    let room = 1.0 - FLIGHT.trim_throttle - gamma * GRAVITY / t.thr_accel - t.thr_kp * gamma;
     let terms = tecs.thr.terms();
     assert!((room - 0.054).abs() < 1e-3, "{room}");
     assert!((terms.i - room).abs() < 1e-3, "{terms:?}");
