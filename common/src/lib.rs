@@ -32,7 +32,11 @@
 //! - [`link`]: MAVLink framing and the simulator interface (`HIL_*` messages).
 //! - [`crc`]: the CRC-32 of the stored records and files, MAVLink's CRC-16.
 //! - [`decimal`]: numbers in texts as fixed-point decimals, without float formatting.
-//! - [`storage`]: power-cut-safe persistence of parameters and missions in flash.
+//! - [`storage`]: power-cut-safe persistence of parameters and missions in flash, and the
+//!   flight logs' region.
+//! - [`logger`]: the flight log: PX4-named topics at their rates, into a ring the board
+//!   drains to its storage.
+//! - [`ulog`]: PX4's ULog format, the flight log's encoding.
 //! - [`math`]: the one definition of every frame change, rotation, geodetic conversion,
 //!   gravity and the standard atmosphere, generic over the float type so the f64 plant and
 //!   the f32 firmware share it.

@@ -28,9 +28,12 @@ const LAYERS: [(&str, &[&[&str]]); 3] = [
         "common",
         &[
             // What every stage is written in; the root holds the exported macros (`param!`).
-            &[ROOT, "math", "crc", "decimal"],
+            &[ROOT, "math", "crc", "decimal", "ulog"],
             // Each stage declares its parameters.
             &["params"],
+            // The flight log: its topics as plain data (the vehicle fills them) and the
+            // logger that writes them with the parameters.
+            &["logger"],
             // The two ends of the tick: typed sensor samples in, surfaces out.
             &["sensors", "actuators"],
             // The stages, and the wire formats of the two links (HIL frames carry samples
