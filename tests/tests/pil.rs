@@ -376,13 +376,13 @@ fn a_qemu_that_dies_mid_flight_ends_it_at_once_naming_how_and_the_log_is_kept() 
     assert_eq!(summary["ended"], "link_failed");
 }
 
-/// The budget of the MCU image (docs/PERFORMANCE.md, "MCU image budget"): flash at most
-/// 160 KiB; statics and the stack's measured peak at most 48 KiB; per 20 ms control period at
-/// most 100,000 instructions on average and 150,000 at most, over the runway, the station's
+/// The budget of the MCU image (docs/PERFORMANCE.md, "MCU image budget"; the design's budget
+/// since it took in autotune and the flight log): flash at most 192 KiB; statics, the stack's
+/// measured peak and the log's buffers at most 64 KiB; per 20 ms control period at most
+/// 100,000 instructions on average and 150,000 at most, over the runway, the station's
 /// parameter and mission traffic, the take-off and the first legs (every period counted).
-/// Measured 2026-12-04, evening (profile `mcu`, 75 s of flight in 51 s of wall time): flash
-/// 162,800 B, statics 2,140 B + stack peak 38,732 B, 86,491 instructions per control period on
-/// average and 140,408 at most.
+/// Measured 2026-12-06 (profile `mcu`, 75 s of flight): flash 165,260 B, statics 2,140 B +
+/// stack peak 38,780 B, 87,988 instructions per control period on average and 143,382 at most.
 #[test]
 fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
     let Some(qemu) = mcu() else { return };
@@ -395,8 +395,8 @@ fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
     .expect("the PIL flight");
     let b = pil.mcu.expect("the image's figures of itself");
     eprintln!("MCU budget: {b:?}");
-    assert!(b.flash_bytes <= 160 * 1024, "flash {b:?}");
-    assert!(b.ram_bytes() <= 48 * 1024, "RAM {b:?}");
+    assert!(b.flash_bytes <= 192 * 1024, "flash {b:?}");
+    assert!(b.ram_bytes() <= 64 * 1024, "RAM {b:?}");
     assert!(b.instr_per_control_period_mean <= 100_000.0, "{b:?}");
     assert!(b.instr_per_control_period_max <= 150_000.0, "{b:?}");
 }
