@@ -257,6 +257,31 @@ impl Ins {
             && within(d[IV].max(d[IV + 1]).max(d[IV + 2]), vel)
     }
 
+    /// The filter's states for the flight log, in PX4's order (attitude quaternion w x y z,
+    /// velocity NED, position NED, gyro bias, the barometer's offset), and the variances of
+    /// its error state in the filter's own order (attitude error, velocity, position, gyro
+    /// bias, the barometer's offset).
+    pub fn states_and_variances(&self) -> ([f32; N + 1], [f32; N]) {
+        let q = self.q.quaternion();
+        let mut x = [0.0; N + 1];
+        x[0] = q.w;
+        x[1] = q.i;
+        x[2] = q.j;
+        x[3] = q.k;
+        for k in 0..3 {
+            x[4 + k] = self.v[k];
+            x[7 + k] = self.p[k];
+            x[10 + k] = self.bias[k];
+        }
+        x[N] = self.baro_offset;
+        let d = self.cov.diagonal();
+        let mut var = [0.0; N];
+        for (v, dk) in var.iter_mut().zip(d.iter()) {
+            *v = *dk;
+        }
+        (x, var)
+    }
+
     /// 1-sigma horizontal position, vertical position and velocity (largest axis) uncertainty.
     pub fn nav_sigmas(&self) -> (f32, f32, f32) {
         let d = self.cov.diagonal();

@@ -608,6 +608,15 @@ impl Estimator {
         self.ins.bias_sigma()
     }
 
+    /// The navigation filter's states and its error state's variances
+    /// ([`Ins::states_and_variances`]), and the 1-sigma horizontal and vertical position
+    /// uncertainty, m: what the flight log records of the filter.
+    pub fn filter_states(&self) -> ([f32; ins::N + 1], [f32; ins::N], f32, f32) {
+        let (x, var) = self.ins.states_and_variances();
+        let (h, v, _) = self.ins.nav_sigmas();
+        (x, var, h, v)
+    }
+
     /// Home as [`EstimatedState::home`] gives it, without forming the whole estimate.
     pub fn home(&self) -> Option<Home> {
         self.origin.home(self.baro_drift_m())

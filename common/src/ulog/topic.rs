@@ -1,6 +1,6 @@
 //! A logged topic's format: its name and fields, as ULog's format message writes them.
 
-use super::Cursor;
+use super::cursor::Cursor;
 
 /// A field's element type, with the C name ULog writes for it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

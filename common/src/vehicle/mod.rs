@@ -26,6 +26,7 @@
 pub mod clock;
 pub mod commander;
 pub mod land_detector;
+pub mod log;
 pub mod modes;
 pub mod params;
 pub mod report;
@@ -59,6 +60,23 @@ pub use commander::Notice;
 
 /// Control period, us: the thesis's 50 Hz.
 pub const CONTROL_PERIOD_US: u64 = 20_000;
+
+/// The angles the outer loops asked the inner loops for, rad (NaN: the loop is off).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopCommands {
+    /// Roll angle asked of the roll loop.
+    pub roll_cmd: f32,
+    /// Pitch angle asked of the pitch loop.
+    pub pitch_cmd: f32,
+}
+
+impl LoopCommands {
+    /// Both loops off.
+    pub const OFF: Self = Self {
+        roll_cmd: f32::NAN,
+        pitch_cmd: f32::NAN,
+    };
+}
 
 /// What the ground link hands the vehicle with each sensor frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -94,6 +112,9 @@ pub struct Vehicle {
     last_gps: Option<GpsFix>,
     truth: Option<Measurements>,
     surfaces: Surfaces,
+    /// The angles the outer loops asked the inner loops for in the last tick (NaN when a
+    /// loop was off), for the flight log.
+    loops: LoopCommands,
     /// The last frame was refused for its time.
     refusing: bool,
 }
@@ -140,6 +161,7 @@ impl Vehicle {
             last_gps: None,
             truth: None,
             surfaces: trim_surfaces(&GainSet::default()),
+            loops: LoopCommands::OFF,
             refusing: false,
         }
     }
@@ -397,10 +419,18 @@ impl Vehicle {
         match out.demand {
             Demand::Surfaces(s) => {
                 self.surfaces = s;
+                self.loops = LoopCommands::OFF;
                 // The loops start from these positions when a stabilised mode engages.
                 self.autopilot.handover(s);
             }
-            Demand::Commands(c) => self.surfaces = self.autopilot.step(&m, &c, dt).surfaces,
+            Demand::Commands(c) => {
+                let out = self.autopilot.step(&m, &c, dt);
+                self.surfaces = out.surfaces;
+                self.loops = LoopCommands {
+                    roll_cmd: out.status.roll_cmd,
+                    pitch_cmd: out.status.pitch_cmd,
+                };
+            }
         }
     }
 

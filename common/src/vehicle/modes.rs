@@ -121,6 +121,9 @@ pub struct ModeFacts {
     pub name: &'static str,
     /// PX4 (main, sub) mode numbers of the heartbeat's `custom_mode`.
     pub px4: (u8, u8),
+    /// PX4's navigation state (`vehicle_status.nav_state`), which the flight log records and
+    /// Flight Review names the mode by.
+    pub px4_nav_state: u8,
     /// The standard-modes number, `NON_STANDARD` for modes the standard does not name.
     pub standard: MavStandardMode,
     /// `AVAILABLE_MODES.properties`.
@@ -137,6 +140,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Manual,
         name: "Manual",
         px4: (px4_main::MANUAL, 0),
+        px4_nav_state: 0,
         standard: MavStandardMode::MAV_STANDARD_MODE_NON_STANDARD,
         properties: MavModeProperty::empty(),
         needs: Needs::Nothing,
@@ -146,6 +150,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Stabilized,
         name: "Stabilized",
         px4: (px4_main::STABILIZED, 0),
+        px4_nav_state: 15,
         standard: MavStandardMode::MAV_STANDARD_MODE_NON_STANDARD,
         properties: MavModeProperty::empty(),
         needs: Needs::Nothing,
@@ -155,6 +160,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Altitude,
         name: "Altitude",
         px4: (px4_main::ALTCTL, 0),
+        px4_nav_state: 1,
         standard: MavStandardMode::MAV_STANDARD_MODE_ALTITUDE_HOLD,
         properties: MavModeProperty::empty(),
         needs: Needs::Attitude,
@@ -164,6 +170,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Hold,
         name: "Hold",
         px4: (px4_main::POSCTL, 0),
+        px4_nav_state: 2,
         // The standard reserves POSITION_HOLD for vehicles that can stop; a fixed wing
         // holding its track and altitude is CRUISE.
         standard: MavStandardMode::MAV_STANDARD_MODE_CRUISE,
@@ -175,6 +182,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Mission,
         name: "Mission",
         px4: (px4_main::AUTO, px4_auto::MISSION),
+        px4_nav_state: 3,
         standard: MavStandardMode::MAV_STANDARD_MODE_MISSION,
         properties: MavModeProperty::MAV_MODE_PROPERTY_AUTO_MODE,
         needs: Needs::PositionAndHome,
@@ -184,6 +192,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Loiter,
         name: "Loiter",
         px4: (px4_main::AUTO, px4_auto::LOITER),
+        px4_nav_state: 4,
         // The standard's ORBIT is a manual, stick-adjusted orbit, and QGroundControl never
         // offers it in its mode menu; PX4 reports its fixed-wing Hold (this Loiter) as
         // non-standard too and takes ORBIT only as an alias (`from_standard`).
@@ -196,6 +205,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Return,
         name: "Return",
         px4: (px4_main::AUTO, px4_auto::RTL),
+        px4_nav_state: 5,
         standard: MavStandardMode::MAV_STANDARD_MODE_SAFE_RECOVERY,
         properties: MavModeProperty::MAV_MODE_PROPERTY_AUTO_MODE,
         needs: Needs::PositionAndHome,
@@ -205,6 +215,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Takeoff,
         name: "Takeoff",
         px4: (px4_main::AUTO, px4_auto::TAKEOFF),
+        px4_nav_state: 17,
         standard: MavStandardMode::MAV_STANDARD_MODE_TAKEOFF,
         properties: MavModeProperty::MAV_MODE_PROPERTY_AUTO_MODE,
         needs: Needs::PositionAndHome,
@@ -214,6 +225,7 @@ pub const MODES: [ModeFacts; 9] = [
         mode: FlightMode::Land,
         name: "Land",
         px4: (px4_main::AUTO, px4_auto::LAND),
+        px4_nav_state: 18,
         standard: MavStandardMode::MAV_STANDARD_MODE_LAND,
         properties: MavModeProperty::MAV_MODE_PROPERTY_AUTO_MODE,
         needs: Needs::PositionAndHome,
@@ -279,6 +291,11 @@ impl FlightMode {
     /// PX4 (main, sub) mode numbers.
     pub const fn px4(self) -> (u8, u8) {
         self.facts().px4
+    }
+
+    /// PX4's navigation state of the mode.
+    pub const fn px4_nav_state(self) -> u8 {
+        self.facts().px4_nav_state
     }
 
     /// The heartbeat's `custom_mode` in PX4's encoding.
