@@ -140,6 +140,7 @@ impl Sitl {
                 Duration::from_secs(1),
                 Some(&mut gcs),
                 Some(&mut storage),
+                None,
             );
             drop(fw_stop);
         });

@@ -119,6 +119,7 @@ fn a_station_flies_the_default_mission_through_sim_host_sim_and_the_host_build()
             Duration::from_secs(5),
             Some(&mut ground),
             None,
+            None,
         )
     });
 

@@ -119,6 +119,15 @@ impl GroundPort {
             .map_or(1, FrameParser::bytes_wanted)
     }
 
+    /// The link's figures for the flight log.
+    pub(crate) fn log_figures(&self) -> super::log::GroundFigures {
+        super::log::GroundFigures {
+            stats: self.stats(),
+            tx_dropped: self.bytes_dropped(),
+            heard_us: self.link.gcs_last_seen_us(),
+        }
+    }
+
     /// Bytes dropped because the output buffer was full.
     pub fn bytes_dropped(&self) -> u32 {
         self.bytes_dropped

@@ -15,6 +15,7 @@
 //! sensor timestamps on the MCU; nothing here reads a clock of its own.
 
 pub mod ground;
+pub mod log;
 pub mod persist;
 pub mod reset;
 pub mod simlink;
@@ -30,6 +31,7 @@ use common::vehicle::modes::FlightMode;
 use common::vehicle::snapshot::VehicleSnapshot;
 use common::vehicle::Vehicle;
 use ground::GroundPort;
+use log::FlightLog;
 use simlink::SimPort;
 
 pub use simlink::SimLinkHealth;
@@ -46,6 +48,7 @@ pub struct App {
     vehicle: Vehicle,
     sim: SimPort,
     ground: GroundPort,
+    log: FlightLog,
 }
 
 impl Default for App {
@@ -72,6 +75,7 @@ impl App {
             vehicle: Vehicle::fresh(),
             sim: SimPort::new(),
             ground: GroundPort::new(),
+            log: FlightLog::new(),
         }
     }
 
@@ -88,6 +92,16 @@ impl App {
     /// The vehicle, writable (loading persisted parameters and missions at start-up).
     pub fn vehicle_mut(&mut self) -> &mut Vehicle {
         &mut self.vehicle
+    }
+
+    /// The flight log (off until the board enables it).
+    pub fn flight_log(&self) -> &FlightLog {
+        &self.log
+    }
+
+    /// The flight log, writable: the board enables it and drains it into its storage.
+    pub fn flight_log_mut(&mut self) -> &mut FlightLog {
+        &mut self.log
     }
 
     /// Counters of the simulator link.
@@ -208,8 +222,13 @@ impl App {
 
     /// Feeds bytes from the simulator link; `out` receives the bytes to send back.
     pub fn on_sim_bytes(&mut self, bytes: &[u8], out: &mut impl FnMut(&[u8])) {
-        self.sim
-            .on_bytes(bytes, &mut self.vehicle, &mut self.ground, out);
+        self.sim.on_bytes(
+            bytes,
+            &mut self.vehicle,
+            &mut self.ground,
+            &mut self.log,
+            out,
+        );
     }
 
     /// Bytes the simulator link's parser needs before it can check its next frame: a board

@@ -11,6 +11,7 @@ use common::vehicle::Vehicle;
 use mavlink::dialects::common::{MavMessage, HIL_STATE_QUATERNION_DATA};
 
 use super::ground::GroundPort;
+use super::log::FlightLog;
 use common::gcs::{COMPONENT_ID, SYSTEM_ID};
 
 /// Counters the autopilot keeps about its simulator link.
@@ -111,11 +112,12 @@ impl SimPort {
         bytes: &[u8],
         vehicle: &mut Vehicle,
         ground: &mut GroundPort,
+        log: &mut FlightLog,
         out: &mut impl FnMut(&[u8]),
     ) {
         let answers = &mut self.answers;
         self.parser.push(bytes, |frame| {
-            answers.on_frame(&frame, vehicle, ground, out)
+            answers.on_frame(&frame, vehicle, ground, log, out)
         });
     }
 }
@@ -126,6 +128,7 @@ impl Answers {
         frame: &Frame,
         vehicle: &mut Vehicle,
         ground: &mut GroundPort,
+        log: &mut FlightLog,
         out: &mut impl FnMut(&[u8]),
     ) {
         if frame.header.system_id != u32::from(SYSTEM_ID) {
@@ -138,6 +141,7 @@ impl Answers {
                 self.count_rejections(rejected);
                 self.health.sensor_frames += 1;
                 vehicle.on_sensors(&sensors, &ground.from_ground());
+                log.after_frame(vehicle, &sensors, &ground.log_figures());
                 ground.poll(vehicle.time_us().unwrap_or(0), vehicle);
                 // The answer names the frame it answers, in the simulator's own time.
                 let answer = ActuatorFrame {

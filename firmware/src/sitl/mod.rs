@@ -8,17 +8,19 @@
 
 use crate::app::App;
 use std::io;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 mod args;
 mod ground;
+mod logs;
 mod run;
 mod storage;
 mod transport;
 
 use args::Args;
 pub use ground::{GcsUdp, MAX_GCS_PEERS, PEER_TIMEOUT};
+pub use logs::LogFiles;
 pub use run::{run, run_with};
 pub use storage::FileStorage;
 pub use transport::{connect, read_serial, read_tcp, timed_out, ByteLink, SimEndpoint};
@@ -46,6 +48,9 @@ pub fn main() -> std::process::ExitCode {
     for note in storage.load_into(&mut app) {
         eprintln!("firmware: {note}");
     }
+    // One ULog file per armed flight, in `logs/` beside the storage file.
+    let mut logs = (args.storage != "none")
+        .then(|| LogFiles::new(LogFiles::beside(Path::new(&args.storage)), &mut app));
     let remote = (args.gcs_remote != "none").then_some(args.gcs_remote.as_str());
     let mut gcs = match GcsUdp::open(&args.gcs_bind, remote) {
         Ok(g) => g,
@@ -67,6 +72,7 @@ pub fn main() -> std::process::ExitCode {
         Duration::from_secs_f64(args.silence_s.max(0.1)),
         Some(&mut gcs),
         Some(&mut storage),
+        logs.as_mut(),
     ) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

@@ -2,6 +2,7 @@
 //! with the ground port and the storage served between reads.
 
 use super::ground::GcsUdp;
+use super::logs::LogFiles;
 use super::storage::FileStorage;
 use super::transport::ByteLink;
 use crate::app::App;
@@ -11,16 +12,17 @@ use std::time::{Duration, Instant};
 /// Runs the autopilot against a simulator link until the link closes or stays silent for
 /// `silence`.
 pub fn run(link: &mut dyn ByteLink, app: &mut App, silence: Duration) -> io::Result<()> {
-    run_with(link, app, silence, None, None)
+    run_with(link, app, silence, None, None, None)
 }
 
-/// [`run`] with a ground-station link and persistent storage.
+/// [`run`] with a ground-station link, persistent storage and flight-log files.
 pub fn run_with(
     link: &mut dyn ByteLink,
     app: &mut App,
     silence: Duration,
     mut gcs: Option<&mut GcsUdp>,
     mut storage: Option<&mut FileStorage>,
+    mut logs: Option<&mut LogFiles>,
 ) -> io::Result<()> {
     // Announce ourselves: a UDP simulator learns our address from the first datagram.
     let hb = crate::app::heartbeat_frame(app);
@@ -38,6 +40,14 @@ pub fn run_with(
         if let Some(s) = storage.as_deref_mut() {
             if let Err(e) = s.save_changes(app) {
                 eprintln!("firmware: {e}");
+            }
+        }
+        if let Some(l) = logs.as_deref_mut() {
+            if let Err(e) = l.service(app) {
+                // A log that cannot be written stops logging, never flying.
+                eprintln!("firmware: flight log: {e}; logging stopped");
+                app.flight_log_mut().enable(false);
+                logs = None;
             }
         }
         if n == 0 {

@@ -231,6 +231,7 @@ impl Transport for PtyServer {
 pub struct Inproc {
     app: firmware::app::App,
     from_app: VecDeque<u8>,
+    logs: Option<firmware::sitl::LogFiles>,
 }
 
 impl Inproc {
@@ -241,7 +242,15 @@ impl Inproc {
         Self {
             app,
             from_app: hello.iter().copied().collect(),
+            logs: None,
         }
+    }
+
+    /// The autopilot writes a ULog file per armed flight into `dir`, as the SITL board does
+    /// beside its storage file.
+    pub fn with_logs(mut self, dir: PathBuf) -> Self {
+        self.logs = Some(firmware::sitl::LogFiles::new(dir, &mut self.app));
+        self
     }
 
     /// The autopilot, for inspection.
@@ -259,6 +268,9 @@ impl Transport for Inproc {
     fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
         let out = &mut self.from_app;
         self.app.on_sim_bytes(bytes, &mut |b| out.extend(b));
+        if let Some(logs) = self.logs.as_mut() {
+            logs.service(&mut self.app)?;
+        }
         Ok(())
     }
 

@@ -40,7 +40,10 @@ pub fn fly_report(
         LinkKind::Inproc => run_on(
             aircraft,
             &cfg,
-            Inproc::new(App::new()),
+            match &opts.out {
+                Some(dir) => Inproc::new(App::new()).with_logs(dir.join("logs")),
+                None => Inproc::new(App::new()),
+            },
             &mut InprocOnboard,
             tlog,
         )?,

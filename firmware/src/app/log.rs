@@ -1,0 +1,136 @@
+//! The flight log of the application: started when the vehicle arms, fed after every sensor
+//! frame, stopped when it disarms; the board drains its bytes into its storage.
+//!
+//! A board without log storage leaves it off ([`FlightLog::enable`]): nothing is encoded, so
+//! a log nobody keeps costs no control period.
+
+use common::link::framing::LinkStats;
+use common::logger::topics::TelemetryStatus;
+use common::logger::{LogStats, Logger, SystemInfo};
+use common::sensors::SensorFrame;
+use common::vehicle::Vehicle;
+
+/// What the log says of the software and the board.
+const INFO: SystemInfo = SystemInfo {
+    sys_name: "fixed-wing autopilot",
+    ver_sw: env!("CARGO_PKG_VERSION"),
+    ver_hw: if cfg!(target_os = "none") {
+        "STM32F405"
+    } else {
+        "SITL"
+    },
+};
+
+/// The application's flight log.
+pub struct FlightLog {
+    logger: Logger,
+    enabled: bool,
+    armed: bool,
+    logs: u32,
+}
+
+impl Default for FlightLog {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl FlightLog {
+    /// A flight log that is off until the board enables it.
+    pub fn new() -> Self {
+        Self {
+            logger: Logger::new(INFO),
+            enabled: false,
+            armed: false,
+            logs: 0,
+        }
+    }
+
+    /// Switches logging on (a board with storage for logs) or off.
+    pub fn enable(&mut self, on: bool) {
+        self.enabled = on;
+        if !on {
+            self.logger.stop();
+        }
+    }
+
+    /// Logs started since boot: a board opens a new file (or flash log) when this changes.
+    pub fn logs_started(&self) -> u32 {
+        self.logs
+    }
+
+    /// Whether a log is being recorded.
+    pub fn recording(&self) -> bool {
+        self.logger.recording()
+    }
+
+    /// What the current (or last) log lost and took.
+    pub fn stats(&self) -> LogStats {
+        self.logger.stats()
+    }
+
+    /// The oldest bytes waiting for the storage.
+    pub fn pending(&self) -> &[u8] {
+        self.logger.pending()
+    }
+
+    /// Bytes waiting for the storage in all.
+    pub fn pending_len(&self) -> usize {
+        self.logger.pending_len()
+    }
+
+    /// The storage took the first `n` bytes of [`FlightLog::pending`].
+    pub fn consume(&mut self, n: usize) {
+        self.logger.consume(n);
+    }
+
+    /// After the vehicle took sensor frame `f`: starts a log on arming, stops it on
+    /// disarming, and writes what is due.
+    pub(crate) fn after_frame(&mut self, v: &Vehicle, f: &SensorFrame, ground: &GroundFigures) {
+        if !self.enabled {
+            return;
+        }
+        let Some(now) = v.time_us() else { return };
+        let armed = v.armed();
+        // A log starts once the last one is drained (the board empties the ring after each
+        // frame), so the board never finds two logs' bytes in the ring at once.
+        if armed && !self.logger.recording() && !self.armed && self.logger.pending_len() == 0 {
+            self.logger.start(now);
+            self.logs = self.logs.wrapping_add(1);
+            self.armed = true;
+        } else if !armed && self.armed {
+            self.logger.stop();
+            self.armed = false;
+        }
+        if !self.logger.recording() {
+            return;
+        }
+        self.logger.step(now, v.params());
+        v.write_log(&mut self.logger, f);
+        if self.logger.due::<TelemetryStatus>(now) {
+            let s = ground.stats;
+            self.logger.write(
+                now,
+                &TelemetryStatus {
+                    rx_message_count: s.frames_ok,
+                    rx_error_count: s
+                        .crc_errors
+                        .saturating_add(s.unknown_ids)
+                        .saturating_add(s.parse_errors)
+                        .saturating_add(s.unsupported),
+                    tx_dropped_count: ground.tx_dropped,
+                    heartbeat_age_ms: ground.heard_us.map_or(u32::MAX, |t| {
+                        u32::try_from(now.saturating_sub(t) / 1000).unwrap_or(u32::MAX)
+                    }),
+                },
+            );
+        }
+    }
+}
+
+/// The ground link's figures the log records.
+pub(crate) struct GroundFigures {
+    pub(crate) stats: LinkStats,
+    pub(crate) tx_dropped: u32,
+    pub(crate) heard_us: Option<u64>,
+}
