@@ -215,7 +215,7 @@ macro_rules! ulog_topic {
                     count: <$ty as $crate::ulog::topic::Value>::COUNT,
                 }),*],
             };
-            fn encode(&self, c: &mut $crate::ulog::Cursor<'_>) {
+            fn encode(&self, c: &mut $crate::ulog::cursor::Cursor<'_>) {
                 $($crate::ulog::topic::Value::put(&self.$field, c);)*
             }
         }
