@@ -2,7 +2,8 @@
 //! frame, stopped when it disarms; the board drains its bytes into its storage.
 //!
 //! A board without log storage leaves it off ([`FlightLog::enable`]): nothing is encoded, so
-//! a log nobody keeps costs no control period.
+//! a log nobody keeps costs no control period. The MCU image, which has no storage for logs
+//! yet, is built without the logging itself.
 
 use common::link::framing::LinkStats;
 use common::logger::topics::TelemetryStatus;
@@ -87,7 +88,9 @@ impl FlightLog {
     /// After the vehicle took sensor frame `f`: starts a log on arming, stops it on
     /// disarming, and writes what is due.
     pub(crate) fn after_frame(&mut self, v: &Vehicle, f: &SensorFrame, ground: &GroundFigures) {
-        if !self.enabled {
+        // The MCU board has no storage for logs yet: the image leaves the logging out (7 KB of
+        // code it would carry switched off) until it has.
+        if !self.enabled || cfg!(target_os = "none") {
             return;
         }
         let Some(now) = v.time_us() else { return };
