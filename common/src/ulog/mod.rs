@@ -28,6 +28,7 @@ pub mod cursor;
 pub mod topic;
 
 pub use cursor::{Cursor, TooLong};
+use topic::Value;
 pub use topic::{Field, Format, Ty};
 
 /// The file's first seven bytes.
@@ -144,31 +145,29 @@ pub fn info_str(buf: &mut [u8], name: &str, value: &str) -> Result<usize, TooLon
 
 /// An information message with a `uint32_t` value.
 pub fn info_u32(buf: &mut [u8], name: &str, value: u32) -> Result<usize, TooLong> {
-    message(buf, MsgType::Info, |c| {
-        key(c, |k| {
-            k.put(b"uint32_t ").put(name.as_bytes());
-        });
-        c.u32(value);
-    })
+    scalar(buf, MsgType::Info, name, value)
 }
 
 /// A parameter with a real value: key `float NAME`.
 pub fn parameter_f32(buf: &mut [u8], name: &str, value: f32) -> Result<usize, TooLong> {
-    message(buf, MsgType::Parameter, |c| {
-        key(c, |k| {
-            k.put(b"float ").put(name.as_bytes());
-        });
-        c.f32(value);
-    })
+    scalar(buf, MsgType::Parameter, name, value)
 }
 
 /// A parameter with an integer value: key `int32_t NAME`.
 pub fn parameter_i32(buf: &mut [u8], name: &str, value: i32) -> Result<usize, TooLong> {
-    message(buf, MsgType::Parameter, |c| {
+    scalar(buf, MsgType::Parameter, name, value)
+}
+
+/// A keyed message with one scalar: key `TYPE NAME` (the C name a topic's field of that type
+/// has), then the value.
+fn scalar<V: Value>(buf: &mut [u8], kind: MsgType, name: &str, value: V) -> Result<usize, TooLong> {
+    message(buf, kind, |c| {
         key(c, |k| {
-            k.put(b"int32_t ").put(name.as_bytes());
+            k.put(V::TY.c_name().as_bytes())
+                .put(b" ")
+                .put(name.as_bytes());
         });
-        c.i32(value);
+        value.put(c);
     })
 }
 
