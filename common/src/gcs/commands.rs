@@ -66,34 +66,28 @@ impl CommandService {
         self.requests.mode.unwrap_or(v.mode)
     }
 
-    /// `COMMAND_LONG`.
-    pub(crate) fn on_command_long(
+    /// `COMMAND_LONG` or `COMMAND_INT` (its position as integers, taken as the same seven
+    /// parameters): acknowledged, and a request for the vehicle where it asks for one.
+    pub(crate) fn on_command_message(
         &mut self,
-        d: &COMMAND_LONG_DATA,
+        msg: &MavMessage,
         from: Peer,
         cx: CommandContext<'_, '_>,
     ) {
-        let c = Command {
-            cmd: d.command,
-            p: [
-                d.param1, d.param2, d.param3, d.param4, d.param5, d.param6, d.param7,
-            ],
-        };
-        self.on_command(c, from, cx);
-    }
-
-    /// `COMMAND_INT`: its integer x and y as floats, as `COMMAND_LONG` carries them.
-    pub(crate) fn on_command_int(
-        &mut self,
-        d: &COMMAND_INT_DATA,
-        from: Peer,
-        cx: CommandContext<'_, '_>,
-    ) {
-        let c = Command {
-            cmd: d.command,
-            p: [
-                d.param1, d.param2, d.param3, d.param4, d.x as f32, d.y as f32, d.z,
-            ],
+        let c = match msg {
+            MavMessage::COMMAND_LONG(d) => Command {
+                cmd: d.command,
+                p: [
+                    d.param1, d.param2, d.param3, d.param4, d.param5, d.param6, d.param7,
+                ],
+            },
+            MavMessage::COMMAND_INT(d) => Command {
+                cmd: d.command,
+                p: [
+                    d.param1, d.param2, d.param3, d.param4, d.x as f32, d.y as f32, d.z,
+                ],
+            },
+            _ => return,
         };
         self.on_command(c, from, cx);
     }

@@ -249,7 +249,7 @@ impl GroundLink {
                 self.commands.on_manual_control(d, now_us);
                 None
             }
-            MavMessage::COMMAND_LONG(d) => {
+            MavMessage::COMMAND_LONG(_) | MavMessage::COMMAND_INT(_) => {
                 let cx = CommandContext {
                     now_us,
                     vehicle,
@@ -258,19 +258,7 @@ impl GroundLink {
                     metadata: self.ftp.general().is_some(),
                     out: &mut *out,
                 };
-                self.commands.on_command_long(d, from, cx);
-                None
-            }
-            MavMessage::COMMAND_INT(d) => {
-                let cx = CommandContext {
-                    now_us,
-                    vehicle,
-                    stores,
-                    streams: &mut self.streams,
-                    metadata: self.ftp.general().is_some(),
-                    out: &mut *out,
-                };
-                self.commands.on_command_int(d, from, cx);
+                self.commands.on_command_message(msg, from, cx);
                 None
             }
             MavMessage::SET_MODE(d) => {
