@@ -185,6 +185,11 @@ impl Logger {
         }
     }
 
+    /// Whether any topic is due at `now_us` (the caller gathers nothing otherwise).
+    pub fn any_due(&self, now_us: u64) -> bool {
+        self.stage == Some(Stage::Data) && self.next_due_us.iter().any(|&t| now_us >= t)
+    }
+
     /// Whether topic `T` is due at `now_us` (the caller builds the sample only then).
     pub fn due<T: Logged>(&self, now_us: u64) -> bool {
         self.stage == Some(Stage::Data)

@@ -24,10 +24,13 @@ impl Vehicle {
     /// Writes every topic due at the vehicle's time; `frame` is the sensor frame just taken.
     pub fn write_log(&self, log: &mut Logger, frame: &SensorFrame) {
         // Before its first frame the vehicle has no time, and nothing to log.
-        let Some(now) = self.clock.now_us() else {
+        let Some(now) = self.clock.now_us().filter(|&t| log.any_due(t)) else {
             return;
         };
+        // Three frames in four have nothing due at the fastest rate: the estimate is formed
+        // only when something is.
         let e = self.estimator.state();
+        let (states, variances, eph, epv) = self.estimator.filter_states();
         if log.due::<VehicleAttitude>(now) {
             let q = e.attitude.quaternion();
             log.write(
@@ -93,7 +96,6 @@ impl Vehicle {
             );
         }
         if log.due::<VehicleLocalPosition>(now) {
-            let (_, _, eph, epv) = self.estimator.filter_states();
             let (ref_lat, ref_lon, ref_alt) = match e.home {
                 Some(h) => {
                     let (lat, lon) = lat_lon(h.point);
@@ -197,15 +199,14 @@ impl Vehicle {
             );
         }
         if log.due::<EstimatorStates>(now) {
-            let (x, var, _, _) = self.estimator.filter_states();
             let mut t = EstimatorStates {
-                n_states: x.len() as u8,
+                n_states: states.len() as u8,
                 ..Default::default()
             };
-            for (d, s) in t.states.iter_mut().zip(x) {
+            for (d, s) in t.states.iter_mut().zip(states) {
                 *d = s;
             }
-            for (d, s) in t.covariances.iter_mut().zip(var) {
+            for (d, s) in t.covariances.iter_mut().zip(variances) {
                 *d = s;
             }
             log.write(now, &t);
