@@ -310,17 +310,6 @@ pub fn read<F: Flash>(
     Ok(done)
 }
 
-/// Erases every sector of the region: all logs gone (MAVLink's LOG_ERASE).
-pub fn erase_all<F: Flash>(flash: &mut F, region: &LogRegion) -> Result<(), LogError<F::Error>> {
-    region.check()?;
-    for s in 0..region.sectors {
-        flash
-            .erase_sector(region.sector_addr(s))
-            .map_err(LogError::Flash)?;
-    }
-    Ok(())
-}
-
 /// A log being written: bytes gather in a block's payload in RAM and go to flash a whole block
 /// at a time; only the last block, written by [`LogWriter::close`], is partly filled (a reader
 /// finds any byte of the log from that).

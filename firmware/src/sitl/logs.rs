@@ -32,11 +32,6 @@ impl LogFiles {
             .map_or_else(|| PathBuf::from("logs"), |p| p.join("logs"))
     }
 
-    /// The file being written, if any.
-    pub fn current(&self) -> Option<&Path> {
-        self.file.as_ref().map(|(p, _)| p.as_path())
-    }
-
     /// Writes what the application's log has for its storage; opens a file when a log
     /// starts and closes it once a stopped log is drained.
     pub fn service(&mut self, app: &mut App) -> io::Result<()> {
