@@ -95,6 +95,15 @@ struct Sitl {
 
 impl Sitl {
     fn start(storage: Option<PathBuf>, gps: Arc<AtomicBool>) -> Self {
+        Self::start_with_logs(storage, gps, None)
+    }
+
+    /// [`Sitl::start`] with its flight logs in `logs`.
+    fn start_with_logs(
+        storage: Option<PathBuf>,
+        gps: Arc<AtomicBool>,
+        logs: Option<PathBuf>,
+    ) -> Self {
         let stop = Arc::new(AtomicBool::new(false));
         let gcs = GcsUdp::open("127.0.0.1:0", None).expect("gcs socket");
         let gcs_addr = gcs.local_addr().expect("gcs addr");
@@ -134,13 +143,14 @@ impl Sitl {
             let mut storage = FileStorage::open(storage);
             storage.load_into(&mut app);
             let mut gcs = gcs;
+            let mut logs = logs.map(|dir| sitl::LogFiles::new(dir, &mut app));
             let _ = sitl::run_with(
                 link.as_mut(),
                 &mut app,
                 Duration::from_secs(1),
                 Some(&mut gcs),
                 Some(&mut storage),
-                None,
+                logs.as_mut(),
             );
             drop(fw_stop);
         });
@@ -602,23 +612,43 @@ fn have_pymavlink() -> bool {
 /// Runs one of `tests/interop/`'s pymavlink scripts against a fresh SITL vehicle; false when
 /// pymavlink is missing outside CI (skipped), a failed assertion when a check fails.
 fn pymavlink_script(name: &str) -> bool {
+    pymavlink_script_with(name, None).is_some()
+}
+
+/// [`pymavlink_script`] with the vehicle's logs in `logs`, passed as the script's second
+/// argument; what it printed, `None` when skipped.
+fn pymavlink_script_with(name: &str, logs: Option<&std::path::Path>) -> Option<String> {
     if !have_pymavlink() {
-        return false;
+        return None;
     }
     let gps = Arc::new(AtomicBool::new(true));
-    let sitl = Sitl::start(None, gps);
+    let sitl = Sitl::start_with_logs(None, gps, logs.map(|p| p.to_path_buf()));
     let script = system_tests::workspace_root()
         .join("tests/interop")
         .join(name);
     let out = std::process::Command::new("python3")
         .arg(script)
         .arg(sitl.gcs_addr.port().to_string())
+        .args(logs)
         .output()
         .expect("python3 runs");
     let text = String::from_utf8_lossy(&out.stdout);
     eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "pymavlink checks of {name}:\n{text}");
-    true
+    Some(text.into_owned())
+}
+
+#[test]
+fn pymavlink_lists_downloads_byte_for_byte_and_erases_the_flight_logs_armed_and_on_the_ground() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let logs = dir.path().join("logs");
+    let Some(text) = pymavlink_script_with("pymavlink_logs.py", Some(&logs)) else {
+        return;
+    };
+    // docs/LOGGING.md quotes these rates.
+    for line in text.lines().filter(|l| l.starts_with("rate ")) {
+        eprintln!("{line}");
+    }
 }
 
 #[test]

@@ -28,6 +28,7 @@ pub mod client;
 pub mod commands;
 pub mod config;
 pub mod ftp;
+pub mod logs;
 pub mod manual;
 pub mod mission;
 pub mod modes;
@@ -78,6 +79,7 @@ pub struct GroundLink {
     rx_errors: u16,
     signing: Signing,
     ftp: ftp::Ftp,
+    logs: logs::LogService,
 }
 
 impl Default for GroundLink {
@@ -104,6 +106,7 @@ impl GroundLink {
             rx_errors: 0,
             signing: Signing::default(),
             ftp: ftp::Ftp::new(cfg.files),
+            logs: logs::LogService::new(),
         }
     }
 
@@ -227,6 +230,22 @@ impl GroundLink {
             }
             MavMessage::FILE_TRANSFER_PROTOCOL(d) if d.target_network == 0 => {
                 self.ftp.handle(d, from, now_us);
+                None
+            }
+            MavMessage::LOG_REQUEST_LIST(d) => {
+                self.logs.on_request_list(d, from);
+                None
+            }
+            MavMessage::LOG_REQUEST_DATA(d) => {
+                self.logs.on_request_data(d, from);
+                None
+            }
+            MavMessage::LOG_REQUEST_END(_) => {
+                self.logs.on_request_end();
+                None
+            }
+            MavMessage::LOG_ERASE(_) => {
+                self.logs.on_erase(vehicle.armed, out);
                 None
             }
             MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS => {
@@ -426,6 +445,28 @@ impl GroundLink {
                 out(Dest::All, m);
             }
         }
+    }
+
+    /// Whether a log-protocol request waits for [`GroundLink::serve_logs`].
+    pub fn logs_busy(&self) -> bool {
+        self.logs.busy()
+    }
+
+    /// Serves the log protocol's requests from the board's `store` (listing, downloading,
+    /// erasing), in at most `room` bytes of the board's output (see [`logs`] for how much of
+    /// it telemetry keeps); the board calls it after [`GroundLink::poll`], so the streams
+    /// have taken their room first. A status text it queues goes out at the next poll.
+    pub fn serve_logs<F: FnMut(Dest, Outgoing)>(
+        &mut self,
+        store: &mut dyn logs::LogStore,
+        armed: bool,
+        room: usize,
+        mut out: F,
+    ) {
+        self.logs
+            .serve(store, armed, room, &mut self.outbox, |d, m| {
+                out(d, Outgoing::Message(m))
+            });
     }
 
     /// What the queued answers and the streams are built from at this poll.

@@ -248,6 +248,23 @@ impl GroundPort {
         *self.link.signing_mut() = signing;
     }
 
+    /// Serves the log protocol's requests from the board's `store`, within `room` bytes and
+    /// what the output buffer has left (after [`GroundPort::poll`]: telemetry first).
+    pub fn serve_logs(
+        &mut self,
+        store: &mut dyn common::gcs::logs::LogStore,
+        armed: bool,
+        room: usize,
+    ) {
+        let left = GCS_OUT.saturating_sub(self.out.len()).min(room);
+        let mut signing = core::mem::take(self.link.signing_mut());
+        let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
+        self.link.serve_logs(store, armed, left, |dest, msg| {
+            queue(tx, out, dropped, &mut signing, dest, &msg)
+        });
+        *self.link.signing_mut() = signing;
+    }
+
     /// A message of the board's own (its figures of itself) to every station, framed and
     /// signed as the link's own.
     pub fn send(&mut self, msg: &MavMessage) {

@@ -197,6 +197,14 @@ impl App {
         self.ground.poll(now, &mut self.vehicle);
     }
 
+    /// Serves the ground stations' log requests (list, download, erase) from the board's
+    /// `store`, in at most `room` bytes of its output, ready for [`App::drain_gcs`]. A board
+    /// calls it when [`GroundLink::logs_busy`] says something waits.
+    pub fn serve_logs(&mut self, store: &mut dyn common::gcs::logs::LogStore, room: usize) {
+        let armed = self.vehicle.armed();
+        self.ground.serve_logs(store, armed, room);
+    }
+
     /// MAVLink 2 signing of the ground link (loading a persisted key at start-up).
     pub fn signing_mut(&mut self) -> &mut common::gcs::signing::Signing {
         self.ground.signing_mut()

@@ -6,6 +6,7 @@ use super::logs::LogFiles;
 use super::storage::FileStorage;
 use super::transport::ByteLink;
 use crate::app::App;
+use common::gcs::logs::{LogStore, NoLogs};
 use std::io;
 use std::time::{Duration, Instant};
 
@@ -48,6 +49,17 @@ pub fn run_with(
                 eprintln!("firmware: flight log: {e}; logging stopped");
                 app.flight_log_mut().enable(false);
                 logs = None;
+            }
+        }
+        if let Some(g) = gcs.as_deref_mut() {
+            if app.ground_link().logs_busy() {
+                // Without a log folder the list is empty.
+                let store: &mut dyn LogStore = match logs.as_deref_mut() {
+                    Some(l) => l,
+                    None => &mut NoLogs,
+                };
+                app.serve_logs(store, usize::MAX);
+                g.flush(app);
             }
         }
         if n == 0 {
