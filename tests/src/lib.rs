@@ -112,3 +112,46 @@ pub fn spawn_qemu(
         .expect("qemu starts");
     (Kill(child), sim, gcs)
 }
+
+/// The flight logs in an MCU image's storage file (its six log sectors of 128 KiB after the
+/// record's two of 16 KiB: `firmware/src/mcu/flash.rs`), as `common::storage::flight_log`
+/// finds them, each with its bytes.
+pub fn flash_logs(
+    storage: &std::path::Path,
+) -> Vec<(common::storage::flight_log::LogInfo, Vec<u8>)> {
+    use common::storage::flight_log::{read, scan, LogRegion};
+    /// The file's log sectors, read only.
+    struct Image(Vec<u8>);
+    impl common::storage::Flash for Image {
+        type Error = ();
+        fn erase_sector(&mut self, _: u32) -> Result<(), ()> {
+            Err(())
+        }
+        fn write(&mut self, _: u32, _: &[u8]) -> Result<(), ()> {
+            Err(())
+        }
+        fn read(&mut self, addr: u32, buf: &mut [u8]) -> Result<(), ()> {
+            let from = addr as usize;
+            let src = self.0.get(from..from + buf.len()).ok_or(())?;
+            buf.copy_from_slice(src);
+            Ok(())
+        }
+    }
+    let file = std::fs::read(storage).expect("the storage file");
+    let mut image = Image(file.get(32 * 1024..).unwrap_or(&[]).to_vec());
+    image.0.resize(768 * 1024, 0xff);
+    let region = LogRegion {
+        start: 0,
+        sector_len: 128 * 1024,
+        sectors: 6,
+    };
+    let (logs, _) = scan(&mut image, &region).expect("the log sectors scan");
+    logs.iter()
+        .map(|l| {
+            let mut bytes = vec![0u8; l.bytes as usize];
+            let n = read(&mut image, &region, l, 0, &mut bytes).expect("the log reads");
+            bytes.truncate(n);
+            (*l, bytes)
+        })
+        .collect()
+}

@@ -386,8 +386,11 @@ fn a_qemu_that_dies_mid_flight_ends_it_at_once_naming_how_and_the_log_is_kept() 
 /// peak 43,164 B, 87,547 instructions per control period on average and 141,576 at most.
 #[test]
 fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
-    let Some(qemu) = mcu() else { return };
+    let Some(mut qemu) = mcu() else { return };
     let dir = tempfile::tempdir().expect("tempdir");
+    // With its storage file, so the flight log is written to its flash sectors as on a board.
+    let storage = dir.path().join("storage.bin");
+    qemu.storage = Some(storage.clone());
     let pil = fly_report(
         &aircraft(),
         &mission(FIRST_LEGS_S),
@@ -395,6 +398,13 @@ fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
     )
     .expect("the PIL flight");
     let b = pil.mcu.expect("the image's figures of itself");
+    let logged: Vec<_> = system_tests::flash_logs(&storage)
+        .into_iter()
+        .map(|(l, _)| l)
+        .collect();
+    eprintln!("flight logs in the image's flash: {logged:?}");
+    assert_eq!(logged.len(), 1, "one log of the flight in flash");
+    assert!(logged[0].bytes > 100_000, "{logged:?}");
     eprintln!("MCU budget: {b:?}");
     assert!(b.flash_bytes <= 192 * 1024, "flash {b:?}");
     assert!(b.ram_bytes() <= 64 * 1024, "RAM {b:?}");

@@ -288,3 +288,71 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
         assert!(out.path().join(f).is_file(), "{f} written");
     }
 }
+
+/// The MCU image's flight log, listed and downloaded over its ground bridge by pymavlink the way
+/// MAVProxy's `log` module does, armed and then disarmed on the runway, and erased: the bytes
+/// are the log in the image's flash sectors (QEMU's storage file, read by the script's own
+/// reader of the block layout), and pyulog reads the download without a warning.
+#[test]
+fn pymavlink_downloads_the_mcu_images_flight_log_from_its_flash_byte_for_byte() {
+    if !tool_available("qemu-system-arm") || !tool_available("python3") {
+        return;
+    }
+    let elf = build_mcu_firmware();
+    let out = tempfile::tempdir().expect("tempdir");
+    let storage = out.path().join("storage.bin");
+    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+    let cfg = FlightConfig {
+        duration_s: 240.0,
+        runway_heading: Some(0.0),
+        scripted_station: false,
+        until_link_closes: true,
+        stop: Some(stop),
+        ..FlightConfig::default()
+    };
+    let opts = SimOptions {
+        link: LinkKind::Qemu,
+        qemu: QemuConfig {
+            elf,
+            storage: Some(storage.clone()),
+            ..QemuConfig::default()
+        },
+        gcs_bind: "127.0.0.1:0".into(),
+        gcs_remote: None,
+        out: Some(out.path().to_path_buf()),
+        plots: false,
+        ..SimOptions::default()
+    };
+    let (ready, sim) = start_sim(cfg, opts);
+    let ground: SocketAddr = ready.ground.expect("the image's ground link");
+    let downloaded = out.path().join("downloaded.ulg");
+    let script = system_tests::workspace_root().join("tests/interop/pymavlink_logs.py");
+    let run = std::process::Command::new("python3")
+        .arg(script)
+        .arg(ground.port().to_string())
+        .arg(format!("image:{}", storage.display()))
+        .arg(&downloaded)
+        .output()
+        .expect("python3 runs");
+    stop.store(true, Ordering::Relaxed);
+    let _ = sim.join();
+    let text = String::from_utf8_lossy(&run.stdout);
+    eprintln!("{text}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(run.status.success(), "pymavlink checks:\n{text}");
+    // PX4's reader, as the SITL log's test reads it (sim-host/tests/flight_log.rs).
+    let info = std::process::Command::new("ulog_info")
+        .arg(&downloaded)
+        .output()
+        .expect("ulog_info runs");
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&info.stdout),
+        String::from_utf8_lossy(&info.stderr)
+    );
+    assert!(info.status.success(), "{said}");
+    assert!(!said.to_lowercase().contains("warning"), "{said}");
+    assert!(said.contains("No Dropouts"), "{said}");
+    for topic in ["vehicle_attitude", "control_loops", "vehicle_status"] {
+        assert!(said.contains(topic), "{topic} in the log: {said}");
+    }
+}

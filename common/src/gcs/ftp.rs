@@ -1,14 +1,20 @@
-//! A read-only MAVLink FTP server (the MAVLink guide's "File Transfer Protocol") for the few
-//! files the vehicle serves from flash: the component metadata a ground station downloads
-//! (`general.json` and the parameter metadata).
+//! A read-only MAVLink FTP server (the MAVLink guide's "File Transfer Protocol") for the
+//! files the vehicle serves: the component metadata a ground station downloads
+//! (`general.json` and the parameter metadata), and the flight logs the board keeps, as
+//! `/logs/log_1.ulg`, `/logs/log_2.ulg`, ... (the ids of the log protocol's `LOG_ENTRY`, 1 the
+//! oldest).
 //!
-//! One session at a time, as PX4's. It answers `OpenFileRO` (the file's length), `ReadFile`,
-//! `BurstReadFile` (the rest of the file streamed a few packets per poll, the last flagged
-//! `burst_complete`, then `EOF`), `ResetSessions`, `TerminateSession` and `None`; anything
-//! else gets `NAK UnknownCommand`. Every reply carries the request's sequence number plus one
+//! One session at a time, as PX4's. It answers `ListDirectory` (`/` and `/logs`),
+//! `OpenFileRO` (the file's length), `ReadFile`, `BurstReadFile` (the rest of the file
+//! streamed a few packets per poll, the last flagged `burst_complete`, then `EOF`),
+//! `ResetSessions`, `TerminateSession` and `None`; anything else gets `NAK UnknownCommand`.
+//! What touches a log waits for the board's [`LogStore`] ([`Ftp::serve_logs`], called where
+//! the log protocol is served). Every reply carries the request's sequence number plus one
 //! (a burst counts on from there), which is what QGroundControl checks.
 
+use super::logs::LogStore;
 use super::peer::Peer;
+use core::fmt::Write;
 use mavlink::dialects::common::{MavMessage, FILE_TRANSFER_PROTOCOL_DATA};
 
 /// A file the vehicle serves.
@@ -55,6 +61,7 @@ const HEADER: usize = 12;
 const OP_NONE: u8 = 0;
 const OP_TERMINATE: u8 = 1;
 const OP_RESET: u8 = 2;
+const OP_LIST: u8 = 3;
 const OP_OPEN_RO: u8 = 4;
 const OP_READ: u8 = 5;
 const OP_BURST: u8 = 15;
@@ -90,7 +97,43 @@ enum Data {
         file: usize,
         len: usize,
     },
+    /// Bytes read for this reply (a log's, a listing).
+    Bytes {
+        buf: [u8; DATA_LEN],
+        len: u8,
+    },
 }
+
+/// The file a session has open.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Open {
+    /// One of the files given at start.
+    Static(usize),
+    /// A flight log, by its place in the board's list (0 the oldest).
+    Log(u16),
+}
+
+/// What a path names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Target {
+    File(Open),
+    Root,
+    Logs,
+}
+
+/// A request that waits for the board's logs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Deferred {
+    /// `ListDirectory` of `/logs`.
+    List,
+    /// `OpenFileRO` of a log.
+    Open(u16),
+    /// `ReadFile` of the open log, this many bytes.
+    Read(u16, usize),
+}
+
+/// The folder the logs are listed in.
+const LOG_DIR: &str = "logs";
 
 /// A burst in progress.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,7 +152,9 @@ struct Burst {
 pub struct Ftp {
     files: &'static [File],
     /// The open file and the station it is open for.
-    session: Option<(usize, Peer)>,
+    session: Option<(Open, Peer)>,
+    /// A request that waits for the logs: the reply's head, what it asked, and whose.
+    deferred: Option<(Reply, Deferred, Peer)>,
     /// When the session's station last asked something, µs.
     last_request_us: u64,
     reply: Option<(Reply, Peer)>,
@@ -185,19 +230,52 @@ impl Ftp {
                 self.session = None;
                 ack(Data::None)
             }
+            OP_LIST => match self.find(data) {
+                Some(Target::Root) => self.root_listing(offset).map_or(nak(ERR_EOF), ack),
+                Some(Target::Logs) => {
+                    self.deferred = Some((ack(Data::None), Deferred::List, from));
+                    self.reply = None;
+                    return;
+                }
+                _ => nak(ERR_NOT_FOUND),
+            },
             OP_OPEN_RO if self.session.is_some() && open.is_none() => nak(ERR_NO_SESSIONS),
             OP_OPEN_RO => match self.find(data) {
-                Some(i) => {
-                    self.session = Some((i, from));
+                Some(Target::File(Open::Static(i))) => {
+                    self.session = Some((Open::Static(i), from));
                     let len = self.file(i).map_or(0, |f| f.bytes.len());
                     ack(Data::Length(u32::try_from(len).unwrap_or(u32::MAX)))
                 }
-                None => nak(ERR_NOT_FOUND),
+                Some(Target::File(Open::Log(i))) => {
+                    self.deferred = Some((ack(Data::None), Deferred::Open(i), from));
+                    self.reply = None;
+                    return;
+                }
+                _ => nak(ERR_NOT_FOUND),
             },
             OP_READ | OP_BURST if session != SESSION => nak(ERR_SESSION),
             OP_READ | OP_BURST => match open {
                 None => nak(ERR_SESSION),
-                Some(f) => {
+                Some(Open::Log(i)) => {
+                    if opcode == OP_READ {
+                        let want = size.clamp(1, DATA_LEN);
+                        self.deferred = Some((ack(Data::None), Deferred::Read(i, want), from));
+                    } else {
+                        self.burst = Some(Burst {
+                            next_seq: reply_seq,
+                            offset,
+                            left: BURST_PACKETS,
+                            chunk: if size == 0 {
+                                DATA_LEN
+                            } else {
+                                size.min(DATA_LEN)
+                            },
+                        });
+                    }
+                    self.reply = None;
+                    return;
+                }
+                Some(Open::Static(f)) => {
                     let len = self.file(f).map_or(0, |f| f.bytes.len());
                     let at = usize::try_from(offset).unwrap_or(usize::MAX);
                     if at >= len {
@@ -232,14 +310,140 @@ impl Ftp {
         files.iter().find(|f| f.name == GENERAL)
     }
 
-    /// The file a request's path names (leading slashes and a trailing NUL ignored).
-    fn find(&self, path: &[u8]) -> Option<usize> {
+    /// What a request's path names (leading and trailing slashes and a trailing NUL
+    /// ignored): a served file, a log (`logs/log_N.ulg`, N from 1), or a folder.
+    fn find(&self, path: &[u8]) -> Option<Target> {
         let end = path.iter().position(|&b| b == 0).unwrap_or(path.len());
         let mut name = path.get(..end)?;
         while let Some(rest) = name.strip_prefix(b"/") {
             name = rest;
         }
-        self.files.iter().position(|f| f.name.as_bytes() == name)
+        while let Some(rest) = name.strip_suffix(b"/") {
+            name = rest;
+        }
+        if name.is_empty() {
+            return Some(Target::Root);
+        }
+        if name == LOG_DIR.as_bytes() {
+            return Some(Target::Logs);
+        }
+        if let Some(n) = name
+            .strip_prefix(b"logs/log_")
+            .and_then(|n| n.strip_suffix(b".ulg"))
+        {
+            let id = core::str::from_utf8(n).ok()?.parse::<u16>().ok()?;
+            return Some(Target::File(Open::Log(id.checked_sub(1)?)));
+        }
+        self.files
+            .iter()
+            .position(|f| f.name.as_bytes() == name)
+            .map(|i| Target::File(Open::Static(i)))
+    }
+
+    /// The root folder's entries from the `from`-th on, as many as a packet holds: the served
+    /// files and the log folder; `None` past the last.
+    fn root_listing(&self, from: u32) -> Option<Data> {
+        let files: &'static [File] = self.files;
+        let count = files.len().saturating_add(1);
+        listing(from, count, |k, s| match files.get(k) {
+            Some(f) => write!(s, "F{}\t{}", f.name, f.bytes.len()),
+            None => write!(s, "D{LOG_DIR}"),
+        })
+    }
+
+    /// Whether a request waits for the board's logs ([`Ftp::serve_logs`]).
+    pub fn wants_logs(&self) -> bool {
+        self.deferred.is_some()
+            || (self.burst.is_some() && matches!(self.session, Some((Open::Log(_), _))))
+    }
+
+    /// The next packet that needs the board's logs, and to whom: a deferred answer, else the
+    /// next of a burst of a log (at most `budget` burst packets).
+    pub fn serve_logs(
+        &mut self,
+        store: &mut dyn LogStore,
+        budget: &mut usize,
+    ) -> Option<(MavMessage, Peer)> {
+        if let Some((head, what, to)) = self.deferred.take() {
+            let nak = |e| Reply {
+                opcode: NAK,
+                data: Data::Error(e),
+                ..head
+            };
+            let ok = |data| Reply { data, ..head };
+            let r = match what {
+                Deferred::List => {
+                    // What is kept now, as for LOG_REQUEST_LIST.
+                    store.refresh();
+                    let count = usize::from(store.count());
+                    let names = |k: usize, s: &mut heapless::String<48>| {
+                        let size = store
+                            .entry(u16::try_from(k).unwrap_or(u16::MAX))
+                            .map_or(0, |e| e.size_bytes);
+                        write!(s, "Flog_{}.ulg\t{}", k.saturating_add(1), size)
+                    };
+                    listing(head.offset, count, names).map_or(nak(ERR_EOF), ok)
+                }
+                Deferred::Open(i) => match {
+                    store.refresh();
+                    store.entry(i)
+                } {
+                    Some(e) => {
+                        self.session = Some((Open::Log(i), to));
+                        ok(Data::Length(e.size_bytes))
+                    }
+                    None => nak(ERR_NOT_FOUND),
+                },
+                Deferred::Read(i, want) => {
+                    read_log(store, i, head.offset, want).map_or(nak(ERR_EOF), ok)
+                }
+            };
+            return Some((self.message(&r, to), to));
+        }
+        let b = self.burst?;
+        let (Open::Log(i), to) = self.session? else {
+            return None;
+        };
+        if *budget == 0 {
+            return None;
+        }
+        *budget = budget.saturating_sub(1);
+        let data = read_log(store, i, b.offset, b.chunk);
+        let r = match data {
+            None => {
+                self.burst = None;
+                Reply {
+                    seq: b.next_seq,
+                    opcode: NAK,
+                    req_opcode: OP_BURST,
+                    burst_complete: false,
+                    offset: b.offset,
+                    data: Data::Error(ERR_EOF),
+                }
+            }
+            Some(data) => {
+                let n = match data {
+                    Data::Bytes { len, .. } => u32::from(len),
+                    _ => 0,
+                };
+                let last = b.left <= 1;
+                self.burst = (!last).then_some(Burst {
+                    next_seq: b.next_seq.wrapping_add(1),
+                    offset: b.offset.saturating_add(n),
+                    left: b.left.saturating_sub(1),
+                    chunk: b.chunk,
+                });
+                Reply {
+                    seq: b.next_seq,
+                    opcode: ACK,
+                    req_opcode: OP_BURST,
+                    burst_complete: last,
+                    offset: b.offset,
+                    data,
+                }
+            }
+        };
+        Some((self.message(&r, to), to))
     }
 
     /// The next packet to send and to whom: a pending reply, else the next of a burst (at most
@@ -249,7 +453,10 @@ impl Ftp {
             return Some((self.message(&r, to), to));
         }
         let b = self.burst?;
-        let (f, to) = self.session?;
+        // A log's burst is served with the logs.
+        let (Open::Static(f), to) = self.session? else {
+            return None;
+        };
         if *budget == 0 {
             return None;
         }
@@ -300,6 +507,7 @@ impl Ftp {
                     .unwrap_or(&[]);
                 (bytes.len() as u8, bytes)
             }
+            Data::Bytes { ref buf, len } => (len, buf.get(..usize::from(len)).unwrap_or(&[])),
         };
         let small: [u8; 4];
         let (size, data) = match r.data {
@@ -339,6 +547,51 @@ impl Ftp {
             payload,
         })
     }
+}
+
+/// Up to `want` bytes of log `index` from `offset`; `None` at or past its end (or unreadable).
+fn read_log(store: &mut dyn LogStore, index: u16, offset: u32, want: usize) -> Option<Data> {
+    let mut buf = [0u8; DATA_LEN];
+    let n = store.read(index, offset, buf.get_mut(..want.min(DATA_LEN))?)?;
+    (n > 0).then_some(Data::Bytes {
+        buf,
+        len: u8::try_from(n).unwrap_or(0),
+    })
+}
+
+/// A `ListDirectory` answer: entries `from`.. of `count`, each written by `entry` and ended by
+/// a NUL, as many as a packet holds; `None` when `from` is past the last.
+fn listing(
+    from: u32,
+    count: usize,
+    mut entry: impl FnMut(usize, &mut heapless::String<48>) -> core::fmt::Result,
+) -> Option<Data> {
+    let first = usize::try_from(from).ok()?;
+    if first >= count {
+        return None;
+    }
+    let mut buf = [0u8; DATA_LEN];
+    let mut len = 0usize;
+    for k in first..count {
+        let mut s = heapless::String::<48>::new();
+        if entry(k, &mut s).is_err() {
+            break;
+        }
+        let end = len.saturating_add(s.len()).saturating_add(1);
+        let Some(dst) = buf.get_mut(len..end) else {
+            break;
+        };
+        let (text, nul) = dst.split_at_mut(s.len());
+        text.copy_from_slice(s.as_bytes());
+        if let Some(z) = nul.first_mut() {
+            *z = 0;
+        }
+        len = end;
+    }
+    Some(Data::Bytes {
+        buf,
+        len: u8::try_from(len).unwrap_or(0),
+    })
 }
 
 #[cfg(test)]
@@ -467,5 +720,103 @@ mod tests {
         // 0xCBF43926, which starts from all ones and inverts).
         assert_eq!(file_crc(b"123456789"), 0x2DFD_2D88);
         assert_eq!(uri(&FILES[0]).as_str(), "mftp://params.json");
+    }
+
+    /// Two logs, as a board keeps them.
+    struct TwoLogs(Vec<Vec<u8>>);
+
+    impl LogStore for TwoLogs {
+        fn refresh(&mut self) {}
+        fn count(&self) -> u16 {
+            self.0.len() as u16
+        }
+        fn entry(&self, index: u16) -> Option<crate::gcs::logs::LogEntryInfo> {
+            self.0
+                .get(usize::from(index))
+                .map(|l| crate::gcs::logs::LogEntryInfo {
+                    size_bytes: l.len() as u32,
+                    time_utc_s: 0,
+                })
+        }
+        fn read(&mut self, index: u16, offset: u32, buf: &mut [u8]) -> Option<usize> {
+            let l = self.0.get(usize::from(index))?;
+            let from = (offset as usize).min(l.len());
+            let n = buf.len().min(l.len() - from);
+            buf[..n].copy_from_slice(&l[from..from + n]);
+            Some(n)
+        }
+        fn erase_all(&mut self) -> bool {
+            false
+        }
+    }
+
+    fn with_logs(f: &mut Ftp, store: &mut TwoLogs) -> Vec<MavMessage> {
+        let mut out = Vec::new();
+        loop {
+            let mut budget = 1000;
+            match f.serve_logs(store, &mut budget) {
+                Some((m, _)) => out.push(m),
+                None => return out,
+            }
+        }
+    }
+
+    fn entries(data: &[u8]) -> Vec<std::string::String> {
+        data.split(|&b| b == 0)
+            .filter(|e| !e.is_empty())
+            .map(|e| std::string::String::from_utf8(e.to_vec()).unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn the_logs_are_listed_and_downloaded_as_files_under_logs() {
+        let log: Vec<u8> = (0..1000u32).map(|k| (k * 7) as u8).collect();
+        let mut store = TwoLogs(std::vec![std::vec![1, 2, 3], log.clone()]);
+        let mut f = Ftp::new(&FILES);
+        // The root: the served file with its size, and the log folder.
+        f.handle(&request(0, OP_LIST, 0, b"/"), QGC, 0);
+        let root = fields(&all(&mut f)[0]);
+        assert_eq!(root.1, ACK);
+        assert_eq!(entries(&root.6), ["Fparams.json\t600", "Dlogs"]);
+        // The folder waits for the logs: nothing from the poll, the list from the store.
+        f.handle(&request(2, OP_LIST, 0, b"/logs"), QGC, 0);
+        assert!(all(&mut f).is_empty() && f.wants_logs());
+        let list = fields(&with_logs(&mut f, &mut store)[0]);
+        assert_eq!((list.0, list.1), (3, ACK));
+        assert_eq!(entries(&list.6), ["Flog_1.ulg\t3", "Flog_2.ulg\t1000"]);
+        // Past the last entry: EOF, as the listing's end.
+        f.handle(&request(4, OP_LIST, 2, b"/logs/"), QGC, 0);
+        let end = fields(&with_logs(&mut f, &mut store)[0]);
+        assert_eq!((end.1, end.6[0]), (NAK, ERR_EOF));
+        // Open log 2: its length; a burst: its bytes, then EOF.
+        f.handle(&request(6, OP_OPEN_RO, 0, b"/logs/log_2.ulg"), QGC, 0);
+        let open = fields(&with_logs(&mut f, &mut store)[0]);
+        assert_eq!(
+            (open.0, open.1, open.6.clone()),
+            (7, ACK, 1000u32.to_le_bytes().to_vec())
+        );
+        f.handle(&request(8, OP_BURST, 0, &[]), QGC, 0);
+        assert!(all(&mut f).is_empty());
+        let burst: Vec<_> = with_logs(&mut f, &mut store).iter().map(fields).collect();
+        let got: Vec<u8> = burst
+            .iter()
+            .filter(|b| b.1 == ACK)
+            .flat_map(|b| b.6.clone())
+            .collect();
+        assert_eq!(got, log);
+        let last = burst.last().unwrap();
+        assert_eq!((last.1, last.6[0]), (NAK, ERR_EOF));
+        // A gap read, and a log that is not there.
+        f.handle(&request(20, OP_READ, 500, &[0; 100]), QGC, 0);
+        let read = fields(&with_logs(&mut f, &mut store)[0]);
+        assert_eq!(
+            (read.0, read.5, read.6.as_slice()),
+            (21, 500, &log[500..600])
+        );
+        f.handle(&request(22, OP_TERMINATE, 0, &[]), QGC, 0);
+        all(&mut f);
+        f.handle(&request(24, OP_OPEN_RO, 0, b"/logs/log_9.ulg"), QGC, 0);
+        let none = fields(&with_logs(&mut f, &mut store)[0]);
+        assert_eq!((none.1, none.6[0]), (NAK, ERR_NOT_FOUND));
     }
 }

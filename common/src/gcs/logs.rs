@@ -15,10 +15,10 @@
 //!   written, refused in the air with a status text.
 //!
 //! The link never reaches the board's storage by itself: requests wait here, and the board
-//! serves them when it calls [`LogService::serve`] with its [`LogStore`] and the room its
-//! output has. Log data only takes room the telemetry left ([`LOG_RESERVE_BYTES`] of it stay
-//! free), and in the air at most [`ARMED_PACKETS_PER_CALL`] packets a call, so a download
-//! never starves the streams.
+//! serves them when it calls [`LogService::serve`] with its [`LogStore`] and the room it
+//! gives log data: what its output has left after the telemetry (less [`LOG_RESERVE_BYTES`]
+//! on a board whose output buffer is larger than a poll's telemetry), and in the air at most
+//! [`ARMED_PACKETS_PER_CALL`] packets a call, so a download never starves the streams.
 
 use super::outbox::Outbox;
 use super::peer::{Dest, Peer};
@@ -78,9 +78,13 @@ pub const DATA_LEN: usize = 90;
 /// Bytes of a `LOG_DATA` frame at most: MAVLink 2 header (10), payload (97), checksum (2),
 /// signature (13).
 pub const LOG_DATA_FRAME: usize = 10 + 97 + 2 + 13;
+/// Bytes of a `FILE_TRANSFER_PROTOCOL` frame at most (a log read over MAVLink FTP).
+pub const FTP_FRAME: usize = 10 + 254 + 2 + 13;
 /// Bytes of a `LOG_ENTRY` frame at most.
 pub const LOG_ENTRY_FRAME: usize = 10 + 14 + 2 + 13;
-/// Room of the board's output that log transfer leaves to telemetry and answers, bytes.
+/// Room of a board's output buffer that log transfer leaves to the telemetry and answers of
+/// the next poll, bytes (a board that hands its output to a UART as it goes gives log data
+/// only what the UART can take now instead).
 pub const LOG_RESERVE_BYTES: usize = 1024;
 /// `LOG_DATA` packets a call at most while armed (on the ground: as many as there is room
 /// for).
@@ -177,9 +181,9 @@ impl LogService {
         self.listing = None;
     }
 
-    /// Serves what was asked from `store`, within `room` bytes of the board's output (less
-    /// [`LOG_RESERVE_BYTES`]; while `armed` at most [`ARMED_PACKETS_PER_CALL`] packets of
-    /// data). Status texts (an erase done or failed) go to `out`.
+    /// Serves what was asked from `store`, in at most `room` bytes (while `armed` at most
+    /// [`ARMED_PACKETS_PER_CALL`] packets of data). Status texts (an erase done or failed)
+    /// go to `outbox`.
     pub(crate) fn serve<F: FnMut(Dest, MavMessage)>(
         &mut self,
         store: &mut dyn LogStore,
@@ -203,7 +207,7 @@ impl LogService {
         if core::mem::take(&mut self.refresh) {
             store.refresh();
         }
-        let mut room = room.saturating_sub(LOG_RESERVE_BYTES);
+        let mut room = room;
         self.send_list(store, &mut room, &mut send);
         let mut packets = if armed {
             ARMED_PACKETS_PER_CALL

@@ -449,7 +449,7 @@ impl GroundLink {
 
     /// Whether a log-protocol request waits for [`GroundLink::serve_logs`].
     pub fn logs_busy(&self) -> bool {
-        self.logs.busy()
+        self.logs.busy() || self.ftp.wants_logs()
     }
 
     /// Serves the log protocol's requests from the board's `store` (listing, downloading,
@@ -463,6 +463,21 @@ impl GroundLink {
         room: usize,
         mut out: F,
     ) {
+        // The files first (a station waits for each answer), then the log protocol, in what
+        // room is left.
+        let mut room = room;
+        let mut packets = if armed {
+            logs::ARMED_PACKETS_PER_CALL
+        } else {
+            usize::MAX
+        };
+        while room >= logs::FTP_FRAME && packets > 0 {
+            let Some((m, to)) = self.ftp.serve_logs(store, &mut packets) else {
+                break;
+            };
+            out(to.dest(), Outgoing::Message(m));
+            room = room.saturating_sub(logs::FTP_FRAME);
+        }
         self.logs
             .serve(store, armed, room, &mut self.outbox, |d, m| {
                 out(d, Outgoing::Message(m))

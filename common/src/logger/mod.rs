@@ -12,6 +12,7 @@
 //! before the first sample; a flight's samples start once they are out, a few periods
 //! after arming.
 
+pub mod params;
 pub mod ring;
 pub mod topics;
 
@@ -27,6 +28,13 @@ pub const RING_LEN: usize = 4096;
 pub const MESSAGE_MAX: usize = 512;
 /// Every how many microseconds a sync message is written.
 pub const SYNC_PERIOD_US: u64 = 1_000_000;
+/// Bytes of definitions encoded a control period at most: the log's opening (about 10 KB of
+/// formats and parameters) spread over half a second, so no period pays for much of it (the
+/// MCU's budget is per period).
+pub const DEFINITIONS_PER_STEP: usize = 512;
+/// The first samples of the topics, one topic a period after the definitions, µs apart: no
+/// period encodes every topic at once.
+pub const FIRST_SAMPLE_STAGGER_US: u64 = 20_000;
 
 /// A topic of this log: its message id is its place in [`TOPICS`].
 pub trait Logged: Topic {
@@ -116,6 +124,8 @@ pub struct Logger {
     dropout_since_us: Option<u64>,
     stats: LogStats,
     info: SystemInfo,
+    /// No topic faster than this, Hz (0: each at its own rate).
+    rate_cap_hz: u16,
 }
 
 impl Logger {
@@ -130,7 +140,23 @@ impl Logger {
             dropout_since_us: None,
             stats: LogStats::default(),
             info,
+            rate_cap_hz: 0,
         }
+    }
+
+    /// Caps every topic's rate at `hz` (0: each at its own rate): a board whose storage is
+    /// small or slow (the MCU's flash) logs the same topics less often.
+    pub fn set_rate_cap(&mut self, hz: u16) {
+        self.rate_cap_hz = hz;
+    }
+
+    /// The rate topic `id` is written at, Hz: its own, or the cap when lower.
+    pub fn rate_hz(&self, id: u16) -> Option<u16> {
+        let (_, rate) = TOPICS.get(usize::from(id))?;
+        Some(match self.rate_cap_hz {
+            0 => *rate,
+            cap => (*rate).min(cap),
+        })
     }
 
     /// Whether a log is being recorded.
@@ -162,7 +188,11 @@ impl Logger {
     /// Moves the definitions on as far as the ring has room, then writes a sync marker when
     /// one is due. Call once a control period, before the samples.
     pub fn step(&mut self, now_us: u64, params: &ParamStore) {
+        let mut budget = DEFINITIONS_PER_STEP;
         while let Some(stage) = self.stage.filter(|s| *s != Stage::Data) {
+            if budget == 0 {
+                return;
+            }
             let mut b = [0u8; MESSAGE_MAX];
             let Some((n, next)) = self.definition(stage, params, &mut b) else {
                 // An oversized definition is skipped, not allowed to stall the log.
@@ -173,7 +203,15 @@ impl Logger {
                 return;
             }
             self.stats.bytes = self.stats.bytes.saturating_add(n as u32);
+            budget = budget.saturating_sub(n);
             self.stage = Some(next);
+            if next == Stage::Data {
+                // The samples start now, one topic a period.
+                for (k, due) in self.next_due_us.iter_mut().enumerate() {
+                    *due =
+                        now_us.saturating_add((k as u64).saturating_mul(FIRST_SAMPLE_STAGGER_US));
+                }
+            }
         }
         if self.stage == Some(Stage::Data) && now_us >= self.next_sync_us {
             let mut b = [0u8; 16];
@@ -205,8 +243,9 @@ impl Logger {
             return;
         }
         let id = usize::from(T::ID);
-        if let (Some(due), Some((_, rate))) = (self.next_due_us.get_mut(id), TOPICS.get(id)) {
-            let period = 1_000_000 / u64::from((*rate).max(1));
+        let rate = self.rate_hz(T::ID);
+        if let (Some(due), Some(rate)) = (self.next_due_us.get_mut(id), rate) {
+            let period = 1_000_000 / u64::from(rate.max(1));
             // Keep the phase while on time; after a gap, start again from now.
             let next = due.saturating_add(period);
             *due = if next > now_us {

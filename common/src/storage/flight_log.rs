@@ -152,7 +152,8 @@ impl LogRegion {
         self.start.saturating_add(offset)
     }
 
-    fn sector_addr(&self, sector: u32) -> u32 {
+    /// The address of sector `sector` of the region (0-based).
+    pub fn sector_addr(&self, sector: u32) -> u32 {
         self.start.saturating_add(
             sector
                 .checked_rem(self.sectors)
@@ -310,6 +311,25 @@ pub fn read<F: Flash>(
     Ok(done)
 }
 
+/// The sector a new log starts in: the one after the sector holding the newest log's last
+/// block (the ring runs on from the newest log, over the oldest), the first with no log.
+pub fn first_sector_after(region: &LogRegion, logs: &LogList) -> u32 {
+    let bps = region.blocks_per_sector();
+    match logs.iter().max_by_key(|l| l.id) {
+        Some(newest) => {
+            let last = newest
+                .blocks
+                .saturating_sub(1)
+                .checked_div(bps)
+                .unwrap_or(0);
+            (newest.first_sector.saturating_add(last).saturating_add(1))
+                .checked_rem(region.sectors)
+                .unwrap_or(0)
+        }
+        None => 0,
+    }
+}
+
 /// A log being written: bytes gather in a block's payload in RAM and go to flash a whole block
 /// at a time; only the last block, written by [`LogWriter::close`], is partly filled (a reader
 /// finds any byte of the log from that).
@@ -339,21 +359,7 @@ impl LogWriter {
         sectors: u32,
     ) -> Result<Self, LogError<F::Error>> {
         region.check()?;
-        let bps = region.blocks_per_sector();
-        let first_sector = match logs.iter().max_by_key(|l| l.id) {
-            Some(newest) => {
-                // The sector holding the newest log's last block, then the one after it.
-                let last = newest
-                    .blocks
-                    .saturating_sub(1)
-                    .checked_div(bps)
-                    .unwrap_or(0);
-                (newest.first_sector.saturating_add(last).saturating_add(1))
-                    .checked_rem(region.sectors)
-                    .unwrap_or(0)
-            }
-            None => 0,
-        };
+        let first_sector = first_sector_after(region, logs);
         let n = sectors.clamp(1, region.sectors);
         for k in 0..n {
             let s = first_sector
@@ -364,16 +370,49 @@ impl LogWriter {
                 .erase_sector(region.sector_addr(s))
                 .map_err(LogError::Flash)?;
         }
+        Self::open_erased(region, first_sector, next, n)
+    }
+
+    /// Starts log number `next` in `sectors` sectors from `first_sector` that the caller has
+    /// erased already (a board that erases while on the ground, a sector at a time, so that
+    /// no erase falls in a flight: see [`first_sector_after`] for where).
+    pub fn open_erased<E>(
+        region: &LogRegion,
+        first_sector: u32,
+        next: u32,
+        sectors: u32,
+    ) -> Result<Self, LogError<E>> {
+        region.check()?;
+        if first_sector >= region.sectors {
+            return Err(LogError::Region);
+        }
+        let n = sectors.clamp(1, region.sectors);
         Ok(Self {
             region: *region,
             id: next,
             first_sector,
             blocks: 0,
-            room: n.saturating_mul(bps),
+            room: n.saturating_mul(region.blocks_per_sector()),
             buf: [0xff; PAYLOAD_LEN],
             len: 0,
             bytes: 0,
         })
+    }
+
+    /// The sector the log starts in.
+    pub fn first_sector(&self) -> u32 {
+        self.first_sector
+    }
+
+    /// The log as a reader finds it in flash now: its programmed blocks (what waits in RAM
+    /// for a whole block is not there yet).
+    pub fn info(&self) -> LogInfo {
+        LogInfo {
+            id: self.id,
+            first_sector: self.first_sector,
+            blocks: self.blocks,
+            bytes: self.blocks.saturating_mul(PAYLOAD_LEN as u32),
+        }
     }
 
     /// The log's number.

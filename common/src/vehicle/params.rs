@@ -48,7 +48,7 @@ pub const PARAMS: Group<SystemParams> = Group {
 };
 
 /// Every parameter of the vehicle: the control stages, the estimator, guidance and navigation,
-/// the battery monitor, the failsafes and the vehicle's own settings.
+/// the battery monitor, the failsafes, the logger and the vehicle's own settings.
 pub const REGISTRY: Registry = &[
     &lateral::PARAMS,
     &longitudinal::PARAMS,
@@ -63,6 +63,7 @@ pub const REGISTRY: Registry = &[
     &battery::PARAMS,
     &failsafe::PARAMS,
     &super::land_detector::PARAMS,
+    &crate::logger::params::PARAMS,
     &PARAMS,
 ];
 

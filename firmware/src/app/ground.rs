@@ -4,6 +4,7 @@
 //! one outgoing buffer, each frame tagged with where it goes.
 
 use common::gcs::ftp::{self, File};
+use common::gcs::logs::LOG_RESERVE_BYTES;
 use common::gcs::{
     Dest, GroundLink, LinkConfig, Origin, Outgoing, Stores, COMPONENT_ID, SYSTEM_ID,
 };
@@ -56,7 +57,12 @@ pub struct GroundPort {
     /// Frames waiting, each as `[destination, length lo, length hi, frame...]`.
     out: heapless::Vec<u8, GCS_OUT>,
     bytes_dropped: u32,
+    /// The vehicle's status texts, kept for the flight log (the oldest dropped when full).
+    log_texts: heapless::Deque<(Severity, &'static str), LOG_TEXTS>,
 }
+
+/// Status texts kept for the flight log between two sensor frames.
+const LOG_TEXTS: usize = 8;
 
 impl Default for GroundPort {
     fn default() -> Self {
@@ -86,6 +92,7 @@ impl GroundPort {
             }),
             out: heapless::Vec::new(),
             bytes_dropped: 0,
+            log_texts: heapless::Deque::new(),
         }
     }
 
@@ -126,6 +133,11 @@ impl GroundPort {
             tx_dropped: self.bytes_dropped(),
             heard_us: self.link.gcs_last_seen_us(),
         }
+    }
+
+    /// The vehicle's status texts since the last call, oldest first, for the flight log.
+    pub(crate) fn take_log_text(&mut self) -> Option<(Severity, &'static str)> {
+        self.log_texts.pop_front()
     }
 
     /// Bytes dropped because the output buffer was full.
@@ -222,7 +234,13 @@ impl GroundPort {
     ) {
         while let Some(n) = vehicle.next_notice() {
             match n {
-                Notice::Text(s, text) => self.link.send_statustext(severity(s), text),
+                Notice::Text(s, text) => {
+                    self.link.send_statustext(severity(s), text);
+                    if self.log_texts.is_full() {
+                        self.log_texts.pop_front();
+                    }
+                    let _ = self.log_texts.push_back((s, text));
+                }
                 Notice::Mission { current, reached } => {
                     self.link.mission_progress(current, reached)
                 }
@@ -249,14 +267,18 @@ impl GroundPort {
     }
 
     /// Serves the log protocol's requests from the board's `store`, within `room` bytes and
-    /// what the output buffer has left (after [`GroundPort::poll`]: telemetry first).
+    /// what the output buffer has left after [`GroundPort::poll`] (telemetry first), less
+    /// [`LOG_RESERVE_BYTES`] for the next poll's.
     pub fn serve_logs(
         &mut self,
         store: &mut dyn common::gcs::logs::LogStore,
         armed: bool,
         room: usize,
     ) {
-        let left = GCS_OUT.saturating_sub(self.out.len()).min(room);
+        let left = GCS_OUT
+            .saturating_sub(self.out.len())
+            .saturating_sub(LOG_RESERVE_BYTES)
+            .min(room);
         let mut signing = core::mem::take(self.link.signing_mut());
         let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
         self.link.serve_logs(store, armed, left, |dest, msg| {

@@ -2,13 +2,16 @@
 //! frame, stopped when it disarms; the board drains its bytes into its storage.
 //!
 //! A board without log storage leaves it off ([`FlightLog::enable`]): nothing is encoded, so
-//! a log nobody keeps costs no control period. The MCU image, which has no storage for logs
-//! yet, is built without the logging itself.
+//! a log nobody keeps costs no control period. A board with little room for logs caps the
+//! topics' rates ([`FlightLog::set_rate_cap`]: the MCU's flash).
 
 use common::link::framing::LinkStats;
+use common::logger::params::LogParams;
 use common::logger::topics::TelemetryStatus;
 use common::logger::{LogStats, Logger, SystemInfo};
 use common::sensors::SensorFrame;
+use common::ulog::Level;
+use common::vehicle::commander::Severity;
 use common::vehicle::Vehicle;
 
 /// What the log says of the software and the board.
@@ -28,6 +31,9 @@ pub struct FlightLog {
     enabled: bool,
     armed: bool,
     logs: u32,
+    /// `SDLOG_MODE` and friends, as of the parameter store's change count.
+    when: LogParams,
+    params_seen: Option<u32>,
 }
 
 impl Default for FlightLog {
@@ -44,6 +50,8 @@ impl FlightLog {
             enabled: false,
             armed: false,
             logs: 0,
+            when: (common::logger::params::PARAMS.base)(),
+            params_seen: None,
         }
     }
 
@@ -53,6 +61,11 @@ impl FlightLog {
         if !on {
             self.logger.stop();
         }
+    }
+
+    /// Caps every topic's rate at `hz` (0: the topics' own rates, `docs/LOGGING.md`).
+    pub fn set_rate_cap(&mut self, hz: u16) {
+        self.logger.set_rate_cap(hz);
     }
 
     /// Logs started since boot: a board opens a new file (or flash log) when this changes.
@@ -85,25 +98,38 @@ impl FlightLog {
         self.logger.consume(n);
     }
 
-    /// After the vehicle took sensor frame `f`: starts a log on arming, stops it on
-    /// disarming, and writes what is due.
+    /// After the vehicle took sensor frame `f`: starts a log when `SDLOG_MODE` says (on
+    /// arming, or at boot), stops it on disarming, and writes what is due.
     pub(crate) fn after_frame(&mut self, v: &Vehicle, f: &SensorFrame, ground: &GroundFigures) {
-        // The MCU board has no storage for logs yet: the image leaves the logging out (7 KB of
-        // code it would carry switched off) until it has.
-        if !self.enabled || cfg!(target_os = "none") {
+        if !self.enabled {
             return;
         }
         let Some(now) = v.time_us() else { return };
         let armed = v.armed();
+        // Looked up by name only when a parameter changed: a lookup a frame costs the MCU
+        // several thousand instructions.
+        let changes = v.params().change_count();
+        if self.params_seen != Some(changes) {
+            self.params_seen = Some(changes);
+            self.when = v.params().load(&common::logger::params::PARAMS);
+        }
+        let when = self.when;
         // A log starts once the last one is drained (the board empties the ring after each
         // frame), so the board never finds two logs' bytes in the ring at once.
-        if armed && !self.logger.recording() && !self.armed && self.logger.pending_len() == 0 {
+        let idle = !self.logger.recording() && self.logger.pending_len() == 0;
+        if idle && !self.armed && when.starts(armed, self.logs) {
             self.logger.start(now);
             self.logs = self.logs.wrapping_add(1);
-            self.armed = true;
-        } else if !armed && self.armed {
+            self.armed = armed;
+            // The arming period is the heaviest of all: the log's first bytes wait for the
+            // next one.
+            return;
+        } else if self.logger.recording() && (when.mode < 0 || (!armed && self.armed)) {
             self.logger.stop();
             self.armed = false;
+        } else if armed && self.logger.recording() {
+            // A log from boot goes on through the flight and ends at its disarming.
+            self.armed = true;
         }
         if !self.logger.recording() {
             return;
@@ -128,6 +154,22 @@ impl FlightLog {
                 },
             );
         }
+    }
+}
+
+impl FlightLog {
+    /// A status text of the vehicle (a failsafe, a mode change, a refusal) into the log, as
+    /// PX4 logs its `mavlink_log` messages.
+    pub(crate) fn text(&mut self, now_us: u64, severity: Severity, text: &str) {
+        if !self.enabled || !self.logger.recording() {
+            return;
+        }
+        let level = match severity {
+            Severity::Info => Level::Info,
+            Severity::Warning => Level::Warning,
+            Severity::Critical => Level::Critical,
+        };
+        self.logger.text(now_us, level, text);
     }
 }
 

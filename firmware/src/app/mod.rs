@@ -14,6 +14,7 @@
 //! The clock is the simulator's (`time_usec` of the sensor frames) in SITL and the board's
 //! sensor timestamps on the MCU; nothing here reads a clock of its own.
 
+pub mod flash_logs;
 pub mod ground;
 pub mod log;
 pub mod persist;

@@ -142,6 +142,9 @@ impl Answers {
                 self.health.sensor_frames += 1;
                 vehicle.on_sensors(&sensors, &ground.from_ground());
                 log.after_frame(vehicle, &sensors, &ground.log_figures());
+                while let Some((severity, text)) = ground.take_log_text() {
+                    log.text(vehicle.time_us().unwrap_or(0), severity, text);
+                }
                 ground.poll(vehicle.time_us().unwrap_or(0), vehicle);
                 // The answer names the frame it answers, in the simulator's own time.
                 let answer = ActuatorFrame {

@@ -1,6 +1,7 @@
 //! The board's persistent storage: sectors 1 and 2 of the STM32F405's flash (reserved in
-//! `memory.x`), through the flash controller; or, in QEMU, which does not emulate the flash
-//! controller, a host file of the same two sectors over semihosting.
+//! `memory.x`) for the board record, sectors 6 to 11 for the flight logs, through the flash
+//! controller; or, in QEMU, which does not emulate the flash controller, a host file of the
+//! same sectors over semihosting (the record's two first, the logs' six after them).
 //!
 //! The file is chosen by a semihosting argument `storage=PATH`
 //! (`-semihosting-config enable=on,target=native,arg=firmware,arg=storage=PATH`, as
@@ -8,6 +9,7 @@
 //! 0xFF, a write can only clear bits, so the record layer's power-cut reasoning holds.
 
 use common::storage::f4::{F4Error, F4Flash, FlashRegs};
+use common::storage::flight_log::LogRegion;
 use common::storage::{AbRegion, Flash, BOARD_MAGIC};
 use cortex_m_semihosting::{nr, syscall};
 
@@ -16,6 +18,42 @@ pub const START: u32 = 0x0800_4000;
 /// End of the reserved sectors.
 pub const END: u32 = 0x0800_C000;
 const SECTOR: u32 = 16 * 1024;
+
+/// First byte of the flight logs' sectors (6 to 11, 128 KiB each).
+pub const LOG_START: u32 = 0x0804_0000;
+/// End of the flight logs' sectors (the end of the flash).
+pub const LOG_END: u32 = 0x0810_0000;
+const LOG_SECTOR: u32 = 128 * 1024;
+
+/// The flight logs' region: six sectors of 128 KiB (768 KiB).
+pub const LOG_REGION: LogRegion = LogRegion {
+    start: LOG_START,
+    sector_len: LOG_SECTOR,
+    sectors: (LOG_END - LOG_START) / LOG_SECTOR,
+};
+
+/// A window of the flash kept in the host file: its addresses, where they sit in the file,
+/// and its sectors' size.
+#[derive(Clone, Copy)]
+struct Window {
+    start: u32,
+    end: u32,
+    file_offset: u32,
+    sector: u32,
+}
+
+const RECORD_WINDOW: Window = Window {
+    start: START,
+    end: END,
+    file_offset: 0,
+    sector: SECTOR,
+};
+const LOG_WINDOW: Window = Window {
+    start: LOG_START,
+    end: LOG_END,
+    file_offset: END - START,
+    sector: LOG_SECTOR,
+};
 
 /// The board record in sectors 1 and 2.
 pub const REGION: AbRegion = AbRegion {
@@ -58,9 +96,10 @@ impl FlashRegs for Mmio {
     }
 }
 
-/// The two sectors in a host file (QEMU).
+/// The reserved sectors in a host file (QEMU), one window of them per handle.
 pub struct HostFile {
     handle: usize,
+    window: Window,
 }
 
 /// Why the host file failed.
@@ -84,9 +123,30 @@ impl core::fmt::Display for HostError {
 impl core::error::Error for HostError {}
 
 impl HostFile {
-    /// The file named by the `storage=PATH` semihosting argument, created erased when
-    /// missing; `None` without the argument or when it cannot be opened.
+    /// The file named by the `storage=PATH` semihosting argument, its record sectors
+    /// created erased when missing; `None` without the argument or when it cannot be opened.
     pub fn open() -> Option<Self> {
+        Self::open_window(RECORD_WINDOW)
+    }
+
+    /// The same file's flight-log sectors, created erased when the file does not reach them
+    /// yet.
+    pub fn open_logs() -> Option<Self> {
+        let mut f = Self::open_window(LOG_WINDOW)?;
+        // SAFETY: a handle this file opened; returns the file's length or -1.
+        let len = unsafe { syscall!(FLEN, f.handle) };
+        let needed = (LOG_WINDOW.file_offset + (LOG_END - LOG_START)) as usize;
+        if len == usize::MAX || len < needed {
+            let mut at = LOG_START;
+            while at < LOG_END {
+                f.erase(at).ok()?;
+                at += LOG_SECTOR;
+            }
+        }
+        Some(f)
+    }
+
+    fn open_window(window: Window) -> Option<Self> {
         let mut cmdline = [0u8; 256];
         let mut block = [cmdline.as_mut_ptr() as usize, cmdline.len()];
         // SAFETY: SYS_GET_CMDLINE writes at most block[1] bytes into the buffer.
@@ -102,24 +162,30 @@ impl HostFile {
         let open = |mode: usize| {
             // SAFETY: a NUL-terminated name and its length.
             let h = unsafe { syscall!(OPEN, name.as_ptr(), mode, path.len()) };
-            (h != usize::MAX).then_some(Self { handle: h })
+            (h != usize::MAX).then_some(Self { handle: h, window })
         };
         if let Some(f) = open(nr::open::RW_BINARY) {
             return Some(f);
         }
         let mut f = open(nr::open::RW_TRUNC_BINARY)?;
-        f.erase(START).ok()?;
-        f.erase(START + SECTOR).ok()?;
+        let mut record = Self {
+            handle: f.handle,
+            window: RECORD_WINDOW,
+        };
+        record.erase(START).ok()?;
+        record.erase(START + SECTOR).ok()?;
+        f.window = window;
         Some(f)
     }
 
     fn seek(&mut self, addr: u32, len: usize) -> Result<(), HostError> {
+        let w = self.window;
         let end = addr.checked_add(len as u32).ok_or(HostError::Address)?;
-        if addr < START || end > END {
+        if addr < w.start || end > w.end {
             return Err(HostError::Address);
         }
         // SAFETY: a handle this file opened.
-        match unsafe { syscall!(SEEK, self.handle, addr - START) } {
+        match unsafe { syscall!(SEEK, self.handle, w.file_offset + (addr - w.start)) } {
             0 => Ok(()),
             _ => Err(HostError::Io),
         }
@@ -144,11 +210,12 @@ impl HostFile {
     }
 
     fn erase(&mut self, addr: u32) -> Result<(), HostError> {
-        if !(addr - START.min(addr)).is_multiple_of(SECTOR) {
+        let w = self.window;
+        if !(addr - w.start.min(addr)).is_multiple_of(w.sector) {
             return Err(HostError::Address);
         }
         let ones = [0xffu8; 256];
-        for k in 0..SECTOR / 256 {
+        for k in 0..w.sector / 256 {
             self.put(addr + k * 256, &ones)?;
         }
         Ok(())
@@ -220,6 +287,14 @@ impl BoardFlash {
         match HostFile::open() {
             Some(f) => BoardFlash::Host(f),
             None => BoardFlash::Chip(F4Flash::new(Mmio, START, END)),
+        }
+    }
+
+    /// The flight logs' sectors: the host file's under QEMU, the controller's on a board.
+    pub fn open_logs() -> Self {
+        match HostFile::open_logs() {
+            Some(f) => BoardFlash::Host(f),
+            None => BoardFlash::Chip(F4Flash::new(Mmio, LOG_START, LOG_END)),
         }
     }
 

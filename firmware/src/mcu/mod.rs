@@ -15,7 +15,16 @@ mod fault;
 mod flash;
 mod usart;
 mod watchdog;
+use common::gcs::logs::NoLogs;
+use firmware::app::flash_logs::FlashLogs;
 use firmware::app::persist::Persistence;
+
+/// Sectors of 128 KiB a flight log may fill (of six): a log of 384 KiB, and the newest log
+/// before it kept beside it.
+const LOG_SECTORS_PER_LOG: u32 = 3;
+/// No topic of the flash log faster than this, Hz: 2.6 KB a second, 384 KiB in 2.5 minutes
+/// (docs/LOGGING.md).
+const LOG_RATE_CAP_HZ: u16 = 4;
 use usart::{Id, Usart};
 
 /// Every interrupt without a handler of its own comes here (cortex-m-rt's vector table): the
@@ -65,6 +74,21 @@ fn main() -> ! {
         loaded.mission_items,
         loaded.unreadable
     );
+    // The flight logs: sectors 6 to 11 (or the host file's), scanned once here, before the
+    // watchdog runs (a scan reads the whole region). On a board with no room for logs the
+    // vehicle flies without them.
+    let mut logs = FlashLogs::open(
+        flash::BoardFlash::open_logs(),
+        flash::LOG_REGION,
+        LOG_SECTORS_PER_LOG,
+        app,
+    )
+    .ok();
+    app.flight_log_mut().set_rate_cap(LOG_RATE_CAP_HZ);
+    defmt::info!(
+        "flight logs: {} kept",
+        logs.as_ref().map_or(0, |l| l.logs().len())
+    );
     watchdog::start();
     sim.write(&firmware::app::heartbeat_frame(app));
     let (mut sim_held, mut gcs_held) = (Held::new(), Held::new());
@@ -95,6 +119,22 @@ fn main() -> ! {
             }
         }
         let done = store.service(app);
+        // The log's ring into flash, a sector of the next log's room erased on the ground,
+        // and the stations' log requests: in the passes between frames, outside the control
+        // period's cost; log data only takes what the UART can send now.
+        if idle {
+            if let Some(l) = logs.as_mut() {
+                l.service(app);
+            }
+            if app.ground_link().logs_busy() {
+                app.drain_gcs(&mut |out| gcs.write(out));
+                let room = gcs.tx_free();
+                match logs.as_mut() {
+                    Some(l) => app.serve_logs(l, room),
+                    None => app.serve_logs(&mut NoLogs, room),
+                }
+            }
+        }
         // Telemetry and answers for the ground, produced by the calls above.
         app.drain_gcs(&mut |out| gcs.write(out));
         // Only the passes that had work are the control period's cost.

@@ -210,6 +210,11 @@ impl Usart {
         self.kick();
     }
 
+    /// Bytes the transmit ring can take now without waiting.
+    pub fn tx_free(&self) -> usize {
+        self.tx.capacity().saturating_sub(self.tx.len())
+    }
+
     /// Waits until every queued byte has left the USART (before a reset).
     pub fn flush(&mut self) {
         self.kick();

@@ -282,7 +282,7 @@ fn an_unknown_log_id_gets_nothing_and_the_end_request_stops_a_transfer() {
 }
 
 #[test]
-fn in_the_air_a_download_takes_two_packets_a_call_and_never_the_reserve() {
+fn in_the_air_a_download_takes_two_packets_a_call_and_never_more_than_the_room() {
     let mut store = Memory {
         logs: vec![bytes(50_000, 4)],
         visible: 1,
