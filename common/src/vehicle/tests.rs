@@ -610,17 +610,79 @@ fn a_ground_link_loss_on_the_take_off_roll_aborts_the_take_off_instead_of_return
     assert_eq!(c.flown_mode(), FlightMode::Takeoff);
 }
 
-/// At 3 m/s the land detector still reads the aircraft as on the ground, but the take-off
-/// roll is watched from its first metre: the failsafe gives the take-off up all the same.
+/// Whatever raised it, a failsafe that changes the mode flown gives the take-off roll up: the
+/// ground link silent, GPS lost, the battery critical or at its emergency level; one that
+/// changes nothing (the airspeed sensor failed, the battery low: a warning) does not. At 3 m/s
+/// the land detector still reads the aircraft as on the ground, but the roll is watched from
+/// its first metre.
 #[test]
-fn a_ground_link_loss_at_the_start_of_the_take_off_roll_aborts_it_too() {
+fn every_failsafe_that_changes_the_mode_aborts_the_take_off_roll_and_no_other_does() {
+    use crate::battery::Warning;
     use crate::navigation::navigator::io::Phase;
-    let (mut c, mut n, e) = on_the_take_off(3.0);
-    assert!(!c.flying(), "the land detector has seen no flight yet");
-    let o = tick_at(&mut c, &mut n, &e, &MissionStore::default(), 5_100_000);
-    assert!(texts(&mut c).contains(&TEXT_ABORTED));
-    assert_eq!(c.navigation().phase, Phase::TakeoffAbort);
-    assert!(matches!(commands(&o).lon, LonMode::Pitch { throttle, .. } if throttle == 0.0));
+    type Fault = fn(&mut EstimatedState) -> (Option<u64>, Option<Warning>);
+    let faults: [(&str, Fault, bool); 6] = [
+        ("link", |_| (Some(0), None), true),
+        (
+            "gps",
+            |e| {
+                e.health.gps.healthy = false;
+                (None, None)
+            },
+            true,
+        ),
+        (
+            "battery critical",
+            |_| (None, Some(Warning::Critical)),
+            true,
+        ),
+        (
+            "battery emergency",
+            |_| (None, Some(Warning::Emergency)),
+            true,
+        ),
+        (
+            "airspeed",
+            |e| {
+                e.health.pitot.healthy = false;
+                (None, None)
+            },
+            false,
+        ),
+        ("battery low", |_| (None, Some(Warning::Low)), false),
+    ];
+    for (what, fault, aborts) in faults {
+        let (mut c, mut n, mut e) = on_the_take_off(3.0);
+        assert!(!c.flying(), "the land detector has seen no flight yet");
+        let (heard, battery) = fault(&mut e);
+        let o = c.step(CommanderInputs {
+            now_us: 5_100_000,
+            dt: 0.02,
+            estimate: &e,
+            navigator: &mut n,
+            plan: &MissionStore::default(),
+            gains: &DESIGNED,
+            watch: &Watch::default(),
+            land: &land_detector::LandParams::default(),
+            specific_force: Some(9.81),
+            gcs_heard_us: heard,
+            battery,
+        });
+        let said = texts(&mut c);
+        let throttle = match commands(&o).lon {
+            LonMode::Pitch { throttle, .. } => throttle,
+            other => panic!("{what}: {other:?}"),
+        };
+        assert_eq!(c.flown_mode(), FlightMode::Takeoff, "{what}");
+        if aborts {
+            assert!(said.contains(&TEXT_ABORTED), "{what}: {said:?}");
+            assert_eq!(c.navigation().phase, Phase::TakeoffAbort, "{what}");
+            assert_eq!(throttle, 0.0, "{what}");
+        } else {
+            assert!(!said.contains(&TEXT_ABORTED), "{what}: {said:?}");
+            assert_eq!(c.navigation().phase, Phase::TakeoffRoll, "{what}");
+            assert!(throttle > 0.5, "{what}: the roll goes on at {throttle}");
+        }
+    }
 }
 
 #[test]
