@@ -457,7 +457,7 @@ impl NavParams {
         } else {
             1.0
         };
-        (frac < 1.0).then(|| self.ground_roll_max + (90.0 * DEG - self.ground_roll_max) * frac)
+        (frac < 1.0).then_some(self.ground_roll_max + (90.0 * DEG - self.ground_roll_max) * frac)
     }
 }
 
