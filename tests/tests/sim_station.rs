@@ -83,41 +83,12 @@ fn upload_arm_and_start(gcs: &mut Station, speed: f64) -> u16 {
 #[test]
 fn a_station_flies_the_default_mission_through_sim_host_sim_and_the_host_build() {
     let out = tempfile::tempdir().expect("tempdir");
-    let cfg = FlightConfig {
-        duration_s: HOST_FLIGHT_S,
-        realtime: true,
-        speed: SPEED,
-        runway_heading: Some(0.0),
-        scripted_station: false,
-        until_link_closes: true,
-        ..FlightConfig::default()
-    };
-    let opts = SimOptions {
-        link: LinkKind::Tcp,
-        bind: "127.0.0.1:0".into(),
-        wait: Some(Duration::from_secs(20)),
-        out: Some(out.path().to_path_buf()),
-        plots: false,
-        ..SimOptions::default()
-    };
-    let (ready, sim) = start_sim(cfg, opts);
-    // The autopilot: the host build's SITL loop, its ground link on a UDP port of its own.
-    let (ground_addr, autopilot) = start_host_autopilot(&ready);
+    let (ground_addr, sim, autopilot) = start_host_flight(HOST_FLIGHT_S, SPEED, Some(out.path()));
 
     let socket = UdpSocket::bind("127.0.0.1:0").expect("station socket");
     let mut gcs = Station::new(socket, ground_addr);
     let n = upload_arm_and_start(&mut gcs, SPEED);
-    while !sim.is_finished() {
-        gcs.pump();
-        gcs.inbox.clear();
-    }
-    let r = sim.join().expect("sim thread").expect("the flight");
-    // The simulator closed its end at the duration: the autopilot saw the link close.
-    let ended = autopilot.join().expect("autopilot thread");
-    assert!(
-        matches!(&ended, Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof),
-        "{ended:?}"
-    );
+    let r = listen_to_the_end(&mut gcs, sim, autopilot);
 
     let log = &gcs.log;
     eprintln!("reached {:?}; texts {:?}", log.reached, log.texts);
@@ -270,9 +241,38 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     }
 }
 
-/// The host build's SITL loop on its own thread, connected to the simulator at `ready`, its
-/// ground link on a UDP port of its own; returns that port and the thread.
-fn start_host_autopilot(ready: &Ready) -> (SocketAddr, JoinHandle<std::io::Result<()>>) {
+/// A flight of the host build: `sim-host sim` on the runway heading north for `duration_s`
+/// of simulated time paced at `speed` times real time, its files in `out`, and the autopilot's
+/// SITL loop (what `cargo run -p firmware -- --sim tcp:...` runs) connected to it, its ground
+/// link on a UDP port of its own. Returns that port, the simulator's thread and the
+/// autopilot's.
+fn start_host_flight(
+    duration_s: f64,
+    speed: f64,
+    out: Option<&std::path::Path>,
+) -> (
+    SocketAddr,
+    JoinHandle<anyhow::Result<FlyReport>>,
+    JoinHandle<std::io::Result<()>>,
+) {
+    let cfg = FlightConfig {
+        duration_s,
+        realtime: true,
+        speed,
+        runway_heading: Some(0.0),
+        scripted_station: false,
+        until_link_closes: true,
+        ..FlightConfig::default()
+    };
+    let opts = SimOptions {
+        link: LinkKind::Tcp,
+        bind: "127.0.0.1:0".into(),
+        wait: Some(Duration::from_secs(20)),
+        out: out.map(std::path::Path::to_path_buf),
+        plots: false,
+        ..SimOptions::default()
+    };
+    let (ready, sim) = start_sim(cfg, opts);
     let sim_addr = ready
         .sim_link
         .strip_prefix("tcp ")
@@ -294,7 +294,28 @@ fn start_host_autopilot(ready: &Ready) -> (SocketAddr, JoinHandle<std::io::Resul
             None,
         )
     });
-    (ground_addr, autopilot)
+    (ground_addr, sim, autopilot)
+}
+
+/// The station listens (and, unless silent, keeps its heartbeat) until the simulator ends the
+/// flight at its duration; the simulator closed its end then, and the autopilot saw the link
+/// close. Returns the simulator's report.
+fn listen_to_the_end(
+    gcs: &mut Station,
+    sim: JoinHandle<anyhow::Result<FlyReport>>,
+    autopilot: JoinHandle<std::io::Result<()>>,
+) -> FlyReport {
+    while !sim.is_finished() {
+        gcs.pump();
+        gcs.inbox.clear();
+    }
+    let r = sim.join().expect("sim thread").expect("the flight");
+    let ended = autopilot.join().expect("autopilot thread");
+    assert!(
+        matches!(&ended, Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof),
+        "{ended:?}"
+    );
+    r
 }
 
 /// Simulated seconds per wall second of the take-off abort: slow enough that the station's
@@ -319,24 +340,7 @@ fn a_ground_link_loss_on_the_take_off_roll_aborts_it_through_sim_host_sim_and_th
     use common::vehicle::commander::{TEXT_ABORTED, TEXT_ABORT_DISARMED};
     use common::vehicle::modes::FlightMode;
     use sim_host::flight::strikes::{clearance, propeller_hub_m, strike_points};
-    let cfg = FlightConfig {
-        duration_s: 50.0,
-        realtime: true,
-        speed: ABORT_SPEED,
-        runway_heading: Some(0.0),
-        scripted_station: false,
-        until_link_closes: true,
-        ..FlightConfig::default()
-    };
-    let opts = SimOptions {
-        link: LinkKind::Tcp,
-        bind: "127.0.0.1:0".into(),
-        wait: Some(Duration::from_secs(20)),
-        plots: false,
-        ..SimOptions::default()
-    };
-    let (ready, sim) = start_sim(cfg, opts);
-    let (ground_addr, autopilot) = start_host_autopilot(&ready);
+    let (ground_addr, sim, autopilot) = start_host_flight(50.0, ABORT_SPEED, None);
 
     let socket = UdpSocket::bind("127.0.0.1:0").expect("station socket");
     let mut gcs = Station::new(socket, ground_addr);
@@ -347,16 +351,7 @@ fn a_ground_link_loss_on_the_take_off_roll_aborts_it_through_sim_host_sim_and_th
     // the timeout runs from the roll's start), then the station listens on and sends nothing.
     gcs.heartbeat();
     gcs.silent = true;
-    while !sim.is_finished() {
-        gcs.pump();
-        gcs.inbox.clear();
-    }
-    let r = sim.join().expect("sim thread").expect("the flight");
-    let ended = autopilot.join().expect("autopilot thread");
-    assert!(
-        matches!(&ended, Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof),
-        "{ended:?}"
-    );
+    let r = listen_to_the_end(&mut gcs, sim, autopilot);
 
     // What the station heard: the loss, the abort, the stop; never a return.
     let log = &gcs.log;

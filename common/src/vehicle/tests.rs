@@ -755,19 +755,28 @@ fn on_final(h: f32) -> EstimatedState {
     e
 }
 
-#[test]
-fn a_ground_link_loss_in_the_flare_lets_the_landing_finish() {
-    use crate::navigation::navigator::io::Phase;
+/// Armed in Mission on the final of [`on_final`] at `h` m, its landing item at home flown for
+/// one tick; then the ground link silent for more than `FS_GCS_TOUT_S`. Returns the commander
+/// and the phase before the loss.
+fn loss_on_final(h: f32) -> (Commander, crate::navigation::navigator::io::Phase) {
     let plan = land_at_home();
     let mut c = Commander::new();
     let mut n = Navigator::default();
-    let e = on_final(1.0);
+    let e = on_final(h);
     c.apply(&arm(), &e, &mut n);
     c.apply(&mode(FlightMode::Mission), &e, &mut n);
     tick_at(&mut c, &mut n, &e, &plan, 0);
-    assert_eq!(c.navigation().phase, Phase::Flare);
+    let before = c.navigation().phase;
     texts(&mut c);
     tick_at(&mut c, &mut n, &e, &plan, 5_100_000);
+    (c, before)
+}
+
+#[test]
+fn a_ground_link_loss_in_the_flare_lets_the_landing_finish_and_one_on_the_approach_returns() {
+    use crate::navigation::navigator::io::Phase;
+    let (mut c, before) = loss_on_final(1.0);
+    assert_eq!(before, Phase::Flare);
     assert_eq!(c.flown_mode(), FlightMode::Mission);
     assert_eq!(c.navigation().phase, Phase::Flare);
     assert_eq!(
@@ -775,14 +784,8 @@ fn a_ground_link_loss_in_the_flare_lets_the_landing_finish() {
         [crate::failsafe::Event::GcsLost.text(), TEXT_LANDING_FIRST]
     );
     // The same loss higher on the approach returns.
-    let mut c = Commander::new();
-    let mut n = Navigator::default();
-    let e = on_final(20.0);
-    c.apply(&arm(), &e, &mut n);
-    c.apply(&mode(FlightMode::Mission), &e, &mut n);
-    tick_at(&mut c, &mut n, &e, &plan, 0);
-    assert_eq!(c.navigation().phase, Phase::Approach);
-    tick_at(&mut c, &mut n, &e, &plan, 5_100_000);
+    let (c, before) = loss_on_final(20.0);
+    assert_eq!(before, Phase::Approach);
     assert_eq!(c.flown_mode(), FlightMode::Return);
 }
 
