@@ -19,6 +19,11 @@
 //! Without GPS there is no home to fly to: the GPS reaction comes before every other. The
 //! emergency landing comes before a return.
 //!
+//! Near the ground the commander flies a reaction otherwise (`vehicle::commander`): on the
+//! take-off roll, which is watched from its first metre, it aborts the take-off; past the
+//! rotation it waits, wings level, for `NAV_TKO_CLR_M`; in a flare or roll-out it lets the
+//! landing finish.
+//!
 //! Each failsafe is reported once when it is raised and once when its cause clears (the
 //! battery's never clears in flight).
 

@@ -839,3 +839,161 @@ fn a_low_battery_during_the_mission_warns_returns_home_and_lands_on_the_runway()
         b.final_remaining_pct
     );
 }
+
+/// The wing tips of the aircraft file (its belly points out on the span), as the flight
+/// summary's strike check names them.
+fn wing_tips(a: &Aircraft) -> Vec<sim_host::flight::strikes::Point> {
+    use sim_host::flight::strikes::{propeller_hub_m, strike_points};
+    strike_points(a, propeller_hub_m(a, [0.0; 3]))
+        .into_iter()
+        .filter(|p| p.name.contains("wing tip"))
+        .collect()
+}
+
+/// The lowest clearance of either wing tip over the runway (the ground at home's altitude)
+/// at a sample, m: the aircraft file's geometry turned by the true attitude.
+fn tip_clearance(s: &Sample, tips: &[sim_host::flight::strikes::Point], ground: f64) -> f64 {
+    tips.iter()
+        .map(|p| sim_host::flight::strikes::clearance(s, ground, p))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The report's case: the ground link lost as the take-off starts (the last heartbeat at
+/// arming), so that `FS_GCS_TOUT_S` (5 s) runs out just past the rotation, the wheels still
+/// on the runway at 15 m/s. The take-off goes on, wings level and on the runway's heading, to
+/// `NAV_TKO_CLR_M` above it; only there does the return turn the aircraft for home, and the
+/// wing tips stay clear of the runway (the aircraft file's geometry turned by the true
+/// attitude).
+#[test]
+fn a_ground_link_loss_just_after_rotation_climbs_wings_level_to_nav_tko_clr_m_before_turning_home()
+{
+    use common::vehicle::commander::TEXT_CLIMB_FIRST;
+    let o = mission_flight(vec![step(0.0, Action::Silence)], |c| c.duration_s = 60.0);
+    trace(&o, 0.5);
+    let a = aircraft();
+    let ground = a.environment.home_alt_msl_m;
+    let rest = o.samples.first().expect("samples").alt;
+    let height = |s: &Sample| s.alt - rest;
+    let t_lost = said(&o, Event::GcsLost.text(), 0.0).expect("link loss reported");
+    let t_wait = said(&o, TEXT_CLIMB_FIRST, 0.0).expect("the wait reported");
+    assert!((t_wait - t_lost).abs() < 0.05, "{t_wait} {t_lost}");
+    let at = o.samples.iter().find(|s| s.t >= t_lost).expect("samples");
+    let vr = default_of("NAV_TKO_VR");
+    eprintln!(
+        "link lost at {:.2} s: {:.1} m/s, {:.2} m up, phase {}",
+        t_lost - armed_at(&o),
+        at.airspeed,
+        height(at),
+        at.nav_phase
+    );
+    assert!(
+        phase_is(at, Phase::TakeoffClimb) && at.airspeed >= vr && height(at) < 0.5,
+        "rotated, still at the runway: {at:?}"
+    );
+    let t_return = o
+        .samples
+        .iter()
+        .find(|s| s.t > t_lost && phase_is(s, Phase::Return))
+        .expect("returns")
+        .t;
+    let climb: Vec<&Sample> = between(&o, t_lost, t_return).collect();
+    let roll_max = climb.iter().map(|s| s.roll.abs()).fold(0.0, f64::max);
+    let yaw_max = climb.iter().map(|s| s.yaw.abs()).fold(0.0, f64::max);
+    let turn_at = o.samples.iter().find(|s| s.t >= t_return).expect("sample");
+    let clear = default_of("NAV_TKO_CLR_M");
+    eprintln!(
+        "climb-out: largest roll {:.2} deg, heading within {:.2} deg of the runway; return from \
+         {:.2} m",
+        roll_max / DEG,
+        yaw_max / DEG,
+        height(turn_at)
+    );
+    // Wings level, on the runway's heading (north), every sample of the climb.
+    assert!(roll_max < 2.0 * DEG, "roll {:.2} deg", roll_max / DEG);
+    assert!(yaw_max < 3.0 * DEG, "heading {:.2} deg", yaw_max / DEG);
+    // The return begins at the clearance height (the estimate's height, within 1.5 m of the
+    // truth's) and not lower.
+    assert!(
+        height(turn_at) >= clear - 0.5 && height(turn_at) < clear + 1.5,
+        "return from {:.2} m, NAV_TKO_CLR_M {clear} m",
+        height(turn_at)
+    );
+    // Then it turns for home (behind it): more than 90 deg within 10 s.
+    let turned = between(&o, t_return, t_return + 10.0)
+        .map(|s| s.yaw.abs())
+        .fold(0.0, f64::max);
+    assert!(turned > 90.0 * DEG, "turned {:.0} deg", turned / DEG);
+    // The turn at the roll limit costs height: never down to where the ground's bank limit
+    // (NAV_GND_RLL_M) would hold it.
+    let lowest = between(&o, t_return, f64::INFINITY)
+        .map(height)
+        .fold(f64::INFINITY, f64::min);
+    eprintln!("lowest after the turn began: {lowest:.2} m");
+    assert!(lowest > default_of("NAV_GND_RLL_M"), "{lowest:.2} m");
+    let tips = wing_tips(&a);
+    assert_eq!(tips.len(), 2);
+    let closest = o
+        .samples
+        .iter()
+        .filter(|s| s.armed)
+        .map(|s| tip_clearance(s, &tips, ground))
+        .fold(f64::INFINITY, f64::min);
+    eprintln!("closest wing tip to the runway: {closest:.3} m");
+    assert!(closest > 0.0, "a wing tip touched: {closest:.3} m");
+}
+
+/// The bank allowed near the ground (`NAV_GND_RLL_DEG` 5 deg on it, widening linearly to
+/// 90 deg at `NAV_GND_RLL_M` 3 m, then the roll limit `LIM_ROLL_DEG`) keeps both wing tips of
+/// the aircraft file off the runway at every height the autopilot can read, from the wheels
+/// on it up: the tips' clearance is the file's geometry (the belly points out on the span)
+/// turned by that bank, with the nose at the three-point attitude or level, the centre of
+/// gravity as far above its resting height as the autopilot's height above home says. The
+/// roll limit alone would put a tip on the runway (the limit is what keeps it off).
+#[test]
+fn the_bank_allowed_near_the_ground_keeps_the_aircraft_file_s_wing_tips_off_the_runway() {
+    use common::math::Euler;
+    use common::navigation::navigator::params::NavParams;
+    use sim_host::plant::ground::rest_state;
+    let a = aircraft();
+    let tips = wing_tips(&a);
+    assert_eq!(tips.len(), 2);
+    let ground = a.environment.home_alt_msl_m;
+    let (rest, _) = rest_state(&ModelParams::new(&a), 0.0, 0.0, 0.0);
+    let rest_pitch = Euler::from_quaternion(&rest.attitude).theta;
+    let rest_alt = ground - rest.pos_ned.z;
+    let p = NavParams::default();
+    let roll_limit = default_of("LIM_ROLL_DEG") * DEG;
+    let widen = f64::from(p.ground_roll_height);
+    let at = |h: f64, roll: f64, pitch: f64| Sample {
+        alt: rest_alt + h,
+        roll,
+        pitch,
+        armed: true,
+        ..Sample::default()
+    };
+    let mut closest = (f64::INFINITY, 0.0, 0.0);
+    for k in 0..=400 {
+        let h = widen * 1.2 * f64::from(k) / 400.0;
+        let allowed = p
+            .bank_near_ground(h as f32, p.ground_roll_height)
+            .map_or(roll_limit, |b| f64::from(b).min(roll_limit));
+        for pitch in [rest_pitch, 0.0] {
+            for roll in [allowed, -allowed] {
+                let c = tip_clearance(&at(h, roll, pitch), &tips, ground);
+                if c < closest.0 {
+                    closest = (c, h, allowed);
+                }
+            }
+        }
+    }
+    eprintln!(
+        "closest tip {:.3} m, at {:.2} m up and {:.1} deg of bank",
+        closest.0,
+        closest.1,
+        closest.2 / DEG
+    );
+    assert!(closest.0 > 0.0, "a tip touches: {closest:?}");
+    // Without the ground's limit, the roll limit at 0.2 m up puts the tip on the runway.
+    let unlimited = tip_clearance(&at(0.2, roll_limit, rest_pitch), &tips, ground);
+    assert!(unlimited < 0.0, "{unlimited:.3} m");
+}

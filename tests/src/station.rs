@@ -1,8 +1,9 @@
 //! A ground station of the tests' own: a UDP socket, frames encoded and parsed by the
 //! `mavlink` crate alone (none of the autopilot's framing code), speaking to an autopilot's
 //! ground link as an operator with QGroundControl would: the mission protocol both ways,
-//! commands answered by COMMAND_ACK, heartbeats at 1 Hz of the autopilot's clock, and a log
-//! of what it heard (heartbeats, MISSION_CURRENT, MISSION_ITEM_REACHED, STATUSTEXT).
+//! commands answered by COMMAND_ACK, heartbeats at 1 Hz of the autopilot's clock (until it
+//! falls silent, as a lost link does), and a log of what it heard (heartbeats,
+//! MISSION_CURRENT, MISSION_ITEM_REACHED, STATUSTEXT, the landed state).
 
 use common::gcs::client::{command_long, gcs_heartbeat};
 use mavlink::dialects::common::*;
@@ -44,6 +45,8 @@ pub struct Log {
     /// GLOBAL_POSITION_INT while armed: altitude above sea level less height above home, mm
     /// (home's altitude in the aircraft's datum).
     pub armed_datums: Vec<i32>,
+    /// EXTENDED_SYS_STATE's landed state, each time it changed.
+    pub landed_states: Vec<MavLandedState>,
 }
 
 /// The ground station.
@@ -60,6 +63,9 @@ pub struct Station {
     /// Its clock when this station last sent a heartbeat, ms.
     heartbeat_ms: Option<u32>,
     heartbeat_wall: Instant,
+    /// The link is lost the autopilot's way: this station keeps listening and sends nothing
+    /// more, heartbeats included.
+    pub silent: bool,
 }
 
 impl Station {
@@ -75,6 +81,7 @@ impl Station {
             autopilot_ms: None,
             heartbeat_ms: None,
             heartbeat_wall: Instant::now(),
+            silent: false,
         };
         s.heartbeat();
         s
@@ -82,6 +89,7 @@ impl Station {
 
     /// Sends one frame.
     pub fn send(&mut self, m: &MavMessage) {
+        assert!(!self.silent, "a silent station sends nothing");
         let header = MavHeader {
             system_id: u32::from(ME.0),
             component_id: ME.1,
@@ -105,6 +113,9 @@ impl Station {
     /// autopilot would hear it only every `SPEED` seconds and call the link lost), and at
     /// least 1 Hz of wall time while its clock is not known.
     fn heartbeat_if_due(&mut self) {
+        if self.silent {
+            return;
+        }
         let due = match (self.autopilot_ms, self.heartbeat_ms) {
             (Some(now), Some(last)) => now.saturating_sub(last) >= 1000,
             (Some(_), None) => true,
@@ -182,6 +193,11 @@ impl Station {
             }
             MavMessage::GLOBAL_POSITION_INT(g) if self.armed() => {
                 self.log.armed_datums.push(g.alt - g.relative_alt)
+            }
+            MavMessage::EXTENDED_SYS_STATE(x)
+                if self.log.landed_states.last() != Some(&x.landed_state) =>
+            {
+                self.log.landed_states.push(x.landed_state)
             }
             MavMessage::STATUSTEXT(t) => self
                 .log

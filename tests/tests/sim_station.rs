@@ -8,6 +8,8 @@
 //!   `cargo run -p firmware -- --sim tcp:...` runs) connects to the simulator's TCP port; the
 //!   flight is paced at [`SPEED`] so that this station, which lives in wall time, keeps its
 //!   1 Hz heartbeat of the autopilot's clock. The whole mission, to the landing.
+//! - The host build again, the station's link lost on the take-off roll: the take-off is
+//!   given up, and the aircraft stops on the runway wings level and disarms.
 //! - The MCU image: `sim-host sim --link qemu` boots it, and the station speaks to its ground
 //!   bridge. The image answers at about the pace of real time, so the flight is not paced;
 //!   the station watches the take-off and the first leg, then stops the simulator as Ctrl-C
@@ -81,62 +83,12 @@ fn upload_arm_and_start(gcs: &mut Station, speed: f64) -> u16 {
 #[test]
 fn a_station_flies_the_default_mission_through_sim_host_sim_and_the_host_build() {
     let out = tempfile::tempdir().expect("tempdir");
-    let cfg = FlightConfig {
-        duration_s: HOST_FLIGHT_S,
-        realtime: true,
-        speed: SPEED,
-        runway_heading: Some(0.0),
-        scripted_station: false,
-        until_link_closes: true,
-        ..FlightConfig::default()
-    };
-    let opts = SimOptions {
-        link: LinkKind::Tcp,
-        bind: "127.0.0.1:0".into(),
-        wait: Some(Duration::from_secs(20)),
-        out: Some(out.path().to_path_buf()),
-        plots: false,
-        ..SimOptions::default()
-    };
-    let (ready, sim) = start_sim(cfg, opts);
-    let sim_addr = ready
-        .sim_link
-        .strip_prefix("tcp ")
-        .expect("a tcp address")
-        .to_string();
-
-    // The autopilot: the host build's SITL loop, its ground link on a UDP port of its own.
-    let mut ground = firmware::sitl::GcsUdp::open("127.0.0.1:0", None).expect("ground link");
-    let ground_addr = ground.local_addr().expect("ground address");
-    let autopilot = std::thread::spawn(move || {
-        let endpoint = firmware::sitl::SimEndpoint::Tcp(sim_addr);
-        let mut link =
-            firmware::sitl::connect(&endpoint, Duration::from_secs(10)).expect("connects");
-        let mut app = firmware::app::App::new();
-        firmware::sitl::run_with(
-            link.as_mut(),
-            &mut app,
-            Duration::from_secs(5),
-            Some(&mut ground),
-            None,
-            None,
-        )
-    });
+    let (ground_addr, sim, autopilot) = start_host_flight(HOST_FLIGHT_S, SPEED, Some(out.path()));
 
     let socket = UdpSocket::bind("127.0.0.1:0").expect("station socket");
     let mut gcs = Station::new(socket, ground_addr);
     let n = upload_arm_and_start(&mut gcs, SPEED);
-    while !sim.is_finished() {
-        gcs.pump();
-        gcs.inbox.clear();
-    }
-    let r = sim.join().expect("sim thread").expect("the flight");
-    // The simulator closed its end at the duration: the autopilot saw the link close.
-    let ended = autopilot.join().expect("autopilot thread");
-    assert!(
-        matches!(&ended, Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof),
-        "{ended:?}"
-    );
+    let r = listen_to_the_end(&mut gcs, sim, autopilot);
 
     let log = &gcs.log;
     eprintln!("reached {:?}; texts {:?}", log.reached, log.texts);
@@ -287,6 +239,236 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     for f in ["simlink.tlog", "flight.csv", "summary.json", "mcu.defmt"] {
         assert!(out.path().join(f).is_file(), "{f} written");
     }
+}
+
+/// A flight of the host build: `sim-host sim` on the runway heading north for `duration_s`
+/// of simulated time paced at `speed` times real time, its files in `out`, and the autopilot's
+/// SITL loop (what `cargo run -p firmware -- --sim tcp:...` runs) connected to it, its ground
+/// link on a UDP port of its own. Returns that port, the simulator's thread and the
+/// autopilot's.
+fn start_host_flight(
+    duration_s: f64,
+    speed: f64,
+    out: Option<&std::path::Path>,
+) -> (
+    SocketAddr,
+    JoinHandle<anyhow::Result<FlyReport>>,
+    JoinHandle<std::io::Result<()>>,
+) {
+    let cfg = FlightConfig {
+        duration_s,
+        realtime: true,
+        speed,
+        runway_heading: Some(0.0),
+        scripted_station: false,
+        until_link_closes: true,
+        ..FlightConfig::default()
+    };
+    let opts = SimOptions {
+        link: LinkKind::Tcp,
+        bind: "127.0.0.1:0".into(),
+        wait: Some(Duration::from_secs(20)),
+        out: out.map(std::path::Path::to_path_buf),
+        plots: false,
+        ..SimOptions::default()
+    };
+    let (ready, sim) = start_sim(cfg, opts);
+    let sim_addr = ready
+        .sim_link
+        .strip_prefix("tcp ")
+        .expect("a tcp address")
+        .to_string();
+    let mut ground = firmware::sitl::GcsUdp::open("127.0.0.1:0", None).expect("ground link");
+    let ground_addr = ground.local_addr().expect("ground address");
+    let autopilot = std::thread::spawn(move || {
+        let endpoint = firmware::sitl::SimEndpoint::Tcp(sim_addr);
+        let mut link =
+            firmware::sitl::connect(&endpoint, Duration::from_secs(10)).expect("connects");
+        let mut app = firmware::app::App::new();
+        firmware::sitl::run_with(
+            link.as_mut(),
+            &mut app,
+            Duration::from_secs(5),
+            Some(&mut ground),
+            None,
+            None,
+        )
+    });
+    (ground_addr, sim, autopilot)
+}
+
+/// The station listens (and, unless silent, keeps its heartbeat) until the simulator ends the
+/// flight at its duration; the simulator closed its end then, and the autopilot saw the link
+/// close. Returns the simulator's report.
+fn listen_to_the_end(
+    gcs: &mut Station,
+    sim: JoinHandle<anyhow::Result<FlyReport>>,
+    autopilot: JoinHandle<std::io::Result<()>>,
+) -> FlyReport {
+    while !sim.is_finished() {
+        gcs.pump();
+        gcs.inbox.clear();
+    }
+    let r = sim.join().expect("sim thread").expect("the flight");
+    let ended = autopilot.join().expect("autopilot thread");
+    assert!(
+        matches!(&ended, Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof),
+        "{ended:?}"
+    );
+    r
+}
+
+/// Simulated seconds per wall second of the take-off abort: slow enough that the station's
+/// silence, which follows MISSION_START's acknowledgement in wall time, starts within a few
+/// hundredths of a second of the autopilot's.
+const ABORT_SPEED: f64 = 10.0;
+/// The ground-link timeout the station sets: the roll takes 3.7 s from MISSION_START to reach
+/// `NAV_TKO_VR` (13 m/s) with the throttle opened over `NAV_TKO_RAMP_S`, so the link is lost
+/// at about 8 m/s, more than a second before the rotation.
+const ABORT_GCS_TOUT_S: f32 = 2.5;
+
+/// The report's flight done as a user would, three programs apart: `sim-host sim`, the
+/// autopilot's host build and a ground station (this test) that sets `FS_GCS_TOUT_S`,
+/// uploads the default mission, arms, starts it and falls silent. The link is lost on the
+/// take-off roll: the take-off is aborted (no return from the runway), the throttle closed,
+/// the wings held level (both wing tips clear of the runway, from the aircraft file's
+/// geometry and the simulator's true attitude), the aircraft rolls to a stop on the runway's
+/// line, disarms, and the station reads ON_GROUND.
+#[test]
+fn a_ground_link_loss_on_the_take_off_roll_aborts_it_through_sim_host_sim_and_the_host_build() {
+    use common::failsafe::Event;
+    use common::vehicle::commander::{TEXT_ABORTED, TEXT_ABORT_DISARMED};
+    use common::vehicle::modes::FlightMode;
+    use sim_host::flight::strikes::{clearance, propeller_hub_m, strike_points};
+    let (ground_addr, sim, autopilot) = start_host_flight(50.0, ABORT_SPEED, None);
+
+    let socket = UdpSocket::bind("127.0.0.1:0").expect("station socket");
+    let mut gcs = Station::new(socket, ground_addr);
+    gcs.fixed_wing_heartbeat(20.0);
+    assert!(gcs.set_param("FS_GCS_TOUT_S", ABORT_GCS_TOUT_S));
+    upload_arm_and_start(&mut gcs, ABORT_SPEED);
+    // The link is lost: a last heartbeat (the failsafe counts from the last one heard, so
+    // the timeout runs from the roll's start), then the station listens on and sends nothing.
+    gcs.heartbeat();
+    gcs.silent = true;
+    let r = listen_to_the_end(&mut gcs, sim, autopilot);
+
+    // What the station heard: the loss, the abort, the stop; never a return.
+    let log = &gcs.log;
+    eprintln!(
+        "texts {:?}; landed states {:?}",
+        log.texts, log.landed_states
+    );
+    for t in [Event::GcsLost.text(), TEXT_ABORTED, TEXT_ABORT_DISARMED] {
+        assert!(log.texts.iter().any(|x| x == t), "{t:?} in {:?}", log.texts);
+    }
+    let mut flags: Vec<bool> = log.heartbeats.iter().map(|h| h.0).collect();
+    flags.dedup();
+    assert_eq!(
+        flags,
+        [false, true, false],
+        "armed, then disarmed once stopped"
+    );
+    let mission = FlightMode::Mission.custom_mode();
+    assert!(
+        log.heartbeats
+            .iter()
+            .filter(|h| h.0)
+            .all(|h| h.1 == mission),
+        "Mission flown while armed, never a return: {:?}",
+        log.heartbeats
+    );
+    assert_eq!(
+        log.landed_states.last(),
+        Some(&MavLandedState::MAV_LANDED_STATE_ON_GROUND)
+    );
+    assert!(
+        !log.landed_states
+            .contains(&MavLandedState::MAV_LANDED_STATE_IN_AIR),
+        "{:?}",
+        log.landed_states
+    );
+
+    // What the aircraft did (the simulator's truth).
+    let a = aircraft();
+    let samples = &r.outcome.samples;
+    let rest = samples.first().expect("samples").alt;
+    let ground = a.environment.home_alt_msl_m;
+    let vr = f64::from(common::navigation::navigator::params::NavParams::default().takeoff_vr);
+    let full = samples
+        .iter()
+        .position(|s| s.armed && s.throttle > 0.5)
+        .expect("the take-off roll opened the throttle");
+    let cut = full
+        + samples[full..]
+            .iter()
+            .position(|s| s.throttle == 0.0)
+            .expect("the throttle closed");
+    let at_cut = &samples[cut];
+    let after = &samples[cut..];
+    let fastest = after.iter().map(|s| s.airspeed).fold(0.0, f64::max);
+    eprintln!(
+        "throttle closed at {:.2} s, {:.1} m/s; fastest after {fastest:.1} m/s (NAV_TKO_VR {vr})",
+        at_cut.t, at_cut.airspeed
+    );
+    assert!(
+        fastest < vr,
+        "aborted before the rotation: {fastest:.1} m/s"
+    );
+    assert!(
+        after.iter().filter(|s| s.armed).all(|s| s.throttle == 0.0),
+        "the throttle stays closed"
+    );
+    // The wheels never left the runway; wings level; both tips clear of it.
+    let highest = samples.iter().map(|s| s.alt - rest).fold(0.0, f64::max);
+    let roll_max = samples.iter().map(|s| s.roll.abs()).fold(0.0, f64::max);
+    let tips: Vec<_> = strike_points(&a, propeller_hub_m(&a, [0.0; 3]))
+        .into_iter()
+        .filter(|p| p.name.contains("wing tip"))
+        .collect();
+    assert_eq!(tips.len(), 2);
+    let closest = samples
+        .iter()
+        .flat_map(|s| tips.iter().map(move |p| clearance(s, ground, p)))
+        .fold(f64::INFINITY, f64::min);
+    eprintln!(
+        "highest {highest:.3} m over the rest height, largest roll {:.2} deg, closest wing tip \
+         {closest:.3} m",
+        roll_max.to_degrees()
+    );
+    assert!(highest < 0.1, "lifted {highest:.3} m");
+    let ground_roll =
+        f64::from(common::navigation::navigator::params::NavParams::default().ground_roll_max);
+    assert!(
+        roll_max < ground_roll,
+        "roll {:.2} deg, NAV_GND_RLL_DEG {:.1}",
+        roll_max.to_degrees(),
+        ground_roll.to_degrees()
+    );
+    assert!(closest > 0.0, "a wing tip touched: {closest:.3} m");
+    // Stopped on the runway's line (north from home), disarmed.
+    let n = samples.len();
+    let (p, q) = (&samples[n - 11], &samples[n - 1]);
+    let speed = (q.north - p.north).hypot(q.east - p.east) / (q.t - p.t);
+    let off_line = samples.iter().map(|s| s.east.abs()).fold(0.0, f64::max);
+    eprintln!(
+        "stopped {:.1} m down the runway, {off_line:.2} m off its line at most, {speed:.3} m/s \
+         at the end",
+        q.north
+    );
+    let disarmed = after.iter().find(|s| !s.armed).expect("disarmed");
+    let stopped = after
+        .windows(11)
+        .find(|w| (w[10].north - w[0].north).hypot(w[10].east - w[0].east) < 0.01)
+        .map_or(f64::NAN, |w| w[0].t);
+    eprintln!(
+        "disarmed {:.1} s after the throttle closed, stopped {:.1} s after",
+        disarmed.t - at_cut.t,
+        stopped - at_cut.t
+    );
+    assert!(speed < 0.1, "still rolling at {speed:.3} m/s");
+    assert!(off_line < 2.0, "{off_line:.2} m off the runway's line");
+    assert!(!q.armed);
 }
 
 /// The MCU image's flight log, listed and downloaded over its ground bridge by pymavlink the way

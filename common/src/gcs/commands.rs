@@ -379,9 +379,9 @@ impl CommandService {
                 if let Some(why) = telemetry::prearm_failure(v) {
                     out.textf(
                         MavSeverity::MAV_SEVERITY_CRITICAL,
-                        format_args!("Arming denied: {}", why),
+                        format_args!("Arming denied: {}", why.reason()),
                     );
-                    return MavResult::MAV_RESULT_DENIED;
+                    return why.result();
                 }
             }
         } else {

@@ -80,30 +80,94 @@ pub fn heartbeat(v: &VehicleSnapshot) -> MavMessage {
     })
 }
 
-/// Why arming must be refused, `None` when every pre-arm check passes.
-pub fn prearm_failure(v: &VehicleSnapshot) -> Option<&'static str> {
-    let h = &v.health;
-    if !h.gyro_ok {
-        Some("gyro unhealthy")
-    } else if !h.accel_ok {
-        Some("accelerometer unhealthy")
-    } else if !h.mag_ok {
-        Some("magnetometer unhealthy")
-    } else if !h.baro_ok {
-        Some("barometer unhealthy")
-    } else if !h.airspeed_ok {
-        Some("airspeed sensor unhealthy")
-    } else if !h.attitude_converged {
-        Some("attitude estimate not converged")
-    } else if !h.gps_ok || v.gps.fix_type < 3 {
-        Some("no 3D GPS fix")
-    } else if !h.position_valid {
-        Some("position estimate invalid")
-    } else if v.battery.present && v.battery.warning >= Warning::Critical {
-        Some("battery critical")
-    } else {
-        None
+/// A pre-arm check that refuses arming.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum PrearmFailure {
+    /// The gyros are silent or their samples refused.
+    Gyro,
+    /// The accelerometers are.
+    Accelerometer,
+    /// The magnetometer is.
+    Magnetometer,
+    /// The barometer is.
+    Barometer,
+    /// The airspeed sensor is.
+    Airspeed,
+    /// The battery is below its critical level.
+    BatteryCritical,
+    /// The attitude estimate has not converged yet.
+    AttitudeConverging,
+    /// No 3D GPS fix yet.
+    NoGpsFix,
+    /// The position estimate is not valid yet.
+    PositionInvalid,
+}
+
+impl PrearmFailure {
+    /// The reason, as "Arming denied: <reason>" says it.
+    pub fn reason(self) -> &'static str {
+        match self {
+            PrearmFailure::Gyro => "gyro unhealthy",
+            PrearmFailure::Accelerometer => "accelerometer unhealthy",
+            PrearmFailure::Magnetometer => "magnetometer unhealthy",
+            PrearmFailure::Barometer => "barometer unhealthy",
+            PrearmFailure::Airspeed => "airspeed sensor unhealthy",
+            PrearmFailure::BatteryCritical => "battery critical",
+            PrearmFailure::AttitudeConverging => "attitude estimate not converged",
+            PrearmFailure::NoGpsFix => "no 3D GPS fix",
+            PrearmFailure::PositionInvalid => "position estimate invalid",
+        }
     }
+
+    /// Whether waiting mends it: the estimator converging, the GPS receiver acquiring its
+    /// fix. A failed sensor or an empty pack waits for the operator.
+    pub fn passes_with_time(self) -> bool {
+        match self {
+            PrearmFailure::AttitudeConverging
+            | PrearmFailure::NoGpsFix
+            | PrearmFailure::PositionInvalid => true,
+            PrearmFailure::Gyro
+            | PrearmFailure::Accelerometer
+            | PrearmFailure::Magnetometer
+            | PrearmFailure::Barometer
+            | PrearmFailure::Airspeed
+            | PrearmFailure::BatteryCritical => false,
+        }
+    }
+
+    /// The arming command's result, in MAVLink's sense of each: TEMPORARILY_REJECTED for what
+    /// passes with time ("retrying later should work", as a station that retries on it
+    /// does), DENIED for what does not ("retrying the same command will not work").
+    pub fn result(self) -> MavResult {
+        if self.passes_with_time() {
+            MavResult::MAV_RESULT_TEMPORARILY_REJECTED
+        } else {
+            MavResult::MAV_RESULT_DENIED
+        }
+    }
+}
+
+/// Why arming must be refused, `None` when every pre-arm check passes. The checks that do not
+/// pass with time come first, so a station retrying a temporary refusal is not kept waiting
+/// for one that will not pass.
+pub fn prearm_failure(v: &VehicleSnapshot) -> Option<PrearmFailure> {
+    let h = &v.health;
+    let checks = [
+        (h.gyro_ok, PrearmFailure::Gyro),
+        (h.accel_ok, PrearmFailure::Accelerometer),
+        (h.mag_ok, PrearmFailure::Magnetometer),
+        (h.baro_ok, PrearmFailure::Barometer),
+        (h.airspeed_ok, PrearmFailure::Airspeed),
+        (
+            !(v.battery.present && v.battery.warning >= Warning::Critical),
+            PrearmFailure::BatteryCritical,
+        ),
+        (h.attitude_converged, PrearmFailure::AttitudeConverging),
+        (h.gps_ok && v.gps.fix_type >= 3, PrearmFailure::NoGpsFix),
+        (h.position_valid, PrearmFailure::PositionInvalid),
+    ];
+    checks.iter().find(|(ok, _)| !ok).map(|&(_, why)| why)
 }
 
 /// `SYS_STATUS`.

@@ -630,7 +630,7 @@ fn arm_cmd(arm: bool, force: bool) -> MavMessage {
 }
 
 #[test]
-fn arming_with_and_without_prearm_conditions() {
+fn arming_a_healthy_vehicle_on_the_ground_is_accepted_and_queued() {
     let v = healthy();
     let mut l = link();
     let out = exchange(&mut l, &v, 0, arm_cmd(true, false));
@@ -642,46 +642,124 @@ fn arming_with_and_without_prearm_conditions() {
             forced: false
         })
     );
+    assert!(texts(&out).is_empty(), "{:?}", texts(&out));
+}
 
-    type Breaker = fn(&mut VehicleSnapshot);
-    let breakers: [(Breaker, &str); 6] = [
-        (|v| v.health.gyro_ok = false, "gyro"),
-        (|v| v.health.baro_ok = false, "barometer"),
-        (|v| v.health.attitude_converged = false, "attitude estimate"),
-        (|v| v.gps.fix_type = 2, "GPS fix"),
-        (|v| v.health.position_valid = false, "position estimate"),
-        (
-            |v| {
-                v.battery.present = true;
-                v.battery.warning = crate::battery::Warning::Critical
-            },
-            "battery",
-        ),
-    ];
-    for (k, (brk, why)) in breakers.iter().enumerate() {
-        let mut bad = healthy();
-        brk(&mut bad);
-        let mut l = link();
-        let out = exchange(&mut l, &bad, k as u64, arm_cmd(true, false));
-        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_DENIED, "{why}");
-        let t = texts(&out);
-        assert!(
-            t[0].starts_with("Arming denied") && t[0].contains(why),
-            "{t:?}"
-        );
-        assert_eq!(l.take_requests().arm, None);
-        // Forced arming skips the checks.
-        let out = exchange(&mut l, &bad, 100, arm_cmd(true, true));
-        assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
-        assert!(l.take_requests().arm.unwrap().forced);
-    }
-    // Still booting: try again later.
-    let mut booting = healthy();
-    booting.boot_complete = false;
-    let out = exchange(&mut link(), &booting, 0, arm_cmd(true, false));
-    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+/// Arms a vehicle `break_it` has spoiled: the result, the STATUSTEXTs, and that nothing was
+/// queued; then checks that a forced arming is accepted all the same.
+fn arm_refused(break_it: fn(&mut VehicleSnapshot)) -> (MavResult, Vec<std::string::String>) {
+    let mut bad = healthy();
+    break_it(&mut bad);
+    let mut l = link();
+    let out = exchange(&mut l, &bad, 0, arm_cmd(true, false));
+    assert_eq!(l.take_requests().arm, None, "a refusal queues nothing");
+    let refused = (acks(&out)[0].1, texts(&out));
+    // Forced arming skips the checks.
+    let out = exchange(&mut l, &bad, 100, arm_cmd(true, true));
+    assert_eq!(acks(&out)[0].1, MavResult::MAV_RESULT_ACCEPTED);
+    assert!(l.take_requests().arm.is_some_and(|a| a.forced));
+    refused
+}
 
-    // Disarm in the air refused unless forced.
+// MAVLink's MAV_RESULT: TEMPORARILY_REJECTED is "a problem that should be fixed just by
+// waiting (... can't arm because have not got GPS lock ...)"; DENIED is "retrying the same
+// command and parameters will not work". Each refusal says why in one STATUSTEXT.
+
+#[test]
+fn arming_while_the_attitude_estimate_converges_is_temporarily_rejected() {
+    let (r, t) = arm_refused(|v| v.health.attitude_converged = false);
+    assert_eq!(r, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert_eq!(t, ["Arming denied: attitude estimate not converged"]);
+}
+
+#[test]
+fn arming_before_a_3d_gps_fix_is_temporarily_rejected() {
+    let (r, t) = arm_refused(|v| v.gps.fix_type = 2);
+    assert_eq!(r, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert_eq!(t, ["Arming denied: no 3D GPS fix"]);
+}
+
+#[test]
+fn arming_while_the_gps_receiver_is_silent_is_temporarily_rejected() {
+    let (r, t) = arm_refused(|v| v.health.gps_ok = false);
+    assert_eq!(r, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert_eq!(t, ["Arming denied: no 3D GPS fix"]);
+}
+
+#[test]
+fn arming_before_the_position_estimate_is_valid_is_temporarily_rejected() {
+    let (r, t) = arm_refused(|v| v.health.position_valid = false);
+    assert_eq!(r, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert_eq!(t, ["Arming denied: position estimate invalid"]);
+}
+
+#[test]
+fn arming_with_an_unhealthy_gyro_is_denied() {
+    let (r, t) = arm_refused(|v| v.health.gyro_ok = false);
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: gyro unhealthy"]);
+}
+
+#[test]
+fn arming_with_an_unhealthy_accelerometer_is_denied() {
+    let (r, t) = arm_refused(|v| v.health.accel_ok = false);
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: accelerometer unhealthy"]);
+}
+
+#[test]
+fn arming_with_an_unhealthy_magnetometer_is_denied() {
+    let (r, t) = arm_refused(|v| v.health.mag_ok = false);
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: magnetometer unhealthy"]);
+}
+
+#[test]
+fn arming_with_an_unhealthy_barometer_is_denied() {
+    let (r, t) = arm_refused(|v| v.health.baro_ok = false);
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: barometer unhealthy"]);
+}
+
+#[test]
+fn arming_with_an_unhealthy_airspeed_sensor_is_denied() {
+    let (r, t) = arm_refused(|v| v.health.airspeed_ok = false);
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: airspeed sensor unhealthy"]);
+}
+
+#[test]
+fn arming_on_a_critical_battery_is_denied() {
+    let (r, t) = arm_refused(|v| {
+        v.battery.present = true;
+        v.battery.warning = crate::battery::Warning::Critical;
+    });
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: battery critical"]);
+}
+
+/// A station that retries while it is told to wait must not wait for what will not pass: with
+/// a failed sensor and an estimator still converging, the answer is the sensor's DENIED.
+#[test]
+fn arming_with_a_failed_sensor_while_the_estimator_converges_is_denied_for_the_sensor() {
+    let (r, t) = arm_refused(|v| {
+        v.health.attitude_converged = false;
+        v.health.position_valid = false;
+        v.health.baro_ok = false;
+    });
+    assert_eq!(r, MavResult::MAV_RESULT_DENIED);
+    assert_eq!(t, ["Arming denied: barometer unhealthy"]);
+}
+
+#[test]
+fn arming_before_the_boot_is_complete_is_temporarily_rejected() {
+    let (r, t) = arm_refused(|v| v.boot_complete = false);
+    assert_eq!(r, MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+    assert_eq!(t, ["Arming denied: system still starting"]);
+}
+
+#[test]
+fn disarming_in_the_air_is_denied_unless_forced() {
     let mut flying = healthy();
     flying.armed = true;
     flying.landed = LandedState::InAir;

@@ -3,6 +3,7 @@
 extern crate std;
 
 use super::items::*;
+use super::navigator::io::GroundStage;
 use super::navigator::params::PARAMS as EXEC_PARAMS;
 use super::path_manager::PARAMS as PATH_PARAMS;
 use super::plan::MissionItem;
@@ -550,6 +551,183 @@ fn runway_takeoff() {
     let (_, _, end) = log.outs.last().unwrap();
     assert!(-end.z >= 35.0 && -end.z < 40.0 + 1.0);
     assert!(plane.k.airspeed >= vr);
+}
+
+/// The runway take-off of [`runway_takeoff`]: heading east from home, to 40 m.
+fn takeoff_east() -> [MissionItem; 2] {
+    let mut t = item(NAV_TAKEOFF, [0.0, 0.0, 0.0, 90.0], 0.0, 0.0, 40.0);
+    t.x = 0;
+    t.y = 0;
+    [t, wp(0.0, 1500.0, 60.0)]
+}
+
+/// One step of the navigator and of the plane it flies; the output and what the navigator
+/// then says of the ground.
+fn step_plane(
+    nav: &mut Navigator,
+    plane: &mut Plane,
+    items: &[MissionItem],
+) -> (NavOutput, GroundStage) {
+    let out = nav.step(items, &home(), &plane.state(), DT);
+    if let Some(c) = out.commands {
+        plane.apply(&c, DT);
+    }
+    (out, nav.ground_stage())
+}
+
+/// A take-off given up on its roll (a failsafe at 8 m/s, below `NAV_TKO_VR`): from the next
+/// step the throttle is closed, the wings held level and the tail wheel steers along the
+/// runway's line to a stop; the navigator says the aircraft may be disarmed once it rolls
+/// slower than 3 m/s (`NAV_LND_DISARM_S`'s rule), not before. For a failsafe the roll is the
+/// take-off roll, and the roll-out after the abort a touchdown to be finished.
+#[test]
+fn a_take_off_given_up_on_its_roll_rolls_out_wings_level_with_the_throttle_closed_to_a_stop() {
+    let items = takeoff_east();
+    let mut nav = navigator();
+    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    plane.k.airspeed = 0.0;
+    nav.start_mission(0);
+    while plane.k.airspeed < 8.0 {
+        let (out, stage) = step_plane(&mut nav, &mut plane, &items);
+        assert_eq!(
+            (out.phase, stage),
+            (Phase::TakeoffRoll, GroundStage::TakeoffRoll)
+        );
+    }
+    assert!(plane.k.airspeed < nav.params().takeoff_vr);
+    assert!(nav.abort_takeoff(), "a take-off on its roll is given up");
+    assert!(!nav.abort_takeoff(), "once");
+    let mut steps = 0;
+    loop {
+        let speed = plane.state().ground_speed();
+        let (out, stage) = step_plane(&mut nav, &mut plane, &items);
+        steps += 1;
+        assert_eq!(
+            (out.phase, stage),
+            (Phase::TakeoffAbort, GroundStage::Touchdown)
+        );
+        let c = out.commands.expect("commands");
+        assert_eq!(c.roll, RollMode::Roll(0.0), "wings level");
+        assert!(
+            matches!(c.lon, LonMode::Pitch { throttle, .. } if throttle == 0.0),
+            "throttle closed: {:?}",
+            c.lon
+        );
+        assert!(
+            plane.k.pos.x.abs() < 0.5 && plane.k.pos.z == 0.0,
+            "on the runway's line: {:?}",
+            plane.k.pos
+        );
+        assert_eq!(out.landed, speed < 3.0, "at {speed} m/s");
+        if out.landed {
+            break;
+        }
+        assert!(steps < 2000, "still rolling at {speed} m/s");
+    }
+    assert_eq!(out_reached_none(&mut nav, &mut plane, &items), None);
+}
+
+/// The aborted take-off reports no item reached, however long it stands: the mission was not
+/// flown.
+fn out_reached_none(nav: &mut Navigator, plane: &mut Plane, items: &[MissionItem]) -> Option<u16> {
+    (0..100).find_map(|_| step_plane(nav, plane, items).0.reached)
+}
+
+/// Past the rotation airspeed the take-off is committed: it cannot be given up, and a
+/// failsafe waits (the climb-out) until the aircraft is `NAV_TKO_CLR_M` (10 m) above where
+/// the roll began; from there on it is clear.
+#[test]
+fn past_the_rotation_a_take_off_goes_on_and_is_clear_for_a_failsafe_from_nav_tko_clr_m() {
+    let items = takeoff_east();
+    let mut nav = navigator();
+    let clear = nav.params().takeoff_clear;
+    assert_eq!(clear, 10.0);
+    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    plane.k.airspeed = 0.0;
+    nav.start_mission(0);
+    let mut seen = Vec::new();
+    for _ in 0..2000 {
+        let before = plane.height();
+        let (out, stage) = step_plane(&mut nav, &mut plane, &items);
+        if out.phase == Phase::TakeoffClimb {
+            assert!(!nav.abort_takeoff(), "given up past the rotation");
+        }
+        let expected = match out.phase {
+            Phase::TakeoffRoll => GroundStage::TakeoffRoll,
+            Phase::TakeoffClimb if before < clear => GroundStage::ClimbOut,
+            _ => GroundStage::Clear,
+        };
+        assert_eq!(stage, expected, "{:?} at {before} m", out.phase);
+        if seen.last() != Some(&stage) {
+            seen.push(stage);
+        }
+        if out.reached.is_some() {
+            break;
+        }
+    }
+    assert_eq!(
+        seen,
+        [
+            GroundStage::TakeoffRoll,
+            GroundStage::ClimbOut,
+            GroundStage::Clear
+        ]
+    );
+}
+
+/// A return begun on the runway (a failsafe's, before any height was gained) turns for home
+/// within the bank the ground allows: `NAV_GND_RLL_DEG` (5 deg) on it, 47.5 deg at 1.5 m,
+/// the roll limit alone from `NAV_GND_RLL_M` (3 m) up.
+#[test]
+fn a_return_begun_near_the_ground_banks_no_more_than_the_ground_allows() {
+    for (h, limit_deg) in [
+        (0.0, Some(5.0)),
+        (1.5, Some(47.5)),
+        (3.0, None),
+        (60.0, None),
+    ] {
+        let mut nav = navigator();
+        // 200 m north of home, heading north: home is behind.
+        let plane = Plane::flying(200.0, 0.0, h, 0.0);
+        nav.start_return(false);
+        let out = nav.step(&[], &home(), &plane.state(), DT);
+        assert_eq!(out.phase, Phase::Return);
+        match (out.commands.map(|c| c.roll), limit_deg) {
+            (Some(RollMode::CourseWithin { roll_max, .. }), Some(l)) => assert!(
+                (roll_max.to_degrees() - l).abs() < 1e-3,
+                "at {h} m: {} deg",
+                roll_max.to_degrees()
+            ),
+            (Some(RollMode::Course(_)), None) => {}
+            (other, _) => panic!("at {h} m: {other:?}"),
+        }
+    }
+}
+
+/// A landing's flare and roll-out are a touchdown for a failsafe (the landing is finished);
+/// its approach is not.
+#[test]
+fn a_landing_s_flare_and_roll_out_are_a_touchdown_for_a_failsafe_and_its_approach_is_not() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
+    nav.start_mission(0);
+    let mut seen = Vec::new();
+    for _ in 0..8000 {
+        let (out, stage) = step_plane(&mut nav, &mut plane, &items);
+        let expected = match out.phase {
+            Phase::Flare | Phase::Landed => GroundStage::Touchdown,
+            _ => GroundStage::Clear,
+        };
+        assert_eq!(stage, expected, "{:?}", out.phase);
+        if seen.last() != Some(&out.phase) {
+            seen.push(out.phase);
+        }
+        if out.landed {
+            break;
+        }
+    }
+    assert_eq!(seen, [Phase::Approach, Phase::Flare, Phase::Landed]);
 }
 
 /// A take-off item 60 deg off the heading the aircraft stands on (an item placed anywhere by a

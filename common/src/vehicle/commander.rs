@@ -30,13 +30,22 @@ use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
 use crate::navigation::fence::{breached, FenceParams};
 use crate::navigation::item::{NavCommand, NavItem, Route};
 use crate::navigation::items::{Altitude, Place};
-use crate::navigation::navigator::io::{HomeRequest, NavOutput, NavState, Phase};
+use crate::navigation::navigator::io::{GroundStage, HomeRequest, NavOutput, NavState, Phase};
 use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::{MissionStore, PlanKind};
 use crate::sensors::ManualInput;
 
 /// Sticks older than this are ignored (the ground station or the radio stopped sending), us.
 pub const STICK_TIMEOUT_US: u64 = 500_000;
+
+/// A failsafe on the take-off roll gave the take-off up.
+pub const TEXT_ABORTED: &str = "Failsafe on the runway: take-off aborted";
+/// A failsafe in the take-off's climb waits for `NAV_TKO_CLR_M`, wings level.
+pub const TEXT_CLIMB_FIRST: &str = "Failsafe in the climb-out: wings level up first";
+/// A failsafe in a flare or roll-out waits for the stop.
+pub const TEXT_LANDING_FIRST: &str = "Failsafe at touchdown: the landing goes on";
+/// The aborted take-off has rolled to a stop and disarmed.
+pub const TEXT_ABORT_DISARMED: &str = "Take-off aborted, stopped: disarmed";
 
 /// How urgent a [`Notice`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,6 +152,9 @@ pub struct Commander {
     reaction: Reaction,
     /// Altitude (AMSL, m) held while a GPS failsafe flies wings level.
     wings_level: Option<f32>,
+    /// Where a raised failsafe's reaction is held back near the ground (the take-off's
+    /// climb-out, a touchdown), `None` when it is not.
+    held_at: Option<GroundStage>,
     /// The navigator's last output.
     nav: NavOutput,
     /// The mode the navigator was last started for.
@@ -224,6 +236,7 @@ impl Commander {
             sticks: None,
             reaction: Reaction::None,
             wings_level: None,
+            held_at: None,
             nav: NavOutput::default(),
             nav_for: None,
             mission_seq: 0,
@@ -282,7 +295,7 @@ impl Commander {
             airspeed: e.airspeed,
             specific_force,
             // The navigator stays in its roll-out once it disarms the aircraft.
-            rolling_out: self.navigator_flies() && self.nav.phase == Phase::Landed,
+            rolling_out: self.navigator_flies() && self.nav.phase.rolls_out(),
         };
         self.land.update(p, &inputs, dt);
     }
@@ -290,12 +303,16 @@ impl Commander {
     /// The landed state reported (`EXTENDED_SYS_STATE`): the land detector's verdict, told
     /// apart by what the navigator flies. Taking off: armed in the take-off roll or in the
     /// climb to the take-off altitude. Landing: airborne on a landing's approach or flare (or
-    /// rolling out fast enough to count as moving). In the air: airborne otherwise. On the
-    /// ground: the detector's landed, outside a take-off.
+    /// rolling out fast enough to count as moving, after a landing or a take-off given up).
+    /// In the air: airborne otherwise. On the ground: the detector's landed, outside a
+    /// take-off.
     pub fn landed_state(&self) -> LandedState {
         let phase = self.navigated_phase();
         let takeoff = matches!(phase, Some(Phase::TakeoffRoll | Phase::TakeoffClimb));
-        let landing = matches!(phase, Some(Phase::Approach | Phase::Flare | Phase::Landed));
+        let landing = matches!(
+            phase,
+            Some(Phase::Approach | Phase::Flare | Phase::Landed | Phase::TakeoffAbort)
+        );
         match (self.land.landed(), takeoff, landing) {
             (_, true, _) => LandedState::Takeoff,
             (true, false, _) => LandedState::OnGround,
@@ -322,6 +339,12 @@ impl Commander {
     /// Whether any failsafe is raised.
     pub fn failsafe_active(&self) -> bool {
         self.failsafes.active()
+    }
+
+    /// Where a raised failsafe's reaction is held back near the ground (a take-off's
+    /// climb-out, a touchdown), `None` when it is not.
+    pub fn held_at(&self) -> Option<GroundStage> {
+        self.held_at
     }
 
     /// The guided modes' set points.
@@ -476,25 +499,34 @@ impl Commander {
             i.estimate,
             i.watch,
             i.plan,
-            i.gcs_heard_us,
-            i.battery,
+            (i.gcs_heard_us, i.battery),
+            i.navigator,
         );
         let (demand, home) = self.demand(i.now_us, i.dt, i.estimate, i.navigator, i.plan, i.gains);
         CommanderOutput { demand, home }
     }
 
-    /// Watches the failsafes at the control rate and acts on their reaction. `battery` is the
-    /// battery monitor's warning, `None` when no battery is monitored.
+    /// Watches the failsafes at the control rate and acts on their reaction (near the ground
+    /// as [`Commander::near_the_ground`] has it). `link` is when a ground station was last
+    /// heard (us) and the battery monitor's warning (`None` when no battery is monitored).
     pub(crate) fn check_failsafes(
         &mut self,
         now_us: u64,
         e: &EstimatedState,
         watch: &Watch,
         plan: &MissionStore,
-        gcs_heard_us: Option<u64>,
-        battery: Option<Warning>,
+        link: (Option<u64>, Option<Warning>),
+        navigator: &mut Navigator,
     ) {
-        let flying = self.flying();
+        let (gcs_heard_us, battery) = link;
+        let stage = if self.navigator_flies() {
+            navigator.ground_stage()
+        } else {
+            GroundStage::Clear
+        };
+        // The take-off roll is watched from its first metre, before its speed shows the land
+        // detector a flight: the failsafe gives the take-off up there.
+        let flying = self.flying() || (self.armed && stage == GroundStage::TakeoffRoll);
         let fence_breached = match e.home {
             Some(h) => {
                 breached(plan.items(PlanKind::Fence), &h, &e.pos_ned, &watch.fence).is_some()
@@ -519,6 +551,7 @@ impl Commander {
             };
             self.text(sev, ev.text());
         }
+        let reaction = self.near_the_ground(reaction, stage, navigator);
         if reaction == Reaction::WingsLevel && self.wings_level.is_none() {
             self.wings_level = Some(e.alt_amsl_m);
         }
@@ -526,6 +559,52 @@ impl Commander {
             self.wings_level = None;
         }
         self.reaction = reaction;
+    }
+
+    /// The reaction flown for the failsafes' `raised` one with the take-off or landing at
+    /// `stage`, as PX4 and ArduPlane users expect: on the take-off roll the take-off is given
+    /// up (throttle closed, wings level, steered to a stop on the runway; the plant has no
+    /// brakes to apply), past the rotation it climbs on wings level to `NAV_TKO_CLR_M` before
+    /// the reaction turns it, and a flare or roll-out finishes the landing. A reaction
+    /// already flown stays, and a cleared one (the pilot's choice of mode) ends at once.
+    fn near_the_ground(
+        &mut self,
+        raised: Reaction,
+        stage: GroundStage,
+        navigator: &mut Navigator,
+    ) -> Reaction {
+        let change = raised != Reaction::None && raised != self.reaction;
+        let held = match stage {
+            _ if !change => None,
+            GroundStage::Clear => None,
+            GroundStage::TakeoffRoll if !self.armed => None,
+            GroundStage::TakeoffRoll => {
+                if navigator.abort_takeoff() {
+                    self.text(Severity::Critical, TEXT_ABORTED);
+                    if self.nav_for == Some(FlightMode::Mission) {
+                        self.mission_state = MissionRunState::Paused;
+                    }
+                }
+                // The roll-out to a stop is the navigator's from its next step.
+                Some(GroundStage::Touchdown)
+            }
+            GroundStage::ClimbOut | GroundStage::Touchdown => Some(stage),
+        };
+        if held != self.held_at {
+            match (stage, held) {
+                (GroundStage::ClimbOut, Some(_)) => self.text(Severity::Warning, TEXT_CLIMB_FIRST),
+                (GroundStage::Touchdown, Some(_)) => {
+                    self.text(Severity::Warning, TEXT_LANDING_FIRST)
+                }
+                _ => {}
+            }
+        }
+        self.held_at = held;
+        if held.is_some() {
+            self.reaction
+        } else {
+            raised
+        }
     }
 
     /// What the flown mode asks of the actuators this tick, at `now_us`, `dt` after the last
@@ -577,13 +656,18 @@ impl Commander {
         // Disarmed after a landing, the surfaces rest at trim even while the aircraft still
         // rolls: the roll-out's steering and tail-down pitch, run on with no one to stop them,
         // drove the rudder and elevator to their stops and hopped the aircraft into the air.
-        if !self.armed && self.nav.phase == Phase::Landed && flown.needs_navigator() {
+        if !self.armed && self.nav.phase.rolls_out() && flown.needs_navigator() {
             return (Demand::Surfaces(idle), None);
         }
         if let Some(task) = flown.nav_task() {
             let (commands, home) = self.navigate(flown, task, dt, e, navigator, plan);
             // No home yet (refused before, so only after a reset): hold what we have.
-            let c = commands.unwrap_or(hold(sp.alt_amsl_m));
+            let mut c = commands.unwrap_or(hold(sp.alt_amsl_m));
+            // A failsafe waiting for the climb-out's height: wings level until then, the
+            // take-off's pitch and throttle kept.
+            if self.held_at == Some(GroundStage::ClimbOut) {
+                c.roll = RollMode::Roll(0.0);
+            }
             return (Demand::Commands(c), home);
         }
         let unflown = match flown.commands() {
@@ -673,7 +757,12 @@ impl Commander {
         });
         if out.landed && self.armed {
             self.armed = false;
-            self.text(Severity::Info, "Landed, disarmed");
+            let said = if out.phase == Phase::TakeoffAbort {
+                TEXT_ABORT_DISARMED
+            } else {
+                "Landed, disarmed"
+            };
+            self.text(Severity::Info, said);
         }
         let commands = out.commands;
         self.nav = out;

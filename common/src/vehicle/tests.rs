@@ -215,16 +215,23 @@ fn losing_the_ground_station_in_flight_returns_until_the_pilot_chooses_a_mode() 
     let watch = Watch::default();
     let plan = MissionStore::default();
     // Heard at 0 s; FS_GCS_TOUT_S is 5 s by default.
-    c.check_failsafes(4_900_000, &e, &watch, &plan, Some(0), None);
+    c.check_failsafes(4_900_000, &e, &watch, &plan, (Some(0), None), &mut n);
     assert_eq!(c.flown_mode(), FlightMode::Hold);
-    c.check_failsafes(5_100_000, &e, &watch, &plan, Some(0), None);
+    c.check_failsafes(5_100_000, &e, &watch, &plan, (Some(0), None), &mut n);
     assert_eq!(c.reaction(), Reaction::Return);
     assert_eq!(c.flown_mode(), FlightMode::Return);
     assert_eq!(c.chosen_mode(), FlightMode::Hold);
     assert!(!texts(&mut c).is_empty(), "the failsafe is reported");
     // Choosing a mode, even the same one, takes over from the return.
     c.apply(&mode(FlightMode::Hold), &e, &mut n);
-    c.check_failsafes(5_200_000, &e, &watch, &plan, Some(5_150_000), None);
+    c.check_failsafes(
+        5_200_000,
+        &e,
+        &watch,
+        &plan,
+        (Some(5_150_000), None),
+        &mut n,
+    );
     assert_eq!(c.flown_mode(), FlightMode::Hold);
 }
 
@@ -396,8 +403,8 @@ fn at_4_5_m_over_home_sinking_at_approach_speed_it_is_flying_and_the_failsafes_w
         &e,
         &Watch::default(),
         &MissionStore::default(),
-        Some(0),
-        None,
+        (Some(0), None),
+        &mut n,
     );
     assert_eq!(c.reaction(), Reaction::Return);
 }
@@ -489,5 +496,307 @@ fn every_mode_round_trips_through_its_px4_numbers_and_its_standard_mode() {
                 .contains(MavModeProperty::MAV_MODE_PROPERTY_AUTO_MODE),
             m.needs_navigator()
         );
+    }
+}
+
+// ------------------------------------------------ failsafes near the ground
+//
+// What PX4 and ArduPlane users expect: a failsafe on the take-off roll gives the take-off up
+// (throttle closed, wings level; the plant has no brakes), one past the rotation climbs on
+// wings level to the take-off's clearance height (`NAV_TKO_CLR_M`) before the reaction turns
+// the aircraft, and one in the flare or roll-out lets the landing finish.
+
+/// One control tick of the commander with the default settings; the ground station last
+/// heard at 0 s (`FS_GCS_TOUT_S` is 5 s).
+fn tick_at(
+    c: &mut Commander,
+    n: &mut Navigator,
+    e: &EstimatedState,
+    plan: &MissionStore,
+    now_us: u64,
+) -> CommanderOutput {
+    c.step(CommanderInputs {
+        now_us,
+        dt: 0.02,
+        estimate: e,
+        navigator: n,
+        plan,
+        gains: &DESIGNED,
+        watch: &Watch::default(),
+        land: &land_detector::LandParams::default(),
+        specific_force: Some(9.81),
+        gcs_heard_us: Some(0),
+        battery: None,
+    })
+}
+
+/// On the runway at home heading east at `speed` m/s (air and ground), wheels down.
+fn rolling(speed: f32) -> EstimatedState {
+    let mut e = on_ground();
+    e.euler.psi = core::f32::consts::FRAC_PI_2;
+    e.airspeed = speed;
+    e.ground_speed = speed;
+    e.vel_ned = Vector3::new(0.0, speed, 0.0);
+    e
+}
+
+/// Armed in Takeoff on the runway, rolled for a second at `speed` m/s with the ground station
+/// heard: the take-off roll (or, past `NAV_TKO_VR`, its climb).
+fn on_the_take_off(speed: f32) -> (Commander, Navigator, EstimatedState) {
+    let mut c = Commander::new();
+    let mut n = Navigator::default();
+    let e = rolling(0.0);
+    c.apply(&arm(), &e, &mut n);
+    c.apply(&mode(FlightMode::Takeoff), &e, &mut n);
+    let e = rolling(speed);
+    for k in 0..50 {
+        tick_at(&mut c, &mut n, &e, &MissionStore::default(), k * 20_000);
+    }
+    texts(&mut c);
+    (c, n, e)
+}
+
+fn commands(o: &CommanderOutput) -> crate::control::autopilot::Commands {
+    match o.demand {
+        Demand::Commands(c) => c,
+        Demand::Surfaces(s) => panic!("surfaces {s:?}"),
+    }
+}
+
+#[test]
+fn a_ground_link_loss_on_the_take_off_roll_aborts_the_take_off_instead_of_returning() {
+    use super::snapshot::LandedState;
+    use crate::navigation::navigator::io::Phase;
+    let plan = MissionStore::default();
+    // 10 m/s on the runway: the land detector has seen a flight, the rotation is at 13 m/s.
+    let (mut c, mut n, e) = on_the_take_off(10.0);
+    assert_eq!(c.navigation().phase, Phase::TakeoffRoll);
+    assert!(c.flying());
+    // Silent for more than FS_GCS_TOUT_S.
+    let o = tick_at(&mut c, &mut n, &e, &plan, 5_100_000);
+    assert_eq!(
+        texts(&mut c),
+        [crate::failsafe::Event::GcsLost.text(), TEXT_ABORTED]
+    );
+    assert_eq!(
+        c.flown_mode(),
+        FlightMode::Takeoff,
+        "no return from the runway"
+    );
+    assert_eq!(c.navigation().phase, Phase::TakeoffAbort);
+    let cmd = commands(&o);
+    assert_eq!(cmd.roll, RollMode::Roll(0.0), "wings level");
+    assert!(
+        matches!(cmd.lon, LonMode::Pitch { throttle, .. } if throttle == 0.0),
+        "throttle closed: {:?}",
+        cmd.lon
+    );
+    assert_eq!(c.landed_state(), LandedState::Landing);
+    // Rolling out: still no return, still closed.
+    for k in 0..100 {
+        let o = tick_at(&mut c, &mut n, &rolling(6.0), &plan, 5_120_000 + k * 20_000);
+        assert_eq!(c.flown_mode(), FlightMode::Takeoff);
+        assert!(matches!(commands(&o).lon, LonMode::Pitch { throttle, .. } if throttle == 0.0));
+    }
+    assert!(c.armed());
+    // Slower than 3 m/s: disarmed, and on the ground once at rest.
+    tick_at(&mut c, &mut n, &rolling(2.0), &plan, 8_000_000);
+    assert!(!c.armed());
+    assert_eq!(texts(&mut c), [TEXT_ABORT_DISARMED]);
+    for k in 0..100 {
+        tick_at(&mut c, &mut n, &rolling(0.0), &plan, 8_020_000 + k * 20_000);
+    }
+    assert_eq!(c.landed_state(), LandedState::OnGround);
+    assert_eq!(c.flown_mode(), FlightMode::Takeoff);
+}
+
+/// Whatever raised it, a failsafe that changes the mode flown gives the take-off roll up: the
+/// ground link silent, GPS lost, the battery critical or at its emergency level; one that
+/// changes nothing (the airspeed sensor failed, the battery low: a warning) does not. At 3 m/s
+/// the land detector still reads the aircraft as on the ground, but the roll is watched from
+/// its first metre.
+#[test]
+fn every_failsafe_that_changes_the_mode_aborts_the_take_off_roll_and_no_other_does() {
+    use crate::battery::Warning;
+    use crate::navigation::navigator::io::Phase;
+    type Fault = fn(&mut EstimatedState) -> (Option<u64>, Option<Warning>);
+    let faults: [(&str, Fault, bool); 6] = [
+        ("link", |_| (Some(0), None), true),
+        (
+            "gps",
+            |e| {
+                e.health.gps.healthy = false;
+                (None, None)
+            },
+            true,
+        ),
+        (
+            "battery critical",
+            |_| (None, Some(Warning::Critical)),
+            true,
+        ),
+        (
+            "battery emergency",
+            |_| (None, Some(Warning::Emergency)),
+            true,
+        ),
+        (
+            "airspeed",
+            |e| {
+                e.health.pitot.healthy = false;
+                (None, None)
+            },
+            false,
+        ),
+        ("battery low", |_| (None, Some(Warning::Low)), false),
+    ];
+    for (what, fault, aborts) in faults {
+        let (mut c, mut n, mut e) = on_the_take_off(3.0);
+        assert!(!c.flying(), "the land detector has seen no flight yet");
+        let (heard, battery) = fault(&mut e);
+        let o = c.step(CommanderInputs {
+            now_us: 5_100_000,
+            dt: 0.02,
+            estimate: &e,
+            navigator: &mut n,
+            plan: &MissionStore::default(),
+            gains: &DESIGNED,
+            watch: &Watch::default(),
+            land: &land_detector::LandParams::default(),
+            specific_force: Some(9.81),
+            gcs_heard_us: heard,
+            battery,
+        });
+        let said = texts(&mut c);
+        let throttle = match commands(&o).lon {
+            LonMode::Pitch { throttle, .. } => throttle,
+            other => panic!("{what}: {other:?}"),
+        };
+        assert_eq!(c.flown_mode(), FlightMode::Takeoff, "{what}");
+        if aborts {
+            assert!(said.contains(&TEXT_ABORTED), "{what}: {said:?}");
+            assert_eq!(c.navigation().phase, Phase::TakeoffAbort, "{what}");
+            assert_eq!(throttle, 0.0, "{what}");
+        } else {
+            assert!(!said.contains(&TEXT_ABORTED), "{what}: {said:?}");
+            assert_eq!(c.navigation().phase, Phase::TakeoffRoll, "{what}");
+            assert!(throttle > 0.5, "{what}: the roll goes on at {throttle}");
+        }
+    }
+}
+
+#[test]
+fn a_ground_link_loss_just_after_rotation_climbs_wings_level_to_nav_tko_clr_m_then_returns() {
+    use crate::navigation::navigator::io::{GroundStage, Phase};
+    let plan = MissionStore::default();
+    // Rotated at 15 m/s, the wheels just off.
+    let (mut c, mut n, mut e) = on_the_take_off(15.0);
+    assert_eq!(c.navigation().phase, Phase::TakeoffClimb);
+    let clear = n.params().takeoff_clear;
+    let mut t = 5_100_000;
+    for h in [0.2, 3.0, 6.0, clear - 0.5] {
+        e.pos_ned.z = -h;
+        e.alt_amsl_m = 300.0 + h;
+        e.vel_ned.z = -2.0;
+        let o = tick_at(&mut c, &mut n, &e, &plan, t);
+        t += 20_000;
+        assert_eq!(c.flown_mode(), FlightMode::Takeoff, "at {h} m");
+        assert_eq!(c.held_at(), Some(GroundStage::ClimbOut));
+        let cmd = commands(&o);
+        assert_eq!(cmd.roll, RollMode::Roll(0.0), "wings level at {h} m");
+        assert!(
+            matches!(cmd.lon, LonMode::TakeOff { .. }),
+            "still the take-off's climb at {h} m: {:?}",
+            cmd.lon
+        );
+    }
+    assert_eq!(
+        texts(&mut c),
+        [crate::failsafe::Event::GcsLost.text(), TEXT_CLIMB_FIRST]
+    );
+    // At the clearance height the return takes over and turns for home.
+    e.pos_ned.z = -(clear + 0.5);
+    e.alt_amsl_m = 300.0 + clear + 0.5;
+    tick_at(&mut c, &mut n, &e, &plan, t);
+    let o = tick_at(&mut c, &mut n, &e, &plan, t + 20_000);
+    assert_eq!(c.held_at(), None);
+    assert_eq!(c.flown_mode(), FlightMode::Return);
+    assert_eq!(c.navigation().phase, Phase::Return);
+    assert!(matches!(commands(&o).roll, RollMode::Course(_)));
+}
+
+/// A landing item at home, for the flare tests.
+fn land_at_home() -> MissionStore {
+    let h = flying().home.expect("home");
+    let mut plan = MissionStore::default();
+    let land = crate::navigation::plan::MissionItem {
+        params: [0; 4],
+        x: h.point.lat_e7,
+        y: h.point.lon_e7,
+        z: 0f32.to_bits(),
+        command: crate::navigation::items::NAV_LAND,
+        frame: 6,
+        autocontinue: true,
+    };
+    plan.replace(crate::navigation::plan::PlanKind::Mission, &[land])
+        .expect("room");
+    plan
+}
+
+/// `h` m up, 40 m short of home on a northbound final at 13 m/s, sinking 0.5 m/s.
+fn on_final(h: f32) -> EstimatedState {
+    let mut e = flying();
+    e.pos_ned = Vector3::new(-40.0, 0.0, -h);
+    e.alt_amsl_m = 300.0 + h;
+    e.airspeed = 13.0;
+    e.ground_speed = 13.0;
+    e.course = 0.0;
+    e.vel_ned = Vector3::new(13.0, 0.0, 0.5);
+    e
+}
+
+/// Armed in Mission on the final of [`on_final`] at `h` m, its landing item at home flown for
+/// one tick; then the ground link silent for more than `FS_GCS_TOUT_S`. Returns the commander
+/// and the phase before the loss.
+fn loss_on_final(h: f32) -> (Commander, crate::navigation::navigator::io::Phase) {
+    let plan = land_at_home();
+    let mut c = Commander::new();
+    let mut n = Navigator::default();
+    let e = on_final(h);
+    c.apply(&arm(), &e, &mut n);
+    c.apply(&mode(FlightMode::Mission), &e, &mut n);
+    tick_at(&mut c, &mut n, &e, &plan, 0);
+    let before = c.navigation().phase;
+    texts(&mut c);
+    tick_at(&mut c, &mut n, &e, &plan, 5_100_000);
+    (c, before)
+}
+
+#[test]
+fn a_ground_link_loss_in_the_flare_lets_the_landing_finish_and_one_on_the_approach_returns() {
+    use crate::navigation::navigator::io::Phase;
+    let (mut c, before) = loss_on_final(1.0);
+    assert_eq!(before, Phase::Flare);
+    assert_eq!(c.flown_mode(), FlightMode::Mission);
+    assert_eq!(c.navigation().phase, Phase::Flare);
+    assert_eq!(
+        texts(&mut c),
+        [crate::failsafe::Event::GcsLost.text(), TEXT_LANDING_FIRST]
+    );
+    // The same loss higher on the approach returns.
+    let (c, before) = loss_on_final(20.0);
+    assert_eq!(before, Phase::Approach);
+    assert_eq!(c.flown_mode(), FlightMode::Return);
+}
+
+#[test]
+fn every_text_of_the_failsafes_near_the_ground_fits_one_statustext() {
+    for t in [
+        TEXT_ABORTED,
+        TEXT_CLIMB_FIRST,
+        TEXT_LANDING_FIRST,
+        TEXT_ABORT_DISARMED,
+    ] {
+        assert!(t.len() <= crate::gcs::STATUSTEXT_LEN, "{t}");
     }
 }

@@ -116,6 +116,7 @@ pub fn phase_name(index: u8) -> String {
         (P::Hold, "hold"),
         (P::Complete, "complete"),
         (P::GoAround, "go-around"),
+        (P::TakeoffAbort, "aborted take-off"),
     ];
     known
         .iter()

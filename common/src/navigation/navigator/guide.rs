@@ -7,7 +7,7 @@ use crate::control::autopilot::Commands;
 use crate::control::lateral::{RollMode, YawMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::guidance::{Guidance, GuidanceOutput, OrbitDirection, Path};
-use crate::math::{wrap_pi, DEG};
+use crate::math::wrap_pi;
 use nalgebra::Vector3;
 
 /// Largest steering deflection, rad.
@@ -64,17 +64,9 @@ pub(super) fn course_near_ground(course: f32, height: f32, p: &NavParams) -> Rol
 
 /// As [`course_near_ground`], the bank allowed widening to 90 deg at `widen_m` (m) instead.
 pub(super) fn course_widening(course: f32, height: f32, widen_m: f32, p: &NavParams) -> RollMode {
-    let frac = if widen_m > 0.0 && height.is_finite() {
-        (height / widen_m).clamp(0.0, 1.0)
-    } else {
-        1.0
-    };
-    if frac >= 1.0 {
-        return RollMode::Course(course);
-    }
-    RollMode::CourseWithin {
-        course,
-        roll_max: p.ground_roll_max + (90.0 * DEG - p.ground_roll_max) * frac,
+    match p.bank_near_ground(height, widen_m) {
+        Some(roll_max) => RollMode::CourseWithin { course, roll_max },
+        None => RollMode::Course(course),
     }
 }
 
@@ -97,7 +89,8 @@ pub(super) struct Flight<'a> {
 
 impl Flight<'_> {
     /// Follows `path`: its guidance and commands into `out`, with the point flown to and the
-    /// phase.
+    /// phase; the bank limited near the ground ([`course_near_ground`], the height above
+    /// home).
     pub fn emit(
         &self,
         path: &Path,
@@ -109,7 +102,12 @@ impl Flight<'_> {
             .guidance
             .step(path, &self.state.pos_ned, self.state.ground_speed());
         out.guidance = Some(g);
-        out.commands = Some(follow(&g));
+        // Whatever brought the aircraft this low (a failsafe's return or circle just after
+        // the take-off's climb, a go-around's circuit), its wing tips keep off the ground.
+        out.commands = Some(Commands {
+            roll: course_near_ground(g.course, self.state.height(), self.params),
+            ..follow(&g)
+        });
         out.target = target;
         out.phase = phase;
         out.straight = matches!(path, Path::Line { .. });

@@ -134,6 +134,34 @@ pub enum Phase {
     Complete,
     /// A landing given up: climbing away and flying a circuit to a new approach.
     GoAround,
+    /// A take-off given up on the runway (a failsafe before the rotation): throttle closed,
+    /// wings level, rolling out to a stop on the runway's line.
+    TakeoffAbort,
+}
+
+impl Phase {
+    /// On the runway after a touchdown or a take-off given up: rolling out to a stop, its
+    /// wheels seen on the ground.
+    pub fn rolls_out(self) -> bool {
+        matches!(self, Phase::Landed | Phase::TakeoffAbort)
+    }
+}
+
+/// Where a take-off or landing stands, for what a failsafe may do there: near the ground the
+/// reaction waits, or becomes the take-off's abort ([`super::Navigator::ground_stage`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum GroundStage {
+    /// Neither taking off nor touching down: a failsafe's reaction is flown at once.
+    Clear,
+    /// On the take-off roll, below the rotation airspeed: a failsafe aborts the take-off.
+    TakeoffRoll,
+    /// Rotated, lower than `NAV_TKO_CLR_M` above where the roll began: a failsafe's reaction
+    /// waits, wings level, until the climb has reached that height.
+    ClimbOut,
+    /// In a landing's flare or roll-out, or an aborted take-off's roll-out: the aircraft is
+    /// brought to a stop first.
+    Touchdown,
 }
 
 /// Result of one step.

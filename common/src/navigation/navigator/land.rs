@@ -477,22 +477,36 @@ impl Landing {
             LandPhase::Climb | LandPhase::Downwind => {}
             LandPhase::Landed => {
                 out.phase = Phase::Landed;
-                // Slow enough to be left to itself, or rolling for longer than any roll-out
-                // that slows down takes (ArduPilot's LAND_DISARMDELAY): in a strong crosswind
-                // the tail wheel steered against the drift is a keel, and the aircraft sails
-                // along the runway at 10 m/s for minutes; disarmed, it weathervanes and stops.
-                self.rollout_s += dt;
-                out.landed = state.ground_speed() < STOPPED_SPEED
-                    || (self.rollout_s >= p.land_disarm_s && state.airspeed < DISARM_AIRSPEED);
-                out.commands = Some(Commands {
-                    roll: RollMode::Roll(0.0),
-                    yaw: f.steer(g.path_course),
-                    lon: LonMode::Pitch {
-                        pitch: rollout_pitch(state.airspeed),
-                        throttle: 0.0,
-                    },
-                });
+                roll_out(f, g.path_course, &mut self.rollout_s, out);
             }
         }
     }
+
+    /// In the flare or on the runway after it: a failsafe lets the landing finish.
+    pub fn touching_down(&self) -> bool {
+        matches!(self.phase, LandPhase::Flare | LandPhase::Landed)
+    }
+}
+
+/// One step of a roll-out on the runway (after a touchdown, or a take-off given up), steered
+/// along `course` (rad): throttle closed, wings level, the nose as [`rollout_pitch`] holds it;
+/// `rollout_s` is the time rolled so far (s), and [`NavOutput::landed`] says when the
+/// aircraft may be disarmed.
+pub(super) fn roll_out(f: &Flight, course: f32, rollout_s: &mut f32, out: &mut NavOutput) {
+    let state = f.state;
+    // Slow enough to be left to itself, or rolling for longer than any roll-out that slows
+    // down takes (ArduPilot's LAND_DISARMDELAY): in a strong crosswind the tail wheel steered
+    // against the drift is a keel, and the aircraft sails along the runway at 10 m/s for
+    // minutes; disarmed, it weathervanes and stops.
+    *rollout_s += f.dt;
+    out.landed = state.ground_speed() < STOPPED_SPEED
+        || (*rollout_s >= f.params.land_disarm_s && state.airspeed < DISARM_AIRSPEED);
+    out.commands = Some(Commands {
+        roll: RollMode::Roll(0.0),
+        yaw: f.steer(course),
+        lon: LonMode::Pitch {
+            pitch: rollout_pitch(state.airspeed),
+            throttle: 0.0,
+        },
+    });
 }

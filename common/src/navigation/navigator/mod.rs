@@ -36,7 +36,7 @@ pub mod rtl;
 pub mod takeoff;
 
 use self::guide::{horizontal_dist, Flight, Orbit};
-use self::io::{NavOutput, NavState, Phase};
+use self::io::{GroundStage, NavOutput, NavState, Phase};
 use self::land::Landing;
 use self::loiter::Loiter;
 use self::mission::{Leg, MissionWalk};
@@ -158,6 +158,28 @@ impl Navigator {
         match &mut self.active {
             Active::Land(l) => l.go_around(),
             Active::Return(r) => r.go_around(),
+            _ => false,
+        }
+    }
+
+    /// Where the behaviour being flown stands near the ground, for what a failsafe may do:
+    /// on a take-off's roll, in its climb below `NAV_TKO_CLR_M`, in a landing's flare or
+    /// roll-out (a mission's or a return's) or an aborted take-off's, or clear of all that.
+    pub fn ground_stage(&self) -> GroundStage {
+        match &self.active {
+            Active::Takeoff(t) => t.ground_stage(self.params.takeoff_clear),
+            Active::Land(l) if l.touching_down() => GroundStage::Touchdown,
+            Active::Return(r) if r.touching_down() => GroundStage::Touchdown,
+            _ => GroundStage::Clear,
+        }
+    }
+
+    /// Gives up a take-off still on its roll (below the rotation airspeed) for a roll-out to
+    /// a stop on the runway ([`Phase::TakeoffAbort`]); returns whether there was one to give
+    /// up.
+    pub fn abort_takeoff(&mut self) -> bool {
+        match &mut self.active {
+            Active::Takeoff(t) => t.abort(),
             _ => false,
         }
     }

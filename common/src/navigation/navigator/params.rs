@@ -123,7 +123,7 @@ pub const PARAMS: Group<NavParams> = Group {
                 1.0,
                 100.0,
                 "m",
-                "Take-off regime (fixed pitch, full throttle) ends at this height",
+                "Take-off regime (fixed pitch, full throttle) ends at this height; a failsafe past the rotation waits, wings level, until the climb reaches it",
             ),
             NavParams => takeoff_clear
         ),
@@ -364,7 +364,7 @@ pub struct NavParams {
     /// pitch, so a fast cruise airspeed would make the climb a long shallow one (at 23 m/s
     /// the aircraft crossed 2 km before reaching 60 m).
     pub takeoff_airspeed: f32,
-    /// Take-off regime clear height, m.
+    /// Take-off regime clear height, m; a failsafe after the rotation is flown from there.
     pub takeoff_clear: f32,
     /// `NAV_LND_DISARM_S`: longest roll-out before the disarm, s.
     pub land_disarm_s: f32,
@@ -443,6 +443,21 @@ const ZERO: NavParams = NavParams {
 impl Default for NavParams {
     fn default() -> Self {
         PARAMS.defaults()
+    }
+}
+
+impl NavParams {
+    /// The bank allowed at `height` (m) above the ground, rad: `NAV_GND_RLL_DEG` on it,
+    /// widening linearly to 90 deg at `widen_m` (m; `NAV_GND_RLL_M` near the ground, more in
+    /// the flare). `None` from there up, where the roll limit alone governs, and for an
+    /// unknown height.
+    pub fn bank_near_ground(&self, height: f32, widen_m: f32) -> Option<f32> {
+        let frac = if widen_m > 0.0 && height.is_finite() {
+            (height / widen_m).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        (frac < 1.0).then_some(self.ground_roll_max + (90.0 * DEG - self.ground_roll_max) * frac)
     }
 }
 

@@ -54,6 +54,11 @@ impl Return {
         }
     }
 
+    /// In its landing's flare or roll-out: a failsafe lets the landing finish.
+    pub fn touching_down(&self) -> bool {
+        matches!(self.phase, ReturnPhase::Land(l) if l.touching_down())
+    }
+
     /// One step of the return: its commands into `out`. `runway` is the course of the last
     /// take-off (the landing's final approach), `seq` the mission item reported reached on
     /// arriving home.

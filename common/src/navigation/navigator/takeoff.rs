@@ -8,9 +8,16 @@
 //! (`NAV_TKO_TO_ITEM` takes the line to the item's position instead): the tail wheel holds
 //! it until the wheels are off, and the bank allowed near the ground is small
 //! (`NAV_GND_RLL_DEG`), widening with height.
+//!
+//! A failsafe on the roll, below the rotation airspeed, gives the take-off up
+//! ([`Takeoff::abort`]): the throttle closed, wings level, the tail wheel steering along the
+//! runway's line, the roll-out of a landing ([`super::land::roll_out`]) to a stop, and the
+//! disarm. Past the rotation the aircraft is committed: a failsafe waits until the climb has
+//! reached `NAV_TKO_CLR_M` ([`Takeoff::ground_stage`]).
 
 use super::guide::{course_near_ground, horizontal_dist, Flight, Orbit};
-use super::io::{NavOutput, NavState, Phase};
+use super::io::{GroundStage, NavOutput, NavState, Phase};
+use super::land::roll_out;
 use super::params::NavParams;
 use crate::control::autopilot::Commands;
 use crate::control::lateral::{RollMode, RUDDER};
@@ -33,6 +40,10 @@ pub(super) struct Takeoff {
     rolling: bool,
     /// Time on the take-off roll so far, s.
     roll_s: f32,
+    /// Height above where the roll began at the last step, m.
+    climbed: f32,
+    /// Given up on the runway: the time rolled out since, s.
+    aborted: Option<f32>,
 }
 
 impl Takeoff {
@@ -64,6 +75,32 @@ impl Takeoff {
             height: place.height(home).unwrap_or(p.rtl_alt),
             rolling: state.airspeed.is_nan() || state.airspeed < p.takeoff_vr,
             roll_s: 0.0,
+            climbed: 0.0,
+            aborted: None,
+        }
+    }
+
+    /// Gives the take-off up if it is still on its roll (below the rotation airspeed); returns
+    /// whether it did. Past the rotation the take-off goes on.
+    pub fn abort(&mut self) -> bool {
+        if self.rolling && self.aborted.is_none() {
+            self.aborted = Some(0.0);
+            return true;
+        }
+        false
+    }
+
+    /// Where the take-off stands for a failsafe (`NAV_TKO_CLR_M` is `clear`, m).
+    pub fn ground_stage(&self, clear: f32) -> GroundStage {
+        if self.aborted.is_some() {
+            GroundStage::Touchdown
+        } else if self.rolling {
+            GroundStage::TakeoffRoll
+        } else if self.climbed.is_nan() || self.climbed < clear {
+            // An unknown height counts as low: a reaction waits for a known one.
+            GroundStage::ClimbOut
+        } else {
+            GroundStage::Clear
         }
     }
 
@@ -80,13 +117,22 @@ impl Takeoff {
         let state = f.state;
         let pos = state.pos_ned;
         let vg = state.ground_speed();
-        if self.rolling && state.airspeed >= p.takeoff_vr {
+        self.climbed = state.height() + self.start.z;
+        if self.rolling && self.aborted.is_none() && state.airspeed >= p.takeoff_vr {
             self.rolling = false;
         }
         let (dn, de) = (libm::cosf(self.course), libm::sinf(self.course));
         let far = self.start + Vector3::new(dn, de, 0.0) * 1000.0;
         let line = Path::line_between(&self.start, &far, f.cruise);
         out.target = Some(far);
+        if let Some(rolled) = &mut self.aborted {
+            out.phase = Phase::TakeoffAbort;
+            let course = line
+                .map(|l| f.guidance.step(&l, &pos, vg).course)
+                .unwrap_or(self.course);
+            roll_out(f, course, rolled, out);
+            return None;
+        }
         if self.rolling {
             out.phase = Phase::TakeoffRoll;
             // Along the runway line: the course to hold comes from the line's vector
@@ -116,7 +162,7 @@ impl Takeoff {
             out.phase = Phase::TakeoffClimb;
             let g = line.map(|l| f.guidance.step(&l, &pos, vg));
             out.guidance = g;
-            let height = state.height() + self.start.z;
+            let height = self.climbed;
             let roll = match g {
                 Some(g) => course_near_ground(g.course, height, p),
                 None => RollMode::Roll(0.0),
