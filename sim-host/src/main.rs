@@ -257,6 +257,25 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Some(Command::Log { file, out, json }) => {
+            let r = commands::log::log_report(&file, &out)?;
+            // What the reader skipped, or where a cut log ends: the summary is of the rest.
+            for w in &r.summary.warnings {
+                eprintln!("warning: {}: {w}", file.display());
+            }
+            if json {
+                emit(&to_json(&r.summary)?)?;
+            } else {
+                emit(&render(
+                    &commands::log::summary_tables(&r.summary),
+                    Format::Text,
+                ))?;
+                for f in &r.files {
+                    emit(&format!("wrote {}", f.display()))?;
+                }
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Validation { out, out_dir }) => {
             let md = commands::validation::validation_markdown(&aircraft, Some(&out_dir))?;
             if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {

@@ -142,6 +142,8 @@ impl FlightSeries {
                     .collect(),
             )
         };
+        let wrapped = |series: &[Series]| series.iter().map(break_wraps).collect::<Vec<_>>();
+        let (course, heading) = (wrapped(&self.course_deg), wrapped(&self.heading_deg));
         vec![
             (
                 "altitude.png",
@@ -159,8 +161,8 @@ impl FlightSeries {
                 figure(
                     "Course and heading",
                     vec![
-                        ("course (deg)", &self.course_deg),
-                        ("heading (deg)", &self.heading_deg),
+                        ("course (deg)", &course),
+                        ("heading (deg)", &heading),
                         ("aileron, rudder (deg)", &self.aileron_rudder_deg),
                     ],
                 ),
@@ -218,6 +220,23 @@ impl FlightSeries {
     }
 }
 
+/// An angle series in 0..360 deg broken (a NaN put in) where it wraps: a line drawn across
+/// the wrap would sweep the panel, and a thick line turning back on itself within a pixel
+/// spikes out of it.
+pub fn break_wraps(s: &Series) -> Series {
+    let mut x = Vec::with_capacity(s.x.len());
+    let mut y = Vec::with_capacity(s.y.len());
+    for (i, (&xi, &yi)) in s.x.iter().zip(&s.y).enumerate() {
+        if i > 0 && (yi - s.y[i - 1]).abs() > 180.0 {
+            x.push(xi);
+            y.push(f64::NAN);
+        }
+        x.push(xi);
+        y.push(yi);
+    }
+    Series { x, y, ..s.clone() }
+}
+
 /// The ground track of a simulated flight, truth and estimate, at 10 Hz.
 pub fn track_series(samples: &[Sample]) -> Vec<Series> {
     let p: Vec<&Sample> = samples.iter().step_by(10).collect();
@@ -249,4 +268,19 @@ pub fn write_log_and_plots(dir: &Path, samples: &[Sample]) -> anyhow::Result<Vec
     let mut files = vec![csv];
     files.extend(FlightSeries::of_samples(samples).write_figures(dir)?);
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_angle_that_wraps_past_north_is_broken_there_and_nowhere_else() {
+        let s = Series::new("c", vec![0.0, 1.0, 2.0, 3.0], vec![350.0, 359.0, 2.0, 10.0]);
+        let b = break_wraps(&s);
+        assert_eq!(b.x, vec![0.0, 1.0, 2.0, 2.0, 3.0]);
+        assert_eq!(b.y[..2], [350.0, 359.0]);
+        assert!(b.y[2].is_nan());
+        assert_eq!(b.y[3..], [2.0, 10.0]);
+    }
 }
