@@ -634,35 +634,26 @@ impl<'a> Parser<'a> {
     fn part(&mut self, mut pos: usize, end: usize, last: bool) -> Result<(), ParseError> {
         while pos < end {
             match self.step(pos, end) {
-                Step::Message(kind, payload, next) => {
-                    self.message(pos, kind, payload)?;
-                    pos = next;
-                    self.log.bytes_read = self.log.bytes_read.max(pos);
-                }
-                Step::NotAMessage(kind) => match self.find_sync(pos.saturating_add(1), end) {
-                    Some(sync) => {
-                        self.warn(
-                            pos,
-                            format!(
-                                "no message starts here (type byte {}): the file is corrupt; skipped {} bytes to the next sync marker",
-                                type_name(kind),
-                                sync.saturating_sub(pos)
-                            ),
-                        );
-                        pos = sync.saturating_add(SYNC_MAGIC.len());
-                        self.log.syncs = self.log.syncs.saturating_add(1);
-                    }
+                Step::Message(kind, payload, next) => match self.misfit(kind, payload) {
+                    // A sample that its own topic's format cannot hold: the size in its
+                    // header is what is corrupt, and the next message is not where it says.
+                    Some(why) => match self.resync(pos, end, why) {
+                        Some(after) => pos = after,
+                        None => return Ok(()),
+                    },
                     None => {
-                        self.warn(
-                            pos,
-                            format!(
-                                "no message starts here (type byte {}) and no sync marker follows: the file is corrupt from here; read up to byte {pos}",
-                                type_name(kind)
-                            ),
-                        );
-                        return Ok(());
+                        self.message(pos, kind, payload)?;
+                        pos = next;
+                        self.log.bytes_read = self.log.bytes_read.max(pos);
                     }
                 },
+                Step::NotAMessage(kind) => {
+                    let why = format!("no message starts here (type byte {})", type_name(kind));
+                    match self.resync(pos, end, why) {
+                        Some(after) => pos = after,
+                        None => return Ok(()),
+                    }
+                }
                 Step::HeaderCut(left) => {
                     if last {
                         self.warn(
@@ -689,6 +680,53 @@ impl<'a> Parser<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Skips from corrupt bytes at `pos` to the message after the next sync marker: where to
+    /// read on, or `None` when no marker follows (reading stops).
+    fn resync(&mut self, pos: usize, end: usize, why: String) -> Option<usize> {
+        match self.find_sync(pos.saturating_add(1), end) {
+            Some(sync) => {
+                self.warn(
+                    pos,
+                    format!(
+                        "{why}: the file is corrupt; skipped {} bytes to the next sync marker",
+                        sync.saturating_sub(pos)
+                    ),
+                );
+                self.log.syncs = self.log.syncs.saturating_add(1);
+                Some(sync.saturating_add(SYNC_MAGIC.len()))
+            }
+            None => {
+                self.warn(
+                    pos,
+                    format!(
+                        "{why}, and no sync marker follows: the file is corrupt from here; read up to byte {pos}"
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    /// Why a data message cannot be what its header says: a sample longer or shorter than
+    /// its subscription's format.
+    fn misfit(&self, kind: u8, payload: &[u8]) -> Option<String> {
+        if kind != b'D' {
+            return None;
+        }
+        let mut r = Reader::new(payload);
+        let d = self
+            .subscriptions
+            .get(&r.u16()?)
+            .and_then(|&i| self.log.datasets.get(i))?;
+        let got = r.rest().len();
+        (got < d.layout.min_size || got > d.layout.size).then(|| {
+            format!(
+                "a sample of `{}` is {got} bytes, its format {}",
+                d.name, d.layout.size
+            )
+        })
     }
 
     /// The offset of the sync magic next at or after `from` (before `end`), if any.
@@ -938,15 +976,9 @@ impl<'a> Parser<'a> {
             });
             return;
         };
+        // Its size fits its format (`misfit` saw to it).
         let sample = r.rest();
-        let (size, min) = (d.layout.size, d.layout.min_size);
-        if sample.len() < min || sample.len() > size {
-            let (name, got) = (d.name.clone(), sample.len());
-            self.warn_alike(format!("size {name}"), pos, || {
-                format!("a sample of `{name}` is {got} bytes, its format {size}: skipped")
-            });
-            return;
-        }
+        let size = d.layout.size;
         let ts = d
             .layout
             .timestamp

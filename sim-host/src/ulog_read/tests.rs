@@ -295,24 +295,56 @@ fn bytes_that_are_no_message_are_skipped_to_the_next_sync_marker() {
 }
 
 #[test]
-fn samples_of_the_wrong_size_and_of_no_subscription_are_skipped_and_counted() {
+fn a_sample_its_format_cannot_hold_is_corruption_skipped_to_the_next_sync_marker() {
     let mut b = every_message();
+    let bad = b.len();
+    // A size byte gone wrong: the message claims 5 bytes of a 28-byte format, and the next
+    // message is not where it says; the one after the sync marker is.
     b.extend(data(7, &[0; 5]));
-    b.extend(data(7, &[0; 40]));
-    b.extend(data(99, &[0; 24]));
-    b.extend(data(99, &[0; 24]));
+    b.extend(data(7, &attitude(4_000, [1.0; 4])));
+    b.extend(msg(b'S', &SYNC));
+    b.extend(data(7, &attitude(5_000, [1.0; 4])));
     let log = parse(&b).unwrap();
-    assert_eq!(log.dataset("vehicle_attitude").unwrap().len(), 2);
-    let text: Vec<String> = log.warnings.iter().map(Warning::to_string).collect();
-    assert_eq!(text.len(), 2, "{text:?}");
-    assert!(
-        text.iter()
-            .any(|w| w.contains("is 5 bytes, its format 28") && w.contains("1 more")),
-        "{text:?}"
+    assert_eq!(
+        log.dataset("vehicle_attitude").unwrap().timestamps_us(),
+        &[2_000, 3_000, 5_000]
     );
+    assert_eq!(log.warnings.len(), 1, "{:?}", log.warnings);
+    assert_eq!(log.warnings[0].offset, bad);
     assert!(
-        text.iter()
-            .any(|w| w.contains("message id 99") && w.contains("1 more")),
+        log.warnings[0]
+            .what
+            .starts_with("a sample of `vehicle_attitude` is 5 bytes, its format 28: the file is corrupt; skipped"),
+        "{}",
+        log.warnings[0]
+    );
+
+    // Without a sync marker after it, reading stops there.
+    let mut b = every_message();
+    b.extend(data(7, &[0; 40]));
+    let log = parse(&b).unwrap();
+    assert!(
+        log.warnings[0].what.contains("no sync marker follows"),
+        "{:?}",
+        log.warnings
+    );
+    assert_eq!(log.bytes_read, every_message().len());
+}
+
+#[test]
+fn data_that_no_subscription_names_are_skipped_and_counted() {
+    let mut b = every_message();
+    b.extend(data(99, &[0; 24]));
+    b.extend(data(99, &[0; 24]));
+    b.extend(data(7, &attitude(4_000, [1.0; 4])));
+    let log = parse(&b).unwrap();
+    assert_eq!(log.dataset("vehicle_attitude").unwrap().len(), 3);
+    let text: Vec<String> = log.warnings.iter().map(Warning::to_string).collect();
+    assert_eq!(text.len(), 1, "{text:?}");
+    assert!(
+        text[0].contains(
+            "data for message id 99, which no subscription names: skipped (and 1 more like it)"
+        ),
         "{text:?}"
     );
 }
