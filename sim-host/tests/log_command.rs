@@ -288,10 +288,11 @@ fn a_log_cut_anywhere_reads_to_its_last_whole_message_or_fails_naming_where() {
     let starts = messages(&whole);
     let data: Vec<usize> = starts.iter().filter(|m| m.1 == b'D').map(|m| m.0).collect();
     let data_at = data[data.len() / 2];
-    // Inside the header and the definitions byte by byte, every few hundred bytes across the
-    // file, and every byte of one data message.
-    let mut cuts: Vec<usize> = (0..600).collect();
-    cuts.extend((600..whole.len()).step_by(331));
+    // Every byte of the header and the definitions, every few hundred bytes across the data,
+    // and every byte of one data message.
+    let data_from = data[0];
+    let mut cuts: Vec<usize> = (0..=data_from).collect();
+    cuts.extend((data_from..whole.len()).step_by(331));
     cuts.extend(data_at..data_at + 40);
     cuts.push(whole.len() - 1);
     for &cut in &cuts {
