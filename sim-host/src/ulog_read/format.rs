@@ -30,6 +30,10 @@ const DEPTH_MAX: usize = 16;
 /// formats inside arrays) can ask for.
 const ELEMENTS_MAX: usize = 1 << 16;
 
+/// Elements all the layouts of one log may expand to: a PX4 log's few hundred topics have a
+/// few tens of thousands; this bounds the work of a file that subscribes to many large ones.
+pub const LOG_ELEMENTS_MAX: usize = 1 << 21;
+
 /// The type of a field: one of the specification's, or another format by name.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum FieldType {
@@ -153,8 +157,13 @@ pub struct Layout {
 }
 
 impl Layout {
-    /// The layout of format `name`, nested formats resolved in `formats`.
-    pub fn of(formats: &BTreeMap<String, Format>, name: &str) -> Result<Self, String> {
+    /// The layout of format `name`, nested formats resolved in `formats`; `budget` is the
+    /// elements still allowed (the ones laid out are taken from it).
+    pub fn of(
+        formats: &BTreeMap<String, Format>,
+        name: &str,
+        budget: &mut usize,
+    ) -> Result<Self, String> {
         let top = formats
             .get(name)
             .ok_or_else(|| format!("no format is named `{name}`"))?;
@@ -162,8 +171,11 @@ impl Layout {
             formats,
             fields: Vec::new(),
             elements: 0,
+            limit: ELEMENTS_MAX.min(*budget),
         };
-        let size = flat.format(top, "", 0, 0)?;
+        let size = flat.format(top, "", 0, 0);
+        *budget = budget.saturating_sub(flat.elements);
+        let size = size?;
         // The last field, when it pads, may be left out of the data.
         let trailing = match top.fields.last() {
             Some(f) if f.is_padding() => match &f.ty {
@@ -195,6 +207,9 @@ struct Flattener<'a> {
     formats: &'a BTreeMap<String, Format>,
     fields: Vec<FlatField>,
     elements: usize,
+    /// Elements this layout may have: [`ELEMENTS_MAX`], or fewer when the log's budget is
+    /// nearly spent.
+    limit: usize,
 }
 
 impl Flattener<'_> {
@@ -216,11 +231,14 @@ impl Flattener<'_> {
         for field in &f.fields {
             for i in 0..field.count.unwrap_or(1) {
                 self.elements = self.elements.saturating_add(1);
-                if self.elements > ELEMENTS_MAX {
-                    return Err(format!(
-                        "`{}` expands to more than {ELEMENTS_MAX} values",
-                        f.name
-                    ));
+                if self.elements > self.limit {
+                    return Err(if self.limit < ELEMENTS_MAX {
+                        format!(
+                            "the log's formats expand to more than {LOG_ELEMENTS_MAX} values in all"
+                        )
+                    } else {
+                        format!("`{}` expands to more than {ELEMENTS_MAX} values", f.name)
+                    });
                 }
                 let name = match field.count {
                     Some(_) => format!("{prefix}{}[{i}]", field.name),

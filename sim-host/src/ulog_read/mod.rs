@@ -41,6 +41,7 @@ pub use format::{FieldType, FlatField, Format, FormatField, Layout};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Bit 0 of the first incompatibility byte: data were appended at `appended_offsets`.
 const DATA_APPENDED: u8 = 1;
@@ -270,7 +271,7 @@ pub struct Dataset {
     /// Its instance.
     pub multi_id: u8,
     /// Where each value of a sample is.
-    pub layout: Layout,
+    pub layout: Arc<Layout>,
     timestamps_us: Vec<u64>,
     /// The samples back to back, each `layout.size` bytes.
     raw: Vec<u8>,
@@ -432,6 +433,9 @@ pub fn parse(bytes: &[u8]) -> Result<Ulog, ParseError> {
             ..Ulog::default()
         },
         subscriptions: HashMap::new(),
+        layouts: HashMap::new(),
+        budget: format::LOG_ELEMENTS_MAX,
+        instances: HashMap::new(),
         in_data: false,
         last_us: start_us,
         alike: BTreeMap::new(),
@@ -538,6 +542,13 @@ struct Parser<'a> {
     last_us: u64,
     /// Warnings by kind: the first's offset and text, and how many more.
     alike: BTreeMap<String, (usize, String, usize)>,
+    /// Layouts by format name, each worked out once (a file may subscribe to a deep format
+    /// many times; formats are all defined before the first subscription).
+    layouts: HashMap<String, Result<Arc<Layout>, String>>,
+    /// Elements the log's layouts may still expand to.
+    budget: usize,
+    /// The dataset of each topic instance, by name and `multi_id`.
+    instances: HashMap<(String, u8), usize>,
 }
 
 impl<'a> Parser<'a> {
@@ -741,6 +752,11 @@ impl<'a> Parser<'a> {
         let mut r = Reader::new(payload);
         match kind {
             b'B' => self.flag_bits(pos, &mut r)?,
+            // Formats belong to the definitions: one after a subscription could change the
+            // layout of samples already read.
+            b'F' if self.in_data => self.warn_alike("late format".into(), pos, || {
+                "format message after the definitions (the specification puts formats before the data): ignored".into()
+            }),
             b'F' => match std::str::from_utf8(payload) {
                 Ok(text) => match Format::parse(text) {
                     Ok(f) => {
@@ -923,9 +939,15 @@ impl<'a> Parser<'a> {
             return;
         };
         let name = String::from_utf8_lossy(r.rest()).into_owned();
-        let layout = match Layout::of(&self.log.formats, &name) {
-            Ok(l) => l,
+        let (formats, budget) = (&self.log.formats, &mut self.budget);
+        let layout = match self
+            .layouts
+            .entry(name.clone())
+            .or_insert_with(|| Layout::of(formats, &name, budget).map(Arc::new))
+        {
+            Ok(l) => l.clone(),
             Err(e) => {
+                let e = e.clone();
                 self.warn(
                     pos,
                     format!(
@@ -936,23 +958,30 @@ impl<'a> Parser<'a> {
                 return;
             }
         };
-        // A topic subscribed again (after an `R`) goes on filling the same samples.
-        let index = match self
-            .log
-            .datasets
-            .iter()
-            .position(|d| d.name == name && d.multi_id == multi_id && d.layout == layout)
-        {
-            Some(i) => i,
-            None => {
+        // A topic subscribed again (after an `R`) goes on filling the same samples (its layout
+        // is the one worked out for its format).
+        let key = (name, multi_id);
+        let index = match self.instances.get(&key) {
+            Some(&i)
+                if self
+                    .log
+                    .datasets
+                    .get(i)
+                    .is_some_and(|d| Arc::ptr_eq(&d.layout, &layout)) =>
+            {
+                i
+            }
+            _ => {
                 self.log.datasets.push(Dataset {
-                    name,
+                    name: key.0.clone(),
                     multi_id,
                     layout,
                     timestamps_us: Vec::new(),
                     raw: Vec::new(),
                 });
-                self.log.datasets.len().saturating_sub(1)
+                let i = self.log.datasets.len().saturating_sub(1);
+                self.instances.insert(key, i);
+                i
             }
         };
         self.subscriptions.insert(msg_id, index);

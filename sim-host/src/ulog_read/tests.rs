@@ -495,3 +495,54 @@ fn malformed_definitions_are_skipped_with_a_warning_naming_the_message() {
     assert!(text[4].contains("value shorter than its type"), "{text:?}");
     assert!(log.formats.is_empty() && log.info.is_empty() && log.params.is_empty());
 }
+
+#[test]
+fn a_format_after_the_definitions_is_ignored_with_a_warning() {
+    let mut b = every_message();
+    let late = b.len();
+    b.extend(msg(b'F', b"vehicle_attitude:uint64_t timestamp;double x;"));
+    b.extend(data(7, &attitude(4_000, [1.0; 4])));
+    let log = parse(&b).unwrap();
+    assert_eq!(log.dataset("vehicle_attitude").unwrap().len(), 3);
+    assert_eq!(log.warnings.len(), 1, "{:?}", log.warnings);
+    assert_eq!(log.warnings[0].offset, late);
+    assert!(log.warnings[0].what.contains("after the definitions"));
+}
+
+#[test]
+fn subscribing_many_times_to_a_large_format_lays_it_out_once() {
+    let mut b = header(0);
+    b.extend(msg(b'F', b"big:uint64_t timestamp;uint8_t[60000] b;"));
+    for i in 0..20_000u16 {
+        b.extend(add_logged((i % 256) as u8, i, "big"));
+    }
+    let started = std::time::Instant::now();
+    let log = parse(&b).unwrap();
+    // Laid out anew each time, 20,000 x 60,000 values would take minutes.
+    assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+    assert_eq!(log.datasets.len(), 256);
+    assert_eq!(log.warnings, vec![]);
+}
+
+#[test]
+fn the_formats_of_one_log_lay_out_a_bounded_number_of_values_in_all() {
+    let mut b = header(0);
+    for i in 0..40 {
+        b.extend(msg(
+            b'F',
+            format!("big{i}:uint64_t timestamp;uint8_t[60000] b;").as_bytes(),
+        ));
+    }
+    for i in 0..40u16 {
+        b.extend(add_logged(0, i, &format!("big{i}")));
+    }
+    let log = parse(&b).unwrap();
+    // 2^21 values in all: 34 formats of 60,001.
+    assert_eq!(log.datasets.len(), 34);
+    assert_eq!(log.warnings.len(), 6, "{:?}", log.warnings);
+    assert!(
+        log.warnings[0].what.contains("values in all"),
+        "{}",
+        log.warnings[0]
+    );
+}
