@@ -552,3 +552,81 @@ pub fn summary_tables(s: &LogSummary) -> Vec<Table> {
     tables.push(topics);
     tables
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use common::logger::topics::VehicleStatus;
+    use common::ulog::topic::Topic;
+    use common::ulog::{self as enc, Level};
+
+    /// A log of `vehicle_status` samples (time in us, nav_state), a text and two dropouts,
+    /// written with the project's encoder.
+    fn log(states: &[(u64, u8)]) -> Ulog {
+        let mut b = Vec::new();
+        let mut put = |f: &dyn Fn(&mut [u8]) -> Result<usize, enc::TooLong>| {
+            let mut buf = [0u8; 512];
+            let n = f(&mut buf).unwrap();
+            b.extend_from_slice(&buf[..n]);
+        };
+        put(&|x| enc::header(x, 2_000_000));
+        put(&|x| enc::flag_bits(x));
+        put(&|x| enc::format(x, &VehicleStatus::FORMAT));
+        put(&|x| enc::add_logged(x, 0, 0, "vehicle_status"));
+        for &(t, nav_state) in states {
+            let s = VehicleStatus {
+                arming_state: 2,
+                nav_state,
+                ..Default::default()
+            };
+            put(&|x| enc::data(x, 0, t, |c| s.encode(c)));
+        }
+        put(&|x| enc::dropout(x, 120));
+        put(&|x| enc::logging(x, Level::Critical, 3_500_000, "geofence breached"));
+        put(&|x| enc::dropout(x, 30));
+        crate::ulog_read::parse(&b).unwrap()
+    }
+
+    #[test]
+    fn modes_are_named_by_px4_navigation_state_and_last_to_the_logs_end() {
+        let l = log(&[
+            (2_000_000, 0),
+            (2_500_000, 3),
+            (3_000_000, 3),
+            (3_500_000, 5),
+            (4_000_000, 99),
+        ]);
+        let s = summarize("t.ulg", &l);
+        let modes: Vec<(&str, f64, f64)> = s
+            .modes
+            .iter()
+            .map(|m| (m.mode.as_str(), m.from_s, m.to_s))
+            .collect();
+        assert_eq!(
+            modes,
+            [
+                ("Manual", 0.0, 0.5),
+                ("Mission", 0.5, 1.5),
+                ("Return", 1.5, 2.0),
+                ("nav_state 99", 2.0, 2.0)
+            ]
+        );
+        assert_eq!(s.duration_s, 2.0);
+        assert_eq!((s.dropouts, s.dropout_ms), (2, 150));
+        assert_eq!(
+            s.texts,
+            vec![TextLine {
+                t_s: 1.5,
+                level: "critical".into(),
+                text: "geofence breached".into()
+            }]
+        );
+        assert_eq!(s.topics[0].rate_hz, 2.0);
+        // Topics this log lacks give no figure, not a wrong one.
+        assert!(s.attitude.is_none() && s.battery.is_none() && s.distance_m.is_none());
+        let tables = summary_tables(&s);
+        let text = crate::commands::render(&tables, crate::commands::Format::Text);
+        assert!(text.contains("2, 150 ms in all"), "{text}");
+        assert!(text.contains("geofence breached"), "{text}");
+    }
+}

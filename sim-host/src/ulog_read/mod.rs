@@ -12,14 +12,18 @@
 //!   [`read_file`] names the file too);
 //! - a file cut in the middle of a message, as a power cut leaves it, reads up to its last
 //!   whole message, with a [`Warning`] saying where and how it ends;
-//! - a message that makes no sense (an unknown subscription, a sample of the wrong size, a
-//!   format that does not parse) is skipped with a warning; bytes that are no message at all
-//!   are skipped up to the next sync marker, which is what the marker is for.
+//! - a message that makes no sense (data of no subscription, a format that does not parse) is
+//!   skipped with a warning; bytes that are no message at all, and a sample its topic's
+//!   format cannot hold (the size in its header is what is corrupt), are skipped up to the
+//!   next sync marker, which is what the marker is for.
 //!
-//! Why not a crate: the maintained Rust readers (`px4-ulog`, `yule_log`) report a bad or cut
-//! file without the byte offset where it went wrong, and read a cut file either not at all or
-//! only since their latest releases; this one is a few hundred lines beside the project's own
-//! encoder, and the tests hold it to the specification's bytes and to pyulog.
+//! Why not a crate: the two maintained Rust readers do not say where a file goes wrong.
+//! `px4-ulog` (0.6) reports an error as a kind and a description, and reads a cut file's
+//! prefix only since that release; `yule_log` (0.4) stops at a cut with "Unexpected End of
+//! File", without a position either.
+//! The format is the few hundred lines here, beside the project's own encoder
+//! (`common::ulog`), and the tests hold this reader to the specification's bytes and to
+//! pyulog's reading of the autopilot's logs.
 
 // What the file holds decides every length and offset here: no indexing, no unchecked
 // arithmetic, no unwrap can turn a bad file into a panic.
