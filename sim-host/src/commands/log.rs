@@ -462,16 +462,18 @@ pub fn summary_tables(s: &LogSummary) -> Vec<Table> {
     row("warnings", s.warnings.len().to_string());
     let mut tables = vec![log];
 
-    let mut modes = Table::new("Modes", &["mode", "from (s)", "to (s)", "for (s)"]);
-    for m in &s.modes {
-        modes.row([
-            m.mode.clone(),
-            format!("{:.1}", m.from_s),
-            format!("{:.1}", m.to_s),
-            format!("{:.1}", m.to_s - m.from_s),
-        ]);
+    if !s.modes.is_empty() {
+        let mut modes = Table::new("Modes", &["mode", "from (s)", "to (s)", "for (s)"]);
+        for m in &s.modes {
+            modes.row([
+                m.mode.clone(),
+                format!("{:.1}", m.from_s),
+                format!("{:.1}", m.to_s),
+                format!("{:.1}", m.to_s - m.from_s),
+            ]);
+        }
+        tables.push(modes);
     }
-    tables.push(modes);
 
     let mut flight = Table::new("Flight", &["quantity", "min", "max", "mean or RMS"]);
     if let Some(a) = &s.attitude {
@@ -510,7 +512,9 @@ pub fn summary_tables(s: &LogSummary) -> Vec<Table> {
             format!("{d:.0}"),
         ]);
     }
-    tables.push(flight);
+    if !flight.rows.is_empty() {
+        tables.push(flight);
+    }
 
     if let Some(b) = &s.battery {
         let mut bat = Table::new("Battery", &["quantity", "value"]);
@@ -628,5 +632,12 @@ mod tests {
         let text = crate::commands::render(&tables, crate::commands::Format::Text);
         assert!(text.contains("2, 150 ms in all"), "{text}");
         assert!(text.contains("geofence breached"), "{text}");
+        assert!(!text.contains("Flight\n"), "no figure to show: {text}");
+        let dir = tempfile::tempdir().unwrap();
+        assert_eq!(
+            flight_series(&l).write_figures(dir.path()).unwrap(),
+            Vec::<PathBuf>::new(),
+            "no figure without a line to draw"
+        );
     }
 }

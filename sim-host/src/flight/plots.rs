@@ -202,21 +202,24 @@ impl FlightSeries {
 
     /// Draws the figures into `dir`; returns the files written.
     pub fn write_figures(&self, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
-        self.figures()
-            .into_iter()
-            .map(|(name, mut f)| {
-                // An autopilot seen only through its links (QEMU, `sim-host sim`) leaves its
-                // estimate and setpoints out of the simulator's log, and a flight log holds no
-                // truth: no line for them, and no panel when none is left.
-                for p in &mut f.panels {
-                    p.series.retain(|s| s.y.iter().any(|v| v.is_finite()));
-                }
-                f.panels.retain(|p| !p.series.is_empty());
-                let path = dir.join(name);
-                f.save_png(&path)?;
-                Ok(path)
-            })
-            .collect()
+        let mut files = Vec::new();
+        for (name, mut f) in self.figures() {
+            // An autopilot seen only through its links (QEMU, `sim-host sim`) leaves its
+            // estimate and setpoints out of the simulator's log, and a flight log holds no
+            // truth: no line for them, no panel when none is left, no figure without a panel
+            // (a log cut before its first sample).
+            for p in &mut f.panels {
+                p.series.retain(|s| s.y.iter().any(|v| v.is_finite()));
+            }
+            f.panels.retain(|p| !p.series.is_empty());
+            if f.panels.is_empty() {
+                continue;
+            }
+            let path = dir.join(name);
+            f.save_png(&path)?;
+            files.push(path);
+        }
+        Ok(files)
     }
 }
 
