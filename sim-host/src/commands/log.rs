@@ -560,6 +560,7 @@ pub fn summary_tables(s: &LogSummary) -> Vec<Table> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ulog_read::tests::Encoded;
     use common::logger::topics::VehicleStatus;
     use common::ulog::topic::Topic;
     use common::ulog::{self as enc, Level};
@@ -567,28 +568,23 @@ mod tests {
     /// A log of `vehicle_status` samples (time in us, nav_state), a text and two dropouts,
     /// written with the project's encoder.
     fn log(states: &[(u64, u8)]) -> Ulog {
-        let mut b = Vec::new();
-        let mut put = |f: &dyn Fn(&mut [u8]) -> Result<usize, enc::TooLong>| {
-            let mut buf = [0u8; 512];
-            let n = f(&mut buf).unwrap();
-            b.extend_from_slice(&buf[..n]);
-        };
-        put(&|x| enc::header(x, 2_000_000));
-        put(&|x| enc::flag_bits(x));
-        put(&|x| enc::format(x, &VehicleStatus::FORMAT));
-        put(&|x| enc::add_logged(x, 0, 0, "vehicle_status"));
+        let mut b = Encoded::default();
+        b.put(|x| enc::header(x, 2_000_000));
+        b.put(enc::flag_bits);
+        b.put(|x| enc::format(x, &VehicleStatus::FORMAT));
+        b.put(|x| enc::add_logged(x, 0, 0, "vehicle_status"));
         for &(t, nav_state) in states {
             let s = VehicleStatus {
                 arming_state: 2,
                 nav_state,
                 ..Default::default()
             };
-            put(&|x| enc::data(x, 0, t, |c| s.encode(c)));
+            b.put(|x| enc::data(x, 0, t, |c| s.encode(c)));
         }
-        put(&|x| enc::dropout(x, 120));
-        put(&|x| enc::logging(x, Level::Critical, 3_500_000, "geofence breached"));
-        put(&|x| enc::dropout(x, 30));
-        crate::ulog_read::parse(&b).unwrap()
+        b.put(|x| enc::dropout(x, 120));
+        b.put(|x| enc::logging(x, Level::Critical, 3_500_000, "geofence breached"));
+        b.put(|x| enc::dropout(x, 30));
+        crate::ulog_read::parse(&b.0).unwrap()
     }
 
     #[test]

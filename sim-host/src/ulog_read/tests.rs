@@ -60,6 +60,23 @@ fn attitude(t_us: u64, q: [f32; 4]) -> Vec<u8> {
     s
 }
 
+/// A log written message by message with the project's encoder (`common::ulog`).
+#[derive(Default)]
+pub(crate) struct Encoded(pub(crate) Vec<u8>);
+
+impl Encoded {
+    /// Appends what `f` encodes.
+    pub(crate) fn put(
+        &mut self,
+        f: impl FnOnce(&mut [u8]) -> Result<usize, common::ulog::TooLong>,
+    ) -> &mut Self {
+        let mut buf = [0u8; 512];
+        let n = f(&mut buf).unwrap();
+        self.0.extend_from_slice(&buf[..n]);
+        self
+    }
+}
+
 const SYNC: [u8; 8] = [0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12];
 
 /// A log with every message type of the specification.
@@ -431,28 +448,23 @@ fn the_project_encoders_log_reads_back_as_written() {
     use common::logger::topics::VehicleAttitude;
     use common::ulog::topic::Topic;
     use common::ulog::{self as enc, Level};
-    let mut b = Vec::new();
-    let mut put = |f: &dyn Fn(&mut [u8]) -> Result<usize, enc::TooLong>| {
-        let mut buf = [0u8; 512];
-        let n = f(&mut buf).unwrap();
-        b.extend_from_slice(&buf[..n]);
-    };
-    put(&|x| enc::header(x, 5_000_000));
-    put(&|x| enc::flag_bits(x));
-    put(&|x| enc::info_str(x, "ver_sw", "0.1.0"));
-    put(&|x| enc::info_u32(x, "ver_hw_rev", 3));
-    put(&|x| enc::parameter_f32(x, "NAV_ASPD", 17.0));
-    put(&|x| enc::parameter_i32(x, "SYS_GAIN_SET", 2));
-    put(&|x| enc::format(x, &VehicleAttitude::FORMAT));
-    put(&|x| enc::add_logged(x, 0, 4, "vehicle_attitude"));
+    let mut b = Encoded::default();
+    b.put(|x| enc::header(x, 5_000_000));
+    b.put(enc::flag_bits);
+    b.put(|x| enc::info_str(x, "ver_sw", "0.1.0"));
+    b.put(|x| enc::info_u32(x, "ver_hw_rev", 3));
+    b.put(|x| enc::parameter_f32(x, "NAV_ASPD", 17.0));
+    b.put(|x| enc::parameter_i32(x, "SYS_GAIN_SET", 2));
+    b.put(|x| enc::format(x, &VehicleAttitude::FORMAT));
+    b.put(|x| enc::add_logged(x, 0, 4, "vehicle_attitude"));
     let q = VehicleAttitude {
         q: [0.5, -0.5, 0.25, 0.75],
     };
-    put(&|x| enc::data(x, 4, 5_010_000, |c| q.encode(c)));
-    put(&|x| enc::logging(x, Level::Warning, 5_020_000, "battery low"));
-    put(&|x| enc::sync(x));
-    put(&|x| enc::dropout(x, 70_000));
-    let log = parse(&b).unwrap();
+    b.put(|x| enc::data(x, 4, 5_010_000, |c| q.encode(c)));
+    b.put(|x| enc::logging(x, Level::Warning, 5_020_000, "battery low"));
+    b.put(enc::sync);
+    b.put(|x| enc::dropout(x, 70_000));
+    let log = parse(&b.0).unwrap();
     assert_eq!(log.warnings, vec![]);
     assert_eq!(log.start_us, 5_000_000);
     assert_eq!(log.info_text("ver_sw").as_deref(), Some("0.1.0"));
