@@ -159,6 +159,19 @@ pub(crate) enum Command {
     /// aircraft's model, its sensors, the wind and the runway, judged by named criteria;
     /// `--shard I/N` flies a part of it, `merge` joins the parts.
     Campaign(crate::cli_campaign::CampaignCli),
+    /// Read a flight log (ULog, the autopilot's or PX4's): print its summary (duration,
+    /// system, modes flown, attitude, altitude, airspeed, distance, battery, dropouts, texts,
+    /// parameters, topics and their rates) and draw the figures a simulated flight draws.
+    Log {
+        /// The log file (`.ulg`).
+        file: PathBuf,
+        /// Directory for the PNG figures.
+        #[arg(long, default_value = "out/log")]
+        out: PathBuf,
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.

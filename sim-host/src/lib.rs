@@ -13,7 +13,8 @@
 //! - [`mission_file`]: QGroundControl `.plan` and `QGC WPL 110` mission files, read into
 //!   mission, geofence and rally items;
 //! - [`report`]: tables, JSON, CSV and plots shared by every command;
-//! - [`scenario`]: the closed-loop tests of thesis chapter 4 on the nonlinear plant.
+//! - [`scenario`]: the closed-loop tests of thesis chapter 4 on the nonlinear plant;
+//! - [`ulog_read`]: a reader of ULog flight logs, the autopilot's and PX4's.
 #![warn(missing_docs)]
 
 pub mod aircraft;
@@ -28,3 +29,4 @@ pub mod plant;
 pub mod report;
 pub mod scenario;
 pub mod sensors;
+pub mod ulog_read;

@@ -257,6 +257,20 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Some(Command::Log { file, out, json }) => {
+            let r = commands::log::log_report(&file, &out)?;
+            // What the reader skipped, or where a cut log ends: the summary is of the rest.
+            for w in &r.summary.warnings {
+                eprintln!("warning: {}: {w}", file.display());
+            }
+            print_summary(
+                json,
+                &r.summary,
+                &commands::log::summary_tables(&r.summary),
+                &r.files,
+            )?;
+            Ok(ExitCode::SUCCESS)
+        }
         Some(Command::Validation { out, out_dir }) => {
             let md = commands::validation::validation_markdown(&aircraft, Some(&out_dir))?;
             if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -329,16 +343,28 @@ fn sim_command(aircraft: &Aircraft, a: SimArgs) -> anyhow::Result<ExitCode> {
             "sim-host sim: the simulated GPS reports {gps_delay} s late: set the autopilot's EKF_GPS_DELAY to {gps_delay}; Ctrl-C ends the flight and writes the log"
         );
     })?;
-    if a.json {
-        emit(&to_json(&r.outcome.summary)?)?;
-    } else {
-        emit(&render(
-            &commands::fly::summary_tables(&r.outcome),
-            Format::Text,
-        ))?;
-        for f in &r.files {
-            emit(&format!("wrote {}", f.display()))?;
-        }
-    }
+    print_summary(
+        a.json,
+        &r.outcome.summary,
+        &commands::fly::summary_tables(&r.outcome),
+        &r.files,
+    )?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// Prints a command's summary, as JSON or as its tables followed by the files it wrote.
+fn print_summary(
+    json: bool,
+    summary: &impl serde::Serialize,
+    tables: &[sim_host::report::Table],
+    files: &[std::path::PathBuf],
+) -> anyhow::Result<()> {
+    if json {
+        return emit(&to_json(summary)?);
+    }
+    emit(&render(tables, Format::Text))?;
+    for f in files {
+        emit(&format!("wrote {}", f.display()))?;
+    }
+    Ok(())
 }

@@ -4,9 +4,14 @@
 //! roll and pitch under 0.5 deg RMS, heading under 2 deg, height under 1 m). The height is
 //! the one above home: the altitude above sea level is anchored on a GPS fix at arming, and
 //! carries that fix's error (1.6 m on this flight) as every GPS-anchored autopilot does.
+//!
+//! The same log read by pyulog and by `sim_host::ulog_read` gives the same topics, samples,
+//! parameters and attitude.
 
-use std::path::Path;
+mod support;
+
 use std::process::Command;
+use support::{col, csv, flight, rms, wrap_deg};
 
 /// Whether pyulog is here; false (skipped) outside CI, a failure under CI (.ci/run installs it).
 fn have_pyulog() -> bool {
@@ -24,63 +29,17 @@ fn have_pyulog() -> bool {
     ok
 }
 
-/// Rows of a CSV file as numbers, with its header.
-fn csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .expect("a header")
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|x| x.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    (header, rows)
-}
-
-fn col(header: &[String], name: &str) -> usize {
-    header
-        .iter()
-        .position(|h| h == name)
-        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
-}
-
-fn rms(e: &[f64]) -> f64 {
-    (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt()
-}
-
-fn wrap_deg(a: f64) -> f64 {
-    (a + 180.0).rem_euclid(360.0) - 180.0
-}
-
 #[test]
 fn pyulog_reads_the_flight_log_and_its_attitude_and_height_match_the_truth() {
     if !have_pyulog() {
         return;
     }
-    let dir = tempfile::tempdir().expect("tempdir");
-    let out = dir.path();
-    let status = Command::new(env!("CARGO_BIN_EXE_sim-host"))
-        .args(["fly", "--mission", "default", "--duration", "90", "--out"])
-        .arg(out)
-        .output()
-        .expect("sim-host runs");
-    assert!(
-        status.status.success(),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
-    let log = out.join("logs").join("log_001.ulg");
-    assert!(log.exists(), "one log for the one armed flight");
+    let flown = flight();
+    let (out, log) = (flown.dir.as_path(), &flown.log);
+    let scratch = tempfile::tempdir().expect("tempdir");
 
     let info = Command::new("ulog_info")
-        .arg(&log)
+        .arg(log)
         .output()
         .expect("ulog_info runs");
     let said = format!(
@@ -92,11 +51,11 @@ fn pyulog_reads_the_flight_log_and_its_attitude_and_height_match_the_truth() {
     assert!(!said.to_lowercase().contains("warning"), "{said}");
     assert!(said.contains("No Dropouts"), "{said}");
 
-    let csvs = out.join("csv");
+    let csvs = scratch.path().join("csv");
     let conv = Command::new("ulog2csv")
         .args(["-m", "vehicle_attitude,vehicle_local_position", "-o"])
         .arg(&csvs)
-        .arg(&log)
+        .arg(log)
         .output()
         .expect("ulog2csv runs");
     assert!(
@@ -158,4 +117,94 @@ fn pyulog_reads_the_flight_log_and_its_attitude_and_height_match_the_truth() {
     let rh = rms(&eh);
     eprintln!("logged height above home against the truth, RMS: {rh:.3} m");
     assert!(rh < 1.0, "{rh}");
+}
+
+#[test]
+fn pyulog_and_this_projects_reader_read_the_same_topics_samples_parameters_and_attitude() {
+    if !have_pyulog() {
+        return;
+    }
+    let flown = flight();
+    let ours = sim_host::ulog_read::read_file(&flown.log).expect("the log reads");
+    assert_eq!(ours.warnings, vec![], "a whole log");
+    let run = |tool: &str, args: &[&str]| -> String {
+        let out = Command::new(tool)
+            .args(args)
+            .arg(&flown.log)
+            .output()
+            .unwrap_or_else(|e| panic!("{tool} runs: {e}"));
+        assert!(
+            out.status.success(),
+            "{tool}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+
+    // ulog_info: ` name (multi id, message size)   samples   bytes` for every topic.
+    let info = run("ulog_info", &[]);
+    let mut topics: Vec<(String, u8, usize, usize)> = info
+        .lines()
+        .filter_map(|l| {
+            let (name, rest) = l.trim().split_once(" (")?;
+            let (ids, counts) = rest.split_once(')')?;
+            let (multi, size) = ids.split_once(", ")?;
+            let mut n = counts.split_whitespace();
+            Some((
+                name.to_string(),
+                multi.parse().ok()?,
+                size.parse().ok()?,
+                n.next()?.parse().ok()?,
+            ))
+        })
+        .collect();
+    topics.sort();
+    let mut read: Vec<(String, u8, usize, usize)> = ours
+        .datasets
+        .iter()
+        .map(|d| (d.name.clone(), d.multi_id, d.layout.size, d.len()))
+        .collect();
+    read.sort();
+    assert_eq!(read.len(), 19, "{read:?}");
+    assert_eq!(read, topics, "topic, instance, sample size and samples");
+    for key in ["sys_name", "ver_sw", "ver_hw"] {
+        let line = format!(" {key}: {}", ours.info_text(key).expect(key));
+        assert!(info.lines().any(|l| l == line), "{line:?} in\n{info}");
+    }
+
+    // ulog_params: `NAME,value` for every parameter, the value as pyulog holds it.
+    let params = run("ulog_params", &[]);
+    let theirs: Vec<(String, f64)> = params
+        .lines()
+        .filter_map(|l| {
+            let (k, v) = l.split_once(',')?;
+            Some((k.to_string(), v.parse().ok()?))
+        })
+        .collect();
+    assert_eq!(theirs.len(), ours.params.len(), "{params}");
+    for (k, v) in &theirs {
+        let mine = ours.params.get(k).and_then(|v| v.as_f64());
+        assert_eq!(mine, Some(*v), "parameter {k}");
+    }
+
+    // ulog2csv: every attitude sample, its time and quaternion (as f32: the CSV writes the
+    // shortest text that reads back to the same f32).
+    let scratch = tempfile::tempdir().expect("tempdir");
+    let out = scratch.path().to_str().expect("a UTF-8 path");
+    run("ulog2csv", &["-m", "vehicle_attitude", "-o", out]);
+    let (h, rows) = csv(&scratch.path().join("log_001_vehicle_attitude_0.csv"));
+    let att = ours.dataset("vehicle_attitude").expect("attitude");
+    assert_eq!(rows.len(), att.len());
+    let ts = col(&h, "timestamp");
+    for (i, r) in rows.iter().enumerate() {
+        assert_eq!(r[ts] as u64, att.timestamps_us()[i], "sample {i}");
+    }
+    for k in 0..4 {
+        let name = format!("q[{k}]");
+        let c = col(&h, &name);
+        let mine = att.field(&name).expect("q");
+        for (i, r) in rows.iter().enumerate() {
+            assert_eq!(r[c] as f32, mine[i] as f32, "{name} of sample {i}");
+        }
+    }
 }

@@ -9,6 +9,7 @@ pub mod fly;
 pub mod flying;
 pub mod laws;
 pub mod linearize;
+pub mod log;
 pub mod mission_tables;
 pub mod navigation;
 pub mod params;

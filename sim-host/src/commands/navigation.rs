@@ -15,7 +15,7 @@ use crate::flight::landed::{landed_state_honest, ON_GROUND_AFTER_SLOW_S, ON_GROU
 use crate::flight::missions::{
     default_mission, other_runway_missions, runway_mission, RunwayMission,
 };
-use crate::flight::plots::ground_track_figure;
+use crate::flight::plots::{ground_track_figure, track_series};
 use crate::flight::record::Sample;
 use crate::flight::runner::FlightOutcome;
 use crate::flight::summary::MissionSummary;
@@ -147,7 +147,7 @@ pub fn fly_default_at_airspeed(
 }
 
 fn ground_track(samples: &[Sample], title: &str, path: &Path) -> anyhow::Result<()> {
-    ground_track_figure(samples, title).save_png(path)
+    ground_track_figure(track_series(samples), title).save_png(path)
 }
 
 /// Name of the section `sim-host navigation` writes into `docs/RESULTS.md`.

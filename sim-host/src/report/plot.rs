@@ -148,19 +148,22 @@ impl Figure {
             mesh.draw().map_err(|e| anyhow!("{e}"))?;
             for (si, s) in panel.series.iter().enumerate() {
                 let color = palette[si % palette.len()];
-                let pts: Vec<(f64, f64)> = s.x.iter().copied().zip(s.y.iter().copied()).collect();
                 let style = ShapeStyle::from(&color).stroke_width(2);
-                let drawn = if s.dashed {
-                    chart.draw_series(DashedLineSeries::new(pts, 8, 5, style))
-                } else {
-                    chart.draw_series(LineSeries::new(pts, style))
-                };
-                drawn
-                    .map_err(|e| anyhow!("{e}"))?
-                    .label(s.label.as_str())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                    });
+                // A missing value (NaN) breaks the line: drawn through, it would land at the
+                // drawing area's edge and streak across the panels.
+                for (ri, pts) in finite_runs(s).into_iter().enumerate() {
+                    let drawn = if s.dashed {
+                        chart.draw_series(DashedLineSeries::new(pts, 8, 5, style))
+                    } else {
+                        chart.draw_series(LineSeries::new(pts, style))
+                    }
+                    .map_err(|e| anyhow!("{e}"))?;
+                    if ri == 0 {
+                        drawn.label(s.label.as_str()).legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                        });
+                    }
+                }
             }
             chart
                 .configure_series_labels()
@@ -175,6 +178,23 @@ impl Figure {
             .with_context(|| format!("cannot write PNG file `{}`", path.display()))?;
         Ok(())
     }
+}
+
+/// The series' points in runs of finite ones.
+fn finite_runs(s: &Series) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut run = Vec::new();
+    for (x, y) in s.x.iter().copied().zip(s.y.iter().copied()) {
+        if x.is_finite() && y.is_finite() {
+            run.push((x, y));
+        } else if !run.is_empty() {
+            runs.push(std::mem::take(&mut run));
+        }
+    }
+    if !run.is_empty() {
+        runs.push(run);
+    }
+    runs
 }
 
 /// Data range padded by 5 % (and widened when flat) so every line is visible.
@@ -227,5 +247,18 @@ mod tests {
         let bytes = std::fs::read(&path).unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
         assert!(bytes.len() > 5000);
+    }
+
+    #[test]
+    fn a_missing_value_breaks_a_line_in_two() {
+        let s = Series::new(
+            "a",
+            vec![0.0, 1.0, 2.0, 3.0, 4.0, f64::NAN],
+            vec![1.0, f64::NAN, 2.0, 3.0, f64::INFINITY, 5.0],
+        );
+        assert_eq!(
+            finite_runs(&s),
+            vec![vec![(0.0, 1.0)], vec![(2.0, 2.0), (3.0, 3.0)]]
+        );
     }
 }
