@@ -85,6 +85,9 @@ struct Reply {
     data: Data,
 }
 
+// A reply is built and sent within a poll, one at a time (one waits at most): its bytes
+// travel with it rather than in a buffer of the server's that every reply would share.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Data {
     None,
@@ -415,10 +418,7 @@ impl Ftp {
                     };
                     listing(head.offset, count, names).map_or(nak(ERR_EOF), ok)
                 }
-                Deferred::Open(i) => match {
-                    store.refresh();
-                    store.entry(i)
-                } {
+                Deferred::Open(i) => match refreshed_entry(store, i) {
                     Some(e) => {
                         self.session = Some((Open::Log(i), to));
                         ok(Data::Length(e.size_bytes))
@@ -530,6 +530,12 @@ impl Ftp {
             payload,
         })
     }
+}
+
+/// Log `index` as the store finds it now.
+fn refreshed_entry(store: &mut dyn LogStore, index: u16) -> Option<super::logs::LogEntryInfo> {
+    store.refresh();
+    store.entry(index)
 }
 
 /// Up to `want` bytes of log `index` from `offset`; `None` at or past its end (or unreadable).
