@@ -12,13 +12,8 @@ barometer's offset from GPS. Checks:
 """
 import time
 
-from station import MAV, check, connect, finish, wait
+from station import MAV, arm, check, command, connect, finish, wait
 
-
-def command(m, cmd, *p):
-    p = list(p) + [0] * (7 - len(p))
-    m.mav.command_long_send(1, 1, cmd, 0, *p)
-    return wait(m, "COMMAND_ACK", lambda a: a.command == cmd)
 
 
 def home(m):
@@ -28,13 +23,7 @@ def home(m):
 
 m = connect()
 check(wait(m, "HEARTBEAT", lambda h: h.get_srcSystem() == 1) is not None, "vehicle heard")
-ack = None
-end = time.time() + 30
-while time.time() < end:
-    ack = command(m, MAV.MAV_CMD_COMPONENT_ARM_DISARM, 1)
-    if ack is not None and ack.result == MAV.MAV_RESULT_ACCEPTED:
-        break
-    time.sleep(1.0)
+ack = arm(m)
 check(ack is not None and ack.result == MAV.MAV_RESULT_ACCEPTED, "armed on the ground")
 first = home(m)
 check(first is not None, "HOME_POSITION once armed")

@@ -23,7 +23,7 @@ import time
 import zlib
 
 from pymavlink import mavftp
-from station import MAV, check, connect, finish, wait
+from station import MAV, arm, check, command, connect, finish, wait
 
 WHERE = sys.argv[2]
 
@@ -74,11 +74,6 @@ def kept():
             out.append(f.read())
     return out
 
-
-def command(m, cmd, *p):
-    p = list(p) + [0] * (7 - len(p))
-    m.mav.command_long_send(1, 1, cmd, 0, *p)
-    return wait(m, "COMMAND_ACK", lambda a: a.command == cmd)
 
 
 def log_list(m):
@@ -150,12 +145,7 @@ def attitude_rate(m, secs):
 
 m = connect()
 check(wait(m, "HEARTBEAT", lambda h: h.get_srcSystem() == 1) is not None, "vehicle heard")
-ack, end = None, time.time() + 30
-while time.time() < end:
-    ack = command(m, MAV.MAV_CMD_COMPONENT_ARM_DISARM, 1)
-    if ack is not None and ack.result == MAV.MAV_RESULT_ACCEPTED:
-        break
-    time.sleep(1.0)
+ack = arm(m)
 check(ack is not None and ack.result == MAV.MAV_RESULT_ACCEPTED, "armed on the ground")
 time.sleep(4.0)
 before = attitude_rate(m, 3.0)

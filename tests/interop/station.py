@@ -41,5 +41,24 @@ def wait(m, kind, cond=lambda msg: True, secs=5.0):
     return None
 
 
+def command(m, cmd, *p):
+    """COMMAND_LONG to the vehicle; its COMMAND_ACK, or None."""
+    p = list(p) + [0] * (7 - len(p))
+    m.mav.command_long_send(1, 1, cmd, 0, *p)
+    return wait(m, "COMMAND_ACK", lambda a: a.command == cmd)
+
+
+def arm(m, secs=30.0):
+    """Asks to arm once a second until accepted (the pre-arm checks pass as the estimator
+    converges) or `secs` pass; the last COMMAND_ACK."""
+    ack, end = None, time.time() + secs
+    while time.time() < end:
+        ack = command(m, MAV.MAV_CMD_COMPONENT_ARM_DISARM, 1)
+        if ack is not None and ack.result == MAV.MAV_RESULT_ACCEPTED:
+            break
+        time.sleep(1.0)
+    return ack
+
+
 def finish():
     sys.exit(1 if failures else 0)

@@ -85,6 +85,9 @@ struct Reply {
     data: Data,
 }
 
+// A reply is built and sent within a poll, one at a time (one waits at most): its bytes
+// travel with it rather than in a buffer of the server's that every reply would share.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Data {
     None,
@@ -145,6 +148,55 @@ struct Burst {
     /// Bytes per packet: what the request asked for (QGroundControl asks for a full packet,
     /// pymavlink's client for less), a full packet when it asked for none.
     chunk: usize,
+}
+
+impl Burst {
+    /// A burst from `offset`, its first packet numbered `seq`, of packets of `size` bytes (a
+    /// full packet when the request asked for none).
+    fn new(seq: u16, offset: u32, size: usize) -> Self {
+        Self {
+            next_seq: seq,
+            offset,
+            left: BURST_PACKETS,
+            chunk: if size == 0 {
+                DATA_LEN
+            } else {
+                size.min(DATA_LEN)
+            },
+        }
+    }
+
+    /// The burst's next packet: `data` (`n` bytes) and the burst after it, or, with no data
+    /// left, `EOF` and the burst's end.
+    fn step(self, data: Option<(Data, usize)>) -> (Reply, Option<Burst>) {
+        let Some((data, n)) = data else {
+            let eof = Reply {
+                seq: self.next_seq,
+                opcode: NAK,
+                req_opcode: OP_BURST,
+                burst_complete: false,
+                offset: self.offset,
+                data: Data::Error(ERR_EOF),
+            };
+            return (eof, None);
+        };
+        let last = self.left <= 1;
+        let next = (!last).then_some(Burst {
+            next_seq: self.next_seq.wrapping_add(1),
+            offset: self.offset.saturating_add(n as u32),
+            left: self.left.saturating_sub(1),
+            chunk: self.chunk,
+        });
+        let r = Reply {
+            seq: self.next_seq,
+            opcode: ACK,
+            req_opcode: OP_BURST,
+            burst_complete: last,
+            offset: self.offset,
+            data,
+        };
+        (r, next)
+    }
 }
 
 /// The server's state.
@@ -261,16 +313,7 @@ impl Ftp {
                         let want = size.clamp(1, DATA_LEN);
                         self.deferred = Some((ack(Data::None), Deferred::Read(i, want), from));
                     } else {
-                        self.burst = Some(Burst {
-                            next_seq: reply_seq,
-                            offset,
-                            left: BURST_PACKETS,
-                            chunk: if size == 0 {
-                                DATA_LEN
-                            } else {
-                                size.min(DATA_LEN)
-                            },
-                        });
+                        self.burst = Some(Burst::new(reply_seq, offset, size));
                     }
                     self.reply = None;
                     return;
@@ -284,16 +327,7 @@ impl Ftp {
                         let n = len.saturating_sub(at).min(size.max(1)).min(DATA_LEN);
                         ack(Data::Slice { file: f, len: n })
                     } else {
-                        self.burst = Some(Burst {
-                            next_seq: reply_seq,
-                            offset,
-                            left: BURST_PACKETS,
-                            chunk: if size == 0 {
-                                DATA_LEN
-                            } else {
-                                size.min(DATA_LEN)
-                            },
-                        });
+                        self.burst = Some(Burst::new(reply_seq, offset, size));
                         self.reply = None;
                         return;
                     }
@@ -384,10 +418,7 @@ impl Ftp {
                     };
                     listing(head.offset, count, names).map_or(nak(ERR_EOF), ok)
                 }
-                Deferred::Open(i) => match {
-                    store.refresh();
-                    store.entry(i)
-                } {
+                Deferred::Open(i) => match refreshed_entry(store, i) {
                     Some(e) => {
                         self.session = Some((Open::Log(i), to));
                         ok(Data::Length(e.size_bytes))
@@ -408,41 +439,15 @@ impl Ftp {
             return None;
         }
         *budget = budget.saturating_sub(1);
-        let data = read_log(store, i, b.offset, b.chunk);
-        let r = match data {
-            None => {
-                self.burst = None;
-                Reply {
-                    seq: b.next_seq,
-                    opcode: NAK,
-                    req_opcode: OP_BURST,
-                    burst_complete: false,
-                    offset: b.offset,
-                    data: Data::Error(ERR_EOF),
-                }
-            }
-            Some(data) => {
-                let n = match data {
-                    Data::Bytes { len, .. } => u32::from(len),
-                    _ => 0,
-                };
-                let last = b.left <= 1;
-                self.burst = (!last).then_some(Burst {
-                    next_seq: b.next_seq.wrapping_add(1),
-                    offset: b.offset.saturating_add(n),
-                    left: b.left.saturating_sub(1),
-                    chunk: b.chunk,
-                });
-                Reply {
-                    seq: b.next_seq,
-                    opcode: ACK,
-                    req_opcode: OP_BURST,
-                    burst_complete: last,
-                    offset: b.offset,
-                    data,
-                }
-            }
-        };
+        let data = read_log(store, i, b.offset, b.chunk).map(|d| {
+            let n = match d {
+                Data::Bytes { len, .. } => usize::from(len),
+                _ => 0,
+            };
+            (d, n)
+        });
+        let (r, next) = b.step(data);
+        self.burst = next;
         Some((self.message(&r, to), to))
     }
 
@@ -463,34 +468,12 @@ impl Ftp {
         *budget = budget.saturating_sub(1);
         let len = self.file(f).map_or(0, |f| f.bytes.len());
         let at = usize::try_from(b.offset).unwrap_or(usize::MAX);
-        let r = if at >= len {
-            self.burst = None;
-            Reply {
-                seq: b.next_seq,
-                opcode: NAK,
-                req_opcode: OP_BURST,
-                burst_complete: false,
-                offset: b.offset,
-                data: Data::Error(ERR_EOF),
-            }
-        } else {
+        let data = (at < len).then(|| {
             let n = len.saturating_sub(at).min(b.chunk);
-            let last = b.left <= 1;
-            self.burst = (!last).then_some(Burst {
-                next_seq: b.next_seq.wrapping_add(1),
-                offset: b.offset.saturating_add(n as u32),
-                left: b.left.saturating_sub(1),
-                chunk: b.chunk,
-            });
-            Reply {
-                seq: b.next_seq,
-                opcode: ACK,
-                req_opcode: OP_BURST,
-                burst_complete: last,
-                offset: b.offset,
-                data: Data::Slice { file: f, len: n },
-            }
-        };
+            (Data::Slice { file: f, len: n }, n)
+        });
+        let (r, next) = b.step(data);
+        self.burst = next;
         Some((self.message(&r, to), to))
     }
 
@@ -547,6 +530,12 @@ impl Ftp {
             payload,
         })
     }
+}
+
+/// Log `index` as the store finds it now.
+fn refreshed_entry(store: &mut dyn LogStore, index: u16) -> Option<super::logs::LogEntryInfo> {
+    store.refresh();
+    store.entry(index)
 }
 
 /// Up to `want` bytes of log `index` from `offset`; `None` at or past its end (or unreadable).

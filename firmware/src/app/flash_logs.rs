@@ -37,8 +37,10 @@ pub struct FlashLogs<F> {
 }
 
 impl<F: Flash> FlashLogs<F> {
-    /// The logs of `region` on `flash`, each new one given up to `sectors_per_log` sectors;
-    /// switches the application's log on.
+    /// The logs of `region` on `flash`, each new one given up to `sectors_per_log` sectors,
+    /// and the next one's sectors made ready (erased unless blank already: a log from boot,
+    /// `SDLOG_MODE` 1, starts at once); switches the application's log on. Called at boot,
+    /// where a scan and an erase may take seconds.
     pub fn open(
         mut flash: F,
         region: LogRegion,
@@ -47,7 +49,7 @@ impl<F: Flash> FlashLogs<F> {
     ) -> Result<Self, LogError<F::Error>> {
         let (logs, next_id) = scan(&mut flash, &region)?;
         app.flight_log_mut().enable(true);
-        Ok(Self {
+        let mut this = Self {
             flash,
             region,
             sectors_per_log: sectors_per_log.clamp(1, region.sectors),
@@ -59,7 +61,9 @@ impl<F: Flash> FlashLogs<F> {
             seen: app.flight_log().logs_started(),
             full: false,
             flash_errors: 0,
-        })
+        };
+        while this.ready < this.sectors_per_log && this.prepare_next() {}
+        Ok(this)
     }
 
     /// The logs kept, oldest first (the one being written with what is in flash so far).
@@ -126,7 +130,7 @@ impl<F: Flash> FlashLogs<F> {
         if armed || self.writer.is_some() || self.ready >= self.sectors_per_log {
             return false;
         }
-        self.erase_next()
+        self.prepare_next()
     }
 
     /// A log started: it takes the sectors erased for it (none ready: it is not kept).
@@ -151,10 +155,10 @@ impl<F: Flash> FlashLogs<F> {
         self.writer = Some(w);
     }
 
-    /// Erases the next sector of the next log's room; the logs that had blocks in it lose
-    /// them (a log whose first sector it was is gone). The newest log is kept unless the next
-    /// log would have no room at all.
-    fn erase_next(&mut self) -> bool {
+    /// Makes the next sector of the next log's room ready, erasing it unless it is blank; the
+    /// logs that had blocks in it lose them (a log whose first sector it was is gone). The
+    /// newest log is kept unless the next log would have no room at all.
+    fn prepare_next(&mut self) -> bool {
         if self.ready == 0 {
             self.next_first = first_sector_after(&self.region, &self.logs);
         }
@@ -169,16 +173,32 @@ impl<F: Flash> FlashLogs<F> {
         if self.ready > 0 && newest == Some(sector) {
             return false;
         }
-        if self
-            .flash
-            .erase_sector(self.region.sector_addr(sector))
-            .is_err()
-        {
+        let addr = self.region.sector_addr(sector);
+        if !self.blank(addr) && self.flash.erase_sector(addr).is_err() {
             self.flash_errors = self.flash_errors.saturating_add(1);
             return false;
         }
         self.forget_sector(sector);
         self.ready = self.ready.saturating_add(1);
+        true
+    }
+
+    /// Whether the sector at `addr` reads erased throughout (erasing it again would cost a
+    /// second or more of stalled flash for nothing).
+    fn blank(&mut self, addr: u32) -> bool {
+        let mut chunk = [0u8; 64];
+        let mut at = 0u32;
+        while at < self.region.sector_len {
+            if self
+                .flash
+                .read(addr.saturating_add(at), &mut chunk)
+                .is_err()
+                || chunk.iter().any(|&b| b != 0xff)
+            {
+                return false;
+            }
+            at = at.saturating_add(chunk.len() as u32);
+        }
         true
     }
 
@@ -247,5 +267,105 @@ impl<F: Flash> LogStore for FlashLogs<F> {
         self.next_first = 0;
         self.ready = self.sectors_per_log;
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use common::link::framing::Sender;
+    use common::link::simlink::encode_hil_sensor;
+    use common::sensors::{ImuSample, SensorFrame};
+    use common::storage::RamFlash;
+    use mavlink::dialects::common::MavMessage;
+    use std::vec;
+
+    const SECTOR: u32 = 4096;
+    /// Four sectors of 4 KiB: eight blocks each, two sectors a log (15,744 bytes of payload).
+    const REGION: LogRegion = LogRegion {
+        start: 0,
+        sector_len: SECTOR,
+        sectors: 4,
+    };
+
+    /// A frame of the sensors at rest at `time_us`, through the simulator link.
+    fn frame(app: &mut App, time_us: u64) -> bool {
+        let f = SensorFrame {
+            time_us,
+            imu: Some(ImuSample {
+                accel: nalgebra::Vector3::new(0.0, 0.0, -common::math::GRAVITY),
+                gyro: nalgebra::Vector3::zeros(),
+            }),
+            ..Default::default()
+        };
+        let mut sim = Sender::new(1, 51);
+        let raw = sim.encode(&MavMessage::HIL_SENSOR(encode_hil_sensor(&f, 0.0)));
+        let mut answered = false;
+        app.on_sim_bytes(raw.raw_bytes(), &mut |_| answered = true);
+        answered
+    }
+
+    #[test]
+    fn a_log_that_fills_its_sectors_stops_and_the_vehicle_answers_every_frame_after() {
+        let mut app = App::new();
+        app.vehicle_mut()
+            .params_mut()
+            .set("SDLOG_MODE", 1.0)
+            .expect("SDLOG_MODE");
+        let flash = RamFlash::<{ 4 * 4096 }>::new(SECTOR);
+        let mut logs = FlashLogs::open(flash, REGION, 2, &mut app).expect("the region");
+        // Blank sectors are made ready without an erase.
+        assert_eq!((logs.ready(), logs.flash_errors()), (2, 0));
+        let mut answered = 0;
+        // 10 s of frames at 100 Hz: some 80 KB of log for 15.7 KB of room.
+        for k in 1..=1000u64 {
+            answered += usize::from(frame(&mut app, k * 10_000));
+            logs.service(&mut app);
+        }
+        assert_eq!(answered, 1000, "every frame answered");
+        assert!(logs.full(), "the log filled its room");
+        assert_eq!(logs.flash_errors(), 0);
+        let kept = logs.logs().clone();
+        assert_eq!(kept.len(), 1);
+        // Whole blocks only, as many as the two sectors hold (or one fewer when the next
+        // message did not fit the last).
+        assert!(kept[0].blocks >= 15 && kept[0].blocks <= 16, "{kept:?}");
+        let mut head = vec![0u8; 16];
+        let n = LogStore::read(&mut logs, 0, 0, &mut head).expect("reads");
+        assert_eq!(&head[..n.min(7)], b"ULog\x01\x12\x35");
+        // The store answers the log protocol with what flash holds.
+        assert_eq!(
+            LogStore::entry(&logs, 0).map(|e| e.size_bytes),
+            Some(kept[0].bytes)
+        );
+    }
+
+    #[test]
+    fn an_erase_leaves_no_log_and_the_next_one_its_room() {
+        let mut app = App::new();
+        app.vehicle_mut()
+            .params_mut()
+            .set("SDLOG_MODE", 1.0)
+            .expect("SDLOG_MODE");
+        let flash = RamFlash::<{ 4 * 4096 }>::new(SECTOR);
+        let mut logs = FlashLogs::open(flash, REGION, 2, &mut app).expect("the region");
+        for k in 1..=50u64 {
+            frame(&mut app, k * 10_000);
+            logs.service(&mut app);
+        }
+        // Being written: not erased.
+        assert!(!LogStore::erase_all(&mut logs));
+        app.vehicle_mut()
+            .params_mut()
+            .set("SDLOG_MODE", -1.0)
+            .expect("SDLOG_MODE");
+        for k in 51..=60u64 {
+            frame(&mut app, k * 10_000);
+            logs.service(&mut app);
+        }
+        assert_eq!(logs.logs().len(), 1, "the log closed and kept");
+        assert!(LogStore::erase_all(&mut logs));
+        assert_eq!((LogStore::count(&logs), logs.ready()), (0, 2));
     }
 }
