@@ -58,6 +58,20 @@ fn the_summary_of_the_log_agrees_with_the_simulators_truth_of_the_armed_flight()
     );
     assert_eq!(s.sys_name.as_deref(), Some("fixed-wing autopilot"));
 
+    // The vehicle's status texts of the armed flight are in the log, each one the station
+    // received as a STATUSTEXT, within a control period or two of when it arrived there.
+    let station = &flown.outcome.summary.texts;
+    assert!(!s.texts.is_empty(), "no text logged");
+    for t in &s.texts {
+        let at = s.start_s + t.t_s;
+        assert!(
+            station
+                .iter()
+                .any(|(t_s, text)| *text == t.text && (t_s - at).abs() < 0.1),
+            "{t:?} at {at:.2} s not among the station's {station:?}"
+        );
+    }
+
     // The modes, at the PX4 main mode the simulator saw every frame: the same sequence, each
     // change within the 0.5 s between two `vehicle_status` samples.
     let main = |name: &str| {
