@@ -182,33 +182,10 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     if !tool_available("qemu-system-arm") {
         return;
     }
-    let elf = build_mcu_firmware();
     let out = tempfile::tempdir().expect("tempdir");
-    // Ctrl-C, as the user would press it once the first leg is flown.
-    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
-    let cfg = FlightConfig {
-        // A bound should the station fail; it stops the flight well before.
-        duration_s: 150.0,
-        runway_heading: Some(0.0),
-        scripted_station: false,
-        until_link_closes: true,
-        stop: Some(stop),
-        ..FlightConfig::default()
-    };
-    let opts = SimOptions {
-        link: LinkKind::Qemu,
-        qemu: QemuConfig {
-            elf,
-            ..QemuConfig::default()
-        },
-        gcs_bind: "127.0.0.1:0".into(),
-        gcs_remote: None,
-        out: Some(out.path().to_path_buf()),
-        plots: false,
-        ..SimOptions::default()
-    };
-    let (ready, sim) = start_sim(cfg, opts);
-    let ground: SocketAddr = ready.ground.expect("the image's ground link");
+    // Ctrl-C, as the user would press it once the first leg is flown; the duration is a
+    // bound should the station fail: it stops the flight well before.
+    let (ground, sim, stop) = start_mcu_flight(150.0, out.path(), None);
 
     let socket = UdpSocket::bind("127.0.0.1:0").expect("station socket");
     let mut gcs = Station::new(socket, ground);
@@ -239,6 +216,45 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     for f in ["simlink.tlog", "flight.csv", "summary.json", "mcu.defmt"] {
         assert!(out.path().join(f).is_file(), "{f} written");
     }
+}
+
+/// A flight of the MCU image: `sim-host sim --link qemu` on the runway heading north for at
+/// most `duration_s`, its files in `out`, the image's flash in the storage file `storage`
+/// when given. Returns the image's ground bridge, the simulator's thread and its Ctrl-C.
+fn start_mcu_flight(
+    duration_s: f64,
+    out: &std::path::Path,
+    storage: Option<std::path::PathBuf>,
+) -> (
+    SocketAddr,
+    JoinHandle<anyhow::Result<FlyReport>>,
+    &'static AtomicBool,
+) {
+    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+    let cfg = FlightConfig {
+        duration_s,
+        runway_heading: Some(0.0),
+        scripted_station: false,
+        until_link_closes: true,
+        stop: Some(stop),
+        ..FlightConfig::default()
+    };
+    let opts = SimOptions {
+        link: LinkKind::Qemu,
+        qemu: QemuConfig {
+            elf: build_mcu_firmware(),
+            storage,
+            ..QemuConfig::default()
+        },
+        gcs_bind: "127.0.0.1:0".into(),
+        gcs_remote: None,
+        out: Some(out.to_path_buf()),
+        plots: false,
+        ..SimOptions::default()
+    };
+    let (ready, sim) = start_sim(cfg, opts);
+    let ground = ready.ground.expect("the image's ground link");
+    (ground, sim, stop)
 }
 
 /// A flight of the host build: `sim-host sim` on the runway heading north for `duration_s`
@@ -480,33 +496,9 @@ fn pymavlink_downloads_the_mcu_images_flight_log_from_its_flash_byte_for_byte() 
     if !tool_available("qemu-system-arm") || !tool_available("python3") {
         return;
     }
-    let elf = build_mcu_firmware();
     let out = tempfile::tempdir().expect("tempdir");
     let storage = out.path().join("storage.bin");
-    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
-    let cfg = FlightConfig {
-        duration_s: 240.0,
-        runway_heading: Some(0.0),
-        scripted_station: false,
-        until_link_closes: true,
-        stop: Some(stop),
-        ..FlightConfig::default()
-    };
-    let opts = SimOptions {
-        link: LinkKind::Qemu,
-        qemu: QemuConfig {
-            elf,
-            storage: Some(storage.clone()),
-            ..QemuConfig::default()
-        },
-        gcs_bind: "127.0.0.1:0".into(),
-        gcs_remote: None,
-        out: Some(out.path().to_path_buf()),
-        plots: false,
-        ..SimOptions::default()
-    };
-    let (ready, sim) = start_sim(cfg, opts);
-    let ground: SocketAddr = ready.ground.expect("the image's ground link");
+    let (ground, sim, stop) = start_mcu_flight(240.0, out.path(), Some(storage.clone()));
     let downloaded = out.path().join("downloaded.ulg");
     let script = system_tests::workspace_root().join("tests/interop/pymavlink_logs.py");
     let run = std::process::Command::new("python3")
