@@ -291,17 +291,11 @@ fn in_the_air_a_download_takes_two_packets_a_call_and_never_more_than_the_room()
     let mut s = LogService::new();
     s.on_request_data(&request(1, 0, 0xffff_ffff), STATION);
     assert_eq!(data(&serve(&mut s, &mut store, true, 8192)).len(), 2);
-    // On the ground, as many as the room less the reserve holds.
+    // On the ground, as many as the room holds: 4096 / 122 = 33.
     let n = data(&serve(&mut s, &mut store, false, 4096)).len();
-    assert_eq!(n, (4096 - LOG_RESERVE_BYTES) / LOG_DATA_FRAME);
-    // No room beyond the reserve: nothing.
-    assert!(serve(
-        &mut s,
-        &mut store,
-        false,
-        LOG_RESERVE_BYTES + LOG_DATA_FRAME - 1
-    )
-    .is_empty());
+    assert_eq!(n, 33);
+    // No room for a whole packet: nothing.
+    assert!(serve(&mut s, &mut store, false, LOG_DATA_FRAME - 1).is_empty());
 }
 
 #[test]
