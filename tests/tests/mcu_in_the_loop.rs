@@ -314,7 +314,12 @@ fn parameters_and_a_mission_survive_a_reset_of_the_emulated_board() {
     let cmd = MavCmd::MAV_CMD_PREFLIGHT_STORAGE;
     assert_eq!(st.ack(cmd), Some(MavResult::MAV_RESULT_IN_PROGRESS));
     assert_eq!(st.ack(cmd), Some(MavResult::MAV_RESULT_ACCEPTED));
-    assert_eq!(std::fs::metadata(&storage).unwrap().len(), 32 * 1024);
+    // The board record's two sectors of 16 KiB, then the flight logs' six of 128 KiB
+    // (firmware/src/mcu/flash.rs).
+    assert_eq!(
+        std::fs::metadata(&storage).unwrap().len(),
+        32 * 1024 + 768 * 1024
+    );
 
     st.send(&common::gcs::client::command_long(
         MavCmd::MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN,

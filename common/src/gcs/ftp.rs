@@ -570,10 +570,9 @@ fn listing(
         let Some(dst) = buf.get_mut(len..end) else {
             break;
         };
-        let (text, nul) = dst.split_at_mut(s.len());
-        text.copy_from_slice(s.as_bytes());
-        if let Some(z) = nul.first_mut() {
-            *z = 0;
+        // Byte by byte: no slice operation that could panic (the image keeps none).
+        for (d, b) in dst.iter_mut().zip(s.as_bytes().iter().chain([0u8].iter())) {
+            *d = *b;
         }
         len = end;
     }

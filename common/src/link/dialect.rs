@@ -57,11 +57,14 @@ impl Dialect for Common {
 
 /// A payload written into a MAVLink 2 frame's buffer: its length, the message's id and its
 /// `CRC_EXTRA`.
-type Payload = (usize, u32, u8);
+pub(crate) type Payload = (usize, u32, u8);
 
 /// Writes `data`'s payload into `raw` with the `mavlink` crate's `ser` (its trailing zeros
 /// cut), for [`finish_v2`].
-fn write_payload<D: MessageData>(raw: &mut MAVLinkV2MessageRaw, data: &D) -> Option<Payload> {
+pub(crate) fn write_payload<D: MessageData>(
+    raw: &mut MAVLinkV2MessageRaw,
+    data: &D,
+) -> Option<Payload> {
     let payload = raw.as_mut_slice().get_mut(V2_HEAD..V2_HEAD + 255)?;
     Some((data.ser(MavlinkVersion::V2, payload), D::ID, D::EXTRA_CRC))
 }
@@ -75,7 +78,7 @@ const V2_HEAD: usize = 10;
 /// this crate's code in the MCU image, would be panic sites of ours
 /// (`tests/tests/panic_sites.rs`). `None` for a system id over 255 (MAVLink's 32-bit system
 /// ids, which the autopilot never has).
-fn finish_v2(
+pub(crate) fn finish_v2(
     raw: &mut MAVLinkV2MessageRaw,
     header: MavHeader,
     (len, id, extra_crc): Payload,

@@ -561,7 +561,13 @@ impl<D: Dialect> Sender<D> {
     /// dialect's types cannot express) as the next MAVLink 2 frame of this sender.
     pub fn encode_data<M: mavlink::MessageData>(&mut self, data: &M) -> MAVLinkV2MessageRaw {
         let mut raw = MAVLinkV2MessageRaw::new();
-        raw.serialize_message_data(self.next_header(), data);
+        let header = self.next_header();
+        // The dialect's writer, not the crate's `serialize_message_data`, whose bounds checks
+        // inlined into the board's code would be panic sites of ours (its system id is a u8:
+        // the writer never refuses it).
+        if let Some(p) = super::dialect::write_payload(&mut raw, data) {
+            let _ = super::dialect::finish_v2(&mut raw, header, p);
+        }
         raw
     }
 }

@@ -164,6 +164,11 @@ impl Logger {
         self.stage.is_some()
     }
 
+    /// Whether the log is past its definitions: samples and texts are written now.
+    pub fn writes_samples(&self) -> bool {
+        self.stage == Some(Stage::Data)
+    }
+
     /// What this log lost and took.
     pub fn stats(&self) -> LogStats {
         self.stats

@@ -57,8 +57,9 @@ pub struct GroundPort {
     /// Frames waiting, each as `[destination, length lo, length hi, frame...]`.
     out: heapless::Vec<u8, GCS_OUT>,
     bytes_dropped: u32,
-    /// The vehicle's status texts, kept for the flight log (the oldest dropped when full).
-    log_texts: heapless::Deque<(Severity, &'static str), LOG_TEXTS>,
+    /// The vehicle's status texts with when they were sent, µs, kept for the flight log (the
+    /// oldest dropped when full).
+    log_texts: heapless::Deque<(u64, Severity, &'static str), LOG_TEXTS>,
 }
 
 /// Status texts kept for the flight log between two sensor frames.
@@ -135,9 +136,15 @@ impl GroundPort {
         }
     }
 
-    /// The vehicle's status texts since the last call, oldest first, for the flight log.
-    pub(crate) fn take_log_text(&mut self) -> Option<(Severity, &'static str)> {
+    /// The vehicle's status texts since the last call, oldest first, with when they were
+    /// sent, for the flight log.
+    pub(crate) fn take_log_text(&mut self) -> Option<(u64, Severity, &'static str)> {
         self.log_texts.pop_front()
+    }
+
+    /// Forgets the texts kept for the flight log (no log is being recorded).
+    pub(crate) fn forget_log_texts(&mut self) {
+        self.log_texts.clear();
     }
 
     /// Bytes dropped because the output buffer was full.
@@ -239,7 +246,7 @@ impl GroundPort {
                     if self.log_texts.is_full() {
                         self.log_texts.pop_front();
                     }
-                    let _ = self.log_texts.push_back((s, text));
+                    let _ = self.log_texts.push_back((now_us, s, text));
                 }
                 Notice::Mission { current, reached } => {
                     self.link.mission_progress(current, reached)

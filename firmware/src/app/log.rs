@@ -158,8 +158,13 @@ impl FlightLog {
 }
 
 impl FlightLog {
-    /// A status text of the vehicle (a failsafe, a mode change, a refusal) into the log, as
-    /// PX4 logs its `mavlink_log` messages.
+    /// Whether a text given now is written (a log is past its opening).
+    pub(crate) fn takes_texts(&self) -> bool {
+        self.enabled && self.logger.writes_samples()
+    }
+
+    /// A status text of the vehicle (a failsafe, a mode change, a refusal) sent at `now_us`
+    /// into the log, as PX4 logs its `mavlink_log` messages.
     pub(crate) fn text(&mut self, now_us: u64, severity: Severity, text: &str) {
         if !self.enabled || !self.logger.recording() {
             return;

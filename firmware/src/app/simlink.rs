@@ -142,8 +142,15 @@ impl Answers {
                 self.health.sensor_frames += 1;
                 vehicle.on_sensors(&sensors, &ground.from_ground());
                 log.after_frame(vehicle, &sensors, &ground.log_figures());
-                while let Some((severity, text)) = ground.take_log_text() {
-                    log.text(vehicle.time_us().unwrap_or(0), severity, text);
+                // Texts wait while the log's opening goes out, and are not kept without a log.
+                if !log.recording() {
+                    ground.forget_log_texts();
+                }
+                while log.takes_texts() {
+                    let Some((t, severity, text)) = ground.take_log_text() else {
+                        break;
+                    };
+                    log.text(t, severity, text);
                 }
                 ground.poll(vehicle.time_us().unwrap_or(0), vehicle);
                 // The answer names the frame it answers, in the simulator's own time.
