@@ -62,8 +62,16 @@ const LAYERS: [(&str, &[&[&str]]); 3] = [
     (
         "sim-host",
         &[
-            // Output forms, the air, sensor models and mission files: nothing of sim-host.
-            &[ROOT, "report", "environment", "sensors", "mission_file"],
+            // Output forms, the air, sensor models, mission files and the ULog reader: nothing
+            // of sim-host.
+            &[
+                ROOT,
+                "report",
+                "environment",
+                "sensors",
+                "mission_file",
+                "ulog_read",
+            ],
             // The aircraft file, its sensors' configuration included.
             &["aircraft"],
             &["plant"],
