@@ -88,6 +88,8 @@ pub struct Hagl {
     next: u8,
     value: f32,
     last_good_us: Option<u64>,
+    /// When the last reading in range came, us.
+    last_usable_us: Option<u64>,
     /// The stuck detector's start: the range and the height above home then, m.
     anchor: Option<(f32, f32)>,
     stuck: bool,
@@ -116,6 +118,16 @@ impl Hagl {
             self.anchor = None;
             return;
         }
+        // After a silence longer than the timeout the window starts again too: its old readings
+        // are of another height.
+        let gap_s = self
+            .last_usable_us
+            .map_or(0.0, |t| t_us.saturating_sub(t) as f32 * 1e-6);
+        if gap_s > c.timeout_s {
+            self.filled = 0;
+            self.anchor = None;
+        }
+        self.last_usable_us = Some(t_us);
         let h = s.distance_m * cos_tilt;
         if let Some(slot) = self.window.get_mut(usize::from(self.next)) {
             *slot = h;
