@@ -277,8 +277,9 @@ mod tests {
         // Frozen at 5.4 m from reading 10 on: within the 3 m gate for another 2.5 s.
         let out = feed(&mut h, 10, 40, |_| 5.4, home);
         let failed_at = out.iter().position(Option::is_none).expect("failed");
-        // One metre of descent at 1.2 m/s is 0.83 s: 17 readings at 20 Hz.
-        assert!(failed_at <= 17, "failed after {failed_at} readings");
+        // Frozen 0.06 m into a half-metre step, it is judged at the end of the next one: 0.54 m
+        // of descent at 1.2 m/s, 0.45 s, 9 readings at 20 Hz (at worst a metre, 17 readings).
+        assert_eq!(failed_at, 8, "failed after {} readings", failed_at + 1);
         assert!(h.stuck());
         assert!(out[failed_at..].iter().all(Option::is_none));
         // Alive again: following the height over the next metre clears it.
