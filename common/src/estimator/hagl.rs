@@ -146,7 +146,9 @@ impl Hagl {
             return;
         }
         let m = median(self.window);
-        if self.stuck || !(libm::fabsf(m - height_m) <= c.gate_m) {
+        // Written so that a NaN median fails the gate.
+        let consistent = libm::fabsf(m - height_m) <= c.gate_m;
+        if self.stuck || !consistent {
             self.rejected = self.rejected.saturating_add(1);
             return;
         }
