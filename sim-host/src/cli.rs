@@ -199,9 +199,28 @@ pub(crate) struct EnvArgs {
     #[arg(long, default_value_t = 0.001)]
     pub(crate) dt: f64,
     /// A sensor fault over a window of simulated time, KIND:FROM-TO in s with KIND gps,
-    /// pitot, mag or baro; repeatable: `--fault gps:60-90`.
+    /// pitot, mag, baro, or (with a rangefinder) range-stuck, range-short or range-drop;
+    /// repeatable: `--fault gps:60-90`.
     #[arg(long = "fault", value_name = "KIND:FROM-TO", value_parser = sim_host::flight::parse_fault)]
     pub(crate) faults: Vec<sim_host::flight::FaultWindow>,
+    /// Fit the aircraft with a downward rangefinder (a LIDAR-Lite v3: 0.1-40 m, 20 Hz) when
+    /// its file has none, sent as DISTANCE_SENSOR.
+    #[arg(long)]
+    pub(crate) rangefinder: bool,
+}
+
+impl EnvArgs {
+    /// The aircraft as flown: with the default rangefinder if `--rangefinder` asks for one.
+    pub(crate) fn fitted(
+        &self,
+        aircraft: &sim_host::aircraft::Aircraft,
+    ) -> sim_host::aircraft::Aircraft {
+        let mut a = aircraft.clone();
+        if self.rangefinder && a.sensors.rangefinder.is_none() {
+            a.sensors.rangefinder = Some(sim_host::sensors::RangefinderConfig::default());
+        }
+        a
+    }
 }
 
 /// The MCU image and its emulator, for `--link qemu`.

@@ -156,6 +156,7 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Fly(args)) => {
+            let aircraft = args.env.fitted(&aircraft);
             commands::fly::command::fly_command(&aircraft, args.command(), emit)?;
             Ok(ExitCode::SUCCESS)
         }
@@ -302,6 +303,8 @@ fn emit(text: &str) -> anyhow::Result<()> {
 
 fn sim_command(aircraft: &Aircraft, a: SimArgs) -> anyhow::Result<ExitCode> {
     use sim_host::flight::FlightConfig;
+    let fitted = a.env.fitted(aircraft);
+    let aircraft = &fitted;
     let secs = |what: &str, s: f64| {
         anyhow::ensure!(
             s.is_finite() && s > 0.0,

@@ -18,6 +18,7 @@
 
 pub mod air;
 pub mod config;
+pub mod hagl;
 pub mod health;
 pub mod ins;
 pub mod kalman;
@@ -35,7 +36,7 @@ pub use origin::Home;
 use crate::math::atmosphere::pressure_altitude;
 use crate::math::frames::{course_and_speed, AirData, Euler};
 use crate::math::geodetic::{offset_point, GeoPoint};
-use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample};
+use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample, RangeSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
 use ins::{Fusion, GpsNoise, Ins, Motion, ProcessNoise};
 use nalgebra::{UnitQuaternion, Vector3};
@@ -117,6 +118,9 @@ pub struct EstimatedState {
     pub dead_reckoning: bool,
     /// Fit to arm: see [`Estimator::is_converged`].
     pub converged: bool,
+    /// Height above the ground from the rangefinder, m, while its readings pass the gates of
+    /// [`hagl`]; `None` without a rangefinder or with a failed one.
+    pub range_hagl_m: Option<f32>,
 }
 
 /// The estimator facade.
@@ -144,6 +148,7 @@ pub struct Estimator {
     imu_silent_samples: u32,
     alpha_memory: f32,
     pending_dt: f32,
+    hagl: hagl::Hagl,
 }
 
 impl Default for Estimator {
@@ -177,6 +182,7 @@ impl Estimator {
             imu_silent_samples: 0,
             alpha_memory: 0.0,
             pending_dt: 0.0,
+            hagl: hagl::Hagl::default(),
         }
     }
 
@@ -617,6 +623,37 @@ impl Estimator {
         (x, var, h, v)
     }
 
+    /// Replaces the rangefinder's settings.
+    pub fn set_range_config(&mut self, cfg: hagl::RangeParams) {
+        self.hagl.set_config(cfg);
+    }
+
+    /// The height-above-ground stage (its failure flag and rejection count).
+    pub fn hagl(&self) -> &hagl::Hagl {
+        &self.hagl
+    }
+
+    /// A rangefinder reading, taken now, judged against the attitude and the height above home.
+    pub fn update_range(&mut self, sample: &RangeSample) {
+        // cos(roll) cos(pitch): the body z axis's share of the vertical.
+        let q = self.ins.attitude();
+        let cos_tilt = 1.0 - 2.0 * (q.i * q.i + q.j * q.j);
+        // The height above home as `state` gives it (the runway is at home's altitude).
+        let drift = self.baro_drift_m();
+        let z = self.ins.position().z;
+        let z = if self.origin.datum().is_some() && drift.is_finite() {
+            z - drift
+        } else {
+            z
+        };
+        let height = if self.ins.nav_initialized() {
+            -z
+        } else {
+            f32::NAN
+        };
+        self.hagl.update(self.t_us, sample, cos_tilt, height);
+    }
+
     /// Home as [`EstimatedState::home`] gives it, without forming the whole estimate.
     pub fn home(&self) -> Option<Home> {
         self.origin.home(self.baro_drift_m())
@@ -688,6 +725,7 @@ impl Estimator {
             wind_valid: self.wind.is_initialized(),
             dead_reckoning: self.ins.nav_initialized() && !self.health.gps.healthy,
             converged: self.is_converged(),
+            range_hagl_m: self.hagl.value(self.t_us),
         }
     }
 }

@@ -197,6 +197,7 @@ autopilot_dialect! {
         HIL_GPS(HIL_GPS_DATA),
         HIL_STATE_QUATERNION(HIL_STATE_QUATERNION_DATA),
         BATTERY_STATUS(BATTERY_STATUS_DATA),
+        DISTANCE_SENSOR(DISTANCE_SENSOR_DATA),
         RC_CHANNELS(RC_CHANNELS_DATA),
     ],
     // Ground link: the messages that carry a MAV_CMD number, decoded without the crate's

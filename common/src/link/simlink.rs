@@ -1,4 +1,5 @@
-//! PX4's simulator interface: `HIL_SENSOR`, `HIL_GPS` and `BATTERY_STATUS` from the simulator,
+//! PX4's simulator interface: `HIL_SENSOR`, `HIL_GPS`, `BATTERY_STATUS` and a downward
+//! rangefinder's `DISTANCE_SENSOR` from the simulator,
 //! `HIL_ACTUATOR_CONTROLS` back.
 //!
 //! Both sides of the link use these functions, so units and flag bits are defined once:
@@ -17,13 +18,15 @@ use crate::actuators::Surfaces;
 use crate::math::geodetic::GeoPoint;
 use crate::sensors::{
     limits, BaroSample, BatterySample, GpsFix, ImuSample, MagSample, ManualInput, PitotSample,
+    RangeSample,
 };
 
 /// The frame `HIL_SENSOR` decodes into.
 pub use crate::sensors::SensorFrame;
 use mavlink::dialects::common::{
     HilActuatorControlsFlags, HilSensorUpdatedFlags, MavBatteryFunction, MavBatteryType,
-    MavModeFlag, BATTERY_STATUS_DATA, HIL_ACTUATOR_CONTROLS_DATA, HIL_GPS_DATA, HIL_SENSOR_DATA,
+    MavDistanceSensor, MavModeFlag, MavSensorOrientation, BATTERY_STATUS_DATA,
+    DISTANCE_SENSOR_DATA, HIL_ACTUATOR_CONTROLS_DATA, HIL_GPS_DATA, HIL_SENSOR_DATA,
     RC_CHANNELS_DATA,
 };
 use nalgebra::Vector3;
@@ -327,6 +330,50 @@ pub fn decode_battery_status(d: &BATTERY_STATUS_DATA) -> Option<BatterySample> {
     sample.plausible().then_some(sample)
 }
 
+/// `DISTANCE_SENSOR` of a downward rangefinder (simulator side), as PX4's simulator API sends
+/// it: orientation `MAV_SENSOR_ROTATION_PITCH_270`, distances in cm, the variance in cm^2
+/// (255: unknown), the field of view in rad.
+pub fn encode_distance_sensor(
+    time_us: u64,
+    s: &RangeSample,
+    sigma_m: f32,
+    fov_rad: f32,
+) -> DISTANCE_SENSOR_DATA {
+    let cm = |m: f32| libm::roundf(m * 100.0).clamp(0.0, 65_535.0) as u16;
+    let var_cm2 = sigma_m * sigma_m * 1e4;
+    DISTANCE_SENSOR_DATA {
+        time_boot_ms: (time_us / 1000) as u32,
+        min_distance: cm(s.min_m),
+        max_distance: cm(s.max_m),
+        current_distance: cm(s.distance_m),
+        mavtype: MavDistanceSensor::MAV_DISTANCE_SENSOR_LASER,
+        id: 0,
+        orientation: MavSensorOrientation::MAV_SENSOR_ROTATION_PITCH_270,
+        covariance: if var_cm2.is_finite() {
+            libm::roundf(var_cm2).clamp(0.0, 254.0) as u8
+        } else {
+            255
+        },
+        horizontal_fov: fov_rad,
+        vertical_fov: fov_rad,
+        quaternion: [0.0; 4],
+        signal_quality: s.quality,
+    }
+}
+
+/// Decodes `DISTANCE_SENSOR` (autopilot side): `None` for a sensor not looking down, or whose
+/// range limits make no sense (no longer range than its shortest, or beyond 650 m). An
+/// out-of-range distance is passed on as it came: it says the ground is not within reach.
+pub fn decode_distance_sensor(d: &DISTANCE_SENSOR_DATA) -> Option<RangeSample> {
+    let down = d.orientation == MavSensorOrientation::MAV_SENSOR_ROTATION_PITCH_270;
+    (down && d.min_distance < d.max_distance && d.max_distance < u16::MAX).then(|| RangeSample {
+        distance_m: f32::from(d.current_distance) / 100.0,
+        min_m: f32::from(d.min_distance) / 100.0,
+        max_m: f32::from(d.max_distance) / 100.0,
+        quality: d.signal_quality.min(100),
+    })
+}
+
 /// What the autopilot commands for one sensor frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ActuatorFrame {
@@ -536,5 +583,45 @@ mod rc_tests {
         let mut few = d.clone();
         few.chancount = 3;
         assert_eq!(decode_rc_channels(&few, 7), None);
+    }
+}
+
+#[cfg(test)]
+mod range_tests {
+    use super::*;
+
+    #[test]
+    fn distance_sensor_round_trips_in_cm_looking_down_and_refuses_other_orientations() {
+        let s = RangeSample {
+            distance_m: 12.34,
+            min_m: 0.1,
+            max_m: 40.0,
+            quality: 90,
+        };
+        let d = encode_distance_sensor(3_000_000, &s, 0.025, 0.008);
+        assert_eq!(
+            (d.current_distance, d.min_distance, d.max_distance),
+            (1234, 10, 4000)
+        );
+        assert_eq!(
+            d.orientation,
+            MavSensorOrientation::MAV_SENSOR_ROTATION_PITCH_270
+        );
+        // 2.5 cm of noise: 6.25 cm^2 of variance.
+        assert_eq!((d.covariance, d.time_boot_ms), (6, 3000));
+        assert_eq!(decode_distance_sensor(&d), Some(s));
+        // PX4's out-of-range reading, max + 1 cm, is passed on for the estimator to judge.
+        let far = RangeSample {
+            distance_m: 40.01,
+            ..s
+        };
+        let got = decode_distance_sensor(&encode_distance_sensor(0, &far, 0.025, 0.008));
+        assert_eq!(got.map(|r| r.distance_m > r.max_m), Some(true));
+        let mut forward = d.clone();
+        forward.orientation = MavSensorOrientation::MAV_SENSOR_ROTATION_NONE;
+        assert_eq!(decode_distance_sensor(&forward), None);
+        let mut absurd = d.clone();
+        absurd.min_distance = 5000;
+        assert_eq!(decode_distance_sensor(&absurd), None);
     }
 }

@@ -83,6 +83,7 @@ impl Plane {
             airspeed: self.k.airspeed,
             yaw_rate: 0.0,
             wind_speed: self.k.wind.xy().norm(),
+            range_hagl: None,
         }
     }
 
@@ -1009,6 +1010,7 @@ fn garbage_items_and_state_do_not_panic() {
             airspeed: f32::NAN,
             yaw_rate: f32::NAN,
             wind_speed: f32::NAN,
+            range_hagl: Some(f32::NAN),
         };
         nav.set_current((next() % 14) as u16);
         let _ = nav.step(&items, &home(), &bad, f32::NAN);

@@ -68,6 +68,20 @@ pub struct BatterySample {
     pub current_a: f32,
 }
 
+/// One reading of a downward rangefinder (`DISTANCE_SENSOR`, orientation pitch 270).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RangeSample {
+    /// Distance along the sensor's axis, m. At or above `max_m`: no echo within range (PX4
+    /// reports max + 1 cm); at or below `min_m`: too close to measure.
+    pub distance_m: f32,
+    /// Shortest distance the sensor measures, m.
+    pub min_m: f32,
+    /// Longest distance the sensor measures, m.
+    pub max_m: f32,
+    /// Signal quality as MAVLink gives it: 0 unknown, 1 invalid, 2..=100 poor to perfect.
+    pub quality: u8,
+}
+
 /// Stick positions, normalised: a ground station's `MANUAL_CONTROL` or the radio's
 /// `RC_CHANNELS`.
 #[derive(Clone, Copy, Debug, PartialEq)]

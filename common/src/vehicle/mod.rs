@@ -11,7 +11,7 @@
 //!
 //! [`Vehicle`] is what a board runs: one way in for sensors ([`Vehicle::on_sensors`], fed by
 //! HIL decoding in SITL and by drivers on a board; [`Vehicle::on_gps`] and
-//! [`Vehicle::on_battery`] beside it), the ground station's requests handed in
+//! [`Vehicle::on_battery`] and [`Vehicle::on_range`] beside it), the ground station's requests handed in
 //! with them, surfaces out, a [`snapshot::VehicleSnapshot`] for telemetry and [`Notice`]s to
 //! report. It reads no clock: its time is the sensor frames' timestamps.
 //!
@@ -47,7 +47,7 @@ use crate::navigation::plan::MissionStore;
 use crate::navigation::validate::{MissionLimits, PlanRules};
 use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::params::ParamStore;
-use crate::sensors::{BatterySample, GpsFix, ManualInput, SensorFrame};
+use crate::sensors::{BatterySample, GpsFix, ManualInput, RangeSample, SensorFrame};
 use crate::{failsafe, guidance};
 use clock::{Clock, ClockStats, Step};
 use commander::{
@@ -346,6 +346,11 @@ impl Vehicle {
         }
     }
 
+    /// A reading of the downward rangefinder.
+    pub fn on_range(&mut self, s: &RangeSample) {
+        self.estimator.update_range(s);
+    }
+
     /// What the battery monitor knows now.
     pub fn battery(&self) -> battery::Battery {
         self.battery.report(self.clock.now_us())
@@ -485,6 +490,8 @@ impl Vehicle {
         }
         let p = &self.params;
         self.estimator.set_config(p.load(&estimator_config::PARAMS));
+        self.estimator
+            .set_range_config(p.load(&estimator::hagl::PARAMS));
         self.navigator.configure(
             &p.load(&navigator::params::PARAMS),
             &p.load(&path_manager::PARAMS),

@@ -55,6 +55,7 @@ pub const REGISTRY: Registry = &[
     &longitudinal::tecs::gains::PARAMS,
     &autopilot::PARAMS,
     &estimator::config::PARAMS,
+    &estimator::hagl::PARAMS,
     &guidance::PARAMS,
     &path_manager::PARAMS,
     &navigator::params::PARAMS,

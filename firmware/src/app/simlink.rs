@@ -1,4 +1,4 @@
-//! The simulator port: `HIL_SENSOR`, `HIL_GPS` and `BATTERY_STATUS` decoded with their
+//! The simulator port: `HIL_SENSOR`, `HIL_GPS`, `BATTERY_STATUS` and `DISTANCE_SENSOR` decoded with their
 //! plausibility checks into the vehicle's ways in for sensors, `HIL_ACTUATOR_CONTROLS` back for every sensor frame
 //! (lock-step), the radio's `RC_CHANNELS` to the sticks and the simulator's truth to the
 //! vehicle for the `SIM_USE_TRUTH` comparison.
@@ -39,6 +39,8 @@ pub struct SimLinkHealth {
     pub rejected_gps: u32,
     /// BATTERY_STATUS frames dropped: no voltage or current, or implausible.
     pub rejected_battery: u32,
+    /// DISTANCE_SENSOR frames dropped: not looking down, or range limits that make no sense.
+    pub rejected_range: u32,
     /// Sensor frames whose time did not advance.
     pub stale_frames: u32,
     /// RC_CHANNELS frames without a usable signal.
@@ -177,6 +179,10 @@ impl Answers {
                     vehicle.on_battery(&s);
                 }
                 None => self.health.rejected_battery += 1,
+            },
+            MavMessage::DISTANCE_SENSOR(d) => match simlink::decode_distance_sensor(d) {
+                Some(s) => vehicle.on_range(&s),
+                None => self.health.rejected_range += 1,
             },
             MavMessage::HIL_STATE_QUATERNION(d) => {
                 if let Some(m) = truth_measurements(d) {

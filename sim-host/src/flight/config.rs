@@ -3,7 +3,7 @@
 
 use super::script::Script;
 use crate::environment::wind::Turbulence;
-use crate::sensors::models::SensorFaults;
+use crate::sensors::models::{RangeFault, SensorFaults};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
@@ -101,6 +101,8 @@ pub enum Fault {
     BaroFailed,
     /// No battery power monitor (no BATTERY_STATUS).
     BatteryMonitorFailed,
+    /// The rangefinder fails so (it must be fitted: `--rangefinder`).
+    Range(RangeFault),
 }
 
 impl FlightConfig {
@@ -133,6 +135,7 @@ impl FlightConfig {
                 Fault::MagFailed => f.mag_failed = true,
                 Fault::BaroFailed => f.baro_failed = true,
                 Fault::BatteryMonitorFailed => f.battery_failed = true,
+                Fault::Range(r) => f.range = Some(r),
             }
         }
         f
@@ -169,10 +172,11 @@ impl Default for FlightConfig {
 }
 
 /// Parses a sensor fault as the command line spells it: `KIND:FROM-TO` in seconds of
-/// simulated time, KIND one of gps, pitot, mag, baro (`gps:60-90`).
+/// simulated time, KIND one of gps, pitot, mag, baro, or a rangefinder's range-stuck,
+/// range-short, range-drop (`gps:60-90`).
 pub fn parse_fault(s: &str) -> Result<FaultWindow, String> {
     let err = |why: &str| {
-        format!("fault `{s}`: {why} (expected KIND:FROM-TO, e.g. gps:60-90; KIND gps, pitot, mag or baro)")
+        format!("fault `{s}`: {why} (expected KIND:FROM-TO, e.g. gps:60-90; KIND gps, pitot, mag, baro, range-stuck, range-short or range-drop)")
     };
     let (kind, window) = s.split_once(':').ok_or_else(|| err("no `:`"))?;
     let fault = match kind.trim() {
@@ -180,6 +184,9 @@ pub fn parse_fault(s: &str) -> Result<FaultWindow, String> {
         "pitot" => Fault::PitotFailed,
         "mag" => Fault::MagFailed,
         "baro" => Fault::BaroFailed,
+        "range-stuck" => Fault::Range(RangeFault::Stuck),
+        "range-short" => Fault::Range(RangeFault::Short),
+        "range-drop" => Fault::Range(RangeFault::Dropping),
         _ => return Err(err("unknown sensor")),
     };
     let (from, to) = window.split_once('-').ok_or_else(|| err("no `-`"))?;

@@ -1,6 +1,6 @@
 //! The flight loop.
 
-use super::config::FlightConfig;
+use super::config::{Fault, FlightConfig};
 use super::onboard::Onboard;
 use super::record::{AutopilotView, NavView, Sample};
 use super::script::GroundStation;
@@ -22,7 +22,8 @@ use crate::plant::servo::ServoBank;
 use crate::plant::{Plant, Touchdown};
 use crate::sensors::models::{SensorSuite, Truth};
 use common::link::simlink::{
-    encode_battery_status, encode_hil_gps, encode_hil_sensor, encode_rc_channels,
+    encode_battery_status, encode_distance_sensor, encode_hil_gps, encode_hil_sensor,
+    encode_rc_channels,
 };
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::ned_offset;
@@ -145,6 +146,16 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     let params = ModelParams::new(aircraft);
     let home = params.home;
     let home_alt = params.home_alt_msl_m;
+    if aircraft.sensors.rangefinder.is_none()
+        && cfg
+            .faults
+            .iter()
+            .any(|w| matches!(w.fault, Fault::Range(_)))
+    {
+        return Err(FlightError::Config(
+            "a rangefinder fault needs a rangefinder: `--rangefinder`, or a [sensors.rangefinder] table in the aircraft file".into(),
+        ));
+    }
     let mut sensors = SensorSuite::new(aircraft.sensors.clone(), home, home_alt, cfg.seed);
     let frame_us = sensors.period_us();
     let frame_s = frame_us as f64 * 1e-6;
@@ -268,6 +279,14 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         let pack = battery.output();
         if let Some(b) = sensors.sample_battery(time_us, pack.voltage_v, pack.current_a) {
             msgs.push(MavMessage::BATTERY_STATUS(encode_battery_status(&b)));
+        }
+        if let (Some(r), Some((sigma, fov))) = (
+            sensors.sample_range(time_us, &truth),
+            sensors.range_noise_and_fov(),
+        ) {
+            msgs.push(MavMessage::DISTANCE_SENSOR(encode_distance_sensor(
+                time_us, &r, sigma, fov,
+            )));
         }
         if k % 2 == 0 {
             if let Some(r) = cfg.rc_sticks.iter().rev().find(|r| r.from_s <= t_s) {

@@ -5,7 +5,9 @@ use common::link::simlink::SensorFrame;
 use common::math::atmosphere::standard_atmosphere;
 use common::math::geodetic::{offset_point, GeoPoint};
 use common::math::ned_to_body;
-use common::sensors::{BaroSample, BatterySample, GpsFix, ImuSample, MagSample, PitotSample};
+use common::sensors::{
+    BaroSample, BatterySample, GpsFix, ImuSample, MagSample, PitotSample, RangeSample,
+};
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -50,6 +52,23 @@ fn decimation(frame_hz: f64, rate_hz: f64) -> u64 {
     ((frame_hz / rate_hz).round() as u64).max(1)
 }
 
+/// How the rangefinder fails: the failures that flared landings early or not at all (PX4
+/// issues 6456 and 9843, ArduPilot 26932).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RangeFault {
+    /// The reading freezes at the last one before the fault.
+    Stuck,
+    /// A false echo [`SHORT_ECHO_M`] away (grass, rain, an insect), with the sensor's noise.
+    Short,
+    /// The echo comes and goes, each second: 0.3 s of nothing, 0.15 s of readings at the
+    /// minimum (a lost echo some drivers report as 0), 0.1 s out of range (max + 1 cm), then
+    /// 0.45 s of good readings.
+    Dropping,
+}
+
+/// Distance of the [`RangeFault::Short`] echo, m.
+pub const SHORT_ECHO_M: f64 = 1.0;
+
 /// Faults a test or a user can inject.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SensorFaults {
@@ -63,6 +82,8 @@ pub struct SensorFaults {
     pub baro_failed: bool,
     /// No battery power monitor (no BATTERY_STATUS).
     pub battery_failed: bool,
+    /// The rangefinder's failure, if it has one.
+    pub range: Option<RangeFault>,
 }
 
 /// Every sensor of the airplane.
@@ -79,6 +100,10 @@ pub struct SensorSuite {
     rng_pitot: ChaCha8Rng,
     rng_gps: ChaCha8Rng,
     rng_battery: ChaCha8Rng,
+    rng_range: ChaCha8Rng,
+    /// The last reading sent, and the one a stuck rangefinder holds, m.
+    range_last: Option<f64>,
+    range_stuck: Option<f64>,
     gps_queue: VecDeque<(u64, GpsFix)>,
     /// Injected faults.
     pub faults: SensorFaults,
@@ -103,6 +128,9 @@ impl SensorSuite {
             rng_pitot: stream(4),
             rng_gps: stream(5),
             rng_battery: stream(6),
+            rng_range: stream(7),
+            range_last: None,
+            range_stuck: None,
             gps_queue: VecDeque::new(),
             faults: SensorFaults::default(),
         }
@@ -141,6 +169,68 @@ impl SensorSuite {
             voltage_v: (voltage_v + b.voltage_sigma_v * gauss(&mut self.rng_battery)) as f32,
             current_a: (current_a + b.current_sigma_a * gauss(&mut self.rng_battery)) as f32,
         })
+    }
+
+    /// The rangefinder's reading, if the aircraft carries one and a reading is due at frame time
+    /// `time_us`: the boresight's slant range to the flat runway at home's altitude, the
+    /// height over cos(roll) cos(pitch), with noise (its own stream) and the injected fault;
+    /// max + 1 cm beyond the range (as PX4 reports), the minimum below it.
+    pub fn sample_range(&mut self, time_us: u64, t: &Truth) -> Option<RangeSample> {
+        let r = self.cfg.rangefinder.as_ref()?;
+        let n = decimation(self.cfg.imu_rate_hz, r.rate_hz);
+        if !(time_us / self.period_us.max(1)).is_multiple_of(n) {
+            return None;
+        }
+        let cos_tilt = t.attitude.to_rotation_matrix()[(2, 2)];
+        let height = -t.pos_ned.z;
+        let slant = if cos_tilt > 0.0 && height > 0.0 {
+            height / cos_tilt
+        } else {
+            // Inverted or under the runway: no echo comes back.
+            f64::INFINITY
+        };
+        let noise = r.sigma_m * gauss(&mut self.rng_range);
+        let mut d = slant + noise;
+        let fault = self.faults.range;
+        if fault != Some(RangeFault::Stuck) {
+            self.range_stuck = None;
+        }
+        match fault {
+            Some(RangeFault::Stuck) => {
+                d = *self
+                    .range_stuck
+                    .get_or_insert(self.range_last.unwrap_or(r.max_m + 0.01));
+            }
+            Some(RangeFault::Short) => d = SHORT_ECHO_M + noise,
+            Some(RangeFault::Dropping) => match time_us % 1_000_000 {
+                0..300_000 => return None,
+                300_000..450_000 => d = r.min_m,
+                450_000..550_000 => d = f64::INFINITY,
+                _ => {}
+            },
+            None => {}
+        }
+        let d = if d >= r.max_m {
+            r.max_m + 0.01
+        } else {
+            d.max(r.min_m)
+        };
+        self.range_last = Some(d);
+        let in_range = d > r.min_m && d < r.max_m;
+        Some(RangeSample {
+            distance_m: d as f32,
+            min_m: r.min_m as f32,
+            max_m: r.max_m as f32,
+            quality: if in_range { 100 } else { 0 },
+        })
+    }
+
+    /// The rangefinder's noise (1 sigma) and beam width, m and rad, for its messages.
+    pub fn range_noise_and_fov(&self) -> Option<(f32, f32)> {
+        self.cfg
+            .rangefinder
+            .as_ref()
+            .map(|r| (r.sigma_m as f32, r.fov_rad as f32))
     }
 
     /// Samples every sensor due at the next frame time; returns the frame and a GPS fix if one
@@ -405,5 +495,61 @@ mod tests {
         assert!((amps - 8.0).abs() < 4.0 * 0.1 / n.sqrt(), "{amps}");
         s.faults.battery_failed = true;
         assert!((0..100u64).all(|k| s.sample_battery(k * 10_000, 11.1, 8.0).is_none()));
+    }
+
+    #[test]
+    fn the_rangefinder_reads_height_over_cos_roll_cos_pitch_and_fails_as_told() {
+        let cfg = SensorConfig {
+            rangefinder: Some(super::super::RangefinderConfig::default()),
+            ..SensorConfig::default()
+        };
+        let mut s = SensorSuite::new(cfg, GeoPoint::default(), 0.0, 5);
+        // 10 m up, banked 20 deg and pitched 10 deg: 10 / (cos 20 cos 10) = 10.806 m.
+        let t = Truth {
+            pos_ned: Vector3::new(0.0, 0.0, -10.0),
+            attitude: UnitQuaternion::from_euler_angles(
+                20f64.to_radians(),
+                10f64.to_radians(),
+                0.3,
+            ),
+            ..level_truth()
+        };
+        let d: Vec<f64> = (0..2000u64)
+            .filter_map(|k| s.sample_range(k * 10_000, &t))
+            .map(|r| f64::from(r.distance_m))
+            .collect();
+        assert_eq!(d.len(), 400, "20 Hz of 100 Hz frames");
+        let n = d.len() as f64;
+        let mean = d.iter().sum::<f64>() / n;
+        let expect = 10.0 / (20f64.to_radians().cos() * 10f64.to_radians().cos());
+        assert!(
+            (mean - expect).abs() < 4.0 * 0.025 / n.sqrt(),
+            "{mean} vs {expect}"
+        );
+        // Beyond 40 m: PX4's out-of-range reading, max + 1 cm.
+        let high = Truth {
+            pos_ned: Vector3::new(0.0, 0.0, -60.0),
+            ..level_truth()
+        };
+        assert_eq!(s.sample_range(0, &high).map(|r| r.distance_m), Some(40.01));
+        s.faults.range = Some(RangeFault::Stuck);
+        let stuck: Vec<f32> = (0..100u64)
+            .filter_map(|k| s.sample_range(k * 10_000, &t))
+            .map(|r| r.distance_m)
+            .collect();
+        assert!(stuck.iter().all(|x| *x == 40.01), "holds the last reading");
+        s.faults.range = Some(RangeFault::Short);
+        let r = s.sample_range(0, &t).unwrap();
+        assert!((f64::from(r.distance_m) - SHORT_ECHO_M).abs() < 0.15);
+        s.faults.range = Some(RangeFault::Dropping);
+        let kinds: Vec<Option<f32>> = (0..20u64)
+            .map(|k| s.sample_range(k * 50_000, &t).map(|r| r.distance_m))
+            .collect();
+        assert!(kinds[..6].iter().all(Option::is_none));
+        assert!(kinds[6..9].iter().all(|x| *x == Some(0.1)));
+        assert!(kinds[9..11].iter().all(|x| *x == Some(40.01)));
+        assert!(kinds[11..]
+            .iter()
+            .all(|x| x.is_some_and(|d| (d - 10.806).abs() < 0.15)));
     }
 }

@@ -21,6 +21,8 @@ pub struct NavState {
     pub yaw_rate: f32,
     /// Horizontal wind speed, m/s (0 until the estimator has a wind).
     pub wind_speed: f32,
+    /// Height above the ground from the rangefinder, m, while it passes its gates.
+    pub range_hagl: Option<f32>,
 }
 
 impl NavState {
@@ -37,6 +39,7 @@ impl NavState {
             } else {
                 0.0
             },
+            range_hagl: s.range_hagl_m,
         }
     }
 

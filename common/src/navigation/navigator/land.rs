@@ -15,6 +15,10 @@
 //! than 0.5 m/s) is the touchdown: [`NavOutput::landed`] for the firmware to disarm once
 //! stopped.
 //!
+//! The height the flare is triggered on and flown by is the rangefinder's height above ground
+//! while it passes the estimator's gates (`estimator::hagl`) and `NAV_LND_USE_RNG` is set, else
+//! the height above the land point, as without a rangefinder.
+//!
 //! A flare still in the air `NAV_LND_ABORT_M` past the point (floated, or bounced off the
 //! runway) or lifted out of itself by a gust goes around, as a pilot does after a bounce:
 //! full throttle in the take-off regime on the runway's line up to the approach's start
@@ -302,7 +306,11 @@ impl Landing {
         let state = f.state;
         let dt = f.dt;
         let pos = state.pos_ned;
-        let hagl = state.height() + self.point.z;
+        let hagl = match state.range_hagl {
+            // The land point is on the ground the rangefinder sees (flat, at its height).
+            Some(h) if p.land_use_rng && h.is_finite() => h,
+            _ => state.height() + self.point.z,
+        };
         let line =
             Path::line_between(&self.origin, &self.point, p.land_airspeed).unwrap_or(Path::Line {
                 origin: self.point,

@@ -238,6 +238,15 @@ pub const PARAMS: Group<NavParams> = Group {
             NavParams => land_abort
         ),
         param!(
+            ParamDef::boolean(
+                "NAV_LND_USE_RNG",
+                true,
+                "Flare on the rangefinder's height above ground while it passes its gates (PX4's FW_LND_USETER), else on the height above home",
+            ),
+            NavParams => land_use_rng,
+            flag
+        ),
+        param!(
             ParamDef::real(
                 "NAV_LND_DISARM_S",
                 30.0,
@@ -371,6 +380,8 @@ pub struct NavParams {
     /// `NAV_LND_ABORT_M`: distance past the land point at which a flare still in the air goes
     /// around, m (0: never).
     pub land_abort: f32,
+    /// `NAV_LND_USE_RNG`: the flare's height is the rangefinder's while it is valid.
+    pub land_use_rng: bool,
     /// `NAV_TKO_RAMP_S`: time of the take-off roll's throttle ramp, s.
     pub takeoff_ramp: f32,
     /// Glide slope, rad.
@@ -422,6 +433,7 @@ const ZERO: NavParams = NavParams {
     takeoff_ramp: 0.0,
     land_disarm_s: 0.0,
     land_abort: 0.0,
+    land_use_rng: false,
     glide_slope: 0.0,
     land_airspeed: 0.0,
     flare_alt: 0.0,
