@@ -1,7 +1,11 @@
 //! The reader's state: a cursor over the file's bytes and the parser that walks its
 //! messages, resynchronising on corrupt bytes.
 
-use super::*;
+use super::format::{self, Format, Layout};
+use super::types::*;
+use common::ulog::{HEADER_LEN, MAGIC, MSG_HEADER_LEN, SYNC_MAGIC};
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
 
 /// Reads a log from its bytes.
 pub fn parse(bytes: &[u8]) -> Result<Ulog, ParseError> {
