@@ -15,7 +15,7 @@
 //!   written, refused in the air with a status text.
 //!
 //! The link never reaches the board's storage by itself: requests wait here, and the board
-//! serves them when it calls [`LogService::serve`] with its [`LogStore`] and the room it
+//! serves them when it calls `GroundLink::serve_logs` with its [`LogStore`] and the room it
 //! gives log data: what its output has left after the telemetry (less [`LOG_RESERVE_BYTES`]
 //! on a board whose output buffer is larger than a poll's telemetry), and in the air at most
 //! [`ARMED_PACKETS_PER_CALL`] packets a call, so a download never starves the streams.
@@ -130,7 +130,7 @@ impl LogService {
         Self::default()
     }
 
-    /// Whether anything waits for [`LogService::serve`].
+    /// Whether anything waits for the board's store (`GroundLink::serve_logs`).
     pub fn busy(&self) -> bool {
         self.listing.is_some() || self.download.is_some() || self.refresh || self.erase
     }

@@ -105,7 +105,7 @@ pub enum PrearmFailure {
 }
 
 impl PrearmFailure {
-    /// The reason, as "Arming denied: <reason>" says it.
+    /// The reason, as "Arming denied: `reason`" says it.
     pub fn reason(self) -> &'static str {
         match self {
             PrearmFailure::Gyro => "gyro unhealthy",

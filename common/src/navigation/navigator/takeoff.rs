@@ -10,10 +10,10 @@
 //! (`NAV_GND_RLL_DEG`), widening with height.
 //!
 //! A failsafe on the roll, below the rotation airspeed, gives the take-off up
-//! ([`Takeoff::abort`]): the throttle closed, wings level, the tail wheel steering along the
-//! runway's line, the roll-out of a landing ([`super::land::roll_out`]) to a stop, and the
+//! (`Takeoff::abort`): the throttle closed, wings level, the tail wheel steering along the
+//! runway's line, the roll-out of a landing (`land::roll_out`) to a stop, and the
 //! disarm. Past the rotation the aircraft is committed: a failsafe waits until the climb has
-//! reached `NAV_TKO_CLR_M` ([`Takeoff::ground_stage`]).
+//! reached `NAV_TKO_CLR_M` (`Takeoff::ground_stage`).
 
 use super::guide::{course_near_ground, horizontal_dist, Flight, Orbit};
 use super::io::{GroundStage, NavOutput, NavState, Phase};
