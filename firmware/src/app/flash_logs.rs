@@ -274,11 +274,7 @@ impl<F: Flash> LogStore for FlashLogs<F> {
 mod tests {
     extern crate std;
     use super::*;
-    use common::link::framing::Sender;
-    use common::link::simlink::encode_hil_sensor;
-    use common::sensors::{ImuSample, SensorFrame};
     use common::storage::RamFlash;
-    use mavlink::dialects::common::MavMessage;
     use std::vec;
 
     const SECTOR: u32 = 4096;
@@ -289,32 +285,30 @@ mod tests {
         sectors: 4,
     };
 
-    /// A frame of the sensors at rest at `time_us`, through the simulator link.
+    /// Feeds a frame of the sensors at rest at `time_us`; whether the vehicle answered it.
     fn frame(app: &mut App, time_us: u64) -> bool {
-        let f = SensorFrame {
-            time_us,
-            imu: Some(ImuSample {
-                accel: nalgebra::Vector3::new(0.0, 0.0, -common::math::GRAVITY),
-                gyro: nalgebra::Vector3::zeros(),
-            }),
-            ..Default::default()
-        };
-        let mut sim = Sender::new(1, 51);
-        let raw = sim.encode(&MavMessage::HIL_SENSOR(encode_hil_sensor(&f, 0.0)));
         let mut answered = false;
-        app.on_sim_bytes(raw.raw_bytes(), &mut |_| answered = true);
+        app.on_sim_bytes(&crate::app::tests::frame_at(time_us), &mut |_| {
+            answered = true
+        });
         answered
     }
 
-    #[test]
-    fn a_log_that_fills_its_sectors_stops_and_the_vehicle_answers_every_frame_after() {
+    /// An application logging from boot (`SDLOG_MODE` 1) and its logs in the four sectors.
+    fn logging_from_boot() -> (App, FlashLogs<RamFlash<{ 4 * 4096 }>>) {
         let mut app = App::new();
         app.vehicle_mut()
             .params_mut()
             .set("SDLOG_MODE", 1.0)
             .expect("SDLOG_MODE");
         let flash = RamFlash::<{ 4 * 4096 }>::new(SECTOR);
-        let mut logs = FlashLogs::open(flash, REGION, 2, &mut app).expect("the region");
+        let logs = FlashLogs::open(flash, REGION, 2, &mut app).expect("the region");
+        (app, logs)
+    }
+
+    #[test]
+    fn a_log_that_fills_its_sectors_stops_and_the_vehicle_answers_every_frame_after() {
+        let (mut app, mut logs) = logging_from_boot();
         // Blank sectors are made ready without an erase.
         assert_eq!((logs.ready(), logs.flash_errors()), (2, 0));
         let mut answered = 0;
@@ -343,13 +337,7 @@ mod tests {
 
     #[test]
     fn an_erase_leaves_no_log_and_the_next_one_its_room() {
-        let mut app = App::new();
-        app.vehicle_mut()
-            .params_mut()
-            .set("SDLOG_MODE", 1.0)
-            .expect("SDLOG_MODE");
-        let flash = RamFlash::<{ 4 * 4096 }>::new(SECTOR);
-        let mut logs = FlashLogs::open(flash, REGION, 2, &mut app).expect("the region");
+        let (mut app, mut logs) = logging_from_boot();
         for k in 1..=50u64 {
             frame(&mut app, k * 10_000);
             logs.service(&mut app);

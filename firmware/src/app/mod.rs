@@ -290,7 +290,7 @@ pub fn heartbeat_frame(app: &mut App) -> heapless::Vec<u8, 280> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -310,7 +310,8 @@ mod tests {
         frame_at(k * 10_000)
     }
 
-    fn frame_at(time_us: u64) -> Vec<u8> {
+    /// A frame of the sensors at rest at `time_us`, through the simulator link.
+    pub(crate) fn frame_at(time_us: u64) -> Vec<u8> {
         let f = SensorFrame {
             time_us,
             imu: Some(ImuSample {
