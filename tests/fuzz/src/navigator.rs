@@ -98,6 +98,9 @@ pub fn run(data: &[u8]) {
                         airspeed,
                         yaw_rate: 0.0,
                         wind_speed: airspeed - 17.0,
+                        // No rangefinder: the navigator flies on the estimate's height, as
+                        // with a failed one.
+                        range_hagl: None,
                     };
                     let out = nav.step(&items, &home, &state, dt);
                     if let Some(g) = out.guidance {
