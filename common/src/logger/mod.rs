@@ -59,7 +59,7 @@ macro_rules! logged {
 
 // Rates: the estimate and the loops fast enough to see a 1-2 Hz oscillation of the attitude
 // loops sharply, the slow states at a few Hz: 8.1 KB a second in all as flown (1.13 MB over
-// the default mission's first 139 s in SITL; docs/LOGGING.md).
+// the default mission's first 140 s in SITL; docs/LOGGING.md).
 logged! {
     VehicleAttitude => 25,
     SensorCombined => 25,
