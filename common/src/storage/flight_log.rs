@@ -471,11 +471,15 @@ impl LogWriter {
     }
 
     /// Ends the log: what is gathered in RAM goes to flash as its last, partly filled block.
-    pub fn close<F: Flash>(mut self, flash: &mut F) -> Result<(), F::Error> {
+    /// Returns the log as a reader now finds it.
+    pub fn close<F: Flash>(mut self, flash: &mut F) -> Result<LogInfo, F::Error> {
         if self.len > 0 {
             self.program(flash)?;
         }
-        Ok(())
+        Ok(LogInfo {
+            bytes: self.bytes,
+            ..self.info()
+        })
     }
 
     fn program<F: Flash>(&mut self, flash: &mut F) -> Result<(), F::Error> {

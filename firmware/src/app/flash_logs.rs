@@ -115,15 +115,12 @@ impl<F: Flash> FlashLogs<F> {
         }
         if !log.recording() {
             if let Some(w) = self.writer.take() {
-                let bytes = w.bytes();
-                let mut info = w.info();
-                match w.close(&mut self.flash) {
-                    Ok(()) => {
-                        info.bytes = bytes;
-                        info.blocks = bytes.div_ceil(PAYLOAD_LEN as u32);
-                    }
-                    Err(_) => self.flash_errors = self.flash_errors.saturating_add(1),
-                }
+                // A close that failed leaves the log as its whole blocks have it.
+                let whole = w.info();
+                let info = w.close(&mut self.flash).unwrap_or_else(|_| {
+                    self.flash_errors = self.flash_errors.saturating_add(1);
+                    whole
+                });
                 self.note(info);
             }
         }
