@@ -90,6 +90,55 @@ pub const LOG_RESERVE_BYTES: usize = 1024;
 /// for).
 pub const ARMED_PACKETS_PER_CALL: usize = 2;
 
+/// What one call of the board may send of log transfers (the log protocol's and the log
+/// files' over FTP together): bytes of its output, and packets of data (in the air
+/// [`ARMED_PACKETS_PER_CALL`], on the ground as many as there is room for).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pace {
+    room: usize,
+    packets: usize,
+}
+
+impl Pace {
+    /// `room` bytes, and the packets of data the vehicle's state allows.
+    pub fn new(room: usize, armed: bool) -> Self {
+        Self {
+            room,
+            packets: if armed {
+                ARMED_PACKETS_PER_CALL
+            } else {
+                usize::MAX
+            },
+        }
+    }
+
+    /// Whether a frame of `len` bytes fits.
+    pub fn fits(&self, len: usize) -> bool {
+        self.room >= len
+    }
+
+    /// Whether a packet of data in a frame of `len` bytes may go.
+    pub fn data_fits(&self, len: usize) -> bool {
+        self.packets > 0 && self.fits(len)
+    }
+
+    /// A frame of `len` bytes went.
+    pub fn spend(&mut self, len: usize) {
+        self.room = self.room.saturating_sub(len);
+    }
+
+    /// A packet of data in a frame of `len` bytes went.
+    pub fn spend_data(&mut self, len: usize) {
+        self.spend(len);
+        self.packets = self.packets.saturating_sub(1);
+    }
+
+    /// The packets of data left, for a service that counts its own.
+    pub fn packets_mut(&mut self) -> &mut usize {
+        &mut self.packets
+    }
+}
+
 /// `LOG_REQUEST_LIST`'s and `LOG_REQUEST_DATA`'s "to the end".
 const ALL_IDS: u16 = 0xffff;
 const ALL_BYTES: u32 = 0xffff_ffff;
@@ -181,14 +230,12 @@ impl LogService {
         self.listing = None;
     }
 
-    /// Serves what was asked from `store`, in at most `room` bytes (while `armed` at most
-    /// [`ARMED_PACKETS_PER_CALL`] packets of data). Status texts (an erase done or failed)
-    /// go to `outbox`.
+    /// Serves what was asked from `store`, as far as `pace` allows. Status texts (an erase
+    /// done or failed) go to `outbox`.
     pub(crate) fn serve<F: FnMut(Dest, MavMessage)>(
         &mut self,
         store: &mut dyn LogStore,
-        armed: bool,
-        room: usize,
+        pace: &mut Pace,
         outbox: &mut Outbox,
         mut send: F,
     ) {
@@ -207,22 +254,15 @@ impl LogService {
         if core::mem::take(&mut self.refresh) {
             store.refresh();
         }
-        let mut room = room;
-        self.send_list(store, &mut room, &mut send);
-        let mut packets = if armed {
-            ARMED_PACKETS_PER_CALL
-        } else {
-            usize::MAX
-        };
-        while packets > 0 && room >= LOG_DATA_FRAME {
+        self.send_list(store, pace, &mut send);
+        while pace.data_fits(LOG_DATA_FRAME) {
             let Some(m) = self.next_data(store) else {
                 break;
             };
             if let Some(d) = self.download.map(|d| d.to) {
                 send(d.dest(), m);
             }
-            room = room.saturating_sub(LOG_DATA_FRAME);
-            packets = packets.saturating_sub(1);
+            pace.spend_data(LOG_DATA_FRAME);
             if self.download.is_some_and(|d| d.ofs >= d.end) {
                 self.download = None;
             }
@@ -232,15 +272,15 @@ impl LogService {
     fn send_list<F: FnMut(Dest, MavMessage)>(
         &mut self,
         store: &mut dyn LogStore,
-        room: &mut usize,
+        pace: &mut Pace,
         send: &mut F,
     ) {
         let Some(l) = self.listing else { return };
         let num_logs = store.count();
         if num_logs == 0 {
-            if *room >= LOG_ENTRY_FRAME {
+            if pace.fits(LOG_ENTRY_FRAME) {
                 send(l.to.dest(), entry(0, 0, LogEntryInfo::default()));
-                *room = room.saturating_sub(LOG_ENTRY_FRAME);
+                pace.spend(LOG_ENTRY_FRAME);
                 self.listing = None;
             }
             return;
@@ -251,10 +291,10 @@ impl LogService {
             l.last.min(num_logs)
         };
         let mut next = l.next;
-        while next <= last && *room >= LOG_ENTRY_FRAME {
+        while next <= last && pace.fits(LOG_ENTRY_FRAME) {
             let info = store.entry(next.saturating_sub(1)).unwrap_or_default();
             send(l.to.dest(), entry(next, num_logs, info));
-            *room = room.saturating_sub(LOG_ENTRY_FRAME);
+            pace.spend(LOG_ENTRY_FRAME);
             next = next.saturating_add(1);
             if next == 0 {
                 break;

@@ -465,23 +465,17 @@ impl GroundLink {
     ) {
         // The files first (a station waits for each answer), then the log protocol, in what
         // room is left.
-        let mut room = room;
-        let mut packets = if armed {
-            logs::ARMED_PACKETS_PER_CALL
-        } else {
-            usize::MAX
-        };
-        while room >= logs::FTP_FRAME && packets > 0 {
-            let Some((m, to)) = self.ftp.serve_logs(store, &mut packets) else {
+        let mut pace = logs::Pace::new(room, armed);
+        while pace.data_fits(logs::FTP_FRAME) {
+            let Some((m, to)) = self.ftp.serve_logs(store, pace.packets_mut()) else {
                 break;
             };
             out(to.dest(), Outgoing::Message(m));
-            room = room.saturating_sub(logs::FTP_FRAME);
+            pace.spend(logs::FTP_FRAME);
         }
-        self.logs
-            .serve(store, armed, room, &mut self.outbox, |d, m| {
-                out(d, Outgoing::Message(m))
-            });
+        self.logs.serve(store, &mut pace, &mut self.outbox, |d, m| {
+            out(d, Outgoing::Message(m))
+        });
     }
 
     /// What the queued answers and the streams are built from at this poll.

@@ -81,7 +81,9 @@ fn serve(
 ) -> Vec<(Dest, MavMessage)> {
     let mut out = Vec::new();
     let mut outbox = Outbox::default();
-    s.serve(store, armed, room, &mut outbox, |d, m| out.push((d, m)));
+    s.serve(store, &mut Pace::new(room, armed), &mut outbox, |d, m| {
+        out.push((d, m))
+    });
     out
 }
 
