@@ -21,20 +21,13 @@ use sim_host::plant::ModelParams;
 
 use common::gcs::STATUSTEXT_LEN;
 
+mod support;
+use support::default_of;
+
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
 fn aircraft() -> Aircraft {
     Aircraft::ultrastick25e().expect("built-in aircraft")
-}
-
-/// The firmware's default value of a parameter (what a user flies without changing it).
-fn default_of(name: &str) -> f64 {
-    let store = common::params::ParamStore::new(firmware::app::REGISTRY);
-    store
-        .index_of(name)
-        .and_then(|i| store.def(i))
-        .map(|d| f64::from(d.default))
-        .unwrap_or_else(|| panic!("no parameter {name}"))
 }
 
 /// The default mission from the runway, with `steps` after the mission start (1 s after

@@ -15,6 +15,9 @@ use sim_host::plant::ModelParams;
 use sim_host::sensors::models::RangeFault;
 use sim_host::sensors::RangefinderConfig;
 
+mod support;
+use support::default_of;
+
 /// Highest true height above the runway at which a flare may start, m: the nominal flare
 /// height plus 2 m (an early flare from a short reading would start far above it).
 const EARLY_MARGIN_M: f64 = 2.0;
@@ -23,15 +26,6 @@ const EARLY_MARGIN_M: f64 = 2.0;
 const LATE_MARGIN_M: f64 = 0.7;
 /// Pitch under the approach's least pitch that the final descent may show, deg.
 const PITCH_MARGIN_DEG: f64 = 1.0;
-
-fn default_of(name: &str) -> f64 {
-    let store = common::params::ParamStore::new(firmware::app::REGISTRY);
-    store
-        .index_of(name)
-        .and_then(|i| store.def(i))
-        .map(|d| f64::from(d.default))
-        .unwrap_or_else(|| panic!("no parameter {name}"))
-}
 
 /// The default mission from the runway with a rangefinder, failed as `fault` from `from_s`.
 fn landing(fault: Option<(RangeFault, f64)>) -> (FlightOutcome, f64) {

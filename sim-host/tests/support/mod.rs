@@ -1,5 +1,6 @@
-//! A flight of the default mission flown in this process, with the log the autopilot wrote of
-//! it and the simulator's truth beside it, for the tests that read flight logs.
+//! What the flight tests share: a flight of the default mission flown in this process, with
+//! the log the autopilot wrote of it and the simulator's truth beside it, and the firmware's
+//! parameter defaults.
 
 // Each test file uses what it needs of this module.
 #![allow(dead_code)]
@@ -93,4 +94,14 @@ pub fn rms(e: &[f64]) -> f64 {
 
 pub fn wrap_deg(a: f64) -> f64 {
     (a + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// The firmware's default value of a parameter (what a user flies without changing it).
+pub fn default_of(name: &str) -> f64 {
+    let store = common::params::ParamStore::new(firmware::app::REGISTRY);
+    store
+        .index_of(name)
+        .and_then(|i| store.def(i))
+        .map(|d| f64::from(d.default))
+        .unwrap_or_else(|| panic!("no parameter {name}"))
 }
