@@ -260,14 +260,18 @@ impl GroundPort {
             plan,
             rules,
         };
-        // Each message is encoded the moment the link hands it over, so no list of whole
-        // messages (64 of them: 18 KB) waits on the stack. The link's poll only advances the
-        // signing clock; the signing state is lent to the encoder meanwhile.
-        let signing = self.link.signing_mut();
-        signing.tick(now_us);
-        let mut signing = core::mem::take(signing);
+        self.link.signing_mut().tick(now_us);
+        self.through_link(|link, send| link.poll(now_us, &snapshot, &stores, send));
+    }
+
+    /// Lends the link to `f` with a sender that encodes each message the moment the link
+    /// hands it over, signed as the link's own, so no list of whole messages (64 of them:
+    /// 18 KB) waits on the stack. The link only hands messages over: its signing state is
+    /// lent to the encoder meanwhile.
+    fn through_link(&mut self, f: impl FnOnce(&mut GroundLink, &mut dyn FnMut(Dest, Outgoing))) {
+        let mut signing = core::mem::take(self.link.signing_mut());
         let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
-        self.link.poll(now_us, &snapshot, &stores, |dest, msg| {
+        f(&mut self.link, &mut |dest, msg| {
             queue(tx, out, dropped, &mut signing, dest, &msg)
         });
         *self.link.signing_mut() = signing;
@@ -286,12 +290,7 @@ impl GroundPort {
             .saturating_sub(self.out.len())
             .saturating_sub(LOG_RESERVE_BYTES)
             .min(room);
-        let mut signing = core::mem::take(self.link.signing_mut());
-        let (tx, out, dropped) = (&mut self.tx, &mut self.out, &mut self.bytes_dropped);
-        self.link.serve_logs(store, armed, left, |dest, msg| {
-            queue(tx, out, dropped, &mut signing, dest, &msg)
-        });
-        *self.link.signing_mut() = signing;
+        self.through_link(|link, send| link.serve_logs(store, armed, left, send));
     }
 
     /// A message of the board's own (its figures of itself) to every station, framed and
