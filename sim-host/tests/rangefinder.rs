@@ -3,7 +3,8 @@
 //! stuck, reading a short false echo, or dropping out. The expectation is the physics: the
 //! flare starts where the true height above the runway crosses `NAV_FLR_ALT` (the height the
 //! rangefinder sees, range x cos(roll) cos(pitch)), and a failed rangefinder is never believed
-//! where it would flare early or pitch the nose down.
+//! where it would flare early or pitch the nose down. Beside them, the oracle the campaign
+//! measures any height sensor's ceiling with (`SIM_USE_TRUTH` = 2).
 
 use common::navigation::Phase;
 use sim_host::aircraft::Aircraft;
@@ -164,4 +165,37 @@ fn a_dropping_rangefinder_never_flares_early() {
     let from = approach_below(&clean, home_alt, 20.0);
     let (o, _) = landing(Some((RangeFault::Dropping, from)));
     check_safe(&o, home_alt, "dropping");
+}
+
+/// The flare's oracle (`SIM_USE_TRUTH` = 2: the simulator's true height above home and
+/// sink), without a rangefinder and with the GPS altitude 5 m off at start: the flare starts
+/// where the true height of the centre of gravity above where it stood at arming crosses
+/// `NAV_FLR_ALT`, within one 50 Hz period of the approach's 1-1.5 m/s sink (3 cm) and one
+/// of the flight's samples (as much again), and the landing meets the criteria.
+#[test]
+fn given_the_truth_the_flare_starts_at_the_true_flare_height_to_a_period_of_sink() {
+    let mut a = Aircraft::ultrastick25e().expect("built-in aircraft");
+    a.sensors.gps.startup_offset_m = [0.0, 0.0, 5.0];
+    let home_alt = ModelParams::new(&a).home_alt_msl_m;
+    let mut cfg = runway_mission(default_mission(ModelParams::new(&a).home));
+    cfg.script.params.push(("SIM_USE_TRUTH".into(), 2.0));
+    let o = fly_report(&a, &cfg, &FlyOptions::default())
+        .expect("flight")
+        .outcome;
+    let armed_at = o.samples.iter().find(|x| x.armed).expect("armed").alt;
+    let l = landing_figures(&o, armed_at);
+    let flare_alt = default_of("NAV_FLR_ALT");
+    eprintln!(
+        "oracle: flare at {:.3} m above the arming height ({:.3} m above the runway)",
+        l.flare_start_m,
+        armed_at - home_alt
+    );
+    assert!(
+        l.flare_start_m <= flare_alt && l.flare_start_m > flare_alt - 0.06,
+        "flare at {:.3} m",
+        l.flare_start_m
+    );
+    let td = o.summary.touchdown.as_ref().expect("a touchdown");
+    assert!(td.distance_m < TOUCHDOWN_M, "{:.1} m", td.distance_m);
+    assert!(td.sink_rate_mps < SINK_MPS, "{:.2} m/s", td.sink_rate_mps);
 }

@@ -3,7 +3,7 @@
 extern crate std;
 
 use super::items::*;
-use super::navigator::io::GroundStage;
+use super::navigator::io::{GroundStage, HeightOracle};
 use super::navigator::params::PARAMS as EXEC_PARAMS;
 use super::path_manager::PARAMS as PATH_PARAMS;
 use super::plan::MissionItem;
@@ -84,6 +84,7 @@ impl Plane {
             yaw_rate: 0.0,
             wind_speed: self.k.wind.xy().norm(),
             range_hagl: None,
+            oracle: None,
         }
     }
 
@@ -1011,6 +1012,10 @@ fn garbage_items_and_state_do_not_panic() {
             yaw_rate: f32::NAN,
             wind_speed: f32::NAN,
             range_hagl: Some(f32::NAN),
+            oracle: Some(HeightOracle {
+                height_m: f32::NAN,
+                vel_down_mps: f32::INFINITY,
+            }),
         };
         nav.set_current((next() % 14) as u16);
         let _ = nav.step(&items, &home(), &bad, f32::NAN);
@@ -1261,6 +1266,65 @@ fn a_flare_that_sinks_again_after_a_seeming_touch_pitches_up_again() {
         pitch.to_degrees(),
         expected.to_degrees()
     );
+}
+
+/// Given the simulator's truth (`SIM_USE_TRUTH` = 2), the flare flies the true height and sink
+/// instead of the estimate's: the estimate 1.2 m up and climbing 0.5 m/s (the updraft's
+/// floor, 0.6 deg), the truth 0.5 m up sinking 1 m/s: `NAV_FLR_PTCH_DEG` plus `NAV_FLR_K`
+/// times the true sink above the schedule's at the true height.
+#[test]
+fn given_the_truth_the_flare_pitches_for_the_true_height_and_sink_not_the_estimates() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = land_here_until(&mut nav, &items, Phase::Flare);
+    plane.k.pos = Vector3::new(20.0, 0.0, -1.2);
+    plane.climb = 0.5;
+    let state = NavState {
+        oracle: Some(HeightOracle {
+            height_m: 0.5,
+            vel_down_mps: 1.0,
+        }),
+        ..plane.state()
+    };
+    let out = nav.step(&items, &home(), &state, DT);
+    assert_eq!(out.phase, Phase::Flare);
+    let pitch = match out.commands.map(|c| c.lon) {
+        Some(LonMode::Pitch { pitch, .. }) => pitch,
+        other => panic!("flare without a pitch command: {other:?}"),
+    };
+    let p = *nav.params();
+    let approach_sink = state.ground_speed() * libm::tanf(p.glide_slope);
+    let aim = p.flare_sink + (approach_sink - p.flare_sink) * (0.5 / p.flare_alt);
+    let expected = p.flare_pitch + p.flare_k * (1.0 - aim);
+    assert!(
+        (pitch - expected).abs() < 0.05f32.to_radians(),
+        "{} deg, expected {} deg",
+        pitch.to_degrees(),
+        expected.to_degrees()
+    );
+}
+
+/// The truth starts the flare too: 5 m up by the estimate on the approach, 1.4 m by the truth
+/// (under `NAV_FLR_ALT`, 1.5 m), the landing is in its flare; without the truth, not.
+#[test]
+fn given_the_truth_the_flare_starts_at_the_true_height() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let phase_with = |oracle: Option<HeightOracle>| {
+        let mut nav = navigator();
+        let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+        plane.k.pos = Vector3::new(80.0, 0.0, -5.0);
+        let state = NavState {
+            oracle,
+            ..plane.state()
+        };
+        nav.step(&items, &home(), &state, DT).phase
+    };
+    let truth = HeightOracle {
+        height_m: 1.4,
+        vel_down_mps: 1.0,
+    };
+    assert_eq!(phase_with(None), Phase::Approach);
+    assert_eq!(phase_with(Some(truth)), Phase::Flare);
 }
 
 /// A landed aircraft that keeps rolling (sailing along the runway before a crosswind, its tail

@@ -30,7 +30,9 @@ use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
 use crate::navigation::fence::{breached, FenceParams};
 use crate::navigation::item::{NavCommand, NavItem, Route};
 use crate::navigation::items::{Altitude, Place};
-use crate::navigation::navigator::io::{GroundStage, HomeRequest, NavOutput, NavState, Phase};
+use crate::navigation::navigator::io::{
+    GroundStage, HeightOracle, HomeRequest, NavOutput, NavState, Phase,
+};
 use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::{MissionStore, PlanKind};
 use crate::sensors::ManualInput;
@@ -131,6 +133,8 @@ pub struct CommanderInputs<'a> {
     pub gcs_heard_us: Option<u64>,
     /// The battery monitor's warning, `None` when no battery is monitored.
     pub battery: Option<Warning>,
+    /// The simulator's truth for the flare (`SIM_USE_TRUTH`), handed to the navigator.
+    pub oracle: Option<HeightOracle>,
 }
 
 /// What one control tick of the commander decided.
@@ -165,6 +169,8 @@ pub struct Commander {
     land: LandDetector,
     notices: Deque<Notice, NOTICE_CAPACITY>,
     dropped_notices: u32,
+    /// This tick's truth for the flare, if the simulation gives one.
+    oracle: Option<HeightOracle>,
 }
 
 impl Default for Commander {
@@ -245,6 +251,7 @@ impl Commander {
             land: LandDetector::new(),
             notices: Deque::new(),
             dropped_notices: 0,
+            oracle: None,
         }
     }
 
@@ -502,6 +509,7 @@ impl Commander {
             (i.gcs_heard_us, i.battery),
             i.navigator,
         );
+        self.oracle = i.oracle;
         let (demand, home) = self.demand(i.now_us, i.dt, i.estimate, i.navigator, i.plan, i.gains);
         CommanderOutput { demand, home }
     }
@@ -732,7 +740,11 @@ impl Commander {
             NavTask::Takeoff => Route::Item(&takeoff),
             NavTask::Loiter | NavTask::Return | NavTask::Land => Route::Plan(&[]),
         };
-        let out = navigator.step_route(items, &home, &NavState::from_estimate(e), dt);
+        let state = NavState {
+            oracle: self.oracle,
+            ..NavState::from_estimate(e)
+        };
+        let out = navigator.step_route(items, &home, &state, dt);
         if task == NavTask::Mission {
             let current = out.current_seq.filter(|&c| c != self.mission_seq);
             if let Some(c) = out.current_seq {

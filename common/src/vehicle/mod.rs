@@ -42,6 +42,7 @@ use crate::control::autopilot::{Autopilot, GainSet};
 use crate::control::gains::NAMED;
 use crate::control::inputs::Measurements;
 use crate::estimator::{self, config as estimator_config, EstimatedState, Estimator};
+use crate::navigation::navigator::io::HeightOracle;
 use crate::navigation::navigator::Navigator;
 use crate::navigation::plan::MissionStore;
 use crate::navigation::validate::{MissionLimits, PlanRules};
@@ -54,9 +55,20 @@ use commander::{
     above_home, trim_surfaces, Commander, CommanderInputs, Demand, Setpoints, Severity, Watch,
 };
 use modes::FlightMode;
+use params::TruthUse;
 use requests::VehicleRequests;
 
 pub use commander::Notice;
+
+/// The simulator's truth of one frame (HIL_STATE_QUATERNION), for the `SIM_USE_TRUTH`
+/// experiments.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TruthSample {
+    /// What the control loops would measure, the altitude above mean sea level.
+    pub loops: Measurements,
+    /// Vertical speed, down positive, m/s.
+    pub vel_down_mps: f32,
+}
 
 /// Control period, us: the thesis's 50 Hz.
 pub const CONTROL_PERIOD_US: u64 = 20_000;
@@ -103,14 +115,17 @@ pub struct Vehicle {
     /// Magnitude of the last accelerometer sample, m/s^2.
     specific_force: Option<f32>,
     limits: MissionLimits,
-    use_truth: bool,
+    use_truth: TruthUse,
     params_seen: Option<u32>,
     gain_set_seen: u8,
     clock: Clock,
     last_imu_us: Option<u64>,
     last_control_us: Option<u64>,
     last_gps: Option<GpsFix>,
-    truth: Option<Measurements>,
+    truth: Option<TruthSample>,
+    /// Home's true altitude above mean sea level, m: the truth's altitude when home was last
+    /// put (less the estimate's height above it then), for the flare's oracle.
+    truth_home_m: Option<f32>,
     surfaces: Surfaces,
     /// The angles the outer loops asked the inner loops for in the last tick (NaN when a
     /// loop was off), for the flight log.
@@ -152,7 +167,7 @@ impl Vehicle {
             land: land_detector::LandParams::default(),
             specific_force: None,
             limits: MissionLimits::default(),
-            use_truth: false,
+            use_truth: TruthUse::Off,
             params_seen: None,
             gain_set_seen: 0,
             clock: Clock::default(),
@@ -160,6 +175,7 @@ impl Vehicle {
             last_control_us: None,
             last_gps: None,
             truth: None,
+            truth_home_m: None,
             surfaces: trim_surfaces(&GainSet::default()),
             loops: LoopCommands::OFF,
             refusing: false,
@@ -356,9 +372,9 @@ impl Vehicle {
         self.battery.report(self.clock.now_us())
     }
 
-    /// The simulator's truth, flown instead of the estimate when `SIM_USE_TRUTH` is set.
-    pub fn on_truth(&mut self, m: Measurements) {
-        self.truth = Some(m);
+    /// The simulator's truth, flown instead of the estimate where `SIM_USE_TRUTH` says.
+    pub fn on_truth(&mut self, t: TruthSample) {
+        self.truth = Some(t);
     }
 
     /// The radio's sticks.
@@ -380,9 +396,32 @@ impl Vehicle {
     /// Hands a home the commander decided to the estimator, which holds it (the one place
     /// home is written after the first fix set it).
     fn move_home(&mut self, home: Option<estimator::Home>) {
-        if let Some(h) = home {
-            self.estimator.set_home(h);
+        let Some(h) = home else {
+            return;
+        };
+        // Only in a simulation that sends its truth: the true home sits as far under the
+        // truth's altitude as the estimate's height above the new home says.
+        let above = self
+            .truth
+            .map(|_| self.estimator.state().alt_amsl_m - h.alt_amsl_m);
+        if self.estimator.set_home(h) {
+            self.truth_home_m = self
+                .truth
+                .zip(above)
+                .map(|(t, above)| t.loops.altitude - above);
         }
+    }
+
+    /// The truth the flare flies on, when `SIM_USE_TRUTH` asks for it.
+    fn height_oracle(&self) -> Option<HeightOracle> {
+        if self.use_truth != TruthUse::Flare {
+            return None;
+        }
+        let t = self.truth?;
+        Some(HeightOracle {
+            height_m: t.loops.altitude - self.truth_home_m?,
+            vel_down_mps: t.vel_down_mps,
+        })
     }
 
     /// Everything after the sensors: requests, parameters, control at 50 Hz.
@@ -406,6 +445,7 @@ impl Vehicle {
         let e = self.estimator.state();
         let b = self.battery.report(Some(now_us));
         let gains = *self.autopilot.gains();
+        let oracle = self.height_oracle();
         let out = self.commander.step(CommanderInputs {
             now_us,
             dt,
@@ -418,6 +458,7 @@ impl Vehicle {
             specific_force: self.specific_force,
             gcs_heard_us: ground.heard_us,
             battery: b.present.then_some(b.warning),
+            oracle,
         });
         self.move_home(out.home);
         let m = self.measurements(&e);
@@ -440,9 +481,9 @@ impl Vehicle {
     }
 
     fn measurements(&self, e: &EstimatedState) -> Measurements {
-        if self.use_truth {
+        if self.use_truth == TruthUse::Loops {
             if let Some(t) = self.truth {
-                return t;
+                return t.loops;
             }
         }
         Measurements {

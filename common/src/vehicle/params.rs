@@ -4,6 +4,7 @@
 use crate::control::{autopilot, gains, lateral, longitudinal};
 use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::param;
+use crate::params::declare::Choice;
 use crate::params::{independent, Group, ParamDef, Registry};
 use crate::{battery, estimator, failsafe, guidance};
 
@@ -12,8 +13,35 @@ use crate::{battery, estimator, failsafe, guidance};
 pub struct SystemParams {
     /// Index in [`gains::NAMED`] of the gain set loaded into the control parameters.
     pub gain_set: u8,
-    /// Fly on the simulator's truth instead of the estimate.
-    pub use_truth: bool,
+    /// What is flown on the simulator's truth instead of the estimate.
+    pub use_truth: TruthUse,
+}
+
+/// What the vehicle flies on the simulator's truth (HIL_STATE_QUATERNION) instead of its
+/// estimate: experiments that measure what estimation costs, never a real aircraft's setting.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TruthUse {
+    /// Nothing: everything flies on the estimate.
+    Off,
+    /// The control loops' measurements (attitude, rates, course, altitude, airspeed).
+    Loops,
+    /// The landing's flare only: the true height above home and vertical speed, an oracle of
+    /// the best any height sensor could give the flare.
+    Flare,
+}
+
+/// The labels of [`TruthUse`], in its order.
+pub const TRUTH_USES: &[&str] = &["Off", "Control loops", "Flare height and sink"];
+
+impl Choice for TruthUse {
+    fn from_index(i: u8) -> Option<Self> {
+        [Self::Off, Self::Loops, Self::Flare]
+            .get(usize::from(i))
+            .copied()
+    }
+    fn index(self) -> u8 {
+        self as u8
+    }
 }
 
 /// Parameters of the vehicle itself.
@@ -31,18 +59,19 @@ pub const PARAMS: Group<SystemParams> = Group {
             count
         ),
         param!(
-            ParamDef::boolean(
+            ParamDef::choice(
                 "SIM_USE_TRUTH",
-                false,
-                "Fly on the simulator's truth (HIL_STATE_QUATERNION) instead of the estimator, to measure what estimation costs",
+                0,
+                TRUTH_USES,
+                "Fly on the simulator's truth (HIL_STATE_QUATERNION) instead of the estimator, to measure what estimation costs: the control loops, or the flare's height and sink",
             ),
             SystemParams => use_truth,
-            flag
+            choice
         ),
     ],
     base: || SystemParams {
         gain_set: 0,
-        use_truth: false,
+        use_truth: TruthUse::Off,
     },
     check: independent,
 };

@@ -527,6 +527,7 @@ fn tick_at(
         specific_force: Some(9.81),
         gcs_heard_us: Some(0),
         battery: None,
+        oracle: None,
     })
 }
 
@@ -666,6 +667,7 @@ fn every_failsafe_that_changes_the_mode_aborts_the_take_off_roll_and_no_other_do
             specific_force: Some(9.81),
             gcs_heard_us: heard,
             battery,
+            oracle: None,
         });
         let said = texts(&mut c);
         let throttle = match commands(&o).lon {

@@ -7,7 +7,7 @@ use common::control::inputs::Measurements;
 use common::link::dialect::Autopilot;
 use common::link::framing::{Frame, FrameParser, LinkStats, Sender};
 use common::link::simlink::{self, ActuatorFrame, Rejected};
-use common::vehicle::Vehicle;
+use common::vehicle::{TruthSample, Vehicle};
 use mavlink::dialects::common::{MavMessage, HIL_STATE_QUATERNION_DATA};
 
 use super::ground::GroundPort;
@@ -185,8 +185,8 @@ impl Answers {
                 None => self.health.rejected_range += 1,
             },
             MavMessage::HIL_STATE_QUATERNION(d) => {
-                if let Some(m) = truth_measurements(d) {
-                    vehicle.on_truth(m);
+                if let Some(t) = truth_sample(d) {
+                    vehicle.on_truth(t);
                 }
             }
             MavMessage::RC_CHANNELS(d) => {
@@ -214,7 +214,7 @@ impl Answers {
 
 /// Truth as the autopilot's measurements (`HIL_STATE_QUATERNION`: attitude quaternion, body
 /// rates, altitude in mm, velocity in cm/s, true airspeed in cm/s).
-fn truth_measurements(d: &HIL_STATE_QUATERNION_DATA) -> Option<Measurements> {
+fn truth_sample(d: &HIL_STATE_QUATERNION_DATA) -> Option<TruthSample> {
     let q = d.attitude_quaternion;
     if q.iter().any(|x| !x.is_finite()) {
         return None;
@@ -229,15 +229,18 @@ fn truth_measurements(d: &HIL_STATE_QUATERNION_DATA) -> Option<Measurements> {
     } else {
         e.psi
     };
-    Some(Measurements {
-        roll: e.phi,
-        pitch: e.theta,
-        course,
-        roll_rate: d.rollspeed,
-        pitch_rate: d.pitchspeed,
-        yaw_rate: d.yawspeed,
-        altitude: d.alt as f32 / 1000.0,
-        airspeed: f32::from(d.true_airspeed) / 100.0,
-        sideslip: 0.0,
+    Some(TruthSample {
+        loops: Measurements {
+            roll: e.phi,
+            pitch: e.theta,
+            course,
+            roll_rate: d.rollspeed,
+            pitch_rate: d.pitchspeed,
+            yaw_rate: d.yawspeed,
+            altitude: d.alt as f32 / 1000.0,
+            airspeed: f32::from(d.true_airspeed) / 100.0,
+            sideslip: 0.0,
+        },
+        vel_down_mps: v.z,
     })
 }

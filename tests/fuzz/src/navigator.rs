@@ -101,6 +101,8 @@ pub fn run(data: &[u8]) {
                         // No rangefinder: the navigator flies on the estimate's height, as
                         // with a failed one.
                         range_hagl: None,
+                        // The simulator's truth is not flown here: only SIM_USE_TRUTH gives it.
+                        oracle: None,
                     };
                     let out = nav.step(&items, &home, &state, dt);
                     if let Some(g) = out.guidance {

@@ -23,6 +23,19 @@ pub struct NavState {
     pub wind_speed: f32,
     /// Height above the ground from the rangefinder, m, while it passes its gates.
     pub range_hagl: Option<f32>,
+    /// The simulator's truth for the flare, when `SIM_USE_TRUTH` asks for it (never on a real
+    /// aircraft).
+    pub oracle: Option<HeightOracle>,
+}
+
+/// The true height and vertical speed the flare flies on in place of the estimate's: an
+/// oracle that measures the best any height sensor could give the landing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeightOracle {
+    /// Height above home, m, on the same datum as [`NavState::height`].
+    pub height_m: f32,
+    /// Vertical speed, down positive, m/s.
+    pub vel_down_mps: f32,
 }
 
 impl NavState {
@@ -40,6 +53,7 @@ impl NavState {
                 0.0
             },
             range_hagl: s.range_hagl_m,
+            oracle: None,
         }
     }
 

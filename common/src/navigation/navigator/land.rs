@@ -306,11 +306,13 @@ impl Landing {
         let state = f.state;
         let dt = f.dt;
         let pos = state.pos_ned;
-        let hagl = match state.range_hagl {
+        let hagl = match (state.oracle, state.range_hagl) {
+            (Some(o), _) => o.height_m + self.point.z,
             // The land point is on the ground the rangefinder sees (flat, at its height).
-            Some(h) if p.land_use_rng && h.is_finite() => h,
+            (None, Some(h)) if p.land_use_rng && h.is_finite() => h,
             _ => state.height() + self.point.z,
         };
+        let sink_now = state.oracle.map_or(state.vel_ned.z, |o| o.vel_down_mps);
         let line =
             Path::line_between(&self.origin, &self.point, p.land_airspeed).unwrap_or(Path::Line {
                 origin: self.point,
@@ -363,16 +365,13 @@ impl Landing {
         }
         // Lifted off the runway by a gust after the touchdown, the aircraft is flying again:
         // the flare, not the roll-out's level pitch, brings it back down.
-        if self.phase == LandPhase::Landed
-            && hagl > p.touchdown_alt
-            && state.vel_ned.z < -BOUNCE_CLIMB
-        {
+        if self.phase == LandPhase::Landed && hagl > p.touchdown_alt && sink_now < -BOUNCE_CLIMB {
             self.phase = LandPhase::Flare;
             self.touched = false;
             self.ground_time = 0.0;
         }
         if self.phase == LandPhase::Flare {
-            let sink = state.vel_ned.z;
+            let sink = sink_now;
             let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
             // Rising again this close to the ground is the wheels' kick (or a gust about to
             // balloon the aircraft): from then on the flare's pitch-up is over.
@@ -452,7 +451,7 @@ impl Landing {
                 } else {
                     (aim, p.flare_pitch * (1.0 - frac))
                 };
-                let sink = state.vel_ned.z;
+                let sink = sink_now;
                 let pitch = if self.touched {
                     0.0
                 } else if sink.is_finite() {
