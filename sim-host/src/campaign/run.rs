@@ -117,6 +117,24 @@ pub struct CampaignMeta {
     pub shard: Shard,
 }
 
+impl CampaignMeta {
+    /// The command that runs the campaign again (no output directory: it names none).
+    pub fn command(&self) -> String {
+        let mut cmd = String::from("sim-host");
+        if let Some(a) = &self.aircraft_file {
+            cmd += &format!(" --aircraft {a}");
+        }
+        cmd += &format!(
+            " campaign --runs {} --seed {} --mission {}",
+            self.runs, self.seed, self.mission
+        );
+        if let Some(c) = &self.campaign_file {
+            cmd += &format!(" --campaign {c}");
+        }
+        cmd
+    }
+}
+
 /// FNV-1a, 64 bits: a stable fingerprint for identity checks (not for security).
 pub fn fnv1a(bytes: &[u8]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -176,7 +194,7 @@ impl Campaign {
     pub fn plan(&self, index: u64) -> Plan {
         let mut s = Sampler::new(self.seed, index);
         let flight_seed = s.seed();
-        let aircraft = disperse_aircraft(&mut s, &self.spec, &self.aircraft);
+        let mut aircraft = disperse_aircraft(&mut s, &self.spec, &self.aircraft);
         let day = draw_day(&mut s, &self.spec);
         let home = ModelParams::new(&self.aircraft).home;
         let mission = mission_for(
@@ -187,6 +205,19 @@ impl Campaign {
             day.runway_heading_rad,
             self.spec.runway.into_wind,
         );
+        // Drawn last, and only when asked for, so that every other draw stays as it was.
+        let share = self.spec.rangefinder.fitted_share;
+        if share > 0.0 {
+            let fitted = s.unit_silent() < share;
+            s.record("rangefinder.fitted", if fitted { 1.0 } else { 0.0 });
+            aircraft.sensors.rangefinder = fitted.then(|| {
+                self.aircraft
+                    .sensors
+                    .rangefinder
+                    .clone()
+                    .unwrap_or_default()
+            });
+        }
         let mut draws = s.drawn;
         let shift =
             ["mass.cg_x_m", "mass.cg_y_m", "mass.cg_z_m"].map(|k| draws.get(k).unwrap_or(0.0));
@@ -212,6 +243,10 @@ impl Campaign {
             "EKF_GPS_DELAY".into(),
             self.aircraft.sensors.gps.latency_s as f32,
         )];
+        if self.spec.oracle.flare_on_truth {
+            // Not a user's setting: the experiment that measures the flare's ceiling.
+            config.script.params.push(("SIM_USE_TRUTH".into(), 2.0));
+        }
         config.script.fence = mission.fence;
         Plan {
             index,

@@ -172,6 +172,25 @@ pub struct MissionSpec {
     pub land_in_takeoff_direction: bool,
 }
 
+/// The downward rangefinder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RangefinderSpec {
+    /// Share of the flights whose aircraft carries one (the aircraft file's, or a LIDAR-Lite
+    /// v3 where the file names none), drawn after everything else; 0 draws nothing.
+    pub fitted_share: f64,
+}
+
+/// What the autopilot is told of the simulator's truth: experiments on the laws, not on the
+/// aircraft.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct OracleSpec {
+    /// The landing's flare flies on the true height above home and vertical speed
+    /// (`SIM_USE_TRUTH` = 2): the best any height sensor could give it.
+    pub flare_on_truth: bool,
+}
+
 /// Everything a campaign disperses.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
@@ -194,6 +213,16 @@ pub struct CampaignSpec {
     pub runway: RunwaySpec,
     /// Generated missions.
     pub mission: MissionSpec,
+    /// The rangefinder.
+    pub rangefinder: RangefinderSpec,
+    /// Truth given to the autopilot.
+    pub oracle: OracleSpec,
+}
+
+impl Default for RangefinderSpec {
+    fn default() -> Self {
+        Self { fitted_share: 0.0 }
+    }
 }
 
 impl Default for AeroSpec {
@@ -409,6 +438,14 @@ impl CampaignSpec {
                 "mission.loiter_turns",
                 &format!("{t:?}"),
                 "must be [min, max] with min <= max <= 20",
+            ));
+        }
+        let share = self.rangefinder.fitted_share;
+        if !(0.0..=1.0).contains(&share) {
+            return Err(c.bad(
+                "rangefinder.fitted_share",
+                &share.to_string(),
+                "a share of the flights, from 0 to 1",
             ));
         }
         Ok(())
