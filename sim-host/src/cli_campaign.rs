@@ -34,6 +34,10 @@ enum CampaignSub {
         /// notes below its `---` line are kept).
         #[arg(long, value_name = "FILE")]
         doc: Option<PathBuf>,
+        /// Set this campaign's output beside the merged one in the document: the same
+        /// flights with one thing changed (its campaign file), flight for flight.
+        #[arg(long, value_name = "DIR", requires = "doc")]
+        beside: Option<PathBuf>,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
@@ -72,6 +76,12 @@ struct RunArgs {
     /// below its `---` line are kept).
     #[arg(long, value_name = "FILE")]
     doc: Option<PathBuf>,
+    /// Set this campaign's output beside this one in the document: the same flights (same
+    /// seed, mission and aircraft) with one thing changed, such as
+    /// `sim-host/campaigns/flare-oracle.toml`'s flare on the truth; pass rates by group,
+    /// flight for flight.
+    #[arg(long, value_name = "DIR", requires = "doc")]
+    beside: Option<PathBuf>,
     /// Print the report (or, with --index, the flight's record) as JSON.
     #[arg(long)]
     json: bool,
@@ -91,13 +101,17 @@ pub(crate) fn campaign_command(
         dirs,
         out,
         doc,
+        beside,
         json,
     }) = c.sub
     {
         let (_, report) = output::merge(&dirs, &out)?;
         if let Some(d) = &doc {
-            let (_, records) = output::read_campaign(&out)?;
-            output::write_doc(d, &report, &records)?;
+            let (meta, records) = output::read_campaign(&out)?;
+            let beside = beside
+                .map(|dir| output::read_beside(&meta, &records, &dir))
+                .transpose()?;
+            output::write_doc(d, &report, &records, beside.as_ref())?;
         }
         if json {
             emit(&to_json(&report)?)?;
@@ -122,6 +136,7 @@ pub(crate) fn campaign_command(
         jobs: r.jobs,
         out: r.out,
         doc: r.doc,
+        beside: r.beside,
     };
     if r.print_campaign {
         let spec = sim_host::campaign::CampaignSpec::load(args.campaign.as_deref())?;

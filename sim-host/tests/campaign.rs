@@ -304,3 +304,92 @@ fn the_command_line_prints_the_campaign_in_force_and_refuses_a_bad_file_before_f
         "nothing flown, nothing written"
     );
 }
+
+/// Half the aircraft carry a rangefinder (about 500 of 1000, within four binomial standard
+/// deviations of 16), drawn after everything else, so every other draw of a flight is the
+/// built-in campaign's; the flare's oracle changes nothing but the one parameter the station
+/// sets; a share outside 0..1 is refused naming the key.
+#[test]
+fn a_share_of_the_aircraft_carry_a_rangefinder_and_the_oracle_only_sets_sim_use_truth() {
+    let plain = campaign(1000, 1, MissionChoice::Default);
+    let mut fitted = campaign(1000, 1, MissionChoice::Default);
+    fitted.spec.rangefinder.fitted_share = 0.5;
+    let mut carried = 0;
+    for i in 0..1000 {
+        let (a, b) = (plain.plan(i), fitted.plan(i));
+        assert!(a.aircraft.sensors.rangefinder.is_none());
+        let flag = b.draws.get("rangefinder.fitted").expect("drawn");
+        assert_eq!(flag == 1.0, b.aircraft.sensors.rangefinder.is_some());
+        carried += usize::from(flag == 1.0);
+        let others: Vec<_> = b
+            .draws
+            .0
+            .iter()
+            .filter(|(n, _)| n != "rangefinder.fitted")
+            .cloned()
+            .collect();
+        assert_eq!(others, a.draws.0, "flight {i}");
+    }
+    assert!((436..=564).contains(&carried), "{carried} of 1000 fitted");
+
+    let mut oracle = campaign(10, 1, MissionChoice::Default);
+    oracle.spec.oracle.flare_on_truth = true;
+    let (a, b) = (plain.plan(3), oracle.plan(3));
+    assert_eq!(a.draws, b.draws);
+    let mut params = b.config.script.params.clone();
+    assert_eq!(params.pop(), Some(("SIM_USE_TRUTH".to_string(), 2.0)));
+    assert_eq!(params, a.config.script.params);
+
+    let msg = refused("[rangefinder]\nfitted_share = 1.5\n");
+    assert!(
+        msg.contains("`rangefinder.fitted_share`") && msg.contains("1.5"),
+        "{msg}"
+    );
+}
+
+/// Two flights, and beside them the same two with the first one's verdict turned over: the
+/// pairing counts that flight as passing on one side only, every group's counts add up to
+/// its flights, the changed key is named, and a campaign of another seed is refused.
+#[test]
+fn a_campaign_beside_another_of_the_same_flights_pairs_their_verdicts_flight_for_flight() {
+    use sim_host::campaign::groups::{beside, rates};
+    let c = campaign(2, 5, MissionChoice::Default);
+    let meta = c.meta(Shard::WHOLE);
+    let records = c.run(Shard::WHOLE, 2, false).unwrap();
+    let mut other = c.clone();
+    other.spec.oracle.flare_on_truth = true;
+    let mut turned = records.clone();
+    turned[0].verdict.pass = !turned[0].verdict.pass;
+    let b = beside(
+        &meta,
+        &records,
+        Path::new("out/oracle"),
+        (&other.meta(Shard::WHOLE), &turned),
+    )
+    .unwrap();
+    let all = &b.rows[0];
+    assert_eq!(all.here.group, "every flight");
+    assert_eq!(all.here.flights, 2);
+    let first_passed = records[0].verdict.pass;
+    assert_eq!(
+        (all.only_here, all.only_beside),
+        if first_passed { (1, 0) } else { (0, 1) }
+    );
+    assert_eq!(
+        all.beside.passed + all.only_here,
+        all.here.passed + all.only_beside
+    );
+    let groups = rates(&meta, &records);
+    let light_and_moderate: u64 = groups[1..].iter().map(|g| g.flights).sum();
+    assert_eq!((groups.len(), light_and_moderate), (3, 2));
+    assert_eq!(
+        b.changes,
+        vec!["`oracle.flare_on_truth`: false here, true beside".to_string()]
+    );
+    assert!(b.command.contains("--out out/oracle"), "{}", b.command);
+    let elsewhere = campaign(2, 6, MissionChoice::Default).meta(Shard::WHOLE);
+    let msg = beside(&meta, &records, Path::new("x"), (&elsewhere, &turned))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("seed is 6"), "{msg}");
+}

@@ -11,7 +11,9 @@
 //! - [`verdict`]: the verdict by the criteria ([`crate::flight::criteria`]), in one place;
 //! - [`run`]: the campaign, its shards, its flights flown on every core;
 //! - [`output`]: its directory, the merge of shards, the document;
-//! - [`report`], [`plots`], [`stats`]: the report made from the records.
+//! - [`report`], [`plots`], [`stats`]: the report made from the records;
+//! - [`groups`]: pass rates by turbulence and rangefinder, and beside another campaign of the
+//!   same flights.
 //!
 //! Flights run in parallel on a [rayon] pool: each flight is an independent, CPU-bound,
 //! allocation-light loop of about half a second, so a work-stealing pool over the flight
@@ -27,6 +29,7 @@
 //! job arrays run the shards on a cluster (`sim-host/slurm/`).
 
 pub mod draws;
+pub mod groups;
 pub mod mission;
 pub mod output;
 pub mod plots;

@@ -13,6 +13,7 @@
 //! code for a run and for a merge, and carries no wall-clock value: a merge of shards writes
 //! the same bytes as the unsharded run.
 
+use super::groups::{self, Beside};
 use super::plots;
 use super::record::FlightRecord;
 use super::report::{markdown, Images, Report};
@@ -73,7 +74,7 @@ pub fn write_campaign(
         touchdowns: "touchdowns.png".into(),
         sensitivity: "sensitivity.png".into(),
     };
-    write(&dir.join("report.md"), &markdown(&report, &images))?;
+    write(&dir.join("report.md"), &markdown(&report, &images, None))?;
     draw(dir, &images, &report, &records)?;
     Ok(report)
 }
@@ -87,6 +88,16 @@ fn draw(
     plots::histograms(records, &dir.join(&images.histograms))?;
     plots::touchdowns(records, &dir.join(&images.touchdowns))?;
     plots::sensitivity(report, records, &dir.join(&images.sensitivity))
+}
+
+/// The campaign in `dir`, paired flight for flight with `records` of the campaign `meta`.
+pub fn read_beside(
+    meta: &CampaignMeta,
+    records: &[FlightRecord],
+    dir: &Path,
+) -> anyhow::Result<Beside> {
+    let (other, theirs) = read_campaign(dir)?;
+    groups::beside(meta, records, dir, (&other, &theirs))
 }
 
 /// Reads a campaign directory's identity and records; errors name the file and the line.
@@ -255,6 +266,7 @@ pub fn write_doc(
     doc: &Path,
     report: &Report,
     records: &[FlightRecord],
+    beside: Option<&Beside>,
 ) -> anyhow::Result<Vec<PathBuf>> {
     let dir = doc
         .parent()
@@ -272,7 +284,7 @@ pub fn write_doc(
         .ok()
         .and_then(|old| old.find(NOTES_MARKER).map(|i| old[i..].to_string()))
         .unwrap_or_default();
-    write(doc, &(markdown(report, &images) + &notes))?;
+    write(doc, &(markdown(report, &images, beside) + &notes))?;
     Ok(vec![
         doc.to_path_buf(),
         dir.join(&images.histograms),

@@ -4,7 +4,7 @@
 
 use super::record::{Figures, FlightRecord};
 use super::run::CampaignMeta;
-use super::stats::{quantile, spearman, wilson, Z95};
+use super::stats::{pct, quantile, spearman, wilson, Z95};
 use super::verdict::Criterion;
 use crate::report::{sig, sig_or_dash};
 use serde::{Deserialize, Serialize};
@@ -165,6 +165,8 @@ pub struct Report {
     pub flights: u64,
     /// Flights meeting every criterion.
     pub passed: u64,
+    /// Pass rates by turbulence and rangefinder.
+    pub by_group: Vec<super::groups::GroupRate>,
     /// `passed / flights`.
     pub pass_rate: f64,
     /// 95 % Wilson interval of the pass rate.
@@ -346,6 +348,7 @@ impl Report {
                 .partial_cmp(&(b.verdict.pass, b.verdict.margin, b.index))
                 .unwrap_or(std::cmp::Ordering::Equal)
         });
+        let by_group = super::groups::rates(&campaign, &records);
         Self {
             campaign,
             flights,
@@ -356,6 +359,7 @@ impl Report {
                 f64::NAN
             },
             pass_rate_ci95: wilson(passed, flights, Z95),
+            by_group,
             criteria,
             causes: causes(&records),
             lifted_after_disarm: records
@@ -395,26 +399,6 @@ pub struct Images {
     pub sensitivity: String,
 }
 
-fn pct(x: f64) -> String {
-    format!("{:.1} %", 100.0 * x)
-}
-
-/// The command that runs the campaign again (no output directory: it names none).
-pub fn campaign_command(m: &CampaignMeta) -> String {
-    let mut cmd = String::from("sim-host");
-    if let Some(a) = &m.aircraft_file {
-        cmd += &format!(" --aircraft {a}");
-    }
-    cmd += &format!(
-        " campaign --runs {} --seed {} --mission {}",
-        m.runs, m.seed, m.mission
-    );
-    if let Some(c) = &m.campaign_file {
-        cmd += &format!(" --campaign {c}");
-    }
-    cmd
-}
-
 fn brief_table(md: &mut String, flights: &[FlightBrief]) {
     let _ = writeln!(
         md,
@@ -443,7 +427,7 @@ fn brief_table(md: &mut String, flights: &[FlightBrief]) {
 }
 
 /// The report as Markdown (no wall-clock figure: it must not depend on how it was run).
-pub fn markdown(r: &Report, images: &Images) -> String {
+pub fn markdown(r: &Report, images: &Images, beside: Option<&super::groups::Beside>) -> String {
     let m = &r.campaign;
     let mut md = String::new();
     let _ = writeln!(
@@ -460,7 +444,7 @@ pub fn markdown(r: &Report, images: &Images) -> String {
          command that flies it again with its log and plots.\n",
         r.flights,
         m.mission,
-        campaign_command(m)
+        m.command()
     );
     let (lo, hi) = r.pass_rate_ci95;
     let _ = writeln!(
@@ -503,9 +487,11 @@ pub fn markdown(r: &Report, images: &Images) -> String {
          the landing they made after it; {} of them pass.",
         r.went_around.0, r.went_around.1
     );
+    md += "\n";
+    md += &super::groups::markdown(&r.by_group, beside);
     let _ = writeln!(
         md,
-        "\n## Figures\n\nOver the flights that have each figure (a flight that never touched \
+        "## Figures\n\nOver the flights that have each figure (a flight that never touched \
          down has no touchdown figures).\n\n| figure | flights | min | 5 % | median | 95 % | max |\n|---|---|---|---|---|---|---|"
     );
     for f in &r.figures {

@@ -4,6 +4,11 @@
 /// z of the two-sided 95 % normal interval.
 pub const Z95: f64 = 1.959_963_984_540_054;
 
+/// A share as a percentage with one decimal, as the reports print it.
+pub fn pct(x: f64) -> String {
+    format!("{:.1} %", 100.0 * x)
+}
+
 /// The Wilson score interval of a proportion `k` of `n` at the normal quantile `z`. Chosen
 /// over the normal (Wald) interval because pass rates sit near 1, where Wald's collapses to
 /// zero width, and over Clopper-Pearson because its coverage is close to nominal without

@@ -2,6 +2,7 @@
 //! flight of it flown again with its log), and `sim-host campaign merge` of shards.
 
 use crate::aircraft::Aircraft;
+use crate::campaign::groups;
 use crate::campaign::output::{self, TIMING_FILE};
 use crate::campaign::{Campaign, CampaignSpec, MissionChoice, Report, Shard};
 use crate::flight::plots::write_log_and_plots;
@@ -33,6 +34,8 @@ pub struct CampaignArgs {
     pub out: PathBuf,
     /// Also write the report as this document.
     pub doc: Option<PathBuf>,
+    /// The output of a campaign of the same flights to set beside this one in the document.
+    pub beside: Option<PathBuf>,
 }
 
 /// Wall-clock figures of a run, kept apart from its result (`timing.json`).
@@ -99,6 +102,15 @@ pub fn run_campaign(c: &Campaign, a: &CampaignArgs, progress: bool) -> anyhow::R
     } else {
         a.jobs
     };
+    // Read before flying: a wrong directory is refused before the flights, not after.
+    let beside = match (&a.doc, &a.beside) {
+        (Some(_), Some(dir)) => Some((dir, output::read_campaign(dir)?)),
+        (None, Some(dir)) => anyhow::bail!(
+            "--beside {} sets a campaign beside this one in the document: it needs --doc",
+            dir.display()
+        ),
+        _ => None,
+    };
     let (start, cpu0) = (Instant::now(), cpu_time_s());
     let records = c.run(a.shard, threads, progress)?;
     let (wall_s, cpu_s) = (start.elapsed().as_secs_f64(), cpu_time_s() - cpu0);
@@ -119,8 +131,11 @@ pub fn run_campaign(c: &Campaign, a: &CampaignArgs, progress: bool) -> anyhow::R
     let mut files: Vec<PathBuf> = output::RESULT_FILES.iter().map(|f| a.out.join(f)).collect();
     files.push(a.out.join(TIMING_FILE));
     if let Some(doc) = &a.doc {
-        let (_, records) = output::read_campaign(&a.out)?;
-        files.extend(output::write_doc(doc, &report, &records)?);
+        let (meta, records) = output::read_campaign(&a.out)?;
+        let beside = beside
+            .map(|(dir, (m, r))| groups::beside(&meta, &records, dir, (&m, &r)))
+            .transpose()?;
+        files.extend(output::write_doc(doc, &report, &records, beside.as_ref())?);
     }
     Ok(CampaignRun {
         report,
