@@ -1257,9 +1257,16 @@ fn a_flare_that_sinks_again_after_a_seeming_touch_pitches_up_again() {
     let (level, _, _) = flare_pitch_at(&kicked[..0], 0.3, 0.5, 20.0);
     assert!(level.abs() < 1e-6, "after the kick {level} rad, not level");
     let (pitch, state, p) = flare_pitch_at(&kicked, 0.3, -1.0, 20.0);
+    assert_flare_law(pitch, &state, &p, 0.3, 1.0);
+}
+
+/// The flare's law short of the point, unclamped: `NAV_FLR_PTCH_DEG` plus `NAV_FLR_K` times
+/// the sink (m/s) above the schedule's at height `h` (m), from the approach's sink at this
+/// ground speed to `NAV_FLR_SINK`; `pitch` within 0.05 deg of it.
+fn assert_flare_law(pitch: f32, state: &NavState, p: &NavParams, h: f32, sink: f32) {
     let approach_sink = state.ground_speed() * libm::tanf(p.glide_slope);
-    let aim = p.flare_sink + (approach_sink - p.flare_sink) * (0.3 / p.flare_alt);
-    let expected = p.flare_pitch + p.flare_k * (1.0 - aim);
+    let aim = p.flare_sink + (approach_sink - p.flare_sink) * (h / p.flare_alt);
+    let expected = p.flare_pitch + p.flare_k * (sink - aim);
     assert!(
         (pitch - expected).abs() < 0.05f32.to_radians(),
         "{} deg, expected {} deg",
@@ -1292,16 +1299,7 @@ fn given_the_truth_the_flare_pitches_for_the_true_height_and_sink_not_the_estima
         Some(LonMode::Pitch { pitch, .. }) => pitch,
         other => panic!("flare without a pitch command: {other:?}"),
     };
-    let p = *nav.params();
-    let approach_sink = state.ground_speed() * libm::tanf(p.glide_slope);
-    let aim = p.flare_sink + (approach_sink - p.flare_sink) * (0.5 / p.flare_alt);
-    let expected = p.flare_pitch + p.flare_k * (1.0 - aim);
-    assert!(
-        (pitch - expected).abs() < 0.05f32.to_radians(),
-        "{} deg, expected {} deg",
-        pitch.to_degrees(),
-        expected.to_degrees()
-    );
+    assert_flare_law(pitch, &state, nav.params(), 0.5, 1.0);
 }
 
 /// The truth starts the flare too: 5 m up by the estimate on the approach, 1.4 m by the truth

@@ -438,13 +438,14 @@ pub fn markdown(r: &Report, images: &Images, beside: Option<&super::groups::Besi
          with the same result). Each flight is the firmware's `App` in-process, lock-step, on \
          its own estimator, with the firmware's default parameters: the scripted ground \
          station uploads the mission, sets only `EKF_GPS_DELAY` (the receiver's datasheet \
-         latency, not the drawn one), arms once the estimator has converged on the runway and \
+         latency, not the drawn one; and `SIM_USE_TRUTH` where the campaign file's \
+         `[oracle]` asks for the truth), arms once the estimator has converged on the runway and \
          starts the mission. Every flight's draws follow from the campaign seed and its index \
          alone; each record in `flights.jsonl` carries them, its figures, its verdict and the \
          command that flies it again with its log and plots.\n",
         r.flights,
         m.mission,
-        m.command()
+        m.command() + &beside.map_or(String::new(), |b| format!(" --beside {}", b.dir))
     );
     let (lo, hi) = r.pass_rate_ci95;
     let _ = writeln!(
