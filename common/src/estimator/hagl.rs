@@ -15,6 +15,11 @@
 //! - not stuck: each time the height above home has moved [`STUCK_DH_M`], the range must have
 //!   moved at least [`STUCK_SHARE`] of that, or the sensor is failed until it does again;
 //! - fresh: the last reading through the gates within `EKF_RNG_TOUT`.
+//!
+//! Between readings (20 Hz) and while a reading is held through a dropout, the height above
+//! ground follows the height above home: what is kept is the ground's height the last good
+//! reading saw, not the range, so a held value sinks with the aircraft (a range held for
+//! half a second while a gust dropped the aircraft 2 m kept the flare from starting).
 
 use crate::param;
 use crate::params::{independent, Group, ParamDef};
@@ -86,7 +91,8 @@ pub struct Hagl {
     /// Consecutive usable readings in the window (at most [`WINDOW`]).
     filled: u8,
     next: u8,
-    value: f32,
+    /// The height above home of the ground the last good median saw, m.
+    ground_m: f32,
     last_good_us: Option<u64>,
     /// When the last reading in range came, us.
     last_usable_us: Option<u64>,
@@ -152,16 +158,17 @@ impl Hagl {
             self.rejected = self.rejected.saturating_add(1);
             return;
         }
-        self.value = m;
+        self.ground_m = height_m - m;
         self.last_good_us = Some(t_us);
     }
 
-    /// The height above ground at `t_us`, m, while the readings pass the gates.
-    pub fn value(&self, t_us: u64) -> Option<f32> {
+    /// The height above ground at `t_us`, m, with the aircraft `height_m` above home then,
+    /// while the readings pass the gates.
+    pub fn value(&self, t_us: u64, height_m: f32) -> Option<f32> {
         let fresh = self
             .last_good_us
             .is_some_and(|t| t_us.saturating_sub(t) as f32 * 1e-6 <= self.cfg.timeout_s);
-        (fresh && !self.stuck).then_some(self.value)
+        Some(height_m - self.ground_m).filter(|v| fresh && !self.stuck && v.is_finite())
     }
 
     /// The stuck detector has failed the sensor.
@@ -224,7 +231,7 @@ mod tests {
         (k0..k0 + n)
             .map(|k| {
                 h.update(k * PERIOD_US, &reading(range(k)), 1.0, home(k));
-                h.value(k * PERIOD_US)
+                h.value(k * PERIOD_US, home(k))
             })
             .collect()
     }
@@ -240,13 +247,13 @@ mod tests {
         for k in 5..10 {
             h.update(k * PERIOD_US, &reading(8.0 / c), c, 8.0);
         }
-        let v = h.value(9 * PERIOD_US).unwrap();
+        let v = h.value(9 * PERIOD_US, 8.0).unwrap();
         assert!((v - 8.0).abs() < 1e-4, "{v}");
         // 40 deg of bank is beyond the 30 deg limit: the reading is not used.
         let c40 = libm::cosf(40f32.to_radians());
         h.update(10 * PERIOD_US, &reading(8.0 / c40), c40, 8.0);
         assert_eq!(
-            h.value(21 * PERIOD_US),
+            h.value(21 * PERIOD_US, 8.0),
             None,
             "times out 0.5 s after the last good reading"
         );
@@ -299,10 +306,11 @@ mod tests {
     fn dropouts_time_out_and_zero_or_out_of_range_readings_are_not_used() {
         let mut h = stage();
         feed(&mut h, 0, 10, |_| 3.0, |_| 3.0);
-        assert_eq!(h.value(9 * PERIOD_US), Some(3.0));
-        // Silence: valid for EKF_RNG_TOUT (0.5 s), then not.
-        assert_eq!(h.value(19 * PERIOD_US), Some(3.0));
-        assert_eq!(h.value(20 * PERIOD_US + 1), None);
+        assert_eq!(h.value(9 * PERIOD_US, 3.0), Some(3.0));
+        // Silence: valid for EKF_RNG_TOUT (0.5 s), then not; held meanwhile as the ground's
+        // height, so it follows the height above home (2 m lower: 1 m over the ground).
+        assert_eq!(h.value(19 * PERIOD_US, 1.0), Some(1.0));
+        assert_eq!(h.value(20 * PERIOD_US + 1, 3.0), None);
         // Readings at the minimum (a lost echo some drivers report as 0) and above the maximum
         // (PX4's max + 1 cm) never validate, nor do readings of invalid quality.
         let mut h = stage();
@@ -321,11 +329,12 @@ mod tests {
             };
             h.update(k * PERIOD_US, &s, 1.0, 3.0);
         }
-        assert_eq!(h.value(9 * PERIOD_US), None);
+        assert_eq!(h.value(9 * PERIOD_US, 3.0), None);
         // Non-finite inputs are not used either.
         h.update(0, &reading(f32::NAN), 1.0, 3.0);
         h.update(0, &reading(3.0), f32::NAN, 3.0);
         h.update(0, &reading(3.0), 1.0, f32::NAN);
-        assert_eq!(h.value(0), None);
+        assert_eq!(h.value(0, 3.0), None);
+        assert_eq!(h.value(9 * PERIOD_US, f32::NAN), None);
     }
 }

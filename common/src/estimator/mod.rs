@@ -725,7 +725,7 @@ impl Estimator {
             wind_valid: self.wind.is_initialized(),
             dead_reckoning: self.ins.nav_initialized() && !self.health.gps.healthy,
             converged: self.is_converged(),
-            range_hagl_m: self.hagl.value(self.t_us),
+            range_hagl_m: self.hagl.value(self.t_us, -pos.z),
         }
     }
 }

@@ -1302,6 +1302,48 @@ fn given_the_truth_the_flare_pitches_for_the_true_height_and_sink_not_the_estima
     assert_flare_law(pitch, &state, nav.params(), 0.5, 1.0);
 }
 
+/// A rangefinder that reads 0.8 m more than the estimate's height above the runway (the
+/// estimate low by 0.8 m) moves the approach's slope 0.8 m down in the estimate's frame, so
+/// that it meets the ground the rangefinder sees: after 5 s, five of `RANGE_EXCESS_TAU_S`, the
+/// altitude command is 0.8 m x (1 - e^-5) = 0.795 m under the one flown without it (the
+/// slope's integral trim `NAV_APP_I` off, so that only the rangefinder differs; a larger
+/// difference is taken up as the aircraft sinks, the command held within `NAV_APP_DIVE_M`,
+/// 1 m, under the present height).
+#[test]
+fn a_rangefinder_reading_over_the_estimate_lowers_the_approach_onto_the_ground_it_sees() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let command_with = |extra: Option<f32>| {
+        let mut nav = navigator();
+        let mut p = *nav.params();
+        EXEC_PARAMS.set(&mut p, "NAV_APP_I", 0.0).expect("in range");
+        nav.set_params(&p);
+        let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+        // On the slope, where the command is not held within the dive limit of the height.
+        let on_slope = nav.step(&items, &home(), &plane.state(), DT).guidance;
+        plane.k.pos.z = -on_slope.expect("guidance").altitude;
+        let state = NavState {
+            range_hagl: extra.map(|e| plane.height() + e),
+            ..plane.state()
+        };
+        let mut altitude = f32::NAN;
+        for _ in 0..(5.0 / DT).round() as usize {
+            let out = nav.step(&items, &home(), &state, DT);
+            assert_eq!(out.phase, Phase::Approach);
+            altitude = match out.commands.map(|c| c.lon) {
+                Some(LonMode::Glide { altitude, .. }) => altitude,
+                other => panic!("approach without a glide: {other:?}"),
+            };
+        }
+        altitude
+    };
+    let drop = command_with(None) - command_with(Some(0.8));
+    let expected = 0.8 * (1.0 - (-5.0f32).exp());
+    assert!(
+        (drop - expected).abs() < 0.01,
+        "{drop} m, expected {expected} m"
+    );
+}
+
 /// The truth starts the flare too: 5 m up by the estimate on the approach, 1.4 m by the truth
 /// (under `NAV_FLR_ALT`, 1.5 m), the landing is in its flare; without the truth, not.
 #[test]

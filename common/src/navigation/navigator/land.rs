@@ -106,6 +106,11 @@ fn rollout_pitch(airspeed: f32) -> f32 {
 /// its crosswind corrections too long (`docs/NAVIGATION.md`).
 const FLARE_BANK_M: f32 = 10.0;
 
+/// Time constant over which the approach takes up the difference between the estimate's
+/// height and the rangefinder's, s: a few of the rangefinder's 20 Hz readings after its median,
+/// and short against the 10 to 20 s of an approach within the rangefinder's 40 m.
+const RANGE_EXCESS_TAU_S: f32 = 1.0;
+
 /// Most go-arounds one landing flies; after them it lands whatever the flare brings.
 const GO_AROUNDS_MAX: u8 = 2;
 /// Height a flaring aircraft must climb back to, as a multiple of the flare height, for the
@@ -157,6 +162,11 @@ pub(super) struct Landing {
     rollout_s: f32,
     /// Go-arounds flown.
     go_arounds: u8,
+    /// How far the estimate's height above the land point reads over the rangefinder's, m,
+    /// low-passed over [`RANGE_EXCESS_TAU_S`] and held when the rangefinder is not used: the
+    /// approach flies its slope that much higher in the estimate's frame, so that the slope
+    /// meets the ground the rangefinder sees, where the flare starts (PX4's `FW_LND_USETER` 2).
+    range_excess: f32,
 }
 
 /// How far past the point where the glide slope meets the flare height the flare carries
@@ -193,6 +203,7 @@ impl Landing {
             touched: false,
             rollout_s: 0.0,
             go_arounds: 0,
+            range_excess: 0.0,
         }
     }
 
@@ -278,6 +289,7 @@ impl Landing {
         if (state.pos_ned - c.origin).dot(&Vector3::new(back.x, back.y, 0.0)) >= 0.0 {
             *self = Self {
                 go_arounds: self.go_arounds,
+                range_excess: self.range_excess,
                 ..Self::new(c.origin, self.point)
             };
         }
@@ -313,6 +325,14 @@ impl Landing {
             _ => state.height() + self.point.z,
         };
         let sink_now = state.oracle.map_or(state.vel_ned.z, |o| o.vel_down_mps);
+        // The oracle measures the flare alone: the approach stays on the estimate with it.
+        if let (None, Some(h)) = (state.oracle, state.range_hagl) {
+            let excess = state.height() + self.point.z - h;
+            let k = (dt / RANGE_EXCESS_TAU_S).clamp(0.0, 1.0);
+            if p.land_use_rng && excess.is_finite() && k.is_finite() {
+                self.range_excess += (excess - self.range_excess) * k;
+            }
+        }
         let line =
             Path::line_between(&self.origin, &self.point, p.land_airspeed).unwrap_or(Path::Line {
                 origin: self.point,
@@ -408,7 +428,8 @@ impl Landing {
                 // The altitude loop is proportional: on the slope it settles below it by what
                 // its gain needs to make the pitch the slower approach flies at (a metre on
                 // the Ultra Stick). A slow integral of the height error takes that out.
-                let err = g.altitude - state.height();
+                let slope = g.altitude + self.range_excess;
+                let err = slope - state.height();
                 if climb_rate != 0.0 && libm::fabsf(err) < SLOPE_TRIM_MAX_M {
                     self.slope_trim = (self.slope_trim + p.approach_i * err * dt)
                         .clamp(-SLOPE_TRIM_MAX_M, SLOPE_TRIM_MAX_M);
@@ -416,7 +437,7 @@ impl Landing {
                 // Caught high by a gust near the ground, the aircraft is not dived back onto
                 // the slope (that arrives at the flare sinking fast): the command stays within
                 // `NAV_APP_DIVE_M` below the present height, and the landing is long instead.
-                let cmd = (g.altitude + self.slope_trim).max(state.height() - p.approach_dive);
+                let cmd = (slope + self.slope_trim).max(state.height() - p.approach_dive);
                 out.commands = Some(Commands {
                     roll: course_near_ground(g.course, hagl, p),
                     lon: LonMode::Glide {
