@@ -45,6 +45,9 @@ pub struct RangeParams {
     pub timeout_s: f32,
     /// Least signal quality used (MAVLink's 1-100; 0, unknown, is accepted).
     pub quality_min: u8,
+    /// The rangefinder's height reading with the aircraft on its wheels, m: heights above
+    /// ground count from there, as heights above home count from where the aircraft stood.
+    pub ground_clearance_m: f32,
 }
 
 /// The rangefinder's parameters.
@@ -67,12 +70,17 @@ pub const PARAMS: Group<RangeParams> = Group {
             ParamDef::int("EKF_RNG_QMIN", 10, 0, 100, "%", "Least range signal quality used"),
             RangeParams => quality_min, count
         ),
+        param!(
+            ParamDef::real("EKF_RNG_GND", 0.1, 0.0, 2.0, "m", "Range height reading on the wheels (as ArduPilot's RNGFND1_GNDCLEAR)"),
+            RangeParams => ground_clearance_m
+        ),
     ],
     base: || RangeParams {
         tilt_max: 0.0,
         gate_m: 0.0,
         timeout_s: 0.0,
         quality_min: 0,
+        ground_clearance_m: 0.0,
     },
     check: independent,
 };
@@ -134,7 +142,8 @@ impl Hagl {
             self.anchor = None;
         }
         self.last_usable_us = Some(t_us);
-        let h = s.distance_m * cos_tilt;
+        // Counted from the reading on the wheels, as the height above home is.
+        let h = s.distance_m * cos_tilt - c.ground_clearance_m;
         if let Some(slot) = self.window.get_mut(usize::from(self.next)) {
             *slot = h;
         }
@@ -213,10 +222,29 @@ mod tests {
         }
     }
 
+    /// The stage with the default gates, heights counted from the sensor itself.
     fn stage() -> Hagl {
         let mut h = Hagl::default();
-        h.set_config(RangeParams::default());
+        h.set_config(RangeParams {
+            ground_clearance_m: 0.0,
+            ..RangeParams::default()
+        });
         h
+    }
+
+    /// With `EKF_RNG_GND` at its 0.1 m, the aircraft on its wheels (the sensor 0.1 m over the
+    /// runway, home's height 0) is 0 m above the ground, and 0.1 m lower than the sensor
+    /// anywhere else.
+    #[test]
+    fn heights_above_ground_count_from_the_reading_on_the_wheels() {
+        let mut h = Hagl::default();
+        h.set_config(RangeParams::default());
+        let on_wheels = feed(&mut h, 0, 5, |_| 0.1 + 1e-3, |_| 0.0);
+        let v = on_wheels[4].expect("valid");
+        assert!(libm::fabsf(v - 1e-3) < 1e-6, "{v}");
+        let up = feed(&mut h, 5, 5, |_| 10.1, |_| 10.0);
+        let v = up[4].expect("valid");
+        assert!(libm::fabsf(v - 10.0) < 1e-5, "{v}");
     }
 
     /// Feeds `n` readings at 20 Hz from `k0`: the range from `range(k)`, the height above home
