@@ -422,6 +422,7 @@ impl Vehicle {
             height_m: t.loops.altitude - self.truth_home_m?,
             vel_down_mps: t.vel_down_mps,
         })
+        .filter(|o| o.height_m.is_finite() && o.vel_down_mps.is_finite())
     }
 
     /// Everything after the sensors: requests, parameters, control at 50 Hz.
