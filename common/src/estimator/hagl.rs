@@ -8,8 +8,9 @@
 //! - in range (strictly between the sensor's limits) and of usable signal quality;
 //! - the tilt (angle between the body's z axis and the vertical) under `EKF_RNG_TILT`; the
 //!   slant range times cos(roll) cos(pitch) is the height on flat ground;
-//! - the median of the last [`WINDOW`] consecutive usable readings, so a spike of up to two
-//!   readings never shows;
+//! - the median of the ground's height above home by the last [`WINDOW`] consecutive usable
+//!   readings (the height above home less the range's height), so a spike of up to two
+//!   readings never shows, and the median does not lag a descent as a median of ranges would;
 //! - that median within `EKF_RNG_GATE` of the height above home (the runway is at home's
 //!   altitude): a short echo at 20 m is rejected there;
 //! - not stuck: each time the height above home has moved [`STUCK_DH_M`], the range must have
@@ -95,6 +96,7 @@ impl Default for RangeParams {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Hagl {
     cfg: RangeParams,
+    /// The ground's height above home by each of the last readings, m.
     window: [f32; WINDOW],
     /// Consecutive usable readings in the window (at most [`WINDOW`]).
     filled: u8,
@@ -144,8 +146,11 @@ impl Hagl {
         self.last_usable_us = Some(t_us);
         // Counted from the reading on the wheels, as the height above home is.
         let h = s.distance_m * cos_tilt - c.ground_clearance_m;
+        // The window holds the ground's height above home each reading saw, not the ranges:
+        // its median is then as fresh as the last reading on a descent (a median of ranges
+        // lags two readings, 0.1 s at 20 Hz, and the flare started that late).
         if let Some(slot) = self.window.get_mut(usize::from(self.next)) {
-            *slot = h;
+            *slot = height_m - h;
         }
         self.next = (self.next + 1) % WINDOW as u8;
         self.filled = (self.filled + 1).min(WINDOW as u8);
@@ -160,14 +165,14 @@ impl Hagl {
         if usize::from(self.filled) < WINDOW {
             return;
         }
-        let m = median(self.window);
-        // Written so that a NaN median fails the gate.
-        let consistent = libm::fabsf(m - height_m) <= c.gate_m;
+        let ground = median(self.window);
+        // Written so that a NaN median fails the gate: the runway is at home's height.
+        let consistent = libm::fabsf(ground) <= c.gate_m;
         if self.stuck || !consistent {
             self.rejected = self.rejected.saturating_add(1);
             return;
         }
-        self.ground_m = height_m - m;
+        self.ground_m = ground;
         self.last_good_us = Some(t_us);
     }
 
@@ -285,6 +290,24 @@ mod tests {
             None,
             "times out 0.5 s after the last good reading"
         );
+    }
+
+    /// Sinking at 1.5 m/s from 6 m with exact readings at 20 Hz, the height above ground is
+    /// the true height at every reading once valid: a median of the ranges themselves would
+    /// read two readings (0.15 m) high.
+    #[test]
+    fn on_a_descent_the_height_above_ground_does_not_lag() {
+        let mut h = stage();
+        let height = |k: u64| 6.0 - 1.5 * k as f32 * 0.05;
+        let out = feed(&mut h, 0, 30, height, height);
+        for (k, v) in out.iter().enumerate().skip(4) {
+            let v = v.expect("valid");
+            let truth = height(k as u64);
+            assert!(
+                libm::fabsf(v - truth) < 1e-4,
+                "reading {k}: {v} for {truth}"
+            );
+        }
     }
 
     #[test]
