@@ -11,7 +11,7 @@ use sim_host::aircraft::Aircraft;
 use sim_host::commands::fly::{fly_report, FlyOptions};
 use sim_host::flight::criteria::{SINK_MPS, TOUCHDOWN_M};
 use sim_host::flight::missions::{default_mission, runway_mission};
-use sim_host::flight::{Fault, FaultWindow, FlightOutcome, Sample};
+use sim_host::flight::{Fault, FaultWindow, FlightConfig, FlightOutcome, Sample};
 use sim_host::plant::ModelParams;
 use sim_host::sensors::models::RangeFault;
 use sim_host::sensors::RangefinderConfig;
@@ -28,23 +28,31 @@ const LATE_MARGIN_M: f64 = 0.7;
 /// Pitch under the approach's least pitch that the final descent may show, deg.
 const PITCH_MARGIN_DEG: f64 = 1.0;
 
-/// The default mission from the runway with a rangefinder, failed as `fault` from `from_s`.
-fn landing(fault: Option<(RangeFault, f64)>) -> (FlightOutcome, f64) {
+/// The default mission from the runway, the built-in aircraft and the flight changed by
+/// `change`; the flight and the runway's altitude above sea level.
+fn fly_mission(change: impl FnOnce(&mut Aircraft, &mut FlightConfig)) -> (FlightOutcome, f64) {
     let mut a = Aircraft::ultrastick25e().expect("built-in aircraft");
-    a.sensors.rangefinder = Some(RangefinderConfig::default());
-    let home_alt = ModelParams::new(&a).home_alt_msl_m;
     let mut cfg = runway_mission(default_mission(ModelParams::new(&a).home));
-    if let Some((kind, from_s)) = fault {
-        cfg.faults.push(FaultWindow {
-            fault: Fault::Range(kind),
-            from_s,
-            to_s: f64::INFINITY,
-        });
-    }
+    change(&mut a, &mut cfg);
+    let home_alt = ModelParams::new(&a).home_alt_msl_m;
     let o = fly_report(&a, &cfg, &FlyOptions::default())
         .expect("flight")
         .outcome;
     (o, home_alt)
+}
+
+/// The default mission from the runway with a rangefinder, failed as `fault` from `from_s`.
+fn landing(fault: Option<(RangeFault, f64)>) -> (FlightOutcome, f64) {
+    fly_mission(|a, cfg| {
+        a.sensors.rangefinder = Some(RangefinderConfig::default());
+        if let Some((kind, from_s)) = fault {
+            cfg.faults.push(FaultWindow {
+                fault: Fault::Range(kind),
+                from_s,
+                to_s: f64::INFINITY,
+            });
+        }
+    })
 }
 
 fn in_phase(s: &Sample, p: Phase) -> bool {
@@ -174,14 +182,10 @@ fn a_dropping_rangefinder_never_flares_early() {
 /// of the flight's samples (as much again), and the landing meets the criteria.
 #[test]
 fn given_the_truth_the_flare_starts_at_the_true_flare_height_to_a_period_of_sink() {
-    let mut a = Aircraft::ultrastick25e().expect("built-in aircraft");
-    a.sensors.gps.startup_offset_m = [0.0, 0.0, 5.0];
-    let home_alt = ModelParams::new(&a).home_alt_msl_m;
-    let mut cfg = runway_mission(default_mission(ModelParams::new(&a).home));
-    cfg.script.params.push(("SIM_USE_TRUTH".into(), 2.0));
-    let o = fly_report(&a, &cfg, &FlyOptions::default())
-        .expect("flight")
-        .outcome;
+    let (o, home_alt) = fly_mission(|a, cfg| {
+        a.sensors.gps.startup_offset_m = [0.0, 0.0, 5.0];
+        cfg.script.params.push(("SIM_USE_TRUTH".into(), 2.0));
+    });
     let armed_at = o.samples.iter().find(|x| x.armed).expect("armed").alt;
     let l = landing_figures(&o, armed_at);
     let flare_alt = default_of("NAV_FLR_ALT");
