@@ -173,7 +173,7 @@ pub struct MissionSpec {
 }
 
 /// The downward rangefinder.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct RangefinderSpec {
     /// Share of the flights whose aircraft carries one (the aircraft file's, or a LIDAR-Lite
@@ -217,12 +217,6 @@ pub struct CampaignSpec {
     pub rangefinder: RangefinderSpec,
     /// Truth given to the autopilot.
     pub oracle: OracleSpec,
-}
-
-impl Default for RangefinderSpec {
-    fn default() -> Self {
-        Self { fitted_share: 0.0 }
-    }
 }
 
 impl Default for AeroSpec {
