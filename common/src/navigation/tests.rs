@@ -1576,3 +1576,59 @@ fn a_leg_from_the_present_position_is_joined_without_overshooting_its_line() {
     let bound = 17.0 * 1.0 * libm::sinf(15f32.to_radians());
     assert!(straight_xt < bound, "{straight_xt} m off the straight leg");
 }
+
+/// With `NAV_FLR_TIME` 3 s the flare begins where the glide slope's sink at the ground speed
+/// (15 m/s on the 6 deg slope: 1.577 m/s) brings the ground within 3 s: 4.73 m, over the
+/// 4 m `NAV_FLR_ALT`; with it 0 the flare waits for 4 m. A downdraft's sink does not bring
+/// it forward.
+#[test]
+fn a_fast_approach_flares_where_the_ground_is_nav_flr_time_away() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let phase_at = |flare_time: f32, h: f32, sink: f32| {
+        let mut nav = navigator();
+        let mut p = *nav.params();
+        EXEC_PARAMS
+            .set(&mut p, "NAV_FLR_TIME", flare_time)
+            .expect("in range");
+        nav.set_params(&p);
+        let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+        plane.k.pos = Vector3::new(80.0, 0.0, -h);
+        plane.k.airspeed = 15.0;
+        plane.climb = -sink;
+        nav.step(&items, &home(), &plane.state(), DT).phase
+    };
+    assert_eq!(phase_at(3.0, 4.70, 1.58), Phase::Flare);
+    assert_eq!(phase_at(3.0, 4.76, 1.58), Phase::Approach);
+    assert_eq!(phase_at(0.0, 4.70, 1.58), Phase::Approach);
+    assert_eq!(phase_at(0.0, 3.99, 1.58), Phase::Flare);
+    assert_eq!(phase_at(1.0, 4.70, 5.0), Phase::Approach, "in a downdraft");
+}
+
+/// The approach's airspeed command in steady air: `NAV_LND_ASPD` (15 m/s) plus
+/// `NAV_LND_WIND_K` (0.5) times the 2 m/s wind: 16 m/s; in a 6 m/s wind the cruise airspeed's 17 m/s.
+#[test]
+fn the_approach_is_flown_half_the_wind_faster_up_to_the_cruise_airspeed() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let approach_airspeed = |wind: f32| {
+        let mut nav = navigator();
+        let mut p = *nav.params();
+        EXEC_PARAMS
+            .set(&mut p, "NAV_LND_WIND_K", 0.5)
+            .expect("in range");
+        // The test aircraft's deceleration onto the approach would read as gusts.
+        EXEC_PARAMS
+            .set(&mut p, "NAV_LND_GUST_K", 0.0)
+            .expect("in range");
+        nav.set_params(&p);
+        let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+        plane.k.wind = Vector3::new(wind, 0.0, 0.0);
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        match out.commands.map(|c| c.lon) {
+            Some(LonMode::Altitude { airspeed, .. } | LonMode::Glide { airspeed, .. }) => airspeed,
+            other => panic!("no approach command: {other:?}"),
+        }
+    };
+    assert!((approach_airspeed(0.0) - 15.0).abs() < 1e-4);
+    assert!((approach_airspeed(2.0) - 16.0).abs() < 1e-4);
+    assert!((approach_airspeed(6.0) - 17.0).abs() < 1e-4);
+}

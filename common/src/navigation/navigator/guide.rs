@@ -85,6 +85,8 @@ pub(super) struct Flight<'a> {
     pub dt: f32,
     /// Airspeed of the legs and circles, m/s: `DO_CHANGE_SPEED`'s, or `NAV_ASPD`.
     pub cruise: f32,
+    /// The airspeed's gust level, m/s (its standard deviation about its slow mean).
+    pub gust: f32,
 }
 
 impl Flight<'_> {
@@ -157,6 +159,40 @@ mod tests {
                 RollMode::Course(0.3),
                 "at {h} m"
             );
+        }
+    }
+
+    /// A 2.9 m wing whose tip touches the ground at 8 deg of bank on its wheels (about the
+    /// Aerosonde's span): the bank that keeps half the tip's clearance, asin((sin 8 deg +
+    /// 2h/2.9) / 2), governs where it is the narrower: 9.96 deg at 0.3 m (the height law
+    /// allows 13.5), 35.9 deg at 1.5 m (47.5); at 5 m neither limits. The Ultra Stick's
+    /// 1.27 m wing and 17 deg leave the height law governing (8.4 deg on the ground).
+    #[test]
+    fn a_long_wing_banks_near_the_ground_no_more_than_keeps_half_its_tip_clearance() {
+        let p = NavParams {
+            wing_span: 2.9,
+            tip_ground_bank: 8.0_f32.to_radians(),
+            ..NavParams::default()
+        };
+        for (h, expected) in [(0.3, 9.96), (1.5, 35.9)] {
+            match course_near_ground(0.3, h, &p) {
+                RollMode::CourseWithin { roll_max, .. } => assert!(
+                    (roll_max.to_degrees() - expected).abs() < 0.05,
+                    "at {h} m: {} deg",
+                    roll_max.to_degrees()
+                ),
+                other => panic!("at {h} m: {other:?}"),
+            }
+        }
+        assert_eq!(course_near_ground(0.3, 5.0, &p), RollMode::Course(0.3));
+        let ultra_stick = NavParams::default();
+        let on_ground = ultra_stick.bank_for_tip_clearance(0.0).expect("a limit");
+        assert!((on_ground.to_degrees() - 8.41).abs() < 0.05, "{on_ground}");
+        for h in [0.0, 0.3, 1.0, 2.0, 2.9] {
+            let linear = ultra_stick.ground_roll_max
+                + (90.0f32.to_radians() - ultra_stick.ground_roll_max) * h / 3.0;
+            let allowed = ultra_stick.bank_near_ground(h, 3.0).expect("a limit");
+            assert!((allowed - linear).abs() < 1e-6, "at {h} m: {allowed} rad");
         }
     }
 }

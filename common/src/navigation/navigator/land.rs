@@ -17,7 +17,10 @@
 //!
 //! The height the flare is triggered on and flown by is the rangefinder's height above ground
 //! while it passes the estimator's gates (`estimator::hagl`) and `NAV_LND_USE_RNG` is set, else
-//! the height above the land point, as without a rangefinder.
+//! the height above the land point, as without a rangefinder. The flare begins at `NAV_FLR_ALT`,
+//! or earlier where the sink rate brings the ground within `NAV_FLR_TIME`; the approach is
+//! flown at `NAV_LND_ASPD`, faster in wind and gusts (`NAV_LND_WIND_K`, `NAV_LND_GUST_K`:
+//! the gust meter of `gust.rs`).
 //!
 //! A flare still in the air `NAV_LND_ABORT_M` past the point (floated, or bounced off the
 //! runway) or lifted out of itself by a gust goes around, as a pilot does after a bounce:
@@ -28,6 +31,7 @@
 //! `GO_AROUNDS_MAX` go-arounds the landing lands whatever its flare brings.
 
 use super::guide::{course_near_ground, course_widening, follow, horizontal_dist, Flight};
+use super::gust::approach_airspeed;
 use super::io::{NavOutput, Phase};
 use super::params::NavParams;
 use crate::control::autopilot::Commands;
@@ -167,27 +171,44 @@ pub(super) struct Landing {
     /// approach flies its slope that much higher in the estimate's frame, so that the slope
     /// meets the ground the rangefinder sees, where the flare starts (PX4's `FW_LND_USETER` 2).
     range_excess: f32,
+    /// Height the flare began at, m: `NAV_FLR_ALT`, or higher when the sink rate brought the
+    /// ground within `NAV_FLR_TIME` first (0 before a flare).
+    flare_top: f32,
 }
 
 /// How far past the point where the glide slope meets the flare height the flare carries
 /// the aircraft at `ground_speed` (m/s) along the approach, m. The flare's sink rate falls
 /// linearly with height from the slope's `s_a` to the touchdown's `s_t` over the flare
-/// height `h_f`: height decays as `e^(-t/tau)` towards `-s_t tau` with `tau = h_f /
+/// height `h_f` ([`flare_height`] at the slope's sink): height decays as `e^(-t/tau)` towards `-s_t tau` with `tau = h_f /
 /// (s_a - s_t)`, reaching the ground after `tau ln(s_a / s_t)`.
 fn flare_overrun(p: &NavParams, ground_speed: f32) -> f32 {
     let tan_slope = libm::tanf(p.glide_slope);
     let s_a = ground_speed * tan_slope;
     let s_t = p.flare_sink;
-    if !(s_a > s_t && s_t > 0.0 && tan_slope > 0.0 && p.flare_alt > 0.0) {
+    let h_f = flare_height(p, s_a);
+    if !(s_a > s_t && s_t > 0.0 && tan_slope > 0.0 && h_f > 0.0) {
         return 0.0;
     }
-    let tau = p.flare_alt / (s_a - s_t);
+    let tau = h_f / (s_a - s_t);
     let flare_m = ground_speed * tau * libm::logf(s_a / s_t);
-    let overrun = flare_m - p.flare_alt / tan_slope;
+    let overrun = flare_m - h_f / tan_slope;
     if overrun.is_finite() {
         overrun.max(0.0)
     } else {
         0.0
+    }
+}
+
+/// Height the flare begins at, m: `NAV_FLR_ALT`, or where the ground is `NAV_FLR_TIME` away
+/// at the sink rate `sink` (m/s, down positive) when that is higher (PX4's `FW_LND_FL_TIME`,
+/// ArduPlane's `LAND_FLARE_SEC`): a faster or steeper approach flares higher, so that the
+/// flare has the time it needs to arrest the sink.
+fn flare_height(p: &NavParams, sink: f32) -> f32 {
+    let by_time = p.flare_time * sink;
+    if by_time.is_finite() {
+        p.flare_alt.max(by_time)
+    } else {
+        p.flare_alt
     }
 }
 
@@ -204,6 +225,7 @@ impl Landing {
             rollout_s: 0.0,
             go_arounds: 0,
             range_excess: 0.0,
+            flare_top: 0.0,
         }
     }
 
@@ -333,12 +355,12 @@ impl Landing {
                 self.range_excess += (excess - self.range_excess) * k;
             }
         }
-        let line =
-            Path::line_between(&self.origin, &self.point, p.land_airspeed).unwrap_or(Path::Line {
-                origin: self.point,
-                direction: Vector3::x(),
-                airspeed: p.land_airspeed,
-            });
+        let airspeed = approach_airspeed(p, state.wind_speed, f.gust);
+        let line = Path::line_between(&self.origin, &self.point, airspeed).unwrap_or(Path::Line {
+            origin: self.point,
+            direction: Vector3::x(),
+            airspeed,
+        });
         if matches!(self.phase, LandPhase::Climb | LandPhase::Downwind) {
             self.step_circuit(f, &line, out);
             return;
@@ -380,9 +402,15 @@ impl Landing {
         };
         out.guidance = Some(g);
         out.target = Some(self.point);
-        if self.phase == LandPhase::Approach && hagl < p.flare_alt {
+        // On the slope's sink at the present ground speed, not the measured sink: a 0.2 s
+        // downdraft's sink on short final flared aircraft at 2-3 m in moderate turbulence,
+        // and they touched down harder (hard landings 44 -> 67 of 300, docs/NAVIGATION.md).
+        let flare_h = flare_height(p, along * tan_slope);
+        if self.phase == LandPhase::Approach && hagl < flare_h {
             self.phase = LandPhase::Flare;
+            self.flare_top = flare_h;
         }
+        let flare_top = self.flare_top.max(p.flare_alt);
         // Lifted off the runway by a gust after the touchdown, the aircraft is flying again:
         // the flare, not the roll-out's level pitch, brings it back down.
         if self.phase == LandPhase::Landed && hagl > p.touchdown_alt && sink_now < -BOUNCE_CLIMB {
@@ -415,7 +443,7 @@ impl Landing {
             let flying = state.airspeed >= GO_AROUND_AIRSPEED;
             if flying
                 && self.rollout_s == 0.0
-                && (long && airborne || hagl > BALLOON_FLARES * p.flare_alt)
+                && (long && airborne || hagl > BALLOON_FLARES * flare_top)
                 && self.go_around()
             {
                 self.step_circuit(f, &line, out);
@@ -453,7 +481,7 @@ impl Landing {
                 // The sink rate aimed for shrinks from the glide's to the touchdown's with
                 // height; pitch up as the aircraft sinks faster than that.
                 let approach_sink = along * tan_slope;
-                let frac = (hagl / p.flare_alt).clamp(0.0, 1.0);
+                let frac = (hagl / flare_top).clamp(0.0, 1.0);
                 let aim = p.flare_sink + (approach_sink - p.flare_sink).max(0.0) * frac;
                 // Floating past the point (a gust's extra speed at the flare), the flare gives
                 // up on the gentlest touchdown for a nearer one: a faster sink aimed for the

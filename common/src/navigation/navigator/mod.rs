@@ -27,6 +27,7 @@
 //! `DO_CHANGE_SPEED` of ground speed sets the airspeed), terrain, rally points.
 
 mod guide;
+mod gust;
 pub mod io;
 pub mod land;
 pub mod loiter;
@@ -36,6 +37,7 @@ pub mod rtl;
 pub mod takeoff;
 
 use self::guide::{horizontal_dist, Flight, Orbit};
+use self::gust::GustMeter;
 use self::io::{GroundStage, NavOutput, NavState, Phase};
 use self::land::Landing;
 use self::loiter::Loiter;
@@ -84,6 +86,8 @@ pub struct Navigator {
     runway: Option<f32>,
     home: Option<Home>,
     request: Option<Request>,
+    /// The airspeed's gust level, measured on every step.
+    gust: GustMeter,
 }
 
 impl Default for Navigator {
@@ -108,6 +112,7 @@ impl Navigator {
             runway: None,
             home: None,
             request: None,
+            gust: GustMeter::default(),
         }
     }
 
@@ -255,6 +260,7 @@ impl Navigator {
             }
             None => {}
         }
+        self.gust.update(state.airspeed, dt);
         self.fly(items, home, state, dt, &mut out);
         out.current_seq = self.mission.seq;
         if let Some(t) = out.target {
@@ -370,6 +376,7 @@ impl Navigator {
             state,
             dt,
             cruise: self.mission.cruise(&self.params),
+            gust: self.gust.sigma(),
         };
         let seq = self.mission.seq;
         match self.active {

@@ -162,6 +162,28 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_LND_WIND_K",
+                0.0,
+                0.0,
+                2.0,
+                "",
+                "Approach airspeed added per m/s of the estimated wind (PX4's FW_WIND_ARSP_SC), up to NAV_ASPD",
+            ),
+            NavParams => land_wind_k
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LND_GUST_K",
+                1.0,
+                0.0,
+                3.0,
+                "",
+                "Approach airspeed added per m/s of the gusts (the airspeed's standard deviation about its 2 s mean, over 10 s), up to NAV_ASPD",
+            ),
+            NavParams => land_gust_k
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_FLR_ALT",
                 1.5,
                 0.5,
@@ -170,6 +192,17 @@ pub const PARAMS: Group<NavParams> = Group {
                 "Flare below this height above the land point",
             ),
             NavParams => flare_alt
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_FLR_TIME",
+                1.0,
+                0.0,
+                5.0,
+                "s",
+                "Flare also where the ground is this close in time at the glide slope's sink rate at the present ground speed (PX4's FW_LND_FL_TIME; 0: on height alone)",
+            ),
+            NavParams => flare_time
         ),
         param!(
             ParamDef::real(
@@ -342,6 +375,28 @@ pub const PARAMS: Group<NavParams> = Group {
             ),
             NavParams => ground_roll_height
         ),
+        param!(
+            ParamDef::real(
+                "NAV_SPAN_M",
+                1.27,
+                0.2,
+                20.0,
+                "m",
+                "Wing span: with NAV_TIP_GND_DEG, how high the wheels must be for a bank near the ground (the wing tips keep half their clearance)",
+            ),
+            NavParams => wing_span
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TIP_GND_DEG",
+                17.0,
+                1.0,
+                45.0,
+                "deg",
+                "Bank at which a wing tip touches the ground with the wheels on it (measured on the aircraft at rest)",
+            ),
+            NavParams => tip_ground_bank, unit DEG
+        ),
     ],
     base: || ZERO,
     check: consistent,
@@ -390,6 +445,12 @@ pub struct NavParams {
     pub land_airspeed: f32,
     /// Flare height, m.
     pub flare_alt: f32,
+    /// Flare time to touchdown, s (0: height alone).
+    pub flare_time: f32,
+    /// Approach airspeed added per m/s of wind.
+    pub land_wind_k: f32,
+    /// Approach airspeed added per m/s of gust level.
+    pub land_gust_k: f32,
     /// Flare pitch, rad.
     pub flare_pitch: f32,
     /// Touchdown sink rate, m/s.
@@ -408,6 +469,10 @@ pub struct NavParams {
     pub ground_roll_max: f32,
     /// Height at which the bank allowed near the ground has widened to 90 deg, m.
     pub ground_roll_height: f32,
+    /// Wing span, m.
+    pub wing_span: f32,
+    /// Bank at which a wing tip touches the ground on the wheels, rad.
+    pub tip_ground_bank: f32,
     /// Approach integral gain on the height error, 1/s.
     pub approach_i: f32,
     /// Largest height the approach's command lies below the present height, m.
@@ -437,6 +502,9 @@ const ZERO: NavParams = NavParams {
     glide_slope: 0.0,
     land_airspeed: 0.0,
     flare_alt: 0.0,
+    flare_time: 0.0,
+    land_wind_k: 0.0,
+    land_gust_k: 0.0,
     flare_pitch: 0.0,
     flare_sink: 0.0,
     flare_k: 0.0,
@@ -446,6 +514,8 @@ const ZERO: NavParams = NavParams {
     takeoff_to_item: false,
     ground_roll_max: 0.0,
     ground_roll_height: 0.0,
+    wing_span: 0.0,
+    tip_ground_bank: 0.0,
     approach_i: 0.0,
     approach_dive: 0.0,
     flare_past_k: 0.0,
@@ -463,13 +533,37 @@ impl NavParams {
     /// widening linearly to 90 deg at `widen_m` (m; `NAV_GND_RLL_M` near the ground, more in
     /// the flare). `None` from there up, where the roll limit alone governs, and for an
     /// unknown height.
+    ///
+    /// No wider either than the bank that leaves a wing tip half the clearance it has wings
+    /// level ([`NavParams::bank_for_tip_clearance`]): the span, not a tuned height, bounds a
+    /// large aircraft's bank.
     pub fn bank_near_ground(&self, height: f32, widen_m: f32) -> Option<f32> {
         let frac = if widen_m > 0.0 && height.is_finite() {
             (height / widen_m).clamp(0.0, 1.0)
         } else {
             1.0
         };
-        (frac < 1.0).then_some(self.ground_roll_max + (90.0 * DEG - self.ground_roll_max) * frac)
+        let linear = (frac < 1.0)
+            .then_some(self.ground_roll_max + (90.0 * DEG - self.ground_roll_max) * frac);
+        match (linear, self.bank_for_tip_clearance(height)) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The bank at `height` (m, the wheels above the ground) that leaves the lower wing tip
+    /// half the clearance it has wings level, rad; `None` where that is no limit (or the
+    /// height is unknown). Wings level with the wheels on the ground the tip is
+    /// `b/2 sin(phi_0)` up (`NAV_SPAN_M` = b, `NAV_TIP_GND_DEG` = phi_0); at height `h` it is
+    /// `h + b/2 sin(phi_0)` up and a bank `phi` lowers it by `b/2 sin(phi)`, so the bank
+    /// allowed is `asin((sin(phi_0) + 2h/b) / 2)`.
+    pub fn bank_for_tip_clearance(&self, height: f32) -> Option<f32> {
+        let half_span = 0.5 * self.wing_span;
+        if !(height.is_finite() && half_span > 0.0) {
+            return None;
+        }
+        let sin = 0.5 * (libm::sinf(self.tip_ground_bank) + height.max(0.0) / half_span);
+        (sin < 1.0).then(|| libm::asinf(sin))
     }
 }
 
