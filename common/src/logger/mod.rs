@@ -80,6 +80,7 @@ logged! {
     BatteryStatus => 1,
     MissionResult => 1,
     TelemetryStatus => 1,
+    DistanceSensor => 10,
 }
 
 /// What identifies the log's system (ULog information messages).

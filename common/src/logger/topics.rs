@@ -249,6 +249,23 @@ ulog_topic! {
 }
 
 ulog_topic! {
+    /// The downward rangefinder's readings as received (PX4's fields; written while readings
+    /// arrive, none without a rangefinder).
+    DistanceSensor = "distance_sensor" {
+        /// Distance along the sensor's axis, m (at or over `max_distance`: no echo in range).
+        current_distance: f32,
+        /// Shortest distance the sensor measures, m.
+        min_distance: f32,
+        /// Longest distance the sensor measures, m.
+        max_distance: f32,
+        /// Signal quality: -1 unknown, 0 invalid, 1..100 poor to perfect (PX4's scale).
+        signal_quality: i8,
+        /// MAV_SENSOR_ORIENTATION: 25, pitch 270 (downward).
+        orientation: u8,
+    }
+}
+
+ulog_topic! {
     /// The flight pack.
     BatteryStatus = "battery_status" {
         /// Voltage, V.

@@ -234,6 +234,28 @@ impl Vehicle {
                 },
             );
         }
+        // A reading within the last half second (a rangefinder reads at 10-50 Hz): none once
+        // it has gone quiet.
+        let range = self
+            .last_range
+            .filter(|&(t, _)| now.saturating_sub(t) <= 500_000 && log.due::<DistanceSensor>(now));
+        if let Some((_, r)) = range {
+            log.write(
+                now,
+                &DistanceSensor {
+                    current_distance: r.distance_m,
+                    min_distance: r.min_m,
+                    max_distance: r.max_m,
+                    // MAVLink's 0 (unknown) and 1 (invalid) are PX4's -1 and 0.
+                    signal_quality: match r.quality {
+                        0 => -1,
+                        1 => 0,
+                        q => i8::try_from(q.min(100)).unwrap_or(100),
+                    },
+                    orientation: 25,
+                },
+            );
+        }
         if log.due::<BatteryStatus>(now) {
             let b = self.battery.report(Some(now));
             log.write(

@@ -122,6 +122,8 @@ pub struct Vehicle {
     last_imu_us: Option<u64>,
     last_control_us: Option<u64>,
     last_gps: Option<GpsFix>,
+    /// The last rangefinder reading and the vehicle's time it came at, us (for the log).
+    last_range: Option<(u64, RangeSample)>,
     truth: Option<TruthSample>,
     /// Home's true altitude above mean sea level, m: the truth's altitude when home was last
     /// put (less the estimate's height above it then), for the flare's oracle.
@@ -174,6 +176,7 @@ impl Vehicle {
             last_imu_us: None,
             last_control_us: None,
             last_gps: None,
+            last_range: None,
             truth: None,
             truth_home_m: None,
             surfaces: trim_surfaces(&GainSet::default()),
@@ -365,6 +368,7 @@ impl Vehicle {
     /// A reading of the downward rangefinder.
     pub fn on_range(&mut self, s: &RangeSample) {
         self.estimator.update_range(s);
+        self.last_range = self.clock.now_us().map(|t| (t, *s));
     }
 
     /// What the battery monitor knows now.

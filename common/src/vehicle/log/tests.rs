@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 
 use super::*;
 use crate::logger::{Logged, SystemInfo, TOPICS};
-use crate::sensors::{BaroSample, ImuSample};
+use crate::sensors::{BaroSample, ImuSample, RangeSample};
 use crate::ulog::topic::Topic;
 use crate::vehicle::FromGround;
 
@@ -111,9 +111,67 @@ fn a_vehicle_on_the_ground_logs_its_sensors_as_received_and_its_state_in_px4s_nu
             "vehicle_magnetometer",
             "vehicle_gps_position",
             "telemetry_status",
+            "distance_sensor",
         ];
         if !without_data.contains(&f.name) {
             assert!(!samples(&bytes, i as u16).is_empty(), "{}", f.name);
         }
+    }
+}
+
+/// A rangefinder read at 20 Hz is logged as PX4's `distance_sensor` at its 10 Hz, each sample
+/// as received (distance, limits, MAVLink's quality 80 as PX4's 80, orientation 25); once the
+/// readings stop, half a second later, so does the topic.
+#[test]
+fn rangefinder_readings_are_logged_as_distance_sensor_while_they_arrive() {
+    let mut v = Vehicle::new();
+    let mut log = Logger::new(SystemInfo {
+        sys_name: "test",
+        ver_sw: "0",
+        ver_hw: "host",
+    });
+    log.start(0);
+    let mut bytes = Vec::new();
+    for k in 0..400u64 {
+        let f = SensorFrame {
+            time_us: k * 10_000,
+            imu: Some(ImuSample {
+                accel: Vector3::new(0.0, 0.0, -9.8),
+                gyro: Vector3::zeros(),
+            }),
+            ..Default::default()
+        };
+        v.on_sensors(&f, &FromGround::default());
+        // Readings at 20 Hz for the first 2 s.
+        if k % 5 == 0 && k < 200 {
+            v.on_range(&RangeSample {
+                distance_m: 0.25 + 0.001 * k as f32,
+                min_m: 0.05,
+                max_m: 40.0,
+                quality: 80,
+            });
+        }
+        log.step(f.time_us, v.params());
+        v.write_log(&mut log, &f);
+        while log.pending_len() > 0 {
+            let n = log.pending().len();
+            bytes.extend_from_slice(log.pending());
+            log.consume(n);
+        }
+    }
+    let range = samples(&bytes, DistanceSensor::ID);
+    assert_eq!(range[0].1.len() + 8, DistanceSensor::FORMAT.size());
+    // 10 Hz over the 2 s of readings and the half second after them, less the definitions'.
+    assert!((18..=26).contains(&range.len()), "{} samples", range.len());
+    let last = range.last().map_or(0, |(t, _)| *t);
+    assert!((1_990_000..=2_500_000).contains(&last), "last at {last} us");
+    for (t, p) in &range {
+        let k = (*t / 50_000 * 5).min(195);
+        assert!(
+            (f32_at(p, 0) - (0.25 + 0.001 * k as f32)).abs() < 1e-6,
+            "at {t} us"
+        );
+        assert_eq!([f32_at(p, 4), f32_at(p, 8)], [0.05, 40.0]);
+        assert_eq!([p[12], p[13]], [80, 25]);
     }
 }
