@@ -44,7 +44,7 @@ impl Output {
 pub(crate) struct Airspeed {
     /// Trim airspeed, m/s (default: the aircraft file's `[performance] cruise_airspeed_mps`,
     /// else the thesis's 17 m/s).
-    #[arg(long, value_name = "M/S", value_parser = positive_airspeed)]
+    #[arg(long, value_name = "M/S", value_parser = positive_airspeed, allow_negative_numbers = true)]
     pub(crate) airspeed: Option<f64>,
 }
 
