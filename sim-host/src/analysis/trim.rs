@@ -398,3 +398,18 @@ fn solve(p: &ModelParams, target: &TrimTarget, mut z: Z) -> TrimResult {
         controls,
     }
 }
+
+/// Why a trim failed, in words a user can act on.
+pub fn not_trimmed(trim: &TrimResult) -> String {
+    format!(
+        "the aircraft cannot be trimmed for `{}` at {} m/s: the solver stopped at residual {:.3e} \
+         (alpha {:.3} rad, elevator {:.3} rad, throttle {:.3}); try an airspeed nearer the \
+         aircraft's cruise",
+        trim.target.name,
+        trim.target.va_mps,
+        trim.residual_norm,
+        trim.alpha,
+        trim.elevator,
+        trim.throttle
+    )
+}

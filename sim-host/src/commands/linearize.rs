@@ -10,7 +10,7 @@ use crate::analysis::references as refs;
 use crate::analysis::transfer::{
     thesis_transfer_functions, ThesisTransferFunctions, TransferFunction,
 };
-use crate::analysis::trim::{trim_with, TrimResult, TrimTarget};
+use crate::analysis::trim::{not_trimmed, trim_with, TrimResult, TrimTarget};
 use crate::plant::params::ModelParams;
 use crate::report::table::Table;
 use crate::report::{pct, sig};
@@ -339,21 +339,6 @@ pub fn linearize_report_at(
         reduced_closed_form,
         tables,
     })
-}
-
-/// Why a trim failed, in words a user can act on.
-pub fn not_trimmed(trim: &TrimResult) -> String {
-    format!(
-        "the aircraft cannot be trimmed for `{}` at {} m/s: the solver stopped at residual {:.3e} \
-         (alpha {:.3} rad, elevator {:.3} rad, throttle {:.3}); try an airspeed nearer the \
-         aircraft's cruise",
-        trim.target.name,
-        trim.target.va_mps,
-        trim.residual_norm,
-        trim.alpha,
-        trim.elevator,
-        trim.throttle
-    )
 }
 
 /// Beard and McLain's reduced-model coefficients, from the linear model and from their

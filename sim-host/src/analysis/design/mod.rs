@@ -136,10 +136,7 @@ pub fn design_at(
     let params = ModelParams::new(aircraft);
     let trim: TrimResult = trim_with(&params, &TrimTarget::level().at_airspeed(va_mps));
     if !trim.converged {
-        anyhow::bail!(
-            "{}; cannot design",
-            crate::commands::linearize::not_trimmed(&trim)
-        );
+        anyhow::bail!("{}; cannot design", super::trim::not_trimmed(&trim));
     }
     let lin: Linearization = linearize(&params, &trim);
     let va = trim.target.va_mps;
