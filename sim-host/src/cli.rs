@@ -40,10 +40,43 @@ impl Output {
     }
 }
 
+#[derive(Clone, Copy, clap::Args)]
+pub(crate) struct Airspeed {
+    /// Trim airspeed, m/s (default: the aircraft file's `[performance] cruise_airspeed_mps`,
+    /// else the thesis's 17 m/s).
+    #[arg(long, value_name = "M/S", value_parser = positive_airspeed, allow_negative_numbers = true)]
+    pub(crate) airspeed: Option<f64>,
+}
+
+impl Airspeed {
+    /// The airspeed asked for, or the aircraft's cruise airspeed.
+    pub(crate) fn or_cruise(self, aircraft: &sim_host::aircraft::Aircraft) -> f64 {
+        self.airspeed
+            .unwrap_or_else(|| aircraft.cruise_airspeed_mps())
+    }
+}
+
+/// A finite, positive airspeed in m/s.
+fn positive_airspeed(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|e| format!("`{s}` is not a number: {e}"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "`{s}`: an airspeed must be a positive number of m/s"
+        ))
+    }
+}
+
 #[derive(Subcommand)]
 pub(crate) enum Command {
-    /// Trim the thesis's Table 2.3 targets and the 5 deg sideslip (Va 17 m/s, h 100 m).
+    /// Trim the thesis's Table 2.3 targets and the 5 deg sideslip (h 100 m) at the trim
+    /// airspeed.
     Trim {
+        #[command(flatten)]
+        speed: Airspeed,
         #[command(flatten)]
         out: Output,
     },
@@ -52,6 +85,8 @@ pub(crate) enum Command {
         /// Trim to linearise about: level, climb, turn, climbing-turn, sideslip.
         #[arg(long, default_value = "level")]
         trim: String,
+        #[command(flatten)]
+        speed: Airspeed,
         #[command(flatten)]
         out: Output,
     },
@@ -102,6 +137,8 @@ pub(crate) enum Command {
     },
     /// Design the "computed" gain set by successive loop closure and predict every loop.
     Design {
+        #[command(flatten)]
+        speed: Airspeed,
         #[command(flatten)]
         out: Output,
         /// Also write the computed gain set to this TOML file (a gain file for

@@ -30,8 +30,8 @@ fn run() -> anyhow::Result<ExitCode> {
             commands::fly::command::default_flight(&aircraft, emit)?;
             Ok(ExitCode::SUCCESS)
         }
-        Some(Command::Trim { out }) => {
-            let r = commands::trim::trim_report(&aircraft);
+        Some(Command::Trim { speed, out }) => {
+            let r = commands::trim::trim_report_at(&aircraft, speed.or_cruise(&aircraft));
             if out.json {
                 emit(&to_json(&r.trims)?)?;
             } else {
@@ -39,7 +39,10 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             let failed = r.failures();
             for (name, res) in &failed {
-                eprintln!("trim `{name}` did not converge: residual {res:.3e}");
+                eprintln!(
+                    "trim `{name}` did not converge at {} m/s: residual {res:.3e} (the aircraft cannot hold that condition there)",
+                    speed.or_cruise(&aircraft)
+                );
             }
             Ok(if failed.is_empty() {
                 ExitCode::SUCCESS
@@ -47,8 +50,12 @@ fn run() -> anyhow::Result<ExitCode> {
                 ExitCode::FAILURE
             })
         }
-        Some(Command::Linearize { trim, out }) => {
-            let r = commands::linearize::linearize_report(&aircraft, &trim)?;
+        Some(Command::Linearize { trim, speed, out }) => {
+            let r = commands::linearize::linearize_report_at(
+                &aircraft,
+                &trim,
+                speed.or_cruise(&aircraft),
+            )?;
             if out.json {
                 emit(&to_json(&r)?)?;
             } else {
@@ -136,17 +143,23 @@ fn run() -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Some(Command::Design { out, write_gains }) => {
+        Some(Command::Design {
+            speed,
+            out,
+            write_gains,
+        }) => {
+            let va = speed.or_cruise(&aircraft);
             if let Some(path) = &write_gains {
-                let g = sim_host::analysis::design::computed_gain_set(&aircraft)?;
+                let inputs = sim_host::analysis::design::DesignInputs::default();
+                let g = sim_host::analysis::design::design_at(&aircraft, &inputs, va)?.gains;
                 let text = toml::to_string(&g).context("encoding the gain set")?;
                 std::fs::write(path, text)
                     .with_context(|| format!("cannot write `{}`", path.display()))?;
             }
             if out.markdown {
-                emit(&commands::design::design_markdown(&aircraft)?)?;
+                emit(&commands::design::design_markdown_at(&aircraft, va)?)?;
             } else {
-                let r = commands::design::design_report(&aircraft)?;
+                let r = commands::design::design_report_at(&aircraft, va)?;
                 if out.json {
                     emit(&to_json(&r)?)?;
                 } else {

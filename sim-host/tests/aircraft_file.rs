@@ -213,3 +213,123 @@ fn ground_table_is_required_and_checked() {
         .to_string();
     assert!(msg.contains("ground.mu_side") && msg.contains('6'), "{msg}");
 }
+
+/// The Aerosonde's file with the line starting `key_line_start` replaced.
+fn aerosonde_with(key_line_start: &str, new_line: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("aircraft/aerosonde.toml");
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            if l.starts_with(key_line_start) {
+                new_line.to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn the_aerosondes_bad_motor_value_missing_nose_key_and_mixed_gear_are_each_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let load = |text: &str| {
+        Aircraft::from_file(&write(&dir, text))
+            .unwrap_err()
+            .to_string()
+    };
+    let msg = load(&aerosonde_with(
+        "resistance_ohm = ",
+        "resistance_ohm = -0.042",
+    ));
+    assert!(
+        msg.contains("plane.toml")
+            && msg.contains("propulsion.dc_motor.resistance_ohm")
+            && msg.contains("-0.042"),
+        "{msg}"
+    );
+    let msg = load(&aerosonde_with("nose_stiffness_Npm = ", ""));
+    assert!(
+        msg.contains("plane.toml") && msg.contains("ground.nose_stiffness_Npm"),
+        "{msg}"
+    );
+    let msg = load(&aerosonde_with(
+        "nose_wheel_m = ",
+        "nose_wheel_m = [0.45, 0.0, 0.32]\ntail_wheel_m = [-0.9, 0.0, 0.1]",
+    ));
+    assert!(
+        msg.contains("nose_wheel_m") && msg.contains("not both"),
+        "{msg}"
+    );
+    // Mains ahead of the CG with a nose wheel: no tricycle stands on that.
+    let msg = load(&aerosonde_with(
+        "main_wheel_left_m = ",
+        "main_wheel_left_m = [0.10, -0.30, 0.32]",
+    ));
+    assert!(
+        msg.contains("ground.main_wheel_left_m") && msg.contains("0.1"),
+        "{msg}"
+    );
+    // Neither motor, and a torque polynomial given twice.
+    let no_motor: String = aerosonde_with("[propulsion.dc_motor]", "")
+        .lines()
+        .filter(|l| {
+            !["KV_rpm", "resistance_ohm", "no_load_current", "max_voltage"]
+                .iter()
+                .any(|k| l.starts_with(k))
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let msg = load(&no_motor);
+    assert!(
+        msg.contains("plane.toml") && msg.contains("propulsion.motor_power_poly_throttle_W"),
+        "{msg}"
+    );
+    let msg = load(&aerosonde_with(
+        "CQ_poly_J = ",
+        "CQ_poly_J = [0.0, 0.0, -0.01664, 0.004970, 0.005230]\nCP_poly_J = [0.0, 0.0, 0.0, 0.0, 0.1]",
+    ));
+    assert!(
+        msg.contains("propulsion.CQ_poly_J") && msg.contains("not both"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_airspeed_the_aerosonde_cannot_trim_at_is_a_clear_error_not_a_panic() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("aircraft/aerosonde.toml");
+    for command in ["linearize", "design"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_sim-host"))
+            .args([
+                "--aircraft",
+                file.to_str().unwrap(),
+                command,
+                "--airspeed",
+                "90",
+            ])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("cannot be trimmed")
+                && err.contains("90 m/s")
+                && !err.contains("panicked"),
+            "{command}: {err}"
+        );
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_sim-host"))
+        .args([
+            "--aircraft",
+            file.to_str().unwrap(),
+            "trim",
+            "--airspeed",
+            "-5",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("positive"), "{err}");
+}

@@ -697,7 +697,9 @@ fn battery_flight(a: &Aircraft) -> FlightOutcome {
 /// The pack's draw in level cruise at the trim throttle (`TRIM_THR`), W.
 fn cruise_power_w(a: &Aircraft) -> f64 {
     let p = ModelParams::new(a);
-    Battery::new(&a.battery).electrical_power_w(motor_power_w(&p, default_of("TRIM_THR")))
+    // The power curve does not depend on the engine speed.
+    let omega = 1000.0;
+    Battery::new(&a.battery).electrical_power_w(motor_power_w(&p, default_of("TRIM_THR"), omega))
 }
 
 /// Time the motor runs: from the first throttle to the touchdown (the flare closes it, and

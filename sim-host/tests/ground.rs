@@ -312,8 +312,9 @@ fn rudder_steers_the_tail_wheel_nose_left_for_positive_rudder() {
     assert!(psi_right > 0.0);
     // A steered tail wheel with the mains as the pivot: r = -V sin(steer) / wheelbase, less
     // the tyres' slip.
-    let wb = a.ground.main_wheel_left_m[0] - a.ground.tail_wheel_m[0];
-    let kinematic = -v * (0.2 * a.ground.tail_steer_per_rudder).sin() / wb;
+    let tail = a.ground.third_wheel().expect("a taildragger's tail wheel");
+    let wb = a.ground.main_wheel_left_m[0] - tail.pos_m[0];
+    let kinematic = -v * (0.2 * tail.steer_per_rudder).sin() / wb;
     assert!(
         r_left / kinematic > 0.7 && r_left / kinematic < 1.1,
         "yaw rate {r_left}, kinematic {kinematic} at {v} m/s"

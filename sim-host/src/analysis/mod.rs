@@ -6,6 +6,7 @@ pub mod doublet;
 pub mod linearize;
 pub mod lti;
 pub mod metrics;
+pub mod reduced;
 pub mod references;
 pub mod sampled;
 pub mod transfer;

@@ -8,6 +8,13 @@
 //! - UMN linear: same repository, branch `Intermediate` @ 42fe830, `ValidatedDynamics.txt`
 //!   (Simulink linearisation of the same model at the level trim).
 
+/// Whether the thesis's and the Minnesota references describe a trim of `aircraft` at
+/// `va_mps`: the built-in Ultra Stick 25e at the thesis's 17 m/s only.
+pub fn apply_to(aircraft: &crate::aircraft::Aircraft, va_mps: f64) -> bool {
+    va_mps == crate::aircraft::DEFAULT_TRIM_AIRSPEED_MPS
+        && crate::aircraft::Aircraft::ultrastick25e().is_ok_and(|a| &a == aircraft)
+}
+
 /// One row of thesis Table 2.3 (angles rad, rates rad/s).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ThesisTrim {

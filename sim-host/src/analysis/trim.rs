@@ -6,12 +6,20 @@
 //! `r = psi_dot cos phi cos theta`), so a zero body-velocity, body-rate and engine-speed
 //! derivative plus the flight-path constraint make eight equations in eight unknowns, solved by
 //! Levenberg-Marquardt with a central-difference Jacobian.
+//!
+//! The targets are the thesis's, at 17 m/s; [`TrimTarget::at_airspeed`] moves any of them to
+//! another airspeed (an aircraft file's cruise airspeed, or `--airspeed`). The solver starts
+//! from the Ultra Stick's 17 m/s trim, and when that does not converge from a guess of the
+//! aircraft's own: the angle of attack that lifts its weight, the elevator that balances the
+//! pitching moment there, half throttle and the engine speed that holds it.
 
 use crate::aircraft::Aircraft;
 use crate::plant::dynamics::derivatives;
 use crate::plant::inputs::{Controls, Environment};
 use crate::plant::params::ModelParams;
+use crate::plant::propulsion::propulsion;
 use crate::plant::state::State;
+use common::math::atmosphere::standard_atmosphere;
 use common::math::{AirData, Euler};
 use nalgebra::{SMatrix, SVector, Vector3};
 use serde::Serialize;
@@ -102,6 +110,12 @@ impl TrimTarget {
     /// The target with this short name.
     pub fn by_name(name: &str) -> Option<Self> {
         Self::all().into_iter().find(|t| t.name == name)
+    }
+
+    /// The same flight condition at airspeed `va_mps`, m/s.
+    pub fn at_airspeed(mut self, va_mps: f64) -> Self {
+        self.va_mps = va_mps;
+        self
     }
 }
 
@@ -237,7 +251,53 @@ pub fn trim_with(p: &ModelParams, target: &TrimTarget) -> TrimResult {
         0.56,
         827.0,
     ]);
-    solve(p, target, guess)
+    let first = solve(p, target, guess);
+    if first.converged {
+        return first;
+    }
+    let second = solve(p, target, own_guess(p, target));
+    if second.residual_norm < first.residual_norm {
+        second
+    } else {
+        first
+    }
+}
+
+/// A starting point from the aircraft's own data: the linear lift and pitching moment, and
+/// the engine speed at which motor and propeller torques balance at half throttle.
+fn own_guess(p: &ModelParams, t: &TrimTarget) -> Z {
+    let rho = standard_atmosphere(t.alt_msl_m).density;
+    let qbar_s = 0.5 * rho * t.va_mps * t.va_mps * p.s;
+    let (lift, pitch) = (&p.aero.lift, &p.aero.pitch);
+    let cl = p.mass * p.g * t.gamma_rad.cos() / qbar_s.max(1e-9);
+    let alpha = ((cl - lift.CL0) / lift.CL_alpha).clamp(-0.3, 0.3);
+    let elevator = if pitch.Cm_de != 0.0 {
+        (-(pitch.Cm0 + pitch.Cm_alpha * alpha) / pitch.Cm_de).clamp(-0.4, 0.4)
+    } else {
+        0.0
+    };
+    let throttle = 0.5;
+    let [mut lo, mut hi] = p.prop.omega_limits_radps;
+    let accel = |w: f64| propulsion(p, t.va_mps, w, throttle, rho).engine_accel;
+    // The net torque falls with the engine speed: bisect for its zero (or stay at a limit).
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if accel(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Z::from_column_slice(&[
+        alpha,
+        0.0,
+        alpha + t.gamma_rad,
+        elevator,
+        0.0,
+        0.0,
+        throttle,
+        0.5 * (lo + hi),
+    ])
 }
 
 /// Trims `target` starting from the solution of a nearby trim `near` (continuation: the fixed
@@ -337,4 +397,19 @@ fn solve(p: &ModelParams, target: &TrimTarget, mut z: Z) -> TrimResult {
         state,
         controls,
     }
+}
+
+/// Why a trim failed, in words a user can act on.
+pub fn not_trimmed(trim: &TrimResult) -> String {
+    format!(
+        "the aircraft cannot be trimmed for `{}` at {} m/s: the solver stopped at residual {:.3e} \
+         (alpha {:.3} rad, elevator {:.3} rad, throttle {:.3}); try an airspeed nearer the \
+         aircraft's cruise",
+        trim.target.name,
+        trim.target.va_mps,
+        trim.residual_norm,
+        trim.alpha,
+        trim.elevator,
+        trim.throttle
+    )
 }

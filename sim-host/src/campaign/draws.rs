@@ -285,10 +285,7 @@ pub fn shift_cg(a: &mut Aircraft, d: [f64; 3]) {
     };
     mv(&mut a.geometry.aero_arm_from_cg_m);
     mv(&mut a.geometry.prop_arm_from_cg_m);
-    mv(&mut a.ground.main_wheel_left_m);
-    mv(&mut a.ground.main_wheel_right_m);
-    mv(&mut a.ground.tail_wheel_m);
-    a.ground.belly_points_m.iter_mut().for_each(mv);
+    a.ground.translate([-d[0], -d[1], -d[2]]);
 }
 
 /// The wind, its turbulence and the runway, recorded in `s`.

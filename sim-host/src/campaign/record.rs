@@ -153,11 +153,16 @@ fn excursions(samples: &[Sample], points: &[Point], home_alt: f64) -> Excursions
 /// (the main legs compress 1.4 cm at rest; an aircraft on its back is on the ground too).
 fn on_ground(s: &Sample, a: &Aircraft, points: &[Point], home_alt: f64) -> bool {
     let g = &a.ground;
-    let wheels = [g.main_wheel_left_m, g.main_wheel_right_m, g.tail_wheel_m].map(|w| Point {
-        name: String::new(),
-        body: Vector3::from(w),
-        disc_radius: 0.0,
-    });
+    let third = g.third_wheel().map(|w| w.pos_m);
+    let wheels = [Some(g.main_wheel_left_m), Some(g.main_wheel_right_m), third]
+        .into_iter()
+        .flatten()
+        .map(|w| Point {
+            name: String::new(),
+            body: Vector3::from(w),
+            disc_radius: 0.0,
+        })
+        .collect::<Vec<_>>();
     wheels
         .iter()
         .chain(points)

@@ -4,7 +4,8 @@
 use super::Format;
 use crate::aircraft::Aircraft;
 use crate::analysis::design::inputs::DesignInputs;
-use crate::analysis::design::{describe_poles, design, Design};
+use crate::analysis::design::{describe_poles, design_at, Design};
+use crate::analysis::references::apply_to;
 use crate::analysis::sampled::{scaled_at, SampledLoop, SampledLoops};
 use crate::report::table::Table;
 use crate::report::{sig, sig_or_dash};
@@ -32,12 +33,19 @@ pub struct DesignReport {
     pub tables: Vec<Table>,
 }
 
-/// Designs the loops and tabulates them.
+/// Designs the loops at the aircraft's cruise airspeed and tabulates them.
 pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
-    let d = design(aircraft, &DesignInputs::default())?;
+    design_report_at(aircraft, aircraft.cruise_airspeed_mps())
+}
+
+/// Designs the loops at the level trim at `va_mps` and tabulates them. The airspeed-scaling
+/// table judges the firmware's flight set between the Ultra Stick's mission limits, so it
+/// comes with the Ultra Stick at 17 m/s only.
+pub fn design_report_at(aircraft: &Aircraft, va_mps: f64) -> anyhow::Result<DesignReport> {
+    let d = design_at(aircraft, &DesignInputs::default(), va_mps)?;
     let c = &d.coefficients;
     let mut coeffs = Table::new(
-        "Model coefficients at the level trim (Va 17 m/s, h 100 m)",
+        format!("Model coefficients at the level trim (Va {va_mps} m/s, h 100 m)"),
         &["coefficient", "value", "from"],
     );
     coeffs
@@ -163,8 +171,12 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
         ]);
     }
     let inputs = &d.inputs;
-    let model =
-        SampledLoops::at_level_trim(aircraft, inputs.sample_time_s, inputs.delay_periods())?;
+    let model = SampledLoops::at_level_airspeed(
+        aircraft,
+        va_mps,
+        inputs.sample_time_s,
+        inputs.delay_periods(),
+    )?;
     let sampled: Vec<(String, Vec<SampledLoop>)> = [
         ("computed", d.gains),
         ("flight", common::control::gains::FLIGHT),
@@ -184,7 +196,17 @@ pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
             full.row([l.name.clone(), set.clone()].into_iter().chain(figures(s)));
         }
     }
-    let (scaling, scaling_table) = scaling_report(aircraft, inputs)?;
+    let (scaling, scaling_table) = if apply_to(aircraft, va_mps) {
+        scaling_report(aircraft, inputs)?
+    } else {
+        (
+            Vec::new(),
+            Table::new(
+                "Airspeed scaling: judged for the Ultra Stick 25e at 17 m/s only",
+                &["loop"],
+            ),
+        )
+    };
     let tecs = model.judge_tecs(&common::control::gains::FLIGHT);
     let mut energy = Table::new(
         "The total energy control (LON_LAW = 1, its designed gains, the flight defaults' pitch loop) on the same model: the energy rate broken at the throttle with a small height step, the balance broken at the pitch command with a small airspeed step",
@@ -277,7 +299,12 @@ fn scaling_report(
 
 /// The design as a Markdown document.
 pub fn design_markdown(aircraft: &Aircraft) -> anyhow::Result<String> {
-    let r = design_report(aircraft)?;
+    design_markdown_at(aircraft, aircraft.cruise_airspeed_mps())
+}
+
+/// [`design_markdown`] at `va_mps`.
+pub fn design_markdown_at(aircraft: &Aircraft, va_mps: f64) -> anyhow::Result<String> {
+    let r = design_report_at(aircraft, va_mps)?;
     Ok(format!(
         "{}\n{}\n",
         include_str!("design_intro.md"),

@@ -1,13 +1,16 @@
-//! `sim-host linearize`: linear models, poles and transfer functions at a trim.
+//! `sim-host linearize`: linear models, poles and transfer functions at a trim, with the
+//! thesis's and the Minnesota references for the Ultra Stick 25e at 17 m/s, and Beard and
+//! McLain's reduced-model coefficients for any other aircraft or airspeed.
 
 use crate::aircraft::Aircraft;
 use crate::analysis::linearize::StateSpace;
 use crate::analysis::linearize::{lat_modes, linearize, lon_modes, LatModes, LonModes, Mode};
+use crate::analysis::reduced::{closed_form, from_linearization, ReducedCoefficients};
 use crate::analysis::references as refs;
 use crate::analysis::transfer::{
     thesis_transfer_functions, ThesisTransferFunctions, TransferFunction,
 };
-use crate::analysis::trim::{trim_with, TrimResult, TrimTarget};
+use crate::analysis::trim::{not_trimmed, trim_with, TrimResult, TrimTarget};
 use crate::plant::params::ModelParams;
 use crate::report::table::Table;
 use crate::report::{pct, sig};
@@ -29,6 +32,10 @@ pub struct LinearizeReport {
     pub lat_modes: LatModes,
     /// Thesis transfer functions.
     pub transfer_functions: ThesisTransferFunctions,
+    /// Beard and McLain's reduced-model coefficients read off the linear model.
+    pub reduced: ReducedCoefficients,
+    /// The same from their closed-form expressions with the aircraft file's values.
+    pub reduced_closed_form: ReducedCoefficients,
     /// Printed tables.
     pub tables: Vec<Table>,
 }
@@ -75,9 +82,26 @@ fn entry_table(
     t
 }
 
-fn tf_rows(t: &mut Table, name: &str, ours: &TransferFunction, num: &[f64], den: &[f64]) {
+/// The rows of one transfer function's coefficients, beside the thesis's when it applies.
+fn tf_rows(
+    t: &mut Table,
+    name: &str,
+    ours: &TransferFunction,
+    reference: Option<(&[f64], &[f64])>,
+) {
     let ours = ours.trimmed(1e-9);
-    let n = ours.num.len();
+    let (n, m) = (ours.num.len(), ours.den.len());
+    let Some((num, den)) = reference else {
+        for (k, o) in ours.num.iter().enumerate() {
+            let label = format!("{name} num s^{}", n - 1 - k);
+            t.row([label, sig(*o, 5), "-".into(), "-".into()]);
+        }
+        for (k, o) in ours.den.iter().enumerate().skip(1) {
+            let label = format!("{name} den s^{}", m - 1 - k);
+            t.row([label, sig(*o, 5), "-".into(), "-".into()]);
+        }
+        return;
+    };
     for (k, (o, r)) in ours.num.iter().zip(num).enumerate() {
         t.row([
             format!("{name} num s^{}", n - 1 - k),
@@ -86,7 +110,6 @@ fn tf_rows(t: &mut Table, name: &str, ours: &TransferFunction, num: &[f64], den:
             format!("{:+.2} %", pct(*o, *r)),
         ]);
     }
-    let m = ours.den.len();
     for (k, (o, r)) in ours.den.iter().zip(den).enumerate().skip(1) {
         t.row([
             format!("{name} den s^{}", m - 1 - k),
@@ -97,8 +120,18 @@ fn tf_rows(t: &mut Table, name: &str, ours: &TransferFunction, num: &[f64], den:
     }
 }
 
-/// Linearises about the named trim (`level` by default) and tabulates the comparison.
+/// Linearises about the named trim (`level` by default) at the aircraft's cruise airspeed and
+/// tabulates the comparison.
 pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<LinearizeReport> {
+    linearize_report_at(aircraft, trim_name, aircraft.cruise_airspeed_mps())
+}
+
+/// [`linearize_report`] at airspeed `va_mps`.
+pub fn linearize_report_at(
+    aircraft: &Aircraft,
+    trim_name: &str,
+    va_mps: f64,
+) -> anyhow::Result<LinearizeReport> {
     let target = TrimTarget::by_name(trim_name).ok_or_else(|| {
         anyhow!(
             "unknown trim `{trim_name}`; known: {}",
@@ -109,14 +142,11 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
                 .join(", ")
         )
     })?;
+    let target = target.at_airspeed(va_mps);
     let p = ModelParams::new(aircraft);
     let trim = trim_with(&p, &target);
     if !trim.converged {
-        bail!(
-            "trim `{}` did not converge (residual {:.3e}); cannot linearise",
-            target.name,
-            trim.residual_norm
-        );
+        bail!("{}; cannot linearise", not_trimmed(&trim));
     }
     let lin = linearize(&p, &trim);
     let lm = lon_modes(&lin.lon).ok_or_else(|| {
@@ -132,7 +162,8 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
         )
     })?;
     let tfs = thesis_transfer_functions(&lin);
-    let level = target.name == "level";
+    let references = refs::apply_to(aircraft, va_mps);
+    let level = target.name == "level" && references;
     let mut tables = Vec::new();
 
     let mut poles = Table::new(
@@ -219,30 +250,29 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
         &mut tf,
         "p/da",
         &tfs.p_over_da,
-        &refs::THESIS_P_DA.0,
-        &refs::THESIS_P_DA.1,
+        references.then_some((&refs::THESIS_P_DA.0[..], &refs::THESIS_P_DA.1[..])),
     );
     tf_rows(
         &mut tf,
         "q/de",
         &tfs.q_over_de,
-        &refs::THESIS_Q_DE.0,
-        &refs::THESIS_Q_DE.1,
+        references.then_some((&refs::THESIS_Q_DE.0[..], &refs::THESIS_Q_DE.1[..])),
     );
     tf_rows(
         &mut tf,
         "r/dr",
         &tfs.r_over_dr,
-        &refs::THESIS_R_DR.0,
-        &refs::THESIS_R_DR.1,
+        references.then_some((&refs::THESIS_R_DR.0[..], &refs::THESIS_R_DR.1[..])),
     );
-    let p_dar = lin.lat.b[(1, 1)];
-    tf.row([
-        "p/da_R (right aileron, UMN B_lat)".to_string(),
-        sig(p_dar, 5),
-        format!("{} (UMN)", refs::UMN_P_DA_RIGHT),
-        format!("{:+.2} %", pct(p_dar, refs::UMN_P_DA_RIGHT)),
-    ]);
+    if references {
+        let p_dar = lin.lat.b[(1, 1)];
+        tf.row([
+            "p/da_R (right aileron, UMN B_lat)".to_string(),
+            sig(p_dar, 5),
+            format!("{} (UMN)", refs::UMN_P_DA_RIGHT),
+            format!("{:+.2} %", pct(p_dar, refs::UMN_P_DA_RIGHT)),
+        ]);
+    }
     tables.push(tf);
     let mut forms = Table::new("Transfer functions in full", &["tf", "ours"]);
     forms.row(["p/da".to_string(), tfs.p_over_da.format(4)]);
@@ -293,6 +323,11 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
         }
         tables.push(m);
     }
+    let reduced = from_linearization(&lin, &trim);
+    let reduced_closed_form = closed_form(aircraft, &trim);
+    if !references {
+        tables.push(reduced_table(&trim, &reduced, &reduced_closed_form));
+    }
     Ok(LinearizeReport {
         trim,
         lon: lin.lon,
@@ -300,6 +335,38 @@ pub fn linearize_report(aircraft: &Aircraft, trim_name: &str) -> anyhow::Result<
         lon_modes: lm,
         lat_modes: am,
         transfer_functions: tfs,
+        reduced,
+        reduced_closed_form,
         tables,
     })
+}
+
+/// Beard and McLain's reduced-model coefficients, from the linear model and from their
+/// closed forms.
+pub fn reduced_table(
+    trim: &TrimResult,
+    linear: &ReducedCoefficients,
+    closed: &ReducedCoefficients,
+) -> Table {
+    let mut t = Table::new(
+        format!(
+            "Beard and McLain's reduced models at trim `{}` (Va {} m/s, h {} m)",
+            trim.target.name, trim.target.va_mps, trim.target.alt_msl_m
+        ),
+        &[
+            "coefficient",
+            "linear model",
+            "closed form",
+            "linear vs closed",
+        ],
+    );
+    for ((name, l), (_, c)) in linear.named().into_iter().zip(closed.named()) {
+        t.row([
+            name.to_string(),
+            sig(l, 5),
+            sig(c, 5),
+            format!("{:+.2} %", pct(l, c)),
+        ]);
+    }
+    t
 }

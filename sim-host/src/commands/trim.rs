@@ -1,7 +1,8 @@
-//! `sim-host trim`: the thesis's Table 2.3 targets and the steady-heading sideslip.
+//! `sim-host trim`: the thesis's Table 2.3 targets and the steady-heading sideslip, at the
+//! aircraft's cruise airspeed or another.
 
 use crate::aircraft::Aircraft;
-use crate::analysis::references::{umn_trim, ThesisTrim, THESIS_TRIM};
+use crate::analysis::references::{apply_to, umn_trim, ThesisTrim, THESIS_TRIM};
 use crate::analysis::trim::{trim_with, TrimResult, TrimTarget};
 use crate::plant::params::ModelParams;
 use crate::report::table::Table;
@@ -191,15 +192,26 @@ pub fn trim_table(e: &TrimEntry) -> Table {
     t
 }
 
-/// Trims every target.
+/// Trims every target at the aircraft's cruise airspeed.
 pub fn trim_report(aircraft: &Aircraft) -> TrimReport {
+    trim_report_at(aircraft, aircraft.cruise_airspeed_mps())
+}
+
+/// Trims every target at `va_mps`; the thesis's and the Minnesota columns only for the
+/// Ultra Stick 25e at 17 m/s.
+pub fn trim_report_at(aircraft: &Aircraft, va_mps: f64) -> TrimReport {
     let p = ModelParams::new(aircraft);
+    let refs = apply_to(aircraft, va_mps);
     let trims: Vec<TrimEntry> = TrimTarget::all()
-        .iter()
+        .into_iter()
+        .map(|target| target.at_airspeed(va_mps))
         .map(|target| TrimEntry {
-            result: trim_with(&p, target),
-            thesis: THESIS_TRIM.iter().find(|x| x.name == target.name).copied(),
-            umn_level: target.name == "level",
+            result: trim_with(&p, &target),
+            thesis: THESIS_TRIM
+                .iter()
+                .find(|x| refs && x.name == target.name)
+                .copied(),
+            umn_level: refs && target.name == "level",
         })
         .collect();
     let tables = trims.iter().map(trim_table).collect();

@@ -325,7 +325,11 @@ pub fn fly<T: Transport, O: Onboard<T>>(
             && plant.velocity_ned().norm() < 1.0;
         let command = if answer.armed {
             armed_frames += 1;
-            energy_j += motor_power_w(&params, f64::from(answer.surfaces.throttle)) * frame_s;
+            energy_j += motor_power_w(
+                &params,
+                f64::from(answer.surfaces.throttle),
+                plant.engine_speed(),
+            ) * frame_s;
             Controls::from(answer.surfaces)
         } else {
             // The safety pilot holds the trim until the autopilot is armed.
@@ -373,7 +377,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
 
         for _ in 0..substeps {
             let seen = plant.step_servos(&mut servos, &command, &env, dt);
-            let shaft_w = motor_power_w(&params, seen.throttle);
+            let shaft_w = motor_power_w(&params, seen.throttle, plant.engine_speed());
             battery.step(battery.electrical_power_w(shaft_w), dt);
         }
         if answer.armed {

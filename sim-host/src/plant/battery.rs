@@ -164,7 +164,7 @@ mod tests {
         );
         // The motor's 240 W at full throttle over 75 % plus the avionics' 4 W.
         let p = ModelParams::new(&Aircraft::ultrastick25e().expect("built-in"));
-        let shaft = motor_power_w(&p, 1.0);
+        let shaft = motor_power_w(&p, 1.0, 1000.0);
         assert!((shaft - (174.46 + 70.135 - 4.39)).abs() < 1e-9);
         assert!((b.electrical_power_w(shaft) - (shaft / 0.75 + 4.0)).abs() < 1e-9);
         // Asked for more than E^2 / 4R, it gives its most: half its voltage.
@@ -179,7 +179,7 @@ mod tests {
         // falls from 12.0 V (12.6 V less 26 A through 0.024 ohm) as the charge goes.
         let p = ModelParams::new(&Aircraft::ultrastick25e().expect("built-in"));
         let mut b = Battery::new(&pack());
-        let power = b.electrical_power_w(motor_power_w(&p, 1.0));
+        let power = b.electrical_power_w(motor_power_w(&p, 1.0, 1000.0));
         let start = b.load(power);
         let dt = 0.001;
         for _ in 0..60_000 {
@@ -217,7 +217,7 @@ mod tests {
         // resistance burns (I^2 R = 3 W of 127 at 11 A, 2.4 %): 17.1 min.
         let a = Aircraft::ultrastick25e().expect("built-in");
         let p = ModelParams::new(&a);
-        let power = Battery::new(&pack()).electrical_power_w(motor_power_w(&p, 0.569484));
+        let power = Battery::new(&pack()).electrical_power_w(motor_power_w(&p, 0.569484, 1000.0));
         assert!((power - 126.84).abs() < 0.01, "{power}");
         let half = Battery::new(&BatteryParams {
             initial_soc: 0.5,

@@ -1,8 +1,8 @@
-//! Where the airframe can touch the ground: the taildragger's three wheels and the belly
-//! points of the aircraft file's `[ground]` table, each with its spring, damper and friction.
+//! Where the airframe can touch the ground: the three wheels (a taildragger's or a tricycle's)
+//! and the belly points of the aircraft file's `[ground]` table, each with its spring, damper and friction.
 //! The forces they take from the runway are [`super::ground`]'s.
 
-use crate::aircraft::{Ground, MAX_BELLY_POINTS};
+use crate::aircraft::{GearLayout, Ground, MAX_BELLY_POINTS};
 use nalgebra::Vector3;
 
 /// Most contact points a model may have (three wheels and the belly points).
@@ -44,8 +44,11 @@ pub struct ContactPoint {
 /// The contact model's parameters, derived from the aircraft file's `[ground]` table.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GroundParams {
-    /// Contact points: left main wheel, right main wheel, tail wheel, then the belly points.
+    /// Contact points: left main wheel, right main wheel, tail or nose wheel, then the belly
+    /// points.
     pub points: Vec<ContactPoint>,
+    /// Whether the third wheel is a tail wheel or a nose wheel.
+    pub layout: GearLayout,
     /// Down position of the ground plane in the NED frame, m (0: home is on the ground).
     pub ground_down_m: f64,
     /// Slip speed of the friction law, m/s.
@@ -58,11 +61,14 @@ pub struct GroundParams {
 pub const MAIN_LEFT: usize = 0;
 /// Index of the right main wheel.
 pub const MAIN_RIGHT: usize = 1;
-/// Index of the tail wheel.
+/// Index of the third wheel: the tail wheel of a taildragger, the nose wheel of a tricycle.
 pub const TAIL: usize = 2;
+/// Index of a tricycle's nose wheel (the same slot as a taildragger's tail wheel).
+pub const NOSE: usize = TAIL;
 
 impl GroundParams {
-    /// The contact points of a validated `[ground]` table.
+    /// The contact points of a validated `[ground]` table (one without a complete third wheel
+    /// stands on its mains and belly points alone).
     pub fn new(g: &Ground) -> Self {
         let wheel = |pos: [f64; 3], k: f64, c: f64, steer: f64| ContactPoint {
             pos_body: Vector3::from(pos),
@@ -87,13 +93,16 @@ impl GroundParams {
                 g.main_damping_Nspm,
                 0.0,
             ),
-            wheel(
-                g.tail_wheel_m,
-                g.tail_stiffness_Npm,
-                g.tail_damping_Nspm,
-                g.tail_steer_per_rudder,
-            ),
         ];
+        let third = g.third_wheel();
+        if let Some(w) = third {
+            points.push(wheel(
+                w.pos_m,
+                w.stiffness_Npm,
+                w.damping_Nspm,
+                w.steer_per_rudder,
+            ));
+        }
         points.extend(g.belly_points_m.iter().map(|&pos| ContactPoint {
             pos_body: Vector3::from(pos),
             stiffness_npm: g.belly_stiffness_Npm,
@@ -104,6 +113,7 @@ impl GroundParams {
         let reach_m = points.iter().map(|p| p.pos_body.norm()).fold(0.0, f64::max);
         Self {
             points,
+            layout: third.map_or(GearLayout::Taildragger, |w| w.layout),
             ground_down_m: 0.0,
             slip_speed_mps: g.slip_speed_mps,
             reach_m,

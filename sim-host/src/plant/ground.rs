@@ -1,11 +1,13 @@
-//! Contact with a flat, level ground: the taildragger's landing gear and the airframe's belly.
+//! Contact with a flat, level ground: the landing gear (a taildragger's or a tricycle's) and the
+//! airframe's belly.
 //!
 //! Each contact point is a spring and damper normal to the ground, acting only while the point is
 //! below the ground plane and only in compression (the ground pushes, never pulls). Friction
 //! opposes the point's velocity in the ground plane: a wheel rolls along its heading (small
 //! rolling friction) and resists sliding across it (large side friction); a belly point slides
 //! with one coefficient in every direction. The tail wheel's heading turns with the rudder, as on
-//! the Ultra Stick 25e whose tail-wheel wire sits in the rudder.
+//! the Ultra Stick 25e whose tail-wheel wire sits in the rudder; a tricycle's nose wheel is
+//! steered by the rudder the same way.
 //!
 //! Friction is `mu N v / sqrt(v^2 + v_s^2)` rather than `mu N sign(v)`: the discontinuous law
 //! chatters under a fixed-step integrator, the smooth one is a stiff viscous friction below the
@@ -183,7 +185,7 @@ pub fn in_contact(p: &ModelParams, x: &StateVector) -> bool {
 
 /// The aircraft at rest on its three wheels at `(north_m, east_m)` with heading `heading_rad`,
 /// engine stopped: the static equilibrium of the gear springs and the weight (wheels
-/// compressed, the taildragger's nose-up attitude).
+/// compressed; a taildragger's nose-up attitude, a tricycle's about level).
 ///
 /// Solved by Newton's method on the height and pitch for zero vertical force and zero pitching
 /// moment (left and right are symmetric, so roll is zero). If the model's gear cannot hold it
@@ -207,7 +209,7 @@ pub fn rest_state(p: &ModelParams, north_m: f64, east_m: f64, heading_rad: f64) 
         nalgebra::Vector2::new(f_ned.z + weight, gc.moment_body.y)
     };
     // Start at the three-point attitude with uncompressed wheels: the line through the main
-    // and tail contact points is level.
+    // and third (tail or nose) contact points is level.
     let (m, t) = (g.points[MAIN_LEFT].pos_body, g.points[TAIL].pos_body);
     let mut theta = ((m.z - t.z) / (m.x - t.x)).atan();
     let mut down = g.ground_down_m - (-m.x * theta.sin() + m.z * theta.cos());

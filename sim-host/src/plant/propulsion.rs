@@ -1,6 +1,13 @@
 //! The electric motor and propeller, with the engine speed as a state.
+//!
+//! Two motor laws: the Minnesota shaft-power curve in throttle, and Beard and McLain's DC motor
+//! (torque falling with speed through the back-EMF). With the DC motor the engine speed at which
+//! motor and propeller torques balance is the root of Beard and McLain's quadratic in `Omega`,
+//! so a trim reproduces their steady propulsion; the engine-speed state adds the spin-up lag
+//! their model leaves out.
 
-use super::params::ModelParams;
+use super::params::{ModelParams, Motor};
+use crate::aircraft::PropSpin;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
@@ -25,11 +32,35 @@ pub fn polyval<const N: usize>(coeffs: &[f64; N], x: f64) -> f64 {
     coeffs.iter().fold(0.0, |acc, c| acc * x + c)
 }
 
-/// Shaft power the motor delivers at `throttle` (0..1), W: the UMN power curve, clamped.
-pub fn motor_power_w(p: &ModelParams, throttle: f64) -> f64 {
-    let pr = &p.prop;
-    polyval(&pr.motor_power_poly_throttle_W, throttle)
-        .clamp(pr.motor_power_clamp_W[0], pr.motor_power_clamp_W[1])
+/// Shaft power the motor delivers at `throttle` (0..1) and engine speed `omega` (rad/s), W:
+/// the UMN power curve, clamped (it does not depend on the speed), or the DC motor's torque
+/// times the speed (none while the propeller drives the motor: no regeneration into the pack).
+pub fn motor_power_w(p: &ModelParams, throttle: f64, omega: f64) -> f64 {
+    match p.motor {
+        Motor::PowerCurve { poly_w, clamp_w } => {
+            polyval(&poly_w, throttle).clamp(clamp_w[0], clamp_w[1])
+        }
+        Motor::Dc { .. } => {
+            let [lo, hi] = p.prop.omega_limits_radps;
+            let omega_c = omega.clamp(lo, hi);
+            (motor_torque_nm(p, throttle, omega_c) * omega_c).max(0.0)
+        }
+    }
+}
+
+/// Motor torque at `throttle` and the (clamped, positive) engine speed `omega_c`, N m.
+fn motor_torque_nm(p: &ModelParams, throttle: f64, omega_c: f64) -> f64 {
+    match p.motor {
+        Motor::PowerCurve { poly_w, clamp_w } => {
+            polyval(&poly_w, throttle).clamp(clamp_w[0], clamp_w[1]) / omega_c
+        }
+        Motor::Dc {
+            kq,
+            r_ohm,
+            i0_a,
+            v_max,
+        } => kq * ((throttle * v_max - kq * omega_c) / r_ohm - i0_a),
+    }
 }
 
 /// Thrust, torques and engine acceleration at airspeed `va`, engine speed `omega` and `throttle`.
@@ -45,12 +76,11 @@ pub fn propulsion(
     let omega_c = omega.clamp(om_lo, om_hi);
     let j = (PI * va / (omega_c * pr.prop_radius_m)).clamp(pr.J_clamp[0], pr.J_clamp[1]);
     let ct = polyval(&pr.CT_poly_J, j);
-    let cp = polyval(&pr.CP_poly_J, j);
+    let cq = polyval(&p.torque_poly, j);
     let w2 = omega * omega;
     let thrust_n = ct * rho * p.thrust_factor * w2;
-    let prop_torque_nm = cp * rho * p.torque_factor * w2;
-    let power_w = motor_power_w(p, throttle);
-    let motor_torque_nm = power_w / omega_c;
+    let prop_torque_nm = cq * rho * p.torque_factor * w2;
+    let motor_torque_nm = motor_torque_nm(p, throttle, omega_c);
     PropulsionOutput {
         thrust_n,
         motor_torque_nm,
@@ -63,7 +93,8 @@ pub fn propulsion(
 /// Body force (N) and moment about the CG (N m) of the propulsion.
 ///
 /// The roll torque `2 Qm - Qp` is the Simulink wiring (it equals the reaction `Qp` at steady
-/// engine speed); the gyroscopic term is `omega_body x [Jmp Omega, 0, 0]` as wired there.
+/// engine speed); the gyroscopic term is `omega_body x [Jmp Omega, 0, 0]` as wired there. A
+/// propeller turning the other way ([`PropSpin::RightHand`]) has both mirrored.
 pub fn forces_and_moments(
     p: &ModelParams,
     out: &PropulsionOutput,
@@ -71,8 +102,12 @@ pub fn forces_and_moments(
     engine_speed: f64,
 ) -> (Vector3<f64>, Vector3<f64>) {
     let force = Vector3::new(out.thrust_n, 0.0, 0.0);
-    let moment = p.prop_arm.cross(&force)
-        + Vector3::new(2.0 * out.motor_torque_nm - out.prop_torque_nm, 0.0, 0.0)
-        + omega_body.cross(&Vector3::new(p.prop.Jmp_kgm2 * engine_speed, 0.0, 0.0));
+    let roll = Vector3::new(2.0 * out.motor_torque_nm - out.prop_torque_nm, 0.0, 0.0);
+    let gyro = omega_body.cross(&Vector3::new(p.prop.Jmp_kgm2 * engine_speed, 0.0, 0.0));
+    // Summed in the Minnesota order, so the built-in aircraft's moments keep every bit.
+    let moment = match p.spin {
+        PropSpin::Minnesota => p.prop_arm.cross(&force) + roll + gyro,
+        PropSpin::RightHand => p.prop_arm.cross(&force) - roll - gyro,
+    };
     (force, moment)
 }

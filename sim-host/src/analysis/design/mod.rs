@@ -122,15 +122,21 @@ pub struct Design {
     pub gains: GainSet,
 }
 
-/// Designs every loop at the level trim of `aircraft`.
+/// Designs every loop at the level trim of `aircraft` at its cruise airspeed.
 pub fn design(aircraft: &Aircraft, inputs: &DesignInputs) -> anyhow::Result<Design> {
+    design_at(aircraft, inputs, aircraft.cruise_airspeed_mps())
+}
+
+/// Designs every loop at the level trim of `aircraft` at `va_mps`.
+pub fn design_at(
+    aircraft: &Aircraft,
+    inputs: &DesignInputs,
+    va_mps: f64,
+) -> anyhow::Result<Design> {
     let params = ModelParams::new(aircraft);
-    let trim: TrimResult = trim_with(&params, &TrimTarget::level());
+    let trim: TrimResult = trim_with(&params, &TrimTarget::level().at_airspeed(va_mps));
     if !trim.converged {
-        anyhow::bail!(
-            "the level trim did not converge (residual {:.3e}); cannot design",
-            trim.residual_norm
-        );
+        anyhow::bail!("{}; cannot design", super::trim::not_trimmed(&trim));
     }
     let lin: Linearization = linearize(&params, &trim);
     let va = trim.target.va_mps;

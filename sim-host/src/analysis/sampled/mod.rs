@@ -294,6 +294,11 @@ impl SampledLoops {
             };
             trim = trim_near(&params, &target, &trim);
         }
+        if !trim.converged {
+            // An aircraft other than the Ultra Stick may not trim at 17 m/s at all: straight
+            // at the airspeed asked for.
+            trim = trim_with(&params, &level.clone().at_airspeed(airspeed_mps));
+        }
         anyhow::ensure!(
             trim.converged,
             "the level trim did not converge (residual {:.3e})",
