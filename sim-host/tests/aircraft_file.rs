@@ -11,8 +11,12 @@ fn write(dir: &tempfile::TempDir, text: &str) -> std::path::PathBuf {
 }
 
 fn replace(key_line_start: &str, new_line: &str) -> String {
-    DEFAULT_AIRCRAFT_TOML
-        .lines()
+    replace_in(DEFAULT_AIRCRAFT_TOML, key_line_start, new_line)
+}
+
+/// `text` with the line starting `key_line_start` replaced by `new_line`.
+fn replace_in(text: &str, key_line_start: &str, new_line: &str) -> String {
+    text.lines()
         .map(|l| {
             if l.starts_with(key_line_start) {
                 new_line.to_string()
@@ -217,18 +221,11 @@ fn ground_table_is_required_and_checked() {
 /// The Aerosonde's file with the line starting `key_line_start` replaced.
 fn aerosonde_with(key_line_start: &str, new_line: &str) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("aircraft/aerosonde.toml");
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .map(|l| {
-            if l.starts_with(key_line_start) {
-                new_line.to_string()
-            } else {
-                l.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
+    replace_in(
+        &std::fs::read_to_string(path).unwrap(),
+        key_line_start,
+        new_line,
+    )
 }
 
 #[test]

@@ -157,33 +157,35 @@ pub fn coefficients(
         + b.surface * 0.5 * d.lift.CL_da * (al + ar)
         + b.surface * 0.5 * d.lift.CL_df * (fl + fr);
     let ks = b.surface.abs();
+    // The other surfaces' drag and the plate's, added after the polar and the elevator in
+    // this order (the sums of the Minnesota model, to the bit).
+    let others = |sum: f64| {
+        sum + ks * (0.5 * d.drag.CD_da * al).abs()
+            + ks * (0.5 * d.drag.CD_da * ar).abs()
+            + ks * (d.drag.CD_dr * c.rudder).abs()
+            + ks * (0.5 * d.drag.CD_df * fl).abs()
+            + ks * (0.5 * d.drag.CD_df * fr).abs()
+            + b.plate_drag
+    };
     let mut cd = match d.drag.polar {
         DragPolar::TotalLift => {
             let dl = cl - d.drag.CL_at_CD_min;
-            d.drag.CD_min
-                + dl * dl * p.induced_drag_factor
-                + ks * (d.drag.CD_de * c.elevator).abs()
-                + ks * (0.5 * d.drag.CD_da * al).abs()
-                + ks * (0.5 * d.drag.CD_da * ar).abs()
-                + ks * (d.drag.CD_dr * c.rudder).abs()
-                + ks * (0.5 * d.drag.CD_df * fl).abs()
-                + ks * (0.5 * d.drag.CD_df * fr).abs()
-                + b.plate_drag
+            others(
+                d.drag.CD_min
+                    + dl * dl * p.induced_drag_factor
+                    + ks * (d.drag.CD_de * c.elevator).abs(),
+            )
         }
         DragPolar::AngleOfAttackLift => {
             let dl = b.in_plane * b.static_part(d.lift.CL0 + d.lift.CL_alpha * alpha, b.plate_lift)
                 - d.drag.CL_at_CD_min;
             // The elevator's drag is signed, as Beard and McLain write it, and turns with the
             // flow as its lift does.
-            d.drag.CD_min
-                + dl * dl * p.induced_drag_factor
-                + b.surface * d.drag.CD_de * c.elevator
-                + ks * (0.5 * d.drag.CD_da * al).abs()
-                + ks * (0.5 * d.drag.CD_da * ar).abs()
-                + ks * (d.drag.CD_dr * c.rudder).abs()
-                + ks * (0.5 * d.drag.CD_df * fl).abs()
-                + ks * (0.5 * d.drag.CD_df * fr).abs()
-                + b.plate_drag
+            others(
+                d.drag.CD_min
+                    + dl * dl * p.induced_drag_factor
+                    + b.surface * d.drag.CD_de * c.elevator,
+            )
         }
     };
     if d.drag.CD_q != 0.0 {

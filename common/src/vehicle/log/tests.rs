@@ -35,15 +35,32 @@ fn f32_at(p: &[u8], i: usize) -> f32 {
     f32::from_le_bytes(p[i..i + 4].try_into().unwrap())
 }
 
-#[test]
-fn a_vehicle_on_the_ground_logs_its_sensors_as_received_and_its_state_in_px4s_numbers() {
-    let mut v = Vehicle::new();
+/// A logger started at time 0.
+fn started_logger() -> Logger {
     let mut log = Logger::new(SystemInfo {
         sys_name: "test",
         ver_sw: "0",
         ver_hw: "host",
     });
     log.start(0);
+    log
+}
+
+/// The vehicle's topics due after frame `f`, written and drained into `bytes`.
+fn log_frame(v: &Vehicle, log: &mut Logger, f: &SensorFrame, bytes: &mut Vec<u8>) {
+    log.step(f.time_us, v.params());
+    v.write_log(log, f);
+    while log.pending_len() > 0 {
+        let n = log.pending().len();
+        bytes.extend_from_slice(log.pending());
+        log.consume(n);
+    }
+}
+
+#[test]
+fn a_vehicle_on_the_ground_logs_its_sensors_as_received_and_its_state_in_px4s_numbers() {
+    let mut v = Vehicle::new();
+    let mut log = started_logger();
     let imu = ImuSample {
         accel: Vector3::new(0.1, -0.2, -9.8),
         gyro: Vector3::new(0.01, 0.02, -0.03),
@@ -61,13 +78,7 @@ fn a_vehicle_on_the_ground_logs_its_sensors_as_received_and_its_state_in_px4s_nu
             ..Default::default()
         };
         v.on_sensors(&f, &FromGround::default());
-        log.step(f.time_us, v.params());
-        v.write_log(&mut log, &f);
-        while log.pending_len() > 0 {
-            let n = log.pending().len();
-            bytes.extend_from_slice(log.pending());
-            log.consume(n);
-        }
+        log_frame(&v, &mut log, &f, &mut bytes);
     }
     assert_eq!(log.stats().dropped, 0);
 
@@ -125,12 +136,7 @@ fn a_vehicle_on_the_ground_logs_its_sensors_as_received_and_its_state_in_px4s_nu
 #[test]
 fn rangefinder_readings_are_logged_as_distance_sensor_while_they_arrive() {
     let mut v = Vehicle::new();
-    let mut log = Logger::new(SystemInfo {
-        sys_name: "test",
-        ver_sw: "0",
-        ver_hw: "host",
-    });
-    log.start(0);
+    let mut log = started_logger();
     let mut bytes = Vec::new();
     for k in 0..400u64 {
         let f = SensorFrame {
@@ -151,13 +157,7 @@ fn rangefinder_readings_are_logged_as_distance_sensor_while_they_arrive() {
                 quality: 80,
             });
         }
-        log.step(f.time_us, v.params());
-        v.write_log(&mut log, &f);
-        while log.pending_len() > 0 {
-            let n = log.pending().len();
-            bytes.extend_from_slice(log.pending());
-            log.consume(n);
-        }
+        log_frame(&v, &mut log, &f, &mut bytes);
     }
     let range = samples(&bytes, DistanceSensor::ID);
     assert_eq!(range[0].1.len() + 8, DistanceSensor::FORMAT.size());
