@@ -305,15 +305,19 @@ fn the_command_line_prints_the_campaign_in_force_and_refuses_a_bad_file_before_f
     );
 }
 
-/// Half the aircraft carry a rangefinder (about 500 of 1000, within four binomial standard
-/// deviations of 16), drawn after everything else, so every other draw of a flight is the
-/// built-in campaign's; the flare's oracle changes nothing but the one parameter the station
+/// Half the aircraft of the built-in campaign carry a rangefinder (about 500 of 1000, within
+/// four binomial standard deviations of 16), drawn after everything else, so every other draw
+/// of a flight is the one it has with none fitted; the flare's oracle changes nothing but the one parameter the station
 /// sets; a share outside 0..1 is refused naming the key.
 #[test]
 fn a_share_of_the_aircraft_carry_a_rangefinder_and_the_oracle_only_sets_sim_use_truth() {
-    let plain = campaign(1000, 1, MissionChoice::Default);
-    let mut fitted = campaign(1000, 1, MissionChoice::Default);
-    fitted.spec.rangefinder.fitted_share = 0.5;
+    let mut plain = campaign(1000, 1, MissionChoice::Default);
+    plain.spec.rangefinder.fitted_share = 0.0;
+    let fitted = campaign(1000, 1, MissionChoice::Default);
+    assert_eq!(
+        fitted.spec.rangefinder.fitted_share, 0.5,
+        "the built-in share"
+    );
     let mut carried = 0;
     for i in 0..1000 {
         let (a, b) = (plain.plan(i), fitted.plan(i));

@@ -173,12 +173,19 @@ pub struct MissionSpec {
 }
 
 /// The downward rangefinder.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RangefinderSpec {
     /// Share of the flights whose aircraft carries one (the aircraft file's, or a LIDAR-Lite
     /// v3 where the file names none), drawn after everything else; 0 draws nothing.
     pub fitted_share: f64,
+}
+
+impl Default for RangefinderSpec {
+    /// Half the aircraft, so that one campaign gives the pass rates with and without one.
+    fn default() -> Self {
+        Self { fitted_share: 0.5 }
+    }
 }
 
 /// What the autopilot is told of the simulator's truth: experiments on the laws, not on the
