@@ -191,6 +191,47 @@ fn the_mcu_image_flies_the_whole_default_mission_from_the_runway_to_the_runway()
     );
 }
 
+/// The MCU image lands the default mission on its rangefinder (the simulated LIDAR-Lite v3 on
+/// the simulator link's `DISTANCE_SENSOR`, `docs/RANGEFINDER.md`): every item reached, the
+/// flare begun within 0.3 m of its 1.5 m (`NAV_FLR_ALT`) by the true height above the runway,
+/// the touchdown within 20 m of the point under 1.5 m/s, disarmed on the ground; and the
+/// whole flight, landing included, within the image's budgets.
+#[test]
+#[ignore = "about 5 min: docs/PIL.md gives its figures; `cargo test -p system-tests --test pil -- --ignored`"]
+fn the_mcu_image_lands_the_default_mission_on_its_rangefinder_within_its_budget() {
+    let Some(qemu) = mcu() else { return };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut a = aircraft();
+    a.sensors.rangefinder = Some(sim_host::sensors::RangefinderConfig::default());
+    let home_alt = ModelParams::new(&a).home_alt_msl_m;
+    let cfg = runway_mission(default_mission(ModelParams::new(&a).home));
+    let r = fly_report(&a, &cfg, &pil_options(qemu, dir.path())).expect("flight");
+    let s = &r.outcome.summary;
+    let m = s.mission.as_ref().expect("a mission");
+    assert!(
+        m.all_reached,
+        "reached {:?} of {:?}",
+        m.reached, m.nav_items
+    );
+    let flare = r
+        .outcome
+        .samples
+        .iter()
+        .find(|x| x.nav_phase == common::navigation::Phase::Flare as u8)
+        .expect("a flare");
+    let flare_m = flare.alt - home_alt;
+    let td = m.touchdown.expect("a touchdown");
+    let b = r.mcu.expect("the image's figures of itself");
+    eprintln!("flare from {flare_m:.2} m, {td:?}, MCU budget over the flight: {b:?}");
+    assert!((flare_m - 1.5).abs() < 0.3, "flare from {flare_m} m");
+    assert!(td.distance_m < 20.0 && td.sink_rate_mps < 1.5, "{td:?}");
+    assert_eq!(s.ended, Ending::Landed);
+    assert!(b.flash_bytes <= 192 * 1024, "flash {b:?}");
+    assert!(b.ram_bytes() <= 64 * 1024, "RAM {b:?}");
+    assert!(b.instr_per_control_period_mean <= 100_000.0, "{b:?}");
+    assert!(b.instr_per_control_period_max <= 150_000.0, "{b:?}");
+}
+
 #[test]
 #[ignore = "builds sim-host a second time (mcu-libm) and flies 80 s in QEMU: docs/PIL.md"]
 fn with_the_libm_crate_on_both_sides_the_host_build_answers_bit_for_bit_as_the_mcu_image() {
