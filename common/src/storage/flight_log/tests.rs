@@ -218,3 +218,22 @@ fn garbage_in_the_region_is_no_log() {
     let (logs, _) = scan(&mut f, &REGION).unwrap();
     assert!(logs.is_empty());
 }
+
+/// Logs found out of number order (the ring wrapped: a newer log in an earlier sector) are
+/// listed by number, each moved down to its place as it is found.
+#[test]
+fn logs_found_out_of_order_are_listed_by_number() {
+    let mut logs = LogList::new();
+    for id in [5, 2, 9, 1, 7] {
+        let info = LogInfo {
+            id,
+            first_sector: 0,
+            blocks: 1,
+            bytes: 0,
+        };
+        assert!(logs.push(info).is_ok());
+        settle_last(&mut logs);
+    }
+    let ids: std::vec::Vec<u32> = logs.iter().map(|l| l.id).collect();
+    assert_eq!(ids, [1, 2, 5, 7, 9]);
+}
