@@ -217,7 +217,11 @@ fn the_mcu_image_lands_the_default_mission_on_its_rangefinder_within_its_budget(
     let ulog = sim_host::ulog_read::parse(bytes).expect("a ULog");
     let ranges = ulog.dataset("distance_sensor").map_or(0, |d| d.len());
     eprintln!("{td:?}, {ranges} distance_sensor samples, MCU budget over the flight: {b:?}");
-    assert!(m.all_reached, "reached {:?} of {:?}", m.reached, m.nav_items);
+    assert!(
+        m.all_reached,
+        "reached {:?} of {:?}",
+        m.reached, m.nav_items
+    );
     assert!(td.distance_m < 20.0 && td.sink_rate_mps < 1.5, "{td:?}");
     assert_eq!(s.ended, Ending::Landed);
     assert!(ranges >= 200, "{ranges} distance_sensor samples");
