@@ -338,7 +338,7 @@ fn a_share_of_the_aircraft_carry_a_rangefinder_and_the_oracle_only_sets_sim_use_
 
     let mut oracle = campaign(10, 1, MissionChoice::Default);
     oracle.spec.oracle.flare_on_truth = true;
-    let (a, b) = (plain.plan(3), oracle.plan(3));
+    let (a, b) = (fitted.plan(3), oracle.plan(3));
     assert_eq!(a.draws, b.draws);
     let mut params = b.config.script.params.clone();
     assert_eq!(params.pop(), Some(("SIM_USE_TRUTH".to_string(), 2.0)));
@@ -357,7 +357,9 @@ fn a_share_of_the_aircraft_carry_a_rangefinder_and_the_oracle_only_sets_sim_use_
 #[test]
 fn a_campaign_beside_another_of_the_same_flights_pairs_their_verdicts_flight_for_flight() {
     use sim_host::campaign::groups::{beside, rates};
-    let c = campaign(2, 5, MissionChoice::Default);
+    let mut c = campaign(2, 5, MissionChoice::Default);
+    // Grouped by turbulence alone: no rangefinder drawn.
+    c.spec.rangefinder.fitted_share = 0.0;
     let meta = c.meta(Shard::WHOLE);
     let records = c.run(Shard::WHOLE, 2, false).unwrap();
     let mut other = c.clone();

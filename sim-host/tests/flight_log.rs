@@ -165,7 +165,7 @@ fn pyulog_and_this_projects_reader_read_the_same_topics_samples_parameters_and_a
         .map(|d| (d.name.clone(), d.multi_id, d.layout.size, d.len()))
         .collect();
     read.sort();
-    assert_eq!(read.len(), 19, "{read:?}");
+    assert_eq!(read.len(), 20, "{read:?}");
     assert_eq!(read, topics, "topic, instance, sample size and samples");
     for key in ["sys_name", "ver_sw", "ver_hw"] {
         let line = format!(" {key}: {}", ours.info_text(key).expect(key));

@@ -209,7 +209,7 @@ fn every_topic_is_logged_at_the_rate_docs_logging_md_gives_it() {
     let flown = flight();
     let (_, s) = summary(flown);
     let mut documented = documented_rates();
-    assert_eq!(documented.len(), 19, "{documented:?}");
+    assert_eq!(documented.len(), 20, "{documented:?}");
     let mut logged: Vec<(String, f64)> = s
         .topics
         .iter()
@@ -282,7 +282,7 @@ fn sim_host_log_prints_the_summary_and_draws_the_figures_a_simulated_flight_draw
     let j: serde_json::Value = serde_json::from_slice(&r.stdout).expect("JSON");
     let (_, s) = summary(flown);
     assert_eq!(j["duration_s"].as_f64(), Some(s.duration_s));
-    assert_eq!(j["topics"].as_array().map(Vec::len), Some(19));
+    assert_eq!(j["topics"].as_array().map(Vec::len), Some(20));
     assert_eq!(j["modes"][1]["mode"], "Mission", "{}", j["modes"]);
 }
 

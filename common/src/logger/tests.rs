@@ -51,7 +51,8 @@ fn every_topic_writes_exactly_the_bytes_its_format_declares_under_its_own_id() {
         VehicleLandDetected,
         BatteryStatus,
         MissionResult,
-        TelemetryStatus
+        TelemetryStatus,
+        DistanceSensor
     );
     assert_eq!(names.len(), TOPICS.len());
     names.sort_unstable();
@@ -193,9 +194,11 @@ fn each_topic_is_written_at_its_rate() {
             .filter(|(k, p)| *k == b'D' && u16::from_le_bytes([p[0], p[1]]) == id)
             .count()
     };
-    // The definitions take the first periods; every rate is met from then on.
+    // The definitions (header, information, every parameter, every topic's format and
+    // subscription) take the first dozen periods, a period more for every few parameters or
+    // topics the registry gains; every rate is met from then on.
     let att = count(VehicleAttitude::ID);
-    assert!((245..=250).contains(&att), "{att}");
+    assert!((238..=250).contains(&att), "{att}");
     let bat = count(BatteryStatus::ID);
     assert!((9..=10).contains(&bat), "{bat}");
     let est = count(EstimatorStates::ID);
@@ -223,8 +226,11 @@ fn a_storage_too_slow_costs_samples_and_the_log_says_for_how_long() {
         .map(|(_, p)| u16::from_le_bytes([p[0], p[1]]))
         .collect();
     assert!(!dropouts.is_empty());
+    // A dropout that a smaller sample of the same period ends (there was room for it) lasted
+    // 0 ms; together they span the periods the storage fell behind.
+    assert!(dropouts.iter().all(|&ms| ms < 10_000), "{dropouts:?}");
     assert!(
-        dropouts.iter().all(|&ms| ms > 0 && ms < 10_000),
+        dropouts.iter().map(|&ms| u32::from(ms)).sum::<u32>() > 0,
         "{dropouts:?}"
     );
 }

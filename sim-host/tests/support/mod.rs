@@ -23,9 +23,11 @@ pub struct Flown {
 }
 
 /// Flies the default mission from the runway for `duration_s` of simulated time in this
-/// process, its files into `dir` (figures left out).
+/// process, its files into `dir` (figures left out), the aircraft fitted with the default
+/// rangefinder so that every topic of the log has samples.
 pub fn fly_default(dir: &Path, duration_s: f64) -> Flown {
-    let aircraft = Aircraft::load(None).expect("the built-in aircraft");
+    let mut aircraft = Aircraft::load(None).expect("the built-in aircraft");
+    aircraft.sensors.rangefinder = Some(sim_host::sensors::RangefinderConfig::default());
     let cfg = FlightConfig {
         duration_s,
         ..mission_config(&aircraft, Path::new("default")).expect("the default mission")
