@@ -150,8 +150,7 @@ fn run() -> anyhow::Result<ExitCode> {
         }) => {
             let va = speed.or_cruise(&aircraft);
             if let Some(path) = &write_gains {
-                let inputs = sim_host::analysis::design::DesignInputs::default();
-                let g = sim_host::analysis::design::design_at(&aircraft, &inputs, va)?.gains;
+                let g = sim_host::analysis::design::computed_gain_set_at(&aircraft, va)?;
                 let text = toml::to_string(&g).context("encoding the gain set")?;
                 std::fs::write(path, text)
                     .with_context(|| format!("cannot write `{}`", path.display()))?;

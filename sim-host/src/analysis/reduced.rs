@@ -22,7 +22,7 @@ use super::linearize::{ix, Linearization};
 use super::trim::TrimResult;
 use crate::aircraft::Aircraft;
 use crate::plant::params::ModelParams;
-use crate::plant::propulsion::propulsion;
+use crate::plant::propulsion::{propulsion, steady_engine_speed};
 use common::math::atmosphere::standard_atmosphere;
 use serde::Serialize;
 
@@ -101,19 +101,10 @@ pub fn from_linearization(lin: &Linearization, trim: &TrimResult) -> ReducedCoef
     }
 }
 
-/// Thrust with the engine at its torque balance, N (bisection on the engine speed: the net
-/// torque falls with it).
+/// Thrust with the engine at its torque balance, N.
 pub fn steady_thrust_n(p: &ModelParams, va: f64, throttle: f64, rho: f64) -> f64 {
-    let [mut lo, mut hi] = p.prop.omega_limits_radps;
-    for _ in 0..80 {
-        let mid = 0.5 * (lo + hi);
-        if propulsion(p, va, mid, throttle, rho).engine_accel > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    propulsion(p, va, 0.5 * (lo + hi), throttle, rho).thrust_n
+    let omega = steady_engine_speed(p, va, throttle, rho);
+    propulsion(p, va, omega, throttle, rho).thrust_n
 }
 
 /// Beard and McLain's closed-form coefficients with the aircraft file's values at `trim`.

@@ -17,7 +17,7 @@ use crate::aircraft::Aircraft;
 use crate::plant::dynamics::derivatives;
 use crate::plant::inputs::{Controls, Environment};
 use crate::plant::params::ModelParams;
-use crate::plant::propulsion::propulsion;
+use crate::plant::propulsion::steady_engine_speed;
 use crate::plant::state::State;
 use common::math::atmosphere::standard_atmosphere;
 use common::math::{AirData, Euler};
@@ -277,17 +277,6 @@ fn own_guess(p: &ModelParams, t: &TrimTarget) -> Z {
         0.0
     };
     let throttle = 0.5;
-    let [mut lo, mut hi] = p.prop.omega_limits_radps;
-    let accel = |w: f64| propulsion(p, t.va_mps, w, throttle, rho).engine_accel;
-    // The net torque falls with the engine speed: bisect for its zero (or stay at a limit).
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if accel(mid) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
     Z::from_column_slice(&[
         alpha,
         0.0,
@@ -296,7 +285,7 @@ fn own_guess(p: &ModelParams, t: &TrimTarget) -> Z {
         0.0,
         0.0,
         throttle,
-        0.5 * (lo + hi),
+        steady_engine_speed(p, t.va_mps, throttle, rho),
     ])
 }
 

@@ -33,11 +33,6 @@ pub struct DesignReport {
     pub tables: Vec<Table>,
 }
 
-/// Designs the loops at the aircraft's cruise airspeed and tabulates them.
-pub fn design_report(aircraft: &Aircraft) -> anyhow::Result<DesignReport> {
-    design_report_at(aircraft, aircraft.cruise_airspeed_mps())
-}
-
 /// Designs the loops at the level trim at `va_mps` and tabulates them. The airspeed-scaling
 /// table judges the firmware's flight set between the Ultra Stick's mission limits, so it
 /// comes with the Ultra Stick at 17 m/s only.
@@ -297,12 +292,7 @@ fn scaling_report(
     Ok((rows, t))
 }
 
-/// The design as a Markdown document.
-pub fn design_markdown(aircraft: &Aircraft) -> anyhow::Result<String> {
-    design_markdown_at(aircraft, aircraft.cruise_airspeed_mps())
-}
-
-/// [`design_markdown`] at `va_mps`.
+/// The design at `va_mps` as a Markdown document.
 pub fn design_markdown_at(aircraft: &Aircraft, va_mps: f64) -> anyhow::Result<String> {
     let r = design_report_at(aircraft, va_mps)?;
     Ok(format!(

@@ -63,6 +63,22 @@ fn motor_torque_nm(p: &ModelParams, throttle: f64, omega_c: f64) -> f64 {
     }
 }
 
+/// The engine speed at which motor and propeller torques balance at airspeed `va` and
+/// `throttle`, rad/s (bisection within the engine's limits: the net torque falls with the
+/// speed; a limit when it does not cross zero inside them).
+pub fn steady_engine_speed(p: &ModelParams, va: f64, throttle: f64, rho: f64) -> f64 {
+    let [mut lo, mut hi] = p.prop.omega_limits_radps;
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if propulsion(p, va, mid, throttle, rho).engine_accel > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// Thrust, torques and engine acceleration at airspeed `va`, engine speed `omega` and `throttle`.
 pub fn propulsion(
     p: &ModelParams,

@@ -467,7 +467,12 @@ pub fn design_at(
 
 /// The "computed" gain set: [`design`] with the thesis's design inputs.
 pub fn computed_gain_set(aircraft: &Aircraft) -> anyhow::Result<GainSet> {
-    Ok(design(aircraft, &DesignInputs::default())?.gains)
+    computed_gain_set_at(aircraft, aircraft.cruise_airspeed_mps())
+}
+
+/// [`computed_gain_set`] designed at the level trim at `va_mps`.
+pub fn computed_gain_set_at(aircraft: &Aircraft, va_mps: f64) -> anyhow::Result<GainSet> {
+    Ok(design_at(aircraft, &DesignInputs::default(), va_mps)?.gains)
 }
 
 /// Damping and natural frequency of each pole, for reports.
