@@ -164,6 +164,18 @@ pub const PARAMS: Group<EstimatorConfig> = Group {
         ),
         param!(
             ParamDef::real(
+                "EKF_GPS_DLY_SD",
+                0.04,
+                0.0,
+                0.2,
+                "s",
+                "uncertainty of EKF_GPS_DELAY (1 sigma): a fix read at the wrong instant differs \
+                 by the acceleration (velocity) times the error, weighed as noise",
+            ),
+            EstimatorConfig => gps_delay_sd
+        ),
+        param!(
+            ParamDef::real(
                 "EKF_BARO_NOISE",
                 0.8,
                 0.01,
@@ -425,6 +437,8 @@ pub struct EstimatorConfig {
     pub gps_vel_noise: f32,
     /// `EKF_GPS_DELAY`, s.
     pub gps_delay: f32,
+    /// `EKF_GPS_DLY_SD`, s.
+    pub gps_delay_sd: f32,
     /// `EKF_BARO_NOISE`, m.
     pub baro_noise: f32,
     /// `EKF_BARO_B_RW`, m/sqrt(s).
@@ -483,6 +497,7 @@ const ZERO: EstimatorConfig = EstimatorConfig {
     gps_alt_noise: 0.0,
     gps_vel_noise: 0.0,
     gps_delay: 0.0,
+    gps_delay_sd: 0.0,
     baro_noise: 0.0,
     baro_bias_rw: 0.0,
     gate_sigma: 0.0,

@@ -107,6 +107,8 @@ pub struct GpsNoise {
     pub vertical: f32,
     /// Velocity per axis, m/s.
     pub velocity: f32,
+    /// Uncertainty of the fix's latency, s (1 sigma).
+    pub latency_sd: f32,
 }
 
 /// Process noise densities.
@@ -697,6 +699,7 @@ mod tests {
             horizontal: 1.5,
             vertical: 5.5,
             velocity: 0.05,
+            latency_sd: 0.0,
         }
     }
 

@@ -206,6 +206,7 @@ impl Estimator {
             horizontal: self.cfg.gps_pos_noise,
             vertical: self.cfg.gps_alt_noise,
             velocity: self.cfg.gps_vel_noise,
+            latency_sd: self.cfg.gps_delay_sd,
         }
     }
 
