@@ -216,15 +216,26 @@ impl<D: Dialect> FrameParser<D> {
         mut on_frame: impl FnMut(Frame),
         mut on_undecoded: impl FnMut(Undecoded<'_>),
     ) {
-        for &b in bytes {
+        let mut rest = bytes;
+        while let Some((&b, tail)) = rest.split_first() {
             if self.len == 0 && b != STX_V1 && b != STX_V2 {
                 self.stats.bytes_skipped = self.stats.bytes_skipped.wrapping_add(1);
+                rest = tail;
                 continue;
             }
-            if let Some(slot) = self.buf.get_mut(self.len) {
+            // Every byte short of the candidate's header, then of its whole length, would
+            // only be answered "more" (a header the parser cannot take is answered as soon
+            // as it is whole): they go in together and are checked once, not once a byte
+            // (tens of instructions a byte on the MCU, whose budget is per period).
+            let n = self.bytes_wanted().min(rest.len());
+            let (take, after) = (rest.get(..n).unwrap_or(&[]), rest.get(n..).unwrap_or(&[]));
+            let room = self.buf.get_mut(self.len..).unwrap_or(&mut []);
+            let kept = take.len().min(room.len());
+            for (slot, &b) in room.iter_mut().zip(take) {
                 *slot = b;
-                self.len = self.len.saturating_add(1);
             }
+            self.len = self.len.saturating_add(kept);
+            rest = after;
             self.drain(&mut on_frame, &mut on_undecoded);
         }
     }
@@ -740,8 +751,10 @@ mod tests {
         (found, p.stats(), calls)
     }
 
-    #[test]
-    fn bytes_handed_over_once_the_parser_wants_them_give_the_same_frames_at_the_same_bytes() {
+    /// Three clean frames (the first `frames_only` bytes returned), then debris among frames:
+    /// garbage, a bad checksum, a truncated frame, an unknown id, unsupported flags, MAVLink 1,
+    /// and noise with markers and a heartbeat now and then.
+    fn debris_stream() -> (Vec<u8>, usize) {
         let mut s = Vec::new();
         for i in 0..3 {
             s.extend(heartbeat(i));
@@ -776,6 +789,12 @@ mod tests {
                 s.extend(heartbeat((k / 500) as u8 + 7));
             }
         }
+        (s, frames_only)
+    }
+
+    #[test]
+    fn bytes_handed_over_once_the_parser_wants_them_give_the_same_frames_at_the_same_bytes() {
+        let (s, frames_only) = debris_stream();
         let (byte_by_byte, stats, _) = arrivals(&s, false);
         let (waited, waited_stats, _) = arrivals(&s, true);
         assert!(byte_by_byte.len() >= 10, "{byte_by_byte:?}");
@@ -784,6 +803,39 @@ mod tests {
         // Clean frames: two calls each (the first three bytes, then the rest).
         let (_, _, calls) = arrivals(&s[..frames_only], true);
         assert_eq!(calls, 6);
+    }
+
+    /// The bytes of a chunk go into the candidate together, up to what it still lacks: the
+    /// same frames and the same counts as one byte a call, however the stream is cut.
+    #[test]
+    fn a_chunk_taken_in_at_once_gives_what_its_bytes_one_by_one_give() {
+        let (mut s, _) = debris_stream();
+        // Unsupported flags under a length that claims most of a frame: answered as soon as
+        // the header is whole, so the short frame behind it is not held back.
+        s.extend([STX_V2, 250, 0x80]);
+        s.extend(heartbeat(40));
+        s.extend(heartbeat(41));
+        // Each frame with the chunk it came out of.
+        let found = |chunk: usize| {
+            let mut p = FrameParser::new();
+            let mut out = Vec::new();
+            for (k, c) in s.chunks(chunk).enumerate() {
+                p.push(c, |f| {
+                    let id = mavlink::Message::message_id(&f.message);
+                    out.push((f.header.sequence, id, k));
+                });
+            }
+            (out, p.stats())
+        };
+        let (one_by_one, stats) = found(1);
+        assert!(one_by_one.len() >= 12, "{one_by_one:?}");
+        for chunk in [2, 3, 5, 13, 64, 97, 280, 281, s.len()] {
+            let expected: Vec<_> = one_by_one
+                .iter()
+                .map(|&(seq, id, byte)| (seq, id, byte / chunk))
+                .collect();
+            assert_eq!(found(chunk), (expected, stats), "chunks of {chunk}");
+        }
     }
 
     #[test]
