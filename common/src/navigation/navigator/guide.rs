@@ -70,6 +70,20 @@ pub(super) fn course_widening(course: f32, height: f32, widen_m: f32, p: &NavPar
     }
 }
 
+/// `mode` flown near the runway (approach, flare, take-off): a course held without a limit of
+/// its own is held within a right angle of bank, which the autopilot does not slew (its roll
+/// command follows the course loop's answer to gusts there at once; the roll limit still
+/// governs).
+pub(super) fn near_runway(mode: RollMode) -> RollMode {
+    match mode {
+        RollMode::Course(course) => RollMode::CourseWithin {
+            course,
+            roll_max: core::f32::consts::FRAC_PI_2,
+        },
+        other => other,
+    }
+}
+
 /// Distance between two points over the ground, m.
 pub(super) fn horizontal_dist(a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
     libm::hypotf(a.x - b.x, a.y - b.y)
