@@ -705,6 +705,7 @@ mod tests {
         o = lat.step(&m, within_left, YawMode::Off, DT);
         assert!((o.roll_cmd + 10.0 * D).abs() < 1e-5, "{}", o.roll_cmd / D);
         o = lat.step(&m, within, YawMode::Off, DT);
+        assert!((o.roll_cmd - 10.0 * D).abs() < 1e-5, "{}", o.roll_cmd / D);
         // Turned the other way: level at once, then the other bank at the command rate.
         o = lat.step(&m, RollMode::Course(-90.0 * D), YawMode::Off, DT);
         assert!((o.roll_cmd + 1.8 * D).abs() < 1e-5, "{}", o.roll_cmd / D);
