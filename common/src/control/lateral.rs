@@ -46,7 +46,9 @@ pub struct LateralGains {
     pub washout_pole: f32,
     /// Largest commanded roll angle, rad.
     pub roll_max: f32,
-    /// Fastest the course loop's roll command moves, rad/s (0: unlimited).
+    /// Fastest the course loop's roll command grows, rad/s (0: unlimited; absent from older
+    /// gain files: 90 deg/s).
+    #[serde(default = "default_roll_cmd_rate")]
     pub roll_cmd_rate: f32,
     /// Aileron travel the loops may use, rad (at most the servo limit).
     pub aileron_max: f32,
@@ -56,6 +58,10 @@ pub struct LateralGains {
     pub trim_aileron: f32,
     /// Rudder trim, the feed-forward of the rudder loops, rad.
     pub trim_rudder: f32,
+}
+
+fn default_roll_cmd_rate() -> f32 {
+    90.0 * DEG
 }
 
 /// The thesis's designed lateral gains, chapter-3 tables: roll Table 3.3, course Table 3.4,
