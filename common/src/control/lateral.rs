@@ -230,7 +230,7 @@ pub const PARAMS: Group<LateralGains> = Group {
                 0.0,
                 720.0,
                 "deg/s",
-                "Fastest the course loop's roll command moves (PX4's FW_R_RMAX); 0: unlimited",
+                "Fastest the course loop's roll command grows away from level (PX4's FW_R_RMAX); 0: unlimited",
             ),
             LateralGains => roll_cmd_rate, scale RAD2DEG
         ),
@@ -291,10 +291,12 @@ pub enum RollMode {
     Off,
     /// Hold this roll angle, rad (limited to the roll limit).
     Roll(f32),
-    /// Hold this course over ground, rad (any value; the error is wrapped to +-pi).
+    /// Hold this course over ground, rad (any value; the error is wrapped to +-pi); the roll
+    /// command grows at most `LIM_RLL_RATE_DEG`.
     Course(f32),
     /// Hold `course` (rad) banking no further than `roll_max` (rad; the roll limit when
-    /// larger): close to the ground, where a wing tip would touch.
+    /// larger): close to the ground, where a wing tip would touch. The roll command is not
+    /// slewed.
     CourseWithin {
         /// Course over ground, rad.
         course: f32,

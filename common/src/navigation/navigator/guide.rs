@@ -59,28 +59,29 @@ pub(super) fn follow(g: &GuidanceOutput) -> Commands {
 /// once it is the smaller), so a wing tip cannot touch (the Ultra Stick's does at 17 deg of
 /// bank with its wheels on the ground, at 38 deg with them 0.2 m up, at none from 0.45 m).
 pub(super) fn course_near_ground(course: f32, height: f32, p: &NavParams) -> RollMode {
-    course_widening(course, height, p.ground_roll_height, p)
-}
-
-/// As [`course_near_ground`], the bank allowed widening to 90 deg at `widen_m` (m) instead.
-pub(super) fn course_widening(course: f32, height: f32, widen_m: f32, p: &NavParams) -> RollMode {
-    match p.bank_near_ground(height, widen_m) {
+    match p.bank_near_ground(height, p.ground_roll_height) {
         Some(roll_max) => RollMode::CourseWithin { course, roll_max },
         None => RollMode::Course(course),
     }
 }
 
-/// `mode` flown near the runway (approach, flare, take-off): a course held without a limit of
-/// its own is held within a right angle of bank, which the autopilot does not slew (its roll
-/// command follows the course loop's answer to gusts there at once; the roll limit still
-/// governs).
-pub(super) fn near_runway(mode: RollMode) -> RollMode {
-    match mode {
-        RollMode::Course(course) => RollMode::CourseWithin {
-            course,
-            roll_max: core::f32::consts::FRAC_PI_2,
-        },
-        other => other,
+/// Holding `course` (rad) at `height` (m) in the take-off, the approach, the flare and the
+/// go-around's climb: the bank allowed widens to 90 deg at `widen_m` (m) as in
+/// [`course_near_ground`], and is held as a limit above it too, where the roll limit governs.
+/// A course held within a limit is one the autopilot does not slew
+/// ([`RollMode::CourseWithin`]): its roll command follows the course loop's answer to gusts
+/// near the runway at once.
+pub(super) fn course_near_runway(
+    course: f32,
+    height: f32,
+    widen_m: f32,
+    p: &NavParams,
+) -> RollMode {
+    RollMode::CourseWithin {
+        course,
+        roll_max: p
+            .bank_near_ground(height, widen_m)
+            .unwrap_or(core::f32::consts::FRAC_PI_2),
     }
 }
 
@@ -171,6 +172,36 @@ mod tests {
             assert_eq!(
                 course_near_ground(0.3, h, &p),
                 RollMode::Course(0.3),
+                "at {h} m"
+            );
+        }
+    }
+
+    /// Near the runway the course is always held within a limit (so the autopilot does not
+    /// slew its roll command): the same bank as `course_near_ground` low down, 90 deg above
+    /// the widening height.
+    #[test]
+    fn near_the_runway_the_course_is_held_within_the_bank_near_the_ground_or_a_right_angle() {
+        let p = NavParams::default();
+        for h in [0.0, 0.3, 1.5] {
+            let RollMode::CourseWithin { roll_max, .. } = course_near_ground(0.3, h, &p) else {
+                panic!("at {h} m");
+            };
+            assert_eq!(
+                course_near_runway(0.3, h, p.ground_roll_height, &p),
+                RollMode::CourseWithin {
+                    course: 0.3,
+                    roll_max
+                }
+            );
+        }
+        for h in [3.0, 50.0, f32::NAN] {
+            assert_eq!(
+                course_near_runway(0.3, h, p.ground_roll_height, &p),
+                RollMode::CourseWithin {
+                    course: 0.3,
+                    roll_max: core::f32::consts::FRAC_PI_2
+                },
                 "at {h} m"
             );
         }

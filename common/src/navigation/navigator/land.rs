@@ -30,9 +30,7 @@
 //! height. A ground station asks for the same with `MAV_CMD_DO_GO_AROUND`. After
 //! `GO_AROUNDS_MAX` go-arounds the landing lands whatever its flare brings.
 
-use super::guide::{
-    course_near_ground, course_widening, follow, horizontal_dist, near_runway, Flight,
-};
+use super::guide::{course_near_runway, follow, horizontal_dist, Flight};
 use super::gust::approach_airspeed;
 use super::io::{NavOutput, Phase};
 use super::params::NavParams;
@@ -294,7 +292,7 @@ impl Landing {
             out.guidance = Some(g);
             let hagl = state.height() + self.point.z;
             out.commands = Some(Commands {
-                roll: near_runway(course_near_ground(g.course, hagl, p)),
+                roll: course_near_runway(g.course, hagl, p.ground_roll_height, p),
                 yaw: RUDDER,
                 lon: LonMode::TakeOff {
                     altitude: c.height,
@@ -469,7 +467,7 @@ impl Landing {
                 // `NAV_APP_DIVE_M` below the present height, and the landing is long instead.
                 let cmd = (slope + self.slope_trim).max(state.height() - p.approach_dive);
                 out.commands = Some(Commands {
-                    roll: near_runway(course_near_ground(g.course, hagl, p)),
+                    roll: course_near_runway(g.course, hagl, p.ground_roll_height, p),
                     lon: LonMode::Glide {
                         altitude: cmd,
                         airspeed: g.airspeed,
@@ -519,12 +517,12 @@ impl Landing {
                     RUDDER
                 };
                 out.commands = Some(Commands {
-                    roll: near_runway(course_widening(
+                    roll: course_near_runway(
                         g.course,
                         hagl,
                         p.ground_roll_height.max(FLARE_BANK_M),
                         p,
-                    )),
+                    ),
                     yaw,
                     lon: LonMode::Pitch {
                         pitch,
