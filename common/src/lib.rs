@@ -25,6 +25,10 @@
 //!   gains.
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
 //!
+//! Beside the tick, reading what it flew:
+//! - [`tuning`]: the reduced models identified from flight data, for the design by successive
+//!   loop closure.
+//!
 //! Beside the tick:
 //! - [`params`]: how each stage declares its parameters, and the one store of their values.
 //! - [`gcs`]: the ground-station protocols (routing, parameters, missions, commands,
@@ -67,5 +71,6 @@ pub mod navigation;
 pub mod params;
 pub mod sensors;
 pub mod storage;
+pub mod tuning;
 pub mod ulog;
 pub mod vehicle;

@@ -40,8 +40,8 @@ const LAYERS: [(&str, &[&[&str]]); 3] = [
             // and surfaces).
             &["estimator", "guidance", "control", "battery", "link"],
             // The navigator drives guidance and control from the estimate; the failsafes
-            // read the battery.
-            &["navigation", "failsafe"],
+            // read the battery; tuning fits the models the control's gains are designed on.
+            &["navigation", "failsafe", "tuning"],
             // The vehicle wires the stages: commander, modes, snapshot, requests.
             &["vehicle"],
             // The vehicle's stores and snapshot brought out: the ground link and the flash.

@@ -1,0 +1,141 @@
+//! Linear least squares taken in one sample at a time: the upper-triangular factor `R` of a
+//! QR factorisation of the regressors, updated by Givens rotations as each row arrives.
+//!
+//! The normal equations (`X^T X`, `X^T y`) would square the regressors' condition number, and
+//! in `f32` a fit of a roll damping (regressors of a few rad/s beside a constant) would lose
+//! half its digits; the rotations keep it as `X` itself is conditioned. Memory is fixed
+//! (`N x N + N + 4` floats), a row costs `O(N^2)`, so a fit spreads over as many control
+//! periods as it has samples, and none of it needs the heap.
+
+// The matrices and vectors are fixed-size and indexed with loop indices below their
+// dimension: no index comes from outside.
+#![allow(clippy::indexing_slicing)]
+
+use nalgebra::{SMatrix, SVector};
+
+/// Least squares over `N` regressors.
+#[derive(Clone, Debug)]
+pub struct LeastSquares<const N: usize> {
+    /// Upper-triangular factor of the regressors.
+    r: SMatrix<f32, N, N>,
+    /// `Q^T y`: the right-hand side rotated with `r`.
+    z: SVector<f32, N>,
+    /// Residual sum of squares left over by the rotations.
+    rss: f32,
+    /// Sum and sum of squares of the measured outputs, for the variance they had to explain.
+    y_sum: f32,
+    y_sq: f32,
+    rows: u32,
+}
+
+/// A solved fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fit<const N: usize> {
+    /// Coefficients, in the order of the regressors.
+    pub coef: SVector<f32, N>,
+    /// Each coefficient's standard error (the residuals' variance through `(X^T X)^-1`).
+    pub std_err: SVector<f32, N>,
+    /// Share of the outputs' variance the fit explains (R^2, 1 for a perfect fit).
+    pub r2: f32,
+    /// Rows taken in.
+    pub rows: u32,
+}
+
+impl<const N: usize> Default for LeastSquares<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> LeastSquares<N> {
+    /// No rows yet.
+    pub fn new() -> Self {
+        Self {
+            r: SMatrix::zeros(),
+            z: SVector::zeros(),
+            rss: 0.0,
+            y_sum: 0.0,
+            y_sq: 0.0,
+            rows: 0,
+        }
+    }
+
+    /// Rows taken in so far.
+    pub fn rows(&self) -> u32 {
+        self.rows
+    }
+
+    /// Takes in one row: regressors `x`, output `y`. A row with a value that is not finite is
+    /// left out (`false`), so a bad sample costs that sample only.
+    pub fn push(&mut self, x: &SVector<f32, N>, y: f32) -> bool {
+        if !y.is_finite() || x.iter().any(|v| !v.is_finite()) {
+            return false;
+        }
+        let (mut x, y_in) = (*x, y);
+        let mut y = y;
+        for i in 0..N {
+            let (a, b) = (self.r[(i, i)], x[i]);
+            if b == 0.0 {
+                continue;
+            }
+            let h = libm::hypotf(a, b);
+            let (c, s) = (a / h, b / h);
+            self.r[(i, i)] = h;
+            x[i] = 0.0;
+            for j in i + 1..N {
+                let (rij, xj) = (self.r[(i, j)], x[j]);
+                self.r[(i, j)] = c * rij + s * xj;
+                x[j] = c * xj - s * rij;
+            }
+            let zi = self.z[i];
+            self.z[i] = c * zi + s * y;
+            y = c * y - s * zi;
+        }
+        self.rss += y * y;
+        self.y_sum += y_in;
+        self.y_sq += y_in * y_in;
+        self.rows += 1;
+        true
+    }
+
+    /// The fit, or `None` while some regressor has not varied independently of the others
+    /// (a diagonal of `R` under `1e-6` of the largest: that regressor was not excited).
+    pub fn solve(&self) -> Option<Fit<N>> {
+        let scale = (0..N).map(|i| self.r[(i, i)].abs()).fold(0.0, f32::max);
+        if self.rows <= N as u32 || scale <= 0.0 {
+            return None;
+        }
+        if (0..N).any(|i| self.r[(i, i)].abs() <= 1e-6 * scale) {
+            return None;
+        }
+        let mut coef = SVector::<f32, N>::zeros();
+        for i in (0..N).rev() {
+            let mut s = self.z[i];
+            for j in i + 1..N {
+                s -= self.r[(i, j)] * coef[j];
+            }
+            coef[i] = s / self.r[(i, i)];
+        }
+        // (X^T X)^-1 = R^-1 R^-T: each coefficient's variance is a row of R^-1 squared.
+        let inv = self.r.try_inverse()?;
+        let dof = (self.rows - N as u32) as f32;
+        let sigma2 = self.rss / dof;
+        let mut std_err = SVector::<f32, N>::zeros();
+        for i in 0..N {
+            std_err[i] = libm::sqrtf(sigma2 * inv.row(i).norm_squared());
+        }
+        let n = self.rows as f32;
+        let total = self.y_sq - self.y_sum * self.y_sum / n;
+        let r2 = if total > 0.0 {
+            1.0 - self.rss / total
+        } else {
+            0.0
+        };
+        Some(Fit {
+            coef,
+            std_err,
+            r2,
+            rows: self.rows,
+        })
+    }
+}
