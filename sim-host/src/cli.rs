@@ -209,6 +209,19 @@ pub(crate) enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Fit the design's reduced models (roll, pitch, airspeed; the course and altitude
+    /// kinematics) from a simulator link's `.tlog` (`simlink.tlog` of `fly` and `sim`), with
+    /// each fit's quality and excitation, beside the aircraft file's linearisation at the
+    /// same airspeed. An axis the flight did not excite is an error naming it.
+    Identify {
+        /// The log (`.tlog` of the simulator link, with its truth frames).
+        file: PathBuf,
+        /// Airspeed the coefficients are given at, m/s (default: the flown samples' mean).
+        #[arg(long, value_name = "M/S", value_parser = positive_airspeed, allow_negative_numbers = true)]
+        airspeed: Option<f64>,
+        #[command(flatten)]
+        out: Output,
+    },
     /// Write the validation document (trim, poles, transfer functions, doublets).
     Validation {
         /// Markdown file to write.

@@ -50,6 +50,24 @@ fn run() -> anyhow::Result<ExitCode> {
                 ExitCode::FAILURE
             })
         }
+        Some(Command::Identify {
+            file,
+            airspeed,
+            out,
+        }) => {
+            let r = commands::identify::identify_log(&file, &aircraft, airspeed)?;
+            if out.json {
+                emit(&to_json(&r)?)?;
+            } else {
+                emit(&render(&r.tables, out.format()))?;
+            }
+            let failed = r.failures();
+            if failed.is_empty() {
+                Ok(ExitCode::SUCCESS)
+            } else {
+                anyhow::bail!("{}: no model for {}", file.display(), failed.join("; "))
+            }
+        }
         Some(Command::Linearize { trim, speed, out }) => {
             let r = commands::linearize::linearize_report_at(
                 &aircraft,

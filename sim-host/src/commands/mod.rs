@@ -7,6 +7,7 @@ pub mod design;
 pub mod doublet;
 pub mod fly;
 pub mod flying;
+pub mod identify;
 pub mod laws;
 pub mod linearize;
 pub mod log;

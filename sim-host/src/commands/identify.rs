@@ -1,0 +1,350 @@
+//! `sim-host identify LOG`: the reduced models of the design fitted from a flight's simulator
+//! link log, by the same identifier the vehicle runs (`common::tuning::identify`), beside the
+//! aircraft file's linearisation at the same airspeed.
+//!
+//! The log is a `.tlog` of the simulator link (`simlink.tlog` of `sim-host fly` and `sim-host
+//! sim`, or any PX4-interface simulator's recorded the same way): the truth's attitude, rates,
+//! velocity and airspeed (`HIL_STATE_QUATERNION`) and the autopilot's answer to each frame
+//! (`HIL_ACTUATOR_CONTROLS`, the surface commands held until the next). Samples count while
+//! the autopilot is armed and the aircraft is 5 m or more above the lowest height of the
+//! armed flight (the runway): the ground's forces are not the models'. The log holds no
+//! wind, so the angle of attack is read from the ground velocity: a log flown in wind gives
+//! the pitch model a wrong angle of attack (the vehicle, which estimates the wind, does not).
+
+use crate::aircraft::Aircraft;
+use crate::commands::linearize::linearize_report_at;
+use crate::link::tlog::read_tlog;
+use crate::report::sig;
+use crate::report::table::Table;
+use anyhow::{bail, Context};
+use common::actuators::Surfaces;
+use common::gcs::{COMPONENT_ID, SYSTEM_ID};
+use common::link::framing::FrameParser;
+use common::math::frames::{course_and_speed, ned_to_body, AirData, Euler};
+use common::math::{RAD2DEG, STANDARD_GRAVITY};
+use common::tuning::identify::{Axis, AxisError, Identifier, IdentifyConfig, Sample};
+use mavlink::dialects::common::MavMessage;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde::Serialize;
+use std::path::Path;
+
+/// Height above the armed flight's lowest point from which a sample counts as flown, m.
+const AIRBORNE_M: f64 = 5.0;
+
+/// One coefficient: identified, and the linearisation's where it has one.
+#[derive(Clone, Debug, Serialize)]
+pub struct Coefficient {
+    /// Beard and McLain's name (or the kinematic gain's).
+    pub name: String,
+    /// Identified value.
+    pub value: f64,
+    /// Its standard error.
+    pub std_err: f64,
+    /// The aircraft file's linearisation at the same airspeed (1 for the kinematic gains).
+    pub reference: Option<f64>,
+    /// `value` against `reference`, %.
+    pub diff_pct: Option<f64>,
+}
+
+/// One axis: its fit, or why there is none.
+#[derive(Clone, Debug, Serialize)]
+pub struct AxisReport {
+    /// `roll`, `pitch`, `airspeed`, `course`, `altitude`.
+    pub axis: String,
+    /// The input the axis is excited by.
+    pub input: String,
+    /// Its standard deviation over the flight (deg of surface or bank, or throttle).
+    pub input_sd: f64,
+    /// Share of the state's rate the model explains.
+    pub r2: Option<f64>,
+    /// Sample pairs fitted.
+    pub rows: u32,
+    /// The coefficients (none when the axis has no fit).
+    pub coefficients: Vec<Coefficient>,
+    /// Why the axis has no fit.
+    pub error: Option<String>,
+}
+
+/// What `sim-host identify` reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct IdentifyReport {
+    /// The log read.
+    pub log: String,
+    /// Airspeed the coefficients are given at (the flown samples' mean), m/s.
+    pub airspeed_ref_mps: f64,
+    /// Servo time constant the surfaces are followed with (the aircraft file's bandwidth), s.
+    pub servo_tau_s: f64,
+    /// Samples flown (armed, off the ground).
+    pub samples: usize,
+    /// Their span, s.
+    pub flown_s: f64,
+    /// Per axis, in the design's order.
+    pub axes: Vec<AxisReport>,
+    /// The printed tables.
+    #[serde(skip)]
+    pub tables: Vec<Table>,
+}
+
+impl IdentifyReport {
+    /// The axes without a fit, with the reason.
+    pub fn failures(&self) -> Vec<String> {
+        self.axes
+            .iter()
+            .filter_map(|a| a.error.as_ref().map(|e| format!("{}: {e}", a.axis)))
+            .collect()
+    }
+}
+
+/// One sample of the log with its time and height.
+struct Timed {
+    time_us: u64,
+    alt_m: f64,
+    armed: bool,
+    sample: Sample,
+}
+
+/// The samples of a simulator-link `.tlog`: each truth frame joined with the autopilot's
+/// answer to it.
+fn samples(bytes: &[u8]) -> Vec<Timed> {
+    let mut parser = FrameParser::new();
+    let mut truth: Option<(u64, Sample, f64)> = None;
+    let mut out = Vec::new();
+    for (_, frame) in read_tlog(bytes) {
+        parser.push(&frame, |f| match f.message {
+            MavMessage::HIL_STATE_QUATERNION(d) => {
+                let q = d.attitude_quaternion.map(f64::from);
+                let Some(q) =
+                    UnitQuaternion::try_new(Quaternion::new(q[0], q[1], q[2], q[3]), 1e-6)
+                else {
+                    return;
+                };
+                let e = Euler::from_quaternion(&q);
+                let v = Vector3::new(f64::from(d.vx), f64::from(d.vy), f64::from(d.vz)) / 100.0;
+                let (course, gs) = course_and_speed(&v);
+                let va = f64::from(d.true_airspeed) / 100.0;
+                let climb = -v.z;
+                // The log holds no wind: the angle of attack is the ground velocity's, exact
+                // in still air (the aircraft file's linearisation is of still air too).
+                let air = AirData::from_body_velocity(&ned_to_body(&q, &v));
+                let s = Sample {
+                    p: d.rollspeed,
+                    q: d.pitchspeed,
+                    r: d.yawspeed,
+                    phi: e.phi as f32,
+                    theta: e.theta as f32,
+                    airspeed: va as f32,
+                    ay: (f64::from(d.yacc) * STANDARD_GRAVITY / 1000.0) as f32,
+                    alpha: air.alpha as f32,
+                    climb_rate: climb as f32,
+                    course: course as f32,
+                    ground_speed: gs as f32,
+                    ..Sample::default()
+                };
+                truth = Some((d.time_usec, s, f64::from(d.alt) / 1000.0));
+            }
+            MavMessage::HIL_ACTUATOR_CONTROLS(d)
+                if (f.header.system_id, f.header.component_id)
+                    == (u32::from(SYSTEM_ID), COMPONENT_ID) =>
+            {
+                let Some((t, s, alt)) = truth.filter(|(t, ..)| *t == d.time_usec) else {
+                    return;
+                };
+                let c = Surfaces::from_px4_controls([
+                    d.controls[0],
+                    d.controls[1],
+                    d.controls[2],
+                    d.controls[3],
+                ]);
+                out.push(Timed {
+                    time_us: t,
+                    alt_m: alt,
+                    armed: d.mode.bits() & 128 != 0,
+                    sample: Sample {
+                        aileron: c.aileron,
+                        elevator: c.elevator,
+                        throttle: c.throttle,
+                        ..s
+                    },
+                });
+            }
+            _ => {}
+        });
+    }
+    out
+}
+
+/// Fits the log at `path`; `airspeed` overrides the reference airspeed (the flown mean).
+pub fn identify_log(
+    path: &Path,
+    aircraft: &Aircraft,
+    airspeed: Option<f64>,
+) -> anyhow::Result<IdentifyReport> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let all = samples(&bytes);
+    if all.is_empty() {
+        bail!(
+            "{}: no HIL_STATE_QUATERNION answered by an HIL_ACTUATOR_CONTROLS of the autopilot \
+             (a simulator link's .tlog with the truth frames is needed)",
+            path.display()
+        );
+    }
+    let ground = all
+        .iter()
+        .filter(|s| s.armed)
+        .map(|s| s.alt_m)
+        .fold(f64::INFINITY, f64::min);
+    let flown: Vec<&Timed> = all
+        .iter()
+        .filter(|s| s.armed && s.alt_m >= ground + AIRBORNE_M)
+        .collect();
+    if flown.len() < 50 {
+        bail!(
+            "{}: {} samples armed and {AIRBORNE_M} m above the runway: too few to fit",
+            path.display(),
+            flown.len()
+        );
+    }
+    let va_ref = airspeed.unwrap_or_else(|| {
+        flown
+            .iter()
+            .map(|s| f64::from(s.sample.airspeed))
+            .sum::<f64>()
+            / flown.len() as f64
+    });
+    let servo_tau = 1.0 / (2.0 * std::f64::consts::PI * aircraft.actuators.bandwidth_Hz);
+    let mut id = Identifier::new(IdentifyConfig {
+        airspeed_ref: va_ref as f32,
+        servo_tau_s: servo_tau as f32,
+    });
+    let mut last: Option<u64> = None;
+    for s in &flown {
+        let dt = last.map_or(0.0, |l| s.time_us.saturating_sub(l) as f32 * 1e-6);
+        id.push(dt, &s.sample);
+        last = Some(s.time_us);
+    }
+    let span = flown.last().zip(flown.first()).map_or(0.0, |(b, a)| {
+        b.time_us.saturating_sub(a.time_us) as f64 * 1e-6
+    });
+    let reference = linearize_report_at(aircraft, "level", va_ref)
+        .ok()
+        .map(|r| r.reduced);
+    let expected = |name: &str| -> Option<f64> {
+        let r = reference.as_ref();
+        match name {
+            "k_chi" | "k_h" => Some(1.0),
+            _ => r.and_then(|r| r.named().iter().find(|(n, _)| *n == name).map(|(_, v)| *v)),
+        }
+    };
+    let mut axes = Vec::new();
+    for axis in Axis::ALL {
+        let (input, scale) = match axis {
+            Axis::Airspeed => ("throttle", 1.0),
+            Axis::Course => ("bank", RAD2DEG),
+            Axis::Altitude => ("pitch", RAD2DEG),
+            Axis::Roll => ("aileron", RAD2DEG),
+            Axis::Pitch => ("elevator", RAD2DEG),
+        };
+        let report = match id.fit(axis) {
+            Ok(f) => AxisReport {
+                axis: axis.name().into(),
+                input: input.into(),
+                input_sd: f64::from(f.input_sd * scale),
+                r2: Some(f64::from(f.r2)),
+                rows: f.rows,
+                coefficients: axis
+                    .coefficients()
+                    .iter()
+                    .zip(f.coef.iter().zip(f.std_err.iter()))
+                    .map(|(name, (v, e))| {
+                        let value = f64::from(*v);
+                        let reference = expected(name);
+                        Coefficient {
+                            name: (*name).into(),
+                            value,
+                            std_err: f64::from(*e),
+                            reference,
+                            diff_pct: reference
+                                .filter(|r| r.abs() > 1e-9)
+                                .map(|r| 100.0 * (value - r) / r),
+                        }
+                    })
+                    .collect(),
+                error: None,
+            },
+            Err(e) => {
+                let (sd, error) = match e {
+                    AxisError::NotExcited { sd, needed, .. } => (
+                        f64::from(sd * scale),
+                        format!(
+                            "not excited: the {input} varied {} (standard deviation), at least {} needed",
+                            sig(f64::from(sd * scale), 2),
+                            sig(f64::from(needed * scale), 2)
+                        ),
+                    ),
+                    AxisError::Singular => (
+                        f64::NAN,
+                        "its regressors never varied independently of each other".into(),
+                    ),
+                };
+                AxisReport {
+                    axis: axis.name().into(),
+                    input: input.into(),
+                    input_sd: sd,
+                    r2: None,
+                    rows: 0,
+                    coefficients: Vec::new(),
+                    error: Some(error),
+                }
+            }
+        };
+        axes.push(report);
+    }
+    let mut t = Table::new(
+        format!(
+            "Reduced models identified from {} ({} s flown, coefficients at {} m/s; servo time constant {} s), beside the aircraft file's linearisation at that airspeed",
+            path.display(),
+            sig(span, 3),
+            sig(va_ref, 3),
+            sig(servo_tau, 2)
+        ),
+        &["axis", "coefficient", "identified", "std. error", "linearised", "difference", "R^2", "excitation (sd)"],
+    );
+    for a in &axes {
+        let unit = if a.input == "throttle" { "" } else { " deg" };
+        let excitation = format!("{}{unit} {}", sig(a.input_sd, 2), a.input);
+        if let Some(e) = &a.error {
+            t.row([
+                a.axis.clone(),
+                "-".into(),
+                e.clone(),
+                String::new(),
+                String::new(),
+                String::new(),
+                String::new(),
+                excitation,
+            ]);
+            continue;
+        }
+        for c in &a.coefficients {
+            t.row([
+                a.axis.clone(),
+                c.name.clone(),
+                sig(c.value, 4),
+                sig(c.std_err, 2),
+                c.reference.map_or("-".into(), |r| sig(r, 4)),
+                c.diff_pct.map_or("-".into(), |d| format!("{d:+.1} %")),
+                a.r2.map_or("-".into(), |r| format!("{r:.3}")),
+                excitation.clone(),
+            ]);
+        }
+    }
+    Ok(IdentifyReport {
+        log: path.display().to_string(),
+        airspeed_ref_mps: va_ref,
+        servo_tau_s: servo_tau,
+        samples: flown.len(),
+        flown_s: span,
+        axes,
+        tables: vec![t],
+    })
+}
