@@ -6,7 +6,10 @@
 //! samples: the state's rate is its difference over the interval, the states on the right are
 //! their means over it (the trapezoid: a pole at `-a` comes out at `-a` to 0.3 % for
 //! `a T = 0.32`, the 25e's roll at 50 Hz), and the surfaces are where a first-order servo of
-//! time constant `servo_tau_s` puts them, held command by command as the servos see it
+//! time constant `servo_tau_s` and rate limit `servo_rate_radps` puts them, held command by
+//! command as the servos see it (a pilot's full-stick doublet moves the 25e's aileron 45 deg
+//! at its 150 deg/s: 0.3 s on the rate limit, where the first-order lag alone would be done
+//! in a tenth of that)
 //! (left out, a 20 ms servo lag on a 60 ms roll mode reads as a roll damping and an aileron
 //! power a third or more short).
 //!
@@ -17,6 +20,7 @@
 //! ```text
 //! roll      p'  = -a_phi1 v p + a_phi2 v^2 da + k_r v r + k_ay a_y + k_t dt + c v^2
 //! pitch     q'  = -a_theta1 v q - a_theta2 v^2 alpha + a_theta3 v^2 de + k_t dt + c v^2
+//!                 + k_r r + k_pr p r + k_rr (r^2 - p^2)
 //!                                                                          v = Va / Va_ref
 //! airspeed  Va' = -a_V1 (Va - Va_ref) + a_V2 dt - a_V3 theta + k_alpha alpha + c
 //! course    chi' = k_chi g tan(phi) / Vg + c                               (k_chi = 1 ideal)
@@ -28,7 +32,8 @@
 //! the yaw rate's roll; the sideslip's (dihedral) roll, read through the lateral specific force
 //! `a_y`, which the sideslip makes in proportion to the dynamic pressure as its rolling moment
 //! is (no vane needed); the engine's torque and thrust line with the throttle `dt`; the trim
-//! moments; drag with angle of attack. Left out, in the 25e's closed-loop flight of the
+//! moments; drag with angle of attack; in pitch, the yaw rate (the propeller's gyroscopic
+//! moment) and the rates' inertial coupling (`p r`, `r^2 - p^2`), which a turn holds steady. Left out, in the 25e's closed-loop flight of the
 //! thesis's script, the turns' sideslip and the climbs' torque took the roll fit's R^2 from
 //! 0.96 to 0.40 and `a_phi1` to half its value. Signs are the Minnesota model's: a
 //! positive aileron rolls left (`a_phi2 < 0`), a positive elevator pitches down
@@ -79,6 +84,42 @@ pub struct IdentifyConfig {
     pub airspeed_ref: f32,
     /// Time constant of the surface servos, s (`1 / (2 pi bandwidth)`).
     pub servo_tau_s: f32,
+    /// Fastest a surface moves, rad/s (0: no limit).
+    pub servo_rate_radps: f32,
+}
+
+/// Sub-steps a servo is followed with over one interval: the rate limit makes the motion
+/// piecewise, so no closed form serves; eight keep the mean within 0.2 % of the surface's
+/// travel over the interval.
+const SERVO_STEPS: u8 = 8;
+
+/// A first-order servo with a rate limit from `from`, the command `cmd` held for `dt_s`:
+/// where it ends and its mean over the interval (each sub-step exact for the first-order
+/// motion, clamped to the rate limit).
+pub(super) fn servo(c: &IdentifyConfig, from: f32, cmd: f32, dt_s: f32) -> (f32, f32) {
+    if c.servo_tau_s <= 0.0 {
+        return (cmd, cmd);
+    }
+    let h = dt_s / f32::from(SERVO_STEPS);
+    let k = 1.0 - libm::expf(-h / c.servo_tau_s);
+    let max_step = if c.servo_rate_radps > 0.0 {
+        c.servo_rate_radps * h
+    } else {
+        f32::INFINITY
+    };
+    let (mut x, mut sum) = (from, 0.0);
+    for _ in 0..SERVO_STEPS {
+        let step = (k * (cmd - x)).clamp(-max_step, max_step);
+        // The sub-step's mean: the exponential's where unclamped, the ramp's where clamped.
+        let mean = if step.abs() < max_step {
+            cmd + (x - cmd) * c.servo_tau_s / h * k
+        } else {
+            x + 0.5 * step
+        };
+        sum += mean;
+        x += step;
+    }
+    (x, sum / f32::from(SERVO_STEPS))
 }
 
 /// The loops the models are fitted for.
@@ -116,7 +157,9 @@ impl Axis {
     pub fn coefficients(self) -> &'static [&'static str] {
         match self {
             Axis::Roll => &["a_phi1", "a_phi2", "k_r", "k_ay", "k_t", "c_phi"],
-            Axis::Pitch => &["a_theta1", "a_theta2", "a_theta3", "k_t", "c_theta"],
+            Axis::Pitch => &[
+                "a_theta1", "a_theta2", "a_theta3", "k_t", "c_theta", "k_r", "k_pr", "k_rr",
+            ],
             Axis::Airspeed => &["a_V1", "a_V2", "a_V3", "k_alpha", "c_V"],
             Axis::Course => &["k_chi", "c_chi"],
             Axis::Altitude => &["k_h", "c_h"],
@@ -139,7 +182,7 @@ impl Axis {
 }
 
 /// Most coefficients an axis has.
-pub const COEFS: usize = 6;
+pub const COEFS: usize = 8;
 
 /// One axis's fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -202,7 +245,7 @@ pub struct Identifier {
     /// Where the servos hold the aileron and elevator at `prev`, rad.
     surfaces: [f32; 2],
     roll: LeastSquares<6>,
-    pitch: LeastSquares<5>,
+    pitch: LeastSquares<8>,
     speed: LeastSquares<5>,
     course: LeastSquares<2>,
     altitude: LeastSquares<2>,
@@ -266,21 +309,12 @@ impl Identifier {
             self.surfaces = [s.aileron, s.elevator];
             return;
         };
-        // The servos move towards the command held since `a`: exponentially, so over the
-        // interval a surface is at the command less the gap it started with times
-        // `(tau / T) (1 - e^(-T / tau))` on average (the trapezoid would overstate it by 8 %
-        // of the gap where the interval is one time constant).
-        let tau = self.config.servo_tau_s;
-        let (k, mean_gap) = if tau > 0.0 {
-            let k = 1.0 - libm::expf(-dt_s / tau);
-            (k, tau / dt_s * k)
-        } else {
-            (1.0, 0.0)
-        };
+        // The servos move towards the command held since `a`, no faster than their rate
+        // limit: over the interval each surface's mean is what the servo model gives.
         let [ail, ele] = self.surfaces;
-        let da = a.aileron + mean_gap * (ail - a.aileron);
-        let de = a.elevator + mean_gap * (ele - a.elevator);
-        self.surfaces = [ail + k * (a.aileron - ail), ele + k * (a.elevator - ele)];
+        let (ail_end, da) = servo(&self.config, ail, a.aileron, dt_s);
+        let (ele_end, de) = servo(&self.config, ele, a.elevator, dt_s);
+        self.surfaces = [ail_end, ele_end];
         let mid = |f: fn(&Sample) -> f32| 0.5 * (f(&a) + f(s));
         let va = mid(|x| x.airspeed);
         let v = va / self.config.airspeed_ref;
@@ -294,7 +328,16 @@ impl Identifier {
             rate(|x| x.p),
         );
         self.pitch.push(
-            &SVector::from([-v * q, -v2 * alpha, v2 * de, thr, v2]),
+            &SVector::from([
+                -v * q,
+                -v2 * alpha,
+                v2 * de,
+                thr,
+                v2,
+                r,
+                mid(|x| x.p * x.r),
+                mid(|x| x.r * x.r - x.p * x.p),
+            ]),
             rate(|x| x.q),
         );
         self.speed.push(

@@ -96,6 +96,7 @@ fn identified(samples: &[Sample], servo_tau: f32) -> Identifier {
     let mut id = Identifier::new(IdentifyConfig {
         airspeed_ref: VA_REF,
         servo_tau_s: servo_tau,
+        servo_rate_radps: 0.0,
     });
     for s in samples {
         id.push(0.02, s);
@@ -237,6 +238,7 @@ fn bad_time_steps_and_values_start_a_new_stretch_and_leave_the_fit_as_it_was() {
     let mut id = Identifier::new(IdentifyConfig {
         airspeed_ref: VA_REF,
         servo_tau_s: SERVO_TAU,
+        servo_rate_radps: 0.0,
     });
     for (k, s) in data.iter().enumerate() {
         match k {
@@ -268,6 +270,7 @@ fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
     let mut id = Identifier::new(IdentifyConfig {
         airspeed_ref: VA_REF,
         servo_tau_s: SERVO_TAU,
+        servo_rate_radps: 0.0,
     });
     let mut va = VA_REF;
     for k in 0..3000 {
@@ -308,6 +311,7 @@ fn the_course_kinematics_of_banked_turns_give_a_gain_of_one() {
     let mut id = Identifier::new(IdentifyConfig {
         airspeed_ref: VA_REF,
         servo_tau_s: SERVO_TAU,
+        servo_rate_radps: 0.0,
     });
     let mut chi = 0.0f32;
     for k in 0..2000 {
@@ -328,4 +332,21 @@ fn the_course_kinematics_of_banked_turns_give_a_gain_of_one() {
     }
     let f = id.fit(Axis::Course).expect("course");
     assert!(within(f.coef[0], 1.0, 0.01), "{f:?}");
+}
+
+/// A 45 deg command on a 20 ms servo limited to 150 deg/s: 3 deg in the 20 ms interval, a
+/// ramp's mean of 1.5 deg; a 0.1 deg command stays on the first-order curve
+/// (`1 - e^(-1.005)` of it by the end).
+#[test]
+fn a_full_stick_command_moves_the_surface_at_the_rate_limit_and_a_small_one_on_its_lag() {
+    let c = IdentifyConfig {
+        airspeed_ref: VA_REF,
+        servo_tau_s: SERVO_TAU,
+        servo_rate_radps: 150.0 * DEG,
+    };
+    let (end, mean) = super::identify::servo(&c, 0.0, 45.0 * DEG, 0.02);
+    assert!((end - 3.0 * DEG).abs() < 1e-5 && (mean - 1.5 * DEG).abs() < 1e-5);
+    let (end, _) = super::identify::servo(&c, 0.0, 0.1 * DEG, 0.02);
+    let want = 0.1 * DEG * (1.0 - libm::expf(-0.02 / SERVO_TAU));
+    assert!((end - want).abs() < 1e-4 * want.abs() + 1e-9);
 }

@@ -215,6 +215,7 @@ pub fn identify_log(
     let mut id = Identifier::new(IdentifyConfig {
         airspeed_ref: va_ref as f32,
         servo_tau_s: servo_tau as f32,
+        servo_rate_radps: aircraft.actuators.rate_limit_radps as f32,
     });
     let mut last: Option<u64> = None;
     for s in &flown {
