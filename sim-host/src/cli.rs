@@ -145,6 +145,15 @@ pub(crate) enum Command {
         /// `scenario --gains FILE.toml`).
         #[arg(long, value_name = "FILE")]
         write_gains: Option<PathBuf>,
+        /// Design on the reduced models of a `sim-host identify --json` report instead of the
+        /// aircraft file, and check every loop's margins (6 dB; 45 deg for the attitude
+        /// loops, 30 deg for the outer ones).
+        #[arg(long, value_name = "MODEL.json", conflicts_with = "write_gains")]
+        model: Option<PathBuf>,
+        /// With --model: write the gains as a QGroundControl parameter file (`.params`), only
+        /// when every loop meets its margins.
+        #[arg(long, value_name = "FILE.params", requires = "model")]
+        write_params: Option<PathBuf>,
     },
     /// Fly the firmware against the plant over the simulator link, commanded by a scripted
     /// ground station: arm, Hold, +100 m climb, four 90 deg turns, +-10 m altitude doublet.

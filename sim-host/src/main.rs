@@ -162,9 +162,37 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Design {
+            model: Some(model),
+            write_params,
+            out,
+            ..
+        }) => {
+            let m = commands::design_model::read_model(&model)?;
+            let r = commands::design_model::design_model_report(&m)?;
+            if out.json {
+                emit(&to_json(&r)?)?;
+            } else {
+                emit(&render(&r.tables, out.format()))?;
+            }
+            let failed = r.failures();
+            if !failed.is_empty() {
+                anyhow::bail!(
+                    "{}: the design fails its margins, no gains written: {}",
+                    model.display(),
+                    failed.join("; ")
+                );
+            }
+            if let Some(path) = &write_params {
+                std::fs::write(path, r.params_file())
+                    .with_context(|| format!("cannot write `{}`", path.display()))?;
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Some(Command::Design {
             speed,
             out,
             write_gains,
+            ..
         }) => {
             let va = speed.or_cruise(&aircraft);
             if let Some(path) = &write_gains {

@@ -25,6 +25,26 @@ fn flown(dir: &Path) {
     );
 }
 
+/// `sim-host design --model` on the model `v` written to `dir/name`, asked to write
+/// `dir/name.params`: the program's output and the parameter file's path.
+fn design_on(
+    dir: &Path,
+    v: &serde_json::Value,
+    name: &str,
+) -> (std::process::Output, std::path::PathBuf) {
+    let model = dir.join(name);
+    std::fs::write(&model, serde_json::to_vec(v).expect("json")).expect("write");
+    let params = dir.join(format!("{name}.params"));
+    let out = sim_host()
+        .args(["design", "--model"])
+        .arg(&model)
+        .arg("--write-params")
+        .arg(&params)
+        .output()
+        .expect("run sim-host design");
+    (out, params)
+}
+
 fn coefficient(report: &serde_json::Value, axis: &str, name: &str) -> (f64, f64) {
     let a = report["axes"]
         .as_array()
@@ -112,13 +132,10 @@ fn three_two_one_one(from_s: f64, unit_s: f64, amp: f32) -> Vec<(f64, f32)> {
         .collect()
 }
 
-/// Doublets flown by hand in Stabilized (the simulator's radio: RC_CHANNELS), from the hand
-/// launch: roll, then pitch, three times each (3-2-1-1s of 0.3 stick on 0.3 s steps), then
-/// throttle steps. The log gives the roll and pitch models within 15 % of the linearisation
-/// (measured: -1.9 and -0.3 % in roll, +1.1, -7.3 and -1.7 % in pitch; the table is printed
-/// with `--nocapture`, `docs/AUTOTUNE.md`).
-#[test]
-fn stick_doublets_flown_in_stabilized_give_the_roll_and_pitch_models_within_15_percent() {
+/// The stick flight below, its simulator-link log in `dir`: doublets flown by hand in
+/// Stabilized (the simulator's radio: RC_CHANNELS), from the hand launch: roll, then pitch,
+/// three times each (3-2-1-1s of 0.3 stick on 0.3 s steps), then throttle steps.
+fn stick_flight(dir: &Path) -> sim_host::commands::identify::IdentifyReport {
     use sim_host::commands::fly::{fly_report, FlyOptions};
     use sim_host::flight::script::{Action, Script, ScriptStep};
     use sim_host::flight::{FlightConfig, RcSticks};
@@ -173,32 +190,126 @@ fn stick_doublets_flown_in_stabilized_give_the_roll_and_pitch_models_within_15_p
         rc_sticks: sticks,
         ..FlightConfig::default()
     };
-    let dir = tempfile::tempdir().expect("tempdir");
     let opts = FlyOptions {
-        out: Some(dir.path().to_path_buf()),
+        out: Some(dir.to_path_buf()),
         plots: false,
         ..FlyOptions::default()
     };
     let aircraft = sim_host::aircraft::Aircraft::load(None).expect("aircraft");
     fly_report(&aircraft, &cfg, &opts).expect("flight");
-    let r = sim_host::commands::identify::identify_log(
-        &dir.path().join("simlink.tlog"),
-        &aircraft,
-        None,
-    )
-    .expect("identify");
+    sim_host::commands::identify::identify_log(&dir.join("simlink.tlog"), &aircraft, None)
+        .expect("identify")
+}
+
+/// The stick flight gives the roll and pitch models within 15 % of the linearisation
+/// (measured: -1.9 and -0.3 % in roll, +1.1, -7.3 and -1.7 % in pitch; the table is printed
+/// with `--nocapture`, `docs/AUTOTUNE.md`).
+#[test]
+fn stick_doublets_flown_in_stabilized_give_the_roll_and_pitch_models_within_15_percent() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let r = stick_flight(dir.path());
     let report = serde_json::to_value(&r).expect("json");
     eprintln!(
         "{}",
-        sim_host::commands::render(&r.tables, sim_host::commands::Format::Text)
+        sim_host::commands::render(&r.tables, sim_host::commands::Format::Markdown)
     );
     for (axis, name) in [
         ("roll", "a_phi1"),
         ("roll", "a_phi2"),
+        ("pitch", "a_theta1"),
         ("pitch", "a_theta2"),
         ("pitch", "a_theta3"),
     ] {
         let (v, r) = coefficient(&report, axis, name);
         assert!(((v - r) / r).abs() < 0.15, "{name}: {v} against {r}");
     }
+}
+
+/// The stick flight's model, designed on by `design --model` (the program), gives the attitude
+/// loops' gains the aircraft file's design gives at the same airspeed, within 15 %, with every
+/// loop's margins met, as a QGroundControl parameter file.
+#[test]
+fn the_design_on_the_identified_model_gives_the_aircraft_files_attitude_gains_as_a_params_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let r = stick_flight(dir.path());
+    let v = serde_json::to_value(&r).expect("json");
+    let (out, params) = design_on(dir.path(), &v, "model.json");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&params).expect("params file");
+    let value = |name: &str| -> f64 {
+        text.lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| l.split('\t').collect::<Vec<_>>())
+            .find(|f| f.len() == 5 && f[2] == name && f[0] == "1" && f[1] == "1" && f[4] == "9")
+            .and_then(|f| f[3].parse().ok())
+            .unwrap_or_else(|| panic!("{name} in {text}"))
+    };
+    let aircraft = sim_host::aircraft::Aircraft::load(None).expect("aircraft");
+    let reference = sim_host::analysis::design::design_at(
+        &aircraft,
+        &sim_host::analysis::design::DesignInputs::default(),
+        r.airspeed_ref_mps,
+    )
+    .expect("design");
+    let g = reference.gains;
+    for (name, want) in [
+        ("RLL_KP", g.lateral.roll_kp),
+        ("RLL_RATE_KD", g.lateral.roll_rate_kd),
+        ("PTCH_KP", g.longitudinal.pitch_kp),
+        ("PTCH_RATE_KD", g.longitudinal.pitch_rate_kd),
+    ] {
+        let v = value(name);
+        let want = f64::from(want);
+        assert!(
+            ((v - want) / want).abs() < 0.15,
+            "{name}: {v} against {want}"
+        );
+    }
+}
+
+/// Bad models: one whose roll diverges by itself (`a_phi1` -5 1/s: a roll mode that grows,
+/// which the design's damper cannot hold with its margins) gets no gains, the loop and the
+/// margin named; one without a pitch model is refused, the axis named.
+#[test]
+fn a_model_that_fails_its_margins_or_lacks_an_axis_gets_no_gains_and_the_reason() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let r = stick_flight(dir.path());
+    let mut v = serde_json::to_value(&r).expect("json");
+    let run = |v: &serde_json::Value, name: &str| {
+        let (out, params) = design_on(dir.path(), v, name);
+        assert!(!out.status.success());
+        assert!(!params.exists());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let set = |v: &mut serde_json::Value, name: &str, value: f64| {
+        for a in v["axes"].as_array_mut().expect("axes") {
+            for c in a["coefficients"].as_array_mut().expect("coefficients") {
+                if c["name"] == name {
+                    c["value"] = serde_json::json!(value);
+                }
+            }
+        }
+    };
+    let (a_phi1, _) = coefficient(&v, "roll", "a_phi1");
+    set(&mut v, "a_phi1", -5.0);
+    let e = run(&v, "diverging-roll.json");
+    assert!(
+        e.contains("roll attitude") && e.contains("gain margin"),
+        "{e}"
+    );
+    set(&mut v, "a_phi1", a_phi1);
+    for a in v["axes"].as_array_mut().expect("axes") {
+        if a["axis"] == "pitch" {
+            a["error"] = serde_json::json!("not excited");
+        }
+    }
+    let e = run(&v, "no-pitch.json");
+    assert!(
+        e.contains("no-pitch.json") && e.contains("pitch axis has no model"),
+        "{e}"
+    );
 }

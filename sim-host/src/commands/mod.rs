@@ -4,6 +4,7 @@
 pub mod campaign;
 pub mod compare;
 pub mod design;
+pub mod design_model;
 pub mod doublet;
 pub mod fly;
 pub mod flying;

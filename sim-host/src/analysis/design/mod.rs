@@ -45,6 +45,7 @@ pub mod loops;
 
 use super::linearize::{linearize, Linearization};
 use super::lti::{damping_and_frequency, margins};
+use super::reduced::ReducedCoefficients;
 use super::transfer::TransferFunction;
 use super::trim::{trim_with, TrimResult, TrimTarget};
 use crate::aircraft::Aircraft;
@@ -144,7 +145,6 @@ pub fn design_at(
         standard_atmosphere(aircraft.environment.home_alt_msl_m + trim.target.alt_msl_m).density;
     let g = aircraft.environment.g_mps2;
     let (m, geo, aero) = (&aircraft.mass, &aircraft.geometry, &aircraft.aero);
-    let z = inputs.zeta;
 
     // Roll: Appendix C's coefficients from the aero data.
     let gamma = m.Jx_kgm2 * m.Jz_kgm2 - m.Jxz_kgm2 * m.Jxz_kgm2;
@@ -186,9 +186,122 @@ pub fn design_at(
         a_v2,
         engine_pole,
     };
+    // Pitch: predicted on the linear short period.
+    let q_de = &super::transfer::thesis_transfer_functions(&lin).q_over_de;
+    let theta_de = q_de.series(&tf(&[1.0], &[1.0, 0.0]));
+    let trim = Trim {
+        aileron: trim.aileron,
+        rudder: trim.rudder,
+        elevator: trim.elevator,
+        throttle: trim.throttle,
+        theta: trim.theta,
+    };
+    let plant = Plant {
+        coefficients,
+        theta_de,
+        servo_bandwidth_hz: aircraft.actuators.bandwidth_Hz,
+        g,
+    };
+    design_loops(inputs, plant, Some(trim))
+}
+
+/// What the loops are designed on.
+struct Plant {
+    coefficients: Coefficients,
+    /// Pitch attitude per elevator, the loop's prediction model.
+    theta_de: TransferFunction,
+    servo_bandwidth_hz: f64,
+    g: f64,
+}
+
+/// The trim the gains are flown about, rad (throttle 0..1).
+struct Trim {
+    aileron: f64,
+    rudder: f64,
+    elevator: f64,
+    throttle: f64,
+    theta: f64,
+}
+
+/// The reduced models a design from flight data starts from (`sim-host identify`): no
+/// aircraft file, no linearisation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ReducedModel {
+    /// Airspeed the coefficients hold at, m/s.
+    pub va: f64,
+    /// Beard and McLain's coefficients; those not identified are NaN (the sideslip's: its
+    /// loop is then not designed).
+    pub coefficients: ReducedCoefficients,
+    /// The engine speed's pole, 1/s (`None`: not identified, taken as quasi-steady).
+    pub engine_pole: Option<f64>,
+    /// The servos' bandwidth, Hz.
+    pub servo_bandwidth_hz: f64,
+    /// Gravity, m/s^2.
+    pub g: f64,
+}
+
+/// Engine pole a design takes where none was identified, 1/s: two orders of magnitude above
+/// the airspeed loops, so the throttle acts as at once (the margins it predicts are then an
+/// upper bound).
+const QUASI_STEADY_ENGINE_POLE: f64 = 100.0;
+
+/// Designs every loop on a reduced model alone: the pitch loop predicted on its reduced
+/// short period `a_theta3 / (s^2 + a_theta1 s + a_theta2)`, the sideslip loop not designed (no
+/// sideslip model: the base set's gains stay), the trims left to the aircraft's own.
+pub fn design_from_model(model: &ReducedModel, inputs: &DesignInputs) -> anyhow::Result<Design> {
+    let m = &model.coefficients;
+    let c = Coefficients {
+        va: model.va,
+        rho: f64::NAN,
+        a_phi1: m.a_phi1,
+        a_phi2: m.a_phi2,
+        a_phi1_linear: m.a_phi1,
+        a_phi2_linear: m.a_phi2,
+        a_beta1: m.a_beta1,
+        a_beta2: m.a_beta2,
+        a_theta1: m.a_theta1,
+        a_theta2: m.a_theta2,
+        a_theta3: m.a_theta3,
+        a_v1: m.a_v1,
+        a_v2: m.a_v2,
+        engine_pole: model.engine_pole.unwrap_or(QUASI_STEADY_ENGINE_POLE),
+    };
+    let theta_de = tf(&[m.a_theta3], &[1.0, m.a_theta1, m.a_theta2]);
+    let plant = Plant {
+        coefficients: c,
+        theta_de,
+        servo_bandwidth_hz: model.servo_bandwidth_hz,
+        g: model.g,
+    };
+    design_loops(inputs, plant, None)
+}
+
+/// The loops, inner to outer, on `plant`; `trim` `None` keeps the base set's trims.
+fn design_loops(inputs: &DesignInputs, plant: Plant, trim: Option<Trim>) -> anyhow::Result<Design> {
+    let Plant {
+        coefficients,
+        theta_de,
+        servo_bandwidth_hz,
+        g,
+    } = plant;
+    let Coefficients {
+        va,
+        a_phi1,
+        a_phi2,
+        a_beta1,
+        a_beta2,
+        a_theta1,
+        a_theta2,
+        a_theta3,
+        a_v1,
+        a_v2,
+        engine_pole,
+        ..
+    } = coefficients;
+    let z = inputs.zeta;
 
     // What the formulas leave out: servo and delay.
-    let servo_w = 2.0 * PI * aircraft.actuators.bandwidth_Hz;
+    let servo_w = 2.0 * PI * servo_bandwidth_hz;
     let tau = (inputs.delay_samples + 0.5) * inputs.sample_time_s;
     let servo_delay = move |w: f64| {
         let s = Complex::new(0.0, w);
@@ -288,27 +401,34 @@ pub fn design_at(
         20.0,
     ));
 
-    // --- Sideslip.
+    // --- Sideslip (where there is a sideslip model).
     let wn_beta = wn_phi / inputs.sideslip_separation;
-    let slip_kp = (2.0 * z * wn_beta - a_beta1) / a_beta2;
-    let slip_ki = wn_beta * wn_beta / a_beta2;
-    let slip_plant = tf(&[a_beta2], &[1.0, a_beta1]);
-    let slip_loop = tf(&[slip_kp, slip_ki], &[1.0, 0.0]).series(&slip_plant);
-    loops.push(predict(
-        "sideslip (rudder)",
-        vec![
-            gain("SLIP_KP", slip_kp, d.lateral.slip_kp),
-            gain("SLIP_KI", slip_ki, d.lateral.slip_ki),
-        ],
-        wn_beta,
-        &slip_loop.closed_loop(),
-        with_actuation(&slip_loop, servo_delay),
-        20.0,
-    ));
+    let sideslip = a_beta1.is_finite() && a_beta2.is_finite();
+    let (slip_kp, slip_ki) = if sideslip {
+        (
+            (2.0 * z * wn_beta - a_beta1) / a_beta2,
+            wn_beta * wn_beta / a_beta2,
+        )
+    } else {
+        (f64::from(d.lateral.slip_kp), f64::from(d.lateral.slip_ki))
+    };
+    if sideslip {
+        let slip_plant = tf(&[a_beta2], &[1.0, a_beta1]);
+        let slip_loop = tf(&[slip_kp, slip_ki], &[1.0, 0.0]).series(&slip_plant);
+        loops.push(predict(
+            "sideslip (rudder)",
+            vec![
+                gain("SLIP_KP", slip_kp, d.lateral.slip_kp),
+                gain("SLIP_KI", slip_ki, d.lateral.slip_ki),
+            ],
+            wn_beta,
+            &slip_loop.closed_loop(),
+            with_actuation(&slip_loop, servo_delay),
+            20.0,
+        ));
+    }
 
-    // --- Pitch: designed on the reduced model, predicted on the linear short period.
-    let q_de = &super::transfer::thesis_transfer_functions(&lin).q_over_de;
-    let theta_de = q_de.series(&tf(&[1.0], &[1.0, 0.0]));
+    // --- Pitch: designed on the reduced model, predicted on `theta_de`.
     let kp_nominal = a_theta3.signum() * inputs.pitch_elevator_max_deg / inputs.pitch_error_max_deg;
     let wn_nominal = (a_theta2 + kp_nominal * a_theta3).max(0.0).sqrt();
     // The damper from the nominal design, the attitude gain limited by the phase margin.
@@ -438,8 +558,6 @@ pub fn design_at(
     lat.course_ki = course_ki as f32;
     lat.slip_kp = slip_kp as f32;
     lat.slip_ki = slip_ki as f32;
-    lat.trim_aileron = trim.aileron as f32;
-    lat.trim_rudder = trim.rudder as f32;
     let lon_g = &mut gains.longitudinal;
     lon_g.pitch_kp = pitch_kp as f32;
     lon_g.pitch_ki = pitch_ki as f32;
@@ -450,9 +568,14 @@ pub fn design_at(
     lon_g.aspd_pitch_ki = aspd_pitch_ki as f32;
     lon_g.aspd_thr_kp = aspd_thr_kp as f32;
     lon_g.aspd_thr_ki = aspd_thr_ki as f32;
-    lon_g.trim_elevator = trim.elevator as f32;
-    lon_g.trim_throttle = trim.throttle as f32;
-    lon_g.trim_pitch = trim.theta as f32;
+    if let Some(trim) = trim {
+        gains.lateral.trim_aileron = trim.aileron as f32;
+        gains.lateral.trim_rudder = trim.rudder as f32;
+        let lon_g = &mut gains.longitudinal;
+        lon_g.trim_elevator = trim.elevator as f32;
+        lon_g.trim_throttle = trim.throttle as f32;
+        lon_g.trim_pitch = trim.theta as f32;
+    }
     if let Err(e) = gains.validate() {
         anyhow::bail!("the computed gains are outside their parameter bounds: {e}");
     }
