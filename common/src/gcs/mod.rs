@@ -300,7 +300,10 @@ impl GroundLink {
                 let plan = &mut *stores.plan;
                 let r = self.missions.on_item(plan, &stores.rules, d, from, now_us);
                 for w in self.missions.take_warnings().iter() {
-                    out.textf(MavSeverity::MAV_SEVERITY_WARNING, format_args!("{w}"));
+                    out.text(
+                        MavSeverity::MAV_SEVERITY_WARNING,
+                        &MissionManager::warning_text(w),
+                    );
                 }
                 r
             }
