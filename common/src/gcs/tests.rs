@@ -2747,3 +2747,23 @@ fn a_line_writes_what_write_writes_and_stops_at_the_first_piece_that_does_not_fi
     assert!(core::fmt::Write::write_fmt(&mut s, format_args!("abcd{middle}j")).is_err());
     assert_eq!(s.as_str(), l.as_str());
 }
+
+#[test]
+fn the_targets_of_every_message_the_dialect_reads_are_the_crates() {
+    use crate::link::dialect::Autopilot;
+    for &id in Autopilot::READS {
+        let mut m = MavMessage::default_message_from_id(id).expect("a common message");
+        // Different values in the two fields, so that one read for the other shows.
+        if let Some(t) = m.target_system_id_mut() {
+            *t = 7;
+        }
+        if let Some(c) = m.target_component_id_mut() {
+            *c = 9;
+        }
+        assert_eq!(
+            super::targets(&m),
+            (m.target_system_id(), m.target_component_id()),
+            "message {id}"
+        );
+    }
+}
