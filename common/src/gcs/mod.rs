@@ -89,6 +89,7 @@ pub(crate) fn targets(msg: &MavMessage) -> (Option<u8>, Option<u8>) {
 /// with the whole common dialect's messages (the host's tests) has one.
 #[cfg(not(target_os = "none"))]
 fn other_targets(msg: &MavMessage) -> (Option<u8>, Option<u8>) {
+    use mavlink::Message;
     (msg.target_system_id(), msg.target_component_id())
 }
 
@@ -102,7 +103,7 @@ fn other_targets(_: &MavMessage) -> (Option<u8>, Option<u8>) {
 mod tests;
 
 use mavlink::dialects::common::*;
-use mavlink::{MavHeader, Message};
+use mavlink::MavHeader;
 
 use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::VehicleRequests;
