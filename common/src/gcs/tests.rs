@@ -2751,6 +2751,7 @@ fn a_line_writes_what_write_writes_and_stops_at_the_first_piece_that_does_not_fi
 #[test]
 fn the_targets_of_every_message_the_dialect_reads_are_the_crates() {
     use crate::link::dialect::Autopilot;
+    use mavlink::Message;
     for &id in Autopilot::READS {
         let mut m = MavMessage::default_message_from_id(id).expect("a common message");
         // Different values in the two fields, so that one read for the other shows.
