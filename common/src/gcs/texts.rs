@@ -53,11 +53,13 @@ impl<const N: usize> Line<N> {
         const HEX: &[u8; 16] = b"0123456789abcdef";
         let mut buf = [b'0'; 8];
         for (i, d) in buf.iter_mut().rev().enumerate() {
-            let nibble = v.checked_shr(4 * i as u32).unwrap_or(0) & 0xf;
+            let nibble = v.checked_shr((i as u32).saturating_mul(4)).unwrap_or(0) & 0xf;
             *d = HEX.get(nibble as usize).copied().unwrap_or(b'0');
         }
         // The digits `{:x}` writes (one at least), after as many padding zeros as they lack.
-        let significant = (32 - v.leading_zeros()).div_ceil(4).max(1) as usize;
+        let significant = (u32::BITS.saturating_sub(v.leading_zeros()))
+            .div_ceil(4)
+            .max(1) as usize;
         let padding = buf.len().saturating_sub(significant);
         self.str("0x");
         for _ in 0..padding {
