@@ -25,6 +25,13 @@ fn main() {
         return;
     }
     fs::copy("../memory.x", out.join("memory.x")).expect("memory.x at the workspace root");
+    // cortex-m-rt's `device` feature includes a `device.x` of the device's handler names; the
+    // image's interrupts all go to `DefaultHandler` (`mcu::__INTERRUPTS`): it names none.
+    fs::write(
+        out.join("device.x"),
+        "/* Every interrupt vector is DefaultHandler (firmware::mcu's __INTERRUPTS). */\n",
+    )
+    .expect("OUT_DIR is writable");
     println!("cargo:rustc-link-search={}", out.display());
 }
 

@@ -30,7 +30,10 @@ const fn reflected_table<const N: usize>(poly: u32) -> [u32; N] {
     table
 }
 
-/// One reflected CRC step over `bytes` from `state`, by nibbles (low nibble first).
+/// One reflected CRC step over `bytes` from `state`, by nibbles (low nibble first). Not
+/// inlined: CRC-32 serves the records, the mission's id and FTP's checksums, never the control
+/// period, and inlined it was copied into each of its seven callers.
+#[inline(never)]
 fn digest_nibbles(table: &[u32; 16], mut state: u32, bytes: &[u8]) -> u32 {
     for &b in bytes {
         state ^= u32::from(b);

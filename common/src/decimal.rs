@@ -48,15 +48,26 @@ pub fn trimmed(value: f32, places: u8) -> Decimal {
 
 impl fmt::Display for Decimal {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.write_with(&mut |piece| f.write_str(piece))
+    }
+}
+
+impl Decimal {
+    /// Writes what [`Display`](fmt::Display) writes, as pieces of text handed to `put`, the
+    /// same pieces as a `write!` of the number would hand a `core::fmt::Write` (the digits of
+    /// an integer part or of the decimals whole, each padding zero and each digit of a number
+    /// of 2^24 or more on its own); stops at the first piece `put` refuses. Without
+    /// `core::fmt`: the MCU image's texts write numbers this way ([`crate::gcs::texts::Line`]).
+    pub fn write_with<E>(&self, put: &mut dyn FnMut(&str) -> Result<(), E>) -> Result<(), E> {
         let x = self.value;
         if x.is_nan() {
-            return f.write_str("NaN");
+            return put("NaN");
         }
         if x.is_sign_negative() {
-            f.write_str("-")?;
+            put("-")?;
         }
         if x.is_infinite() {
-            return f.write_str("inf");
+            return put("inf");
         }
         let bits = x.to_bits();
         let biased = (bits >> 23) & 0xFF;
@@ -70,8 +81,8 @@ impl fmt::Display for Decimal {
         let places = u32::from(self.places.min(MAX_PLACES));
         if let Ok(shift) = u32::try_from(e) {
             // A whole number, no fraction to round.
-            write_whole(f, m, shift)?;
-            return self.write_fraction(f, 0, places);
+            write_whole(put, m, shift)?;
+            return self.write_fraction(put, 0, places);
         }
         let shift = e.unsigned_abs();
         // Never zero; as `NonZeroU64` the divisions below carry no panic path.
@@ -90,14 +101,35 @@ impl fmt::Display for Decimal {
                 q
             }
         };
-        write!(f, "{}", q / scale)?;
-        self.write_fraction(f, q % scale, places)
+        let mut buf = [0u8; 20];
+        put(digits(q / scale, &mut buf))?;
+        self.write_fraction(put, q % scale, places)
     }
+}
+
+/// `v` in decimal, as `{}` writes it, in the end of `buf`.
+pub(crate) fn digits(v: u64, buf: &mut [u8; 20]) -> &str {
+    let mut n = v;
+    let mut i = buf.len();
+    while let Some(j) = i.checked_sub(1) {
+        i = j;
+        if let Some(d) = buf.get_mut(i) {
+            *d = b'0' + (n % 10) as u8;
+        }
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    // ASCII digits: always UTF-8.
+    buf.get(i..)
+        .and_then(|d| core::str::from_utf8(d).ok())
+        .unwrap_or("")
 }
 
 /// Writes `m * 2^shift` (below 2^128: at most 39 digits) by doubling its decimal digits, so
 /// the image needs no 128-bit formatting for the few texts that could carry such a number.
-fn write_whole(f: &mut fmt::Formatter<'_>, m: u32, shift: u32) -> fmt::Result {
+fn write_whole<E>(put: &mut dyn FnMut(&str) -> Result<(), E>, m: u32, shift: u32) -> Result<(), E> {
     // Least significant digit first; `len` of them in use.
     let mut digits = [0u8; 39];
     let mut len = 0;
@@ -122,14 +154,21 @@ fn write_whole(f: &mut fmt::Formatter<'_>, m: u32, shift: u32) -> fmt::Result {
         }
     }
     for &d in digits.iter().take(len.max(1)).rev() {
-        fmt::Write::write_char(f, char::from(b'0' + d))?;
+        put(DIGITS.get(usize::from(d)..=usize::from(d)).unwrap_or("0"))?;
     }
     Ok(())
 }
 
+const DIGITS: &str = "0123456789";
+
 impl Decimal {
     /// Writes `.` and `digits` (`places` of them, zero-padded; trimmed if asked).
-    fn write_fraction(&self, f: &mut fmt::Formatter<'_>, digits: u64, places: u32) -> fmt::Result {
+    fn write_fraction<E>(
+        &self,
+        put: &mut dyn FnMut(&str) -> Result<(), E>,
+        digits: u64,
+        places: u32,
+    ) -> Result<(), E> {
         let (mut digits, mut places) = (digits, places);
         if self.trim {
             while places > 0 && digits % 10 == 0 {
@@ -140,7 +179,13 @@ impl Decimal {
         if places == 0 {
             return Ok(());
         }
-        write!(f, ".{:0width$}", digits, width = places as usize)
+        put(".")?;
+        let mut buf = [0u8; 20];
+        let text = self::digits(digits, &mut buf);
+        for _ in text.len()..places as usize {
+            put("0")?;
+        }
+        put(text)
     }
 }
 

@@ -10,6 +10,7 @@ use super::outbox::{After, Command, Outbox, Pending};
 use super::peer::Peer;
 use super::streams::{Scheduler, Stream};
 use super::telemetry;
+use super::texts::Line;
 use crate::decimal::trimmed;
 use crate::navigation::plan::MissionStore;
 use crate::vehicle::modes::FlightMode;
@@ -117,9 +118,9 @@ impl CommandService {
                 None => unknown_mode(d.custom_mode, out),
             }
         } else {
-            out.textf(
+            out.text_str(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Mode refused: only custom modes"),
+                "Mode refused: only custom modes",
             );
             MavResult::MAV_RESULT_DENIED
         };
@@ -160,9 +161,9 @@ impl CommandService {
             MavCmd::MAV_CMD_DO_SET_MODE => {
                 let base = c.p[0] as u32;
                 if base & MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as u32 == 0 {
-                    out.textf(
+                    out.text_str(
                         MavSeverity::MAV_SEVERITY_WARNING,
-                        format_args!("Mode refused: only custom modes"),
+                        "Mode refused: only custom modes",
                     );
                     MavResult::MAV_RESULT_DENIED
                 } else {
@@ -176,9 +177,12 @@ impl CommandService {
                 match MavStandardMode::from_u32(c.p[0] as u32).and_then(FlightMode::from_standard) {
                     Some(m) => self.request_mode(m, v, stores.plan, out),
                     None => {
-                        out.textf(
+                        out.text(
                             MavSeverity::MAV_SEVERITY_WARNING,
-                            format_args!("Standard mode {} not supported", c.p[0] as u32),
+                            Line::new()
+                                .str("Standard mode ")
+                                .uint(u64::from(c.p[0] as u32))
+                                .str(" not supported"),
                         );
                         MavResult::MAV_RESULT_FAILED
                     }
@@ -246,14 +250,16 @@ impl CommandService {
                 } else if c.p[0] as i32 > 1 {
                     MavResult::MAV_RESULT_UNSUPPORTED
                 } else if !(lo..=hi).contains(&c.p[1]) {
-                    out.textf(
+                    out.text(
                         MavSeverity::MAV_SEVERITY_WARNING,
-                        format_args!(
-                            "Airspeed {} refused: outside [{}, {}] m/s",
-                            trimmed(c.p[1], 2),
-                            trimmed(lo, 2),
-                            trimmed(hi, 2)
-                        ),
+                        Line::new()
+                            .str("Airspeed ")
+                            .decimal(trimmed(c.p[1], 2))
+                            .str(" refused: outside [")
+                            .decimal(trimmed(lo, 2))
+                            .str(", ")
+                            .decimal(trimmed(hi, 2))
+                            .str("] m/s"),
                     );
                     MavResult::MAV_RESULT_DENIED
                 } else {
@@ -370,16 +376,16 @@ impl CommandService {
             }
             if !forced {
                 if !v.boot_complete {
-                    out.textf(
+                    out.text_str(
                         MavSeverity::MAV_SEVERITY_CRITICAL,
-                        format_args!("Arming denied: system still starting"),
+                        "Arming denied: system still starting",
                     );
                     return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
                 }
                 if let Some(why) = telemetry::prearm_failure(v) {
-                    out.textf(
+                    out.text(
                         MavSeverity::MAV_SEVERITY_CRITICAL,
-                        format_args!("Arming denied: {}", why.reason()),
+                        Line::new().str("Arming denied: ").str(why.reason()),
                     );
                     return why.result();
                 }
@@ -393,9 +399,9 @@ impl CommandService {
                 LandedState::InAir | LandedState::Takeoff | LandedState::Landing
             );
             if flying && !forced {
-                out.textf(
+                out.text_str(
                     MavSeverity::MAV_SEVERITY_CRITICAL,
-                    format_args!("Disarming denied: not landed"),
+                    "Disarming denied: not landed",
                 );
                 return MavResult::MAV_RESULT_DENIED;
             }
@@ -413,16 +419,16 @@ impl CommandService {
         out: &mut Outbox,
     ) -> MavResult {
         if mode == FlightMode::Mission && plan.mission.is_empty() {
-            out.textf(
+            out.text_str(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Mode Mission refused: no mission"),
+                "Mode Mission refused: no mission",
             );
             return MavResult::MAV_RESULT_DENIED;
         }
         if mode == FlightMode::Return && !v.home.valid {
-            out.textf(
+            out.text_str(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Mode Return refused: no home position"),
+                "Mode Return refused: no home position",
             );
             return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
         }
@@ -432,9 +438,13 @@ impl CommandService {
             } else {
                 "not available now"
             };
-            out.textf(
+            out.text(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Mode {} refused: {}", mode.name(), why),
+                Line::new()
+                    .str("Mode ")
+                    .str(mode.name())
+                    .str(" refused: ")
+                    .str(why),
             );
             return MavResult::MAV_RESULT_TEMPORARILY_REJECTED;
         }
@@ -447,9 +457,14 @@ impl CommandService {
     fn set_mission_current(&mut self, seq: u16, plan: &MissionStore, out: &mut Outbox) -> bool {
         let n = plan.mission.len();
         if usize::from(seq) >= n {
-            out.textf(
+            out.text(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Mission item {} does not exist ({} items)", seq, n),
+                Line::new()
+                    .str("Mission item ")
+                    .uint(u64::from(seq))
+                    .str(" does not exist (")
+                    .uint(n as u64)
+                    .str(" items)"),
             );
             return false;
         }
@@ -504,13 +519,14 @@ fn request_message(c: &Command, v: &VehicleSnapshot, metadata: bool) -> (MavResu
 
 /// A mode this autopilot does not fly: FAILED, and a status text naming PX4's numbers.
 fn unknown_mode(custom_mode: u32, out: &mut Outbox) -> MavResult {
-    out.textf(
+    out.text(
         MavSeverity::MAV_SEVERITY_WARNING,
-        format_args!(
-            "Mode {}.{} not supported",
-            (custom_mode >> 16) & 0xff,
-            custom_mode >> 24
-        ),
+        Line::new()
+            .str("Mode ")
+            .uint(u64::from((custom_mode >> 16) & 0xff))
+            .str(".")
+            .uint(u64::from(custom_mode >> 24))
+            .str(" not supported"),
     );
     MavResult::MAV_RESULT_FAILED
 }
@@ -591,9 +607,9 @@ impl CommandService {
         let result = if saved {
             MavResult::MAV_RESULT_ACCEPTED
         } else {
-            out.textf(
+            out.text_str(
                 MavSeverity::MAV_SEVERITY_ERROR,
-                format_args!("Parameters not saved: flash error"),
+                "Parameters not saved: flash error",
             );
             MavResult::MAV_RESULT_FAILED
         };

@@ -14,7 +14,7 @@
 
 use super::logs::LogStore;
 use super::peer::Peer;
-use core::fmt::Write;
+use super::texts::Line;
 use mavlink::dialects::common::{MavMessage, FILE_TRANSFER_PROTOCOL_DATA};
 
 /// A file the vehicle serves.
@@ -380,8 +380,12 @@ impl Ftp {
         let files: &'static [File] = self.files;
         let count = files.len().saturating_add(1);
         listing(from, count, |k, s| match files.get(k) {
-            Some(f) => write!(s, "F{}\t{}", f.name, f.bytes.len()),
-            None => write!(s, "D{LOG_DIR}"),
+            Some(f) => {
+                s.str("F").str(f.name).str("\t").uint(f.bytes.len() as u64);
+            }
+            None => {
+                s.str("D").str(LOG_DIR);
+            }
         })
     }
 
@@ -410,11 +414,14 @@ impl Ftp {
                     // What is kept now, as for LOG_REQUEST_LIST.
                     store.refresh();
                     let count = usize::from(store.count());
-                    let names = |k: usize, s: &mut heapless::String<48>| {
+                    let names = |k: usize, s: &mut Line<48>| {
                         let size = store
                             .entry(u16::try_from(k).unwrap_or(u16::MAX))
                             .map_or(0, |e| e.size_bytes);
-                        write!(s, "Flog_{}.ulg\t{}", k.saturating_add(1), size)
+                        s.str("Flog_")
+                            .uint(k.saturating_add(1) as u64)
+                            .str(".ulg\t")
+                            .uint(u64::from(size));
                     };
                     listing(head.offset, count, names).map_or(nak(ERR_EOF), ok)
                 }
@@ -550,11 +557,7 @@ fn read_log(store: &mut dyn LogStore, index: u16, offset: u32, want: usize) -> O
 
 /// A `ListDirectory` answer: entries `from`.. of `count`, each written by `entry` and ended by
 /// a NUL, as many as a packet holds; `None` when `from` is past the last.
-fn listing(
-    from: u32,
-    count: usize,
-    mut entry: impl FnMut(usize, &mut heapless::String<48>) -> core::fmt::Result,
-) -> Option<Data> {
+fn listing(from: u32, count: usize, mut entry: impl FnMut(usize, &mut Line<48>)) -> Option<Data> {
     let first = usize::try_from(from).ok()?;
     if first >= count {
         return None;
@@ -562,10 +565,12 @@ fn listing(
     let mut buf = [0u8; DATA_LEN];
     let mut len = 0usize;
     for k in first..count {
-        let mut s = heapless::String::<48>::new();
-        if entry(k, &mut s).is_err() {
+        let mut s = Line::<48>::new();
+        entry(k, &mut s);
+        if s.is_cut() {
             break;
         }
+        let s = s.as_str();
         let end = len.saturating_add(s.len()).saturating_add(1);
         let Some(dst) = buf.get_mut(len..end) else {
             break;

@@ -7,6 +7,7 @@
 //! old plan. Home is not item 0: item 0 is the first thing to fly.
 
 use super::peer::Peer;
+use super::texts::{Line, TEXT_MAX};
 use crate::link::mav_cmd::mav_cmd;
 use crate::navigation::fence::validate_fence;
 use crate::navigation::plan::{MissionItem, MissionStore, PlanKind, MISSION_CAPACITY};
@@ -400,6 +401,26 @@ impl MissionManager {
     /// The warnings of the last accepted mission upload (each returned once).
     pub fn take_warnings(&mut self) -> Vec<ValidationWarning, 8> {
         core::mem::take(&mut self.warnings)
+    }
+
+    /// The status text of a warning: what its `Display` writes, by pieces without `core::fmt`
+    /// (the MCU image formats nothing with it; `a_warnings_text_is_what_its_display_writes`).
+    pub fn warning_text(w: &ValidationWarning) -> Line<TEXT_MAX> {
+        let mut line = Line::new();
+        match *w {
+            ValidationWarning::NoLanding => line.str("Mission has no landing: it ends circling"),
+            ValidationWarning::WillSkip { seq, command } => line
+                .str("Item ")
+                .uint(u64::from(seq))
+                .str(": command ")
+                .uint(u64::from(command))
+                .str(" unsupported, skipped"),
+            ValidationWarning::ApproachTooShort { seq } => line
+                .str("Item ")
+                .uint(u64::from(seq))
+                .str(": approach too short, arrives high"),
+        };
+        line
     }
 
     /// Checks a complete upload: the mission as the navigator will fly it, the fence as the

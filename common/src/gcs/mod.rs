@@ -41,11 +41,69 @@ pub mod streams;
 pub mod telemetry;
 pub mod texts;
 
+/// The system and component a message is addressed to, as the `mavlink` crate's
+/// `target_system_id` and `target_component_id` answer, for the messages the autopilot's
+/// dialect reads (`link::dialect`); the crate's own answers for any other. The crate's are
+/// matches over the whole common dialect's 230 messages (1.2 KB of the MCU image), where the
+/// ground link only ever decodes these.
+// The deprecated messages ground stations still send (SET_MODE, MISSION_ITEM, ...) are read.
+#[allow(deprecated)]
+pub(crate) fn targets(msg: &MavMessage) -> (Option<u8>, Option<u8>) {
+    use MavMessage as M;
+    let both = |s: u8, c: u8| (Some(s), Some(c));
+    match msg {
+        M::SETUP_SIGNING(d) => both(d.target_system, d.target_component),
+        M::FILE_TRANSFER_PROTOCOL(d) => both(d.target_system, d.target_component),
+        M::PARAM_REQUEST_LIST(d) => both(d.target_system, d.target_component),
+        M::PARAM_REQUEST_READ(d) => both(d.target_system, d.target_component),
+        M::PARAM_SET(d) => both(d.target_system, d.target_component),
+        M::MANUAL_CONTROL(d) => (Some(d.target), None),
+        M::SET_MODE(d) => (Some(d.target_system), None),
+        M::MISSION_COUNT(d) => both(d.target_system, d.target_component),
+        M::MISSION_REQUEST_LIST(d) => both(d.target_system, d.target_component),
+        M::MISSION_REQUEST_INT(d) => both(d.target_system, d.target_component),
+        M::MISSION_REQUEST(d) => both(d.target_system, d.target_component),
+        M::MISSION_ACK(d) => both(d.target_system, d.target_component),
+        M::MISSION_CLEAR_ALL(d) => both(d.target_system, d.target_component),
+        M::MISSION_SET_CURRENT(d) => both(d.target_system, d.target_component),
+        M::MISSION_ITEM_INT(d) => both(d.target_system, d.target_component),
+        M::MISSION_ITEM(d) => both(d.target_system, d.target_component),
+        M::LOG_REQUEST_LIST(d) => both(d.target_system, d.target_component),
+        M::LOG_REQUEST_DATA(d) => both(d.target_system, d.target_component),
+        M::LOG_REQUEST_END(d) => both(d.target_system, d.target_component),
+        M::LOG_ERASE(d) => both(d.target_system, d.target_component),
+        M::COMMAND_LONG(d) => both(d.target_system, d.target_component),
+        M::COMMAND_INT(d) => both(d.target_system, d.target_component),
+        M::HEARTBEAT(_)
+        | M::HIL_SENSOR(_)
+        | M::HIL_GPS(_)
+        | M::HIL_STATE_QUATERNION(_)
+        | M::BATTERY_STATUS(_)
+        | M::DISTANCE_SENSOR(_)
+        | M::RC_CHANNELS(_) => (None, None),
+        other => other_targets(other),
+    }
+}
+
+/// A message the autopilot's dialect does not read: only a caller of [`GroundLink::handle`]
+/// with the whole common dialect's messages (the host's tests) has one.
+#[cfg(not(target_os = "none"))]
+fn other_targets(msg: &MavMessage) -> (Option<u8>, Option<u8>) {
+    use mavlink::Message;
+    (msg.target_system_id(), msg.target_component_id())
+}
+
+/// The image decodes nothing outside its dialect (`link::dialect::Autopilot`).
+#[cfg(target_os = "none")]
+fn other_targets(_: &MavMessage) -> (Option<u8>, Option<u8>) {
+    (None, None)
+}
+
 #[cfg(test)]
 mod tests;
 
 use mavlink::dialects::common::*;
-use mavlink::{MavHeader, Message};
+use mavlink::MavHeader;
 
 use crate::vehicle::modes::FlightMode;
 use crate::vehicle::requests::VehicleRequests;
@@ -198,12 +256,13 @@ impl GroundLink {
         if sys == self.cfg.system_id && header.component_id == self.cfg.component_id {
             return;
         }
-        if let Some(t) = msg.target_system_id() {
+        let (target_system, target_component) = targets(msg);
+        if let Some(t) = target_system {
             if t != 0 && t != self.cfg.system_id {
                 return;
             }
         }
-        if let Some(c) = msg.target_component_id() {
+        if let Some(c) = target_component {
             if c != 0 && c != self.cfg.component_id {
                 return;
             }
@@ -300,7 +359,10 @@ impl GroundLink {
                 let plan = &mut *stores.plan;
                 let r = self.missions.on_item(plan, &stores.rules, d, from, now_us);
                 for w in self.missions.take_warnings().iter() {
-                    out.textf(MavSeverity::MAV_SEVERITY_WARNING, format_args!("{w}"));
+                    out.text(
+                        MavSeverity::MAV_SEVERITY_WARNING,
+                        &MissionManager::warning_text(w),
+                    );
                 }
                 r
             }

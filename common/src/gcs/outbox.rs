@@ -4,7 +4,7 @@
 use super::mission::MissionReply;
 use super::peer::{Dest, Peer};
 use super::streams::Stream;
-use super::texts::TextQueue;
+use super::texts::{Line, TextQueue, TEXT_MAX};
 use crate::vehicle::modes::FlightMode;
 use heapless::Deque;
 use mavlink::dialects::common::{
@@ -97,9 +97,14 @@ impl Outbox {
         );
     }
 
-    /// Queues a formatted status text for every station.
-    pub fn textf(&mut self, severity: MavSeverity, args: core::fmt::Arguments<'_>) {
-        self.texts.pushf(severity, args);
+    /// Queues a status text built by pieces ([`Line`]) for every station.
+    pub fn text(&mut self, severity: MavSeverity, line: &Line<TEXT_MAX>) {
+        self.texts.push_line(severity, line.clone());
+    }
+
+    /// Queues a status text for every station.
+    pub fn text_str(&mut self, severity: MavSeverity, text: &str) {
+        self.texts.push_str(severity, text);
     }
 
     /// The status-text queue.

@@ -3,6 +3,7 @@
 
 use super::outbox::{Outbox, Pending};
 use super::peer::{Dest, Peer};
+use super::texts::Line;
 use crate::decimal::trimmed;
 use crate::params::store::{encode_wire, param_id_str, ParamStore};
 use crate::params::ParamKind;
@@ -93,9 +94,9 @@ impl ParamService {
             return;
         };
         let Some(index) = params.index_of(name) else {
-            out.textf(
+            out.text(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!("Param {}: unknown", name),
+                Line::new().str("Param ").str(name).str(": unknown"),
             );
             param_error(
                 &d.param_id[..],
@@ -133,15 +134,18 @@ impl ParamService {
                 .map_err(|e| (e.text(), MavParamError::MAV_PARAM_ERROR_VALUE_OUT_OF_RANGE))
         });
         if let Err((why, error)) = result {
-            out.textf(
+            out.text(
                 MavSeverity::MAV_SEVERITY_WARNING,
-                format_args!(
-                    "Param {} refused: {} [{}, {}]",
-                    name,
-                    why,
-                    trimmed(def.min, 6),
-                    trimmed(def.max, 6)
-                ),
+                Line::new()
+                    .str("Param ")
+                    .str(name)
+                    .str(" refused: ")
+                    .str(why)
+                    .str(" [")
+                    .decimal(trimmed(def.min, 6))
+                    .str(", ")
+                    .decimal(trimmed(def.max, 6))
+                    .str("]"),
             );
             param_error(&d.param_id[..], index as i16, error, from, out);
         }

@@ -2675,3 +2675,96 @@ fn sys_status_and_battery_status_carry_the_monitor_s_figures_or_say_unknown() {
             .contains(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_BATTERY));
     }
 }
+
+#[test]
+fn a_warnings_text_is_what_its_display_writes() {
+    use crate::navigation::validate::ValidationWarning;
+    for w in [
+        ValidationWarning::NoLanding,
+        ValidationWarning::WillSkip { seq: 0, command: 0 },
+        ValidationWarning::WillSkip {
+            seq: u16::MAX,
+            command: u16::MAX,
+        },
+        ValidationWarning::ApproachTooShort { seq: 7 },
+        ValidationWarning::ApproachTooShort { seq: u16::MAX },
+    ] {
+        assert_eq!(
+            MissionManager::warning_text(&w).as_str(),
+            w.to_string(),
+            "{w:?}"
+        );
+    }
+}
+
+#[test]
+fn a_line_writes_what_write_writes_and_stops_at_the_first_piece_that_does_not_fit() {
+    use super::texts::Line;
+    use crate::decimal::{fixed, trimmed};
+    use std::format;
+    for v in [0u64, 7, 10, 65_535, u64::from(u32::MAX), u64::MAX] {
+        assert_eq!(Line::<40>::new().uint(v).as_str(), format!("{v}"));
+    }
+    for v in [0u32, 1, 0xf, 0x10, 0x0800_c0de, 0xdead_beef, u32::MAX] {
+        assert_eq!(Line::<40>::new().hex8(v).as_str(), format!("{v:#010x}"));
+    }
+    for x in [
+        0.0f32,
+        -0.0,
+        0.05,
+        17.0,
+        -3.25,
+        1e30,
+        f32::NAN,
+        f32::INFINITY,
+        1.0e-7,
+    ] {
+        for places in [0u8, 2, 6] {
+            assert_eq!(
+                Line::<80>::new().decimal(fixed(x, places)).as_str(),
+                format!("{}", fixed(x, places))
+            );
+            assert_eq!(
+                Line::<80>::new().decimal(trimmed(x, places)).as_str(),
+                format!("{}", trimmed(x, places))
+            );
+        }
+    }
+    // As `write!` into a `heapless::String`: a piece is taken whole or not at all, and
+    // nothing after the first that does not fit.
+    let mut l = Line::<8>::new();
+    l.str("abc").uint(12_345);
+    assert_eq!(l.as_str(), "abc12345");
+    assert!(!l.is_cut());
+    l.str("e");
+    assert!(l.is_cut());
+    let mut l = Line::<8>::new();
+    l.str("abcd").str("efghi").str("j");
+    assert_eq!(l.as_str(), "abcd");
+    assert!(l.is_cut());
+    let mut s = heapless::String::<8>::new();
+    let middle = "efghi".to_string();
+    assert!(core::fmt::Write::write_fmt(&mut s, format_args!("abcd{middle}j")).is_err());
+    assert_eq!(s.as_str(), l.as_str());
+}
+
+#[test]
+fn the_targets_of_every_message_the_dialect_reads_are_the_crates() {
+    use crate::link::dialect::Autopilot;
+    use mavlink::Message;
+    for &id in Autopilot::READS {
+        let mut m = MavMessage::default_message_from_id(id).expect("a common message");
+        // Different values in the two fields, so that one read for the other shows.
+        if let Some(t) = m.target_system_id_mut() {
+            *t = 7;
+        }
+        if let Some(c) = m.target_component_id_mut() {
+            *c = 9;
+        }
+        assert_eq!(
+            super::targets(&m),
+            (m.target_system_id(), m.target_component_id()),
+            "message {id}"
+        );
+    }
+}

@@ -324,19 +324,28 @@ pub fn independent<C>(_: &C) -> Result<(), &'static str> {
 impl<C: 'static> Group<C> {
     /// The settings with every parameter at its default.
     pub fn defaults(&self) -> C {
-        let mut c = (self.base)();
-        for p in self.params {
-            (p.set)(&mut c, p.def.default);
-        }
-        c
+        self.settings(None)
     }
 
     /// The settings from this group's values, in parameter order (as the store keeps them).
     /// Values must have passed their definitions' checks; missing ones keep the base.
     pub fn load(&self, values: &[f32]) -> C {
+        self.settings(Some(values))
+    }
+
+    /// [`Group::load`] of `values`, or [`Group::defaults`] if there are none: one loop for
+    /// both, so that a caller that may take either (the parameter store) has one copy of it
+    /// for each settings type, not two.
+    pub fn settings(&self, values: Option<&[f32]>) -> C {
         let mut c = (self.base)();
-        for (p, v) in self.params.iter().zip(values) {
-            (p.set)(&mut c, *v);
+        for (i, p) in self.params.iter().enumerate() {
+            let v = match values {
+                Some(values) => values.get(i).copied(),
+                None => Some(p.def.default),
+            };
+            if let Some(v) = v {
+                (p.set)(&mut c, v);
+            }
         }
         c
     }

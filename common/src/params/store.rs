@@ -178,11 +178,16 @@ impl ParamStore {
     /// registry, which the vehicle's tests rule out).
     pub fn load<C>(&self, group: &Group<C>) -> C {
         let first = group.params.first().map(|p| p.def.name);
-        let start = first.and_then(|n| self.index_of(n));
-        match start.and_then(|s| self.values.get(s..s + group.params.len())) {
-            Some(values) => group.load(values),
-            None => group.defaults(),
-        }
+        group.settings(self.group_values(first, group.params.len()))
+    }
+
+    /// The `len` values of the group whose first parameter is called `first`. Apart from
+    /// [`ParamStore::load`] and not inlined: the search by name is the same for every
+    /// settings type, and the vehicle loads some fifteen of them in one function.
+    #[inline(never)]
+    fn group_values(&self, first: Option<&str>, len: usize) -> Option<&[f32]> {
+        let start = self.index_of(first?)?;
+        self.values.get(start..start.checked_add(len)?)
     }
 
     /// Value at `index`.

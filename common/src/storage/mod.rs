@@ -71,9 +71,53 @@ pub const SIGNING_MAGIC: u32 = 0x5347_4e31; // "SGN1"
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct SigningRecord {
     /// The secret key; `None`: signing off.
+    #[serde(deserialize_with = "key::deserialize")]
     pub key: Option<[u8; 32]>,
     /// Signing clock, 10 us units since 2015-01-01.
     pub timestamp: u64,
+}
+
+/// The signing key read back as serde's `[u8; 32]` reads it (a tuple of 32 bytes: the same
+/// record), by a loop: serde's own reading of an array is its 32 elements unrolled, 0.5 KB of
+/// the MCU image's boot code.
+mod key {
+    use serde::de::{Deserialize, Deserializer, Error, SeqAccess, Visitor};
+
+    /// The key's 32 bytes.
+    struct Key([u8; 32]);
+
+    impl<'de> Deserialize<'de> for Key {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            d.deserialize_tuple(32, KeyVisitor)
+        }
+    }
+
+    struct KeyVisitor;
+
+    impl<'de> Visitor<'de> for KeyVisitor {
+        type Value = Key;
+
+        fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            f.write_str("an array of length 32")
+        }
+
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Key, A::Error> {
+            let mut key = [0u8; 32];
+            for (i, b) in key.iter_mut().enumerate() {
+                *b = seq
+                    .next_element()?
+                    .ok_or_else(|| A::Error::invalid_length(i, &self))?;
+            }
+            Ok(Key(key))
+        }
+    }
+
+    /// `Option<[u8; 32]>` as serde derives its reading, the array by [`Key`].
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Option<[u8; 32]>, D::Error> {
+        Ok(Option::<Key>::deserialize(d)?.map(|k| k.0))
+    }
 }
 
 const HEADER_LEN: u32 = 16;

@@ -524,3 +524,38 @@ fn a_power_cut_anywhere_in_a_streamed_board_save_loads_the_old_record_or_the_new
     // An erase and every payload and header byte.
     assert!(cuts > 9 * 20, "{cuts}");
 }
+
+#[test]
+fn a_signing_key_reads_back_as_serde_reads_an_array() {
+    /// The record as serde derives its reading, the array unrolled.
+    #[derive(Debug, PartialEq, Deserialize)]
+    struct Derived {
+        key: Option<[u8; 32]>,
+        timestamp: u64,
+    }
+    let key: [u8; 32] = core::array::from_fn(|i| (i * 37 + 200) as u8);
+    for r in [
+        SigningRecord {
+            key: Some(key),
+            timestamp: 1 << 40,
+        },
+        SigningRecord {
+            key: None,
+            timestamp: 7,
+        },
+    ] {
+        let mut buf = [0u8; 64];
+        let bytes = postcard::to_slice(&r, &mut buf).unwrap();
+        assert_eq!(postcard::from_bytes::<SigningRecord>(bytes).unwrap(), r);
+        let d = postcard::from_bytes::<Derived>(bytes).unwrap();
+        assert_eq!((d.key, d.timestamp), (r.key, r.timestamp));
+        // Cut short anywhere: refused by both.
+        for n in 0..bytes.len() {
+            assert!(
+                postcard::from_bytes::<SigningRecord>(&bytes[..n]).is_err(),
+                "{n}"
+            );
+            assert!(postcard::from_bytes::<Derived>(&bytes[..n]).is_err(), "{n}");
+        }
+    }
+}

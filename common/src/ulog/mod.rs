@@ -192,6 +192,34 @@ pub fn data(
     })
 }
 
+/// Bytes before a sample's fields in a data message: the message's header, the message id
+/// and the timestamp.
+pub const DATA_HEADER_LEN: usize = MSG_HEADER_LEN + 2 + 8;
+
+/// [`data`] with the fields already in place: they are `fields` bytes from
+/// [`DATA_HEADER_LEN`] on in `buf` (or did not fit: [`TooLong`]), and the message's header,
+/// id and timestamp go in front of them. The bytes are [`data`]'s; a caller that encodes its
+/// sample where it stands (the logger) keeps only the fields' encoding its own.
+pub fn data_in_place(
+    buf: &mut [u8],
+    msg_id: u16,
+    timestamp_us: u64,
+    fields: Result<usize, TooLong>,
+) -> Result<usize, TooLong> {
+    let n = fields?.checked_add(DATA_HEADER_LEN).ok_or(TooLong)?;
+    if n > buf.len() {
+        return Err(TooLong);
+    }
+    let size = u16::try_from(n.checked_sub(MSG_HEADER_LEN).ok_or(TooLong)?).map_err(|_| TooLong)?;
+    let mut c = Cursor::new(buf.get_mut(..DATA_HEADER_LEN).ok_or(TooLong)?);
+    c.u16(size)
+        .u8(MsgType::Data as u8)
+        .u16(msg_id)
+        .u64(timestamp_us);
+    c.finish()?;
+    Ok(n)
+}
+
 /// A text with its level and time.
 pub fn logging(
     buf: &mut [u8],

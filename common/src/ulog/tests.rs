@@ -63,6 +63,33 @@ fn a_sample_is_the_message_id_then_as_many_bytes_as_its_format_says() {
 }
 
 #[test]
+fn a_sample_encoded_in_place_is_the_same_message() {
+    let fields = |c: &mut Cursor<'_>| {
+        c.f32s(&[1.0, 0.0, 0.0, 0.5]).u8(7).f64(-2.5);
+    };
+    for len in [0, 12, 13, 24, 25, 26, 40, 128] {
+        let mut whole = [0u8; 128];
+        let mut buf = [0u8; 128];
+        let whole = &mut whole[..len];
+        let buf = &mut buf[..len];
+        let expected = data(whole, 3, 1_000_000, fields);
+        let encoded = match buf.get_mut(DATA_HEADER_LEN..) {
+            Some(rest) => {
+                let mut c = Cursor::new(rest);
+                fields(&mut c);
+                c.finish()
+            }
+            None => Err(TooLong),
+        };
+        let n = data_in_place(buf, 3, 1_000_000, encoded);
+        assert_eq!(n, expected, "buffer of {len}");
+        if let Ok(n) = n {
+            assert_eq!(buf[..n], whole[..n]);
+        }
+    }
+}
+
+#[test]
 fn an_information_text_names_its_length_in_the_key() {
     let mut b = [0u8; 64];
     let n = info_str(&mut b, "sys_name", "Ultra").unwrap();

@@ -146,7 +146,7 @@ impl<F: Flash> FlashLogs<F> {
         self.next_id = self.next_id.wrapping_add(1).max(1);
         self.ready = 0;
         if self.logs.is_full() {
-            self.logs.remove(0);
+            drop_oldest(&mut self.logs);
         }
         let _ = self.logs.push(w.info());
         self.writer = Some(w);
@@ -267,6 +267,20 @@ impl<F: Flash> LogStore for FlashLogs<F> {
     }
 }
 
+/// Drops the list's first (oldest) log, the others kept in order: each swapped one place
+/// towards the front, so the first ends last and is popped. `Vec::remove(0)` moves them with
+/// `memmove`, which nothing else in the image calls (1.6 KB of flash for one call a log).
+fn drop_oldest(logs: &mut LogList) {
+    let mut rest = logs.iter_mut();
+    if let Some(mut slot) = rest.next() {
+        for next in rest {
+            core::mem::swap(slot, next);
+            slot = next;
+        }
+    }
+    logs.pop();
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -281,6 +295,27 @@ mod tests {
         sector_len: SECTOR,
         sectors: 4,
     };
+
+    #[test]
+    fn the_oldest_log_is_dropped_and_the_others_keep_their_order() {
+        let log = |id| LogInfo {
+            id,
+            first_sector: id,
+            blocks: 1,
+            bytes: id * 10,
+        };
+        let mut logs = LogList::new();
+        for id in 1..=3 {
+            logs.push(log(id)).unwrap();
+        }
+        drop_oldest(&mut logs);
+        assert_eq!(logs.as_slice(), &[log(2), log(3)]);
+        drop_oldest(&mut logs);
+        drop_oldest(&mut logs);
+        assert!(logs.is_empty());
+        drop_oldest(&mut logs);
+        assert!(logs.is_empty());
+    }
 
     /// Feeds a frame of the sensors at rest at `time_us`; whether the vehicle answered it.
     fn frame(app: &mut App, time_us: u64) -> bool {

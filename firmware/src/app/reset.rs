@@ -4,7 +4,7 @@
 //! handlers left in a RAM word that start-up does not clear (`.uninit`): a tag with the kind
 //! and the line or program counter. This module turns both into one STATUSTEXT.
 
-use core::fmt::Write;
+use common::gcs::texts::Line;
 
 /// `RCC_CSR` reset flags (RM0090 7.3.21).
 pub mod csr {
@@ -73,11 +73,22 @@ impl Fault {
 /// that is set, `unknown` when none is (QEMU does not emulate RCC: it reads 0). A fault or
 /// watchdog reset is a warning worth the pilot's attention.
 pub fn boot_text(rcc_csr: u32, fault: Option<Fault>) -> (bool, heapless::String<50>) {
-    let mut s = heapless::String::new();
-    let (warn, _) = match fault {
-        Some(Fault::Panic { line }) => (true, write!(s, "Reset by a panic (line {line})")),
-        Some(Fault::HardFault { pc }) => (true, write!(s, "Reset by a HardFault (pc {pc:#010x})")),
-        Some(Fault::Requested) => (false, write!(s, "Rebooted on request")),
+    let mut s = Line::<50>::new();
+    let warn = match fault {
+        Some(Fault::Panic { line }) => {
+            s.str("Reset by a panic (line ")
+                .uint(u64::from(line))
+                .str(")");
+            true
+        }
+        Some(Fault::HardFault { pc }) => {
+            s.str("Reset by a HardFault (pc ").hex8(pc).str(")");
+            true
+        }
+        Some(Fault::Requested) => {
+            s.str("Rebooted on request");
+            false
+        }
         None => {
             let (warn, why) = if rcc_csr & csr::IWDGRSTF != 0 {
                 (true, "independent watchdog")
@@ -96,10 +107,11 @@ pub fn boot_text(rcc_csr: u32, fault: Option<Fault>) -> (bool, heapless::String<
             } else {
                 (false, "unknown")
             };
-            (warn, write!(s, "Reset cause: {why}"))
+            s.str("Reset cause: ").str(why);
+            warn
         }
     };
-    (warn, s)
+    (warn, s.into_string())
 }
 
 #[cfg(test)]

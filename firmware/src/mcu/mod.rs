@@ -40,6 +40,23 @@ unsafe fn DefaultHandler(irqn: i16) {
     }
 }
 
+/// Interrupts of the STM32F405 (RM0090's vector table: 82, WWDG at 0 to FPU at 81).
+const IRQS: usize = 82;
+
+/// The interrupts' part of the vector table, each to `DefaultHandler`, which serves the USARTs
+/// by the interrupt's number. As many as the chip has: without a device crate cortex-m-rt
+/// fills the 240 an ARMv7-M core may have, 632 bytes of flash for interrupts that do not exist
+/// (its `device` feature leaves the table to the image; `build.rs` writes the `device.x` it
+/// includes).
+#[link_section = ".vector_table.interrupts"]
+#[no_mangle]
+static __INTERRUPTS: [unsafe extern "C" fn(); IRQS] = {
+    extern "C" {
+        fn DefaultHandler();
+    }
+    [DefaultHandler; IRQS]
+};
+
 #[entry]
 fn main() -> ! {
     let (Some(mut sim), Some(mut gcs)) = (Usart::open(Id::Usart1), Usart::open(Id::Usart2)) else {
