@@ -357,6 +357,12 @@ pub(crate) struct FlyArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub(crate) json: bool,
+    /// Fly Stabilized from the hand launch as a pilot flies for identification, instead of the
+    /// thesis's script: the simulator's radio (RC_CHANNELS) flies 3-2-1-1 doublets in roll,
+    /// then in pitch, three times each, then throttle steps, at the aircraft's level-trim
+    /// throttle; `sim-host identify OUT/simlink.tlog` fits the models (docs/AUTOTUNE.md).
+    #[arg(long, conflicts_with = "mission")]
+    pub(crate) stick_doublets: bool,
     /// Fly a mission from the runway instead of the thesis's script: a QGroundControl `.plan`
     /// or `QGC WPL 110` file (mission and geofence are uploaded), or `default` for the
     /// built-in take-off, rectangle, orbit, return and landing, or `runway-120` / `runway-250`
@@ -395,6 +401,7 @@ impl FlyArgs {
             profile: self.profile,
             json: self.json,
             mission: self.mission,
+            stick_doublets: self.stick_doublets,
             params: self.params,
         }
     }

@@ -123,79 +123,18 @@ fn a_log_without_the_simulators_truth_is_refused_with_what_it_lacks() {
     );
 }
 
-/// A 3-2-1-1 of `amp` from `from_s` on steps of `unit_s`: the stick positions a pilot flies
-/// for a broad band with few reversals, then centred.
-fn three_two_one_one(from_s: f64, unit_s: f64, amp: f32) -> Vec<(f64, f32)> {
-    [(0.0, amp), (3.0, -amp), (5.0, amp), (6.0, -amp), (7.0, 0.0)]
-        .iter()
-        .map(|(k, a)| (from_s + k * unit_s, *a))
-        .collect()
-}
-
-/// The stick flight below, its simulator-link log in `dir`: doublets flown by hand in
-/// Stabilized (the simulator's radio: RC_CHANNELS), from the hand launch: roll, then pitch,
-/// three times each (3-2-1-1s of 0.3 stick on 0.3 s steps), then throttle steps.
+/// The stick flight of `sim-host fly --stick-doublets` (`flight::missions::stick_doublets`,
+/// at the level trim's throttle), its simulator-link log in `dir`, identified.
 fn stick_flight(dir: &Path) -> sim_host::commands::identify::IdentifyReport {
-    use sim_host::commands::fly::{fly_report, FlyOptions};
-    use sim_host::flight::script::{Action, Script, ScriptStep};
-    use sim_host::flight::{FlightConfig, RcSticks};
-    let throttle = 0.54;
-    let mut sticks = vec![RcSticks {
-        from_s: 0.0,
-        roll: 0.0,
-        pitch: 0.0,
-        throttle,
-        yaw: 0.0,
-    }];
-    for k in 0..3 {
-        let t0 = 10.0 + 20.0 * f64::from(k);
-        for (from_s, roll) in three_two_one_one(t0, 0.3, 0.3) {
-            sticks.push(RcSticks {
-                from_s,
-                roll,
-                pitch: 0.0,
-                throttle,
-                yaw: 0.0,
-            });
-        }
-        for (from_s, pitch) in three_two_one_one(t0 + 10.0, 0.3, 0.3) {
-            sticks.push(RcSticks {
-                from_s,
-                roll: 0.0,
-                pitch,
-                throttle,
-                yaw: 0.0,
-            });
-        }
-    }
-    // Then throttle steps (a pilot's full and idle power, 6 s each) for the airspeed model.
-    for (from_s, throttle) in [(72.0, 0.9), (78.0, 0.2), (84.0, 0.54)] {
-        sticks.push(RcSticks {
-            from_s,
-            roll: 0.0,
-            pitch: 0.0,
-            throttle,
-            yaw: 0.0,
-        });
-    }
-    let cfg = FlightConfig {
-        duration_s: 95.0,
-        script: Script {
-            steps: vec![ScriptStep {
-                after_arm_s: 0.0,
-                action: Action::Mode(7),
-            }],
-            ..Script::thesis()
-        },
-        rc_sticks: sticks,
-        ..FlightConfig::default()
-    };
+    use sim_host::commands::fly::{command::level_trim_throttle, fly_report, FlyOptions};
+    let aircraft = sim_host::aircraft::Aircraft::load(None).expect("aircraft");
+    let cfg =
+        sim_host::flight::missions::stick_doublets(level_trim_throttle(&aircraft).expect("trim"));
     let opts = FlyOptions {
         out: Some(dir.to_path_buf()),
         plots: false,
         ..FlyOptions::default()
     };
-    let aircraft = sim_host::aircraft::Aircraft::load(None).expect("aircraft");
     fly_report(&aircraft, &cfg, &opts).expect("flight");
     sim_host::commands::identify::identify_log(&dir.join("simlink.tlog"), &aircraft, None)
         .expect("identify")

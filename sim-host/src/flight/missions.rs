@@ -1,8 +1,8 @@
 //! Missions written as a planner would write them: MAVLink `MISSION_ITEM_INT`s with global
 //! positions, built from offsets in metres from the simulator's home (the runway).
 
-use super::config::FlightConfig;
-use super::script::{Action, Script, ScriptStep};
+use super::config::{FlightConfig, RcSticks};
+use super::script::{Action, Script, ScriptStep, PX4_STABILIZED};
 use common::math::geodetic::{offset_point, GeoPoint};
 use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
 
@@ -362,6 +362,52 @@ pub fn runway_mission(mission: Vec<MISSION_ITEM_INT_DATA>) -> FlightConfig {
             mission,
             ..Script::thesis()
         },
+        ..FlightConfig::default()
+    }
+}
+
+/// A 3-2-1-1 of `amp` from `from_s` on steps of `unit_s`, then centred: the stick positions a
+/// pilot flies for a broad band with few reversals.
+fn three_two_one_one(from_s: f64, unit_s: f64, amp: f32) -> [(f64, f32); 5] {
+    [(0.0, amp), (3.0, -amp), (5.0, amp), (6.0, -amp), (7.0, 0.0)]
+        .map(|(k, a)| (from_s + k * unit_s, a))
+}
+
+/// An identification flight as a pilot flies it with the simulator's radio (RC_CHANNELS):
+/// Stabilized from the hand launch at `throttle`, 3-2-1-1s of 0.3 stick on 0.3 s steps in
+/// roll, then in pitch, three times each, then full and idle power for 6 s each (the airspeed
+/// model's excitation), 95 s in all.
+pub fn stick_doublets(throttle: f32) -> FlightConfig {
+    let stick = |from_s, roll, pitch, throttle| RcSticks {
+        from_s,
+        roll,
+        pitch,
+        throttle,
+        yaw: 0.0,
+    };
+    let mut sticks = vec![stick(0.0, 0.0, 0.0, throttle)];
+    for k in 0..3 {
+        let t0 = 10.0 + 20.0 * f64::from(k);
+        for (from_s, roll) in three_two_one_one(t0, 0.3, 0.3) {
+            sticks.push(stick(from_s, roll, 0.0, throttle));
+        }
+        for (from_s, pitch) in three_two_one_one(t0 + 10.0, 0.3, 0.3) {
+            sticks.push(stick(from_s, 0.0, pitch, throttle));
+        }
+    }
+    for (from_s, power) in [(72.0, 0.9), (78.0, 0.2), (84.0, throttle)] {
+        sticks.push(stick(from_s, 0.0, 0.0, power));
+    }
+    FlightConfig {
+        duration_s: 95.0,
+        script: Script {
+            steps: vec![ScriptStep {
+                after_arm_s: 0.0,
+                action: Action::Mode(PX4_STABILIZED),
+            }],
+            ..Script::thesis()
+        },
+        rc_sticks: sticks,
         ..FlightConfig::default()
     }
 }

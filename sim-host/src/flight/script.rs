@@ -30,6 +30,8 @@ const LAST_WORDS: std::time::Duration = std::time::Duration::from_millis(300);
 pub const GCS_SYSTEM_ID: u8 = 255;
 /// Component id of the ground station (MAV_COMP_ID_MISSIONPLANNER, what QGC uses).
 pub const GCS_COMPONENT_ID: u8 = 190;
+/// PX4 main mode STABILIZED (roll and pitch held, the sticks command them).
+pub const PX4_STABILIZED: u8 = FlightMode::Stabilized.px4().0;
 /// PX4 main mode ALTCTL (the autopilot's "Altitude").
 pub const PX4_ALTCTL: u8 = FlightMode::Altitude.px4().0;
 /// PX4 main mode POSCTL (the autopilot's "Hold": course, altitude and airspeed hold).

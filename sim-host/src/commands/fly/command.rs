@@ -13,7 +13,9 @@ use crate::commands::sim::stop_on_ctrl_c;
 use crate::commands::{render, Format};
 use crate::environment::wind::Turbulence;
 use crate::flight::config::{FaultWindow, FlightConfig};
-use crate::flight::missions::{default_mission, other_runway_missions, runway_mission};
+use crate::flight::missions::{
+    default_mission, other_runway_missions, runway_mission, stick_doublets,
+};
 use crate::link::profile::ProfileWindow;
 use crate::link::qemu::QemuConfig;
 use crate::report::{to_json, NOTES_MARKER};
@@ -62,6 +64,8 @@ pub struct FlyCommand {
     pub json: bool,
     /// A mission from the runway: a mission file, `default`, `runway-120` or `runway-250`.
     pub mission: Option<PathBuf>,
+    /// Fly the stick doublets of an identification flight instead of the thesis's script.
+    pub stick_doublets: bool,
     /// Parameters set before arming, name and value.
     pub params: Vec<(String, f32)>,
 }
@@ -94,6 +98,15 @@ pub fn mission_config(aircraft: &Aircraft, which: &Path) -> anyhow::Result<Fligh
     Ok(cfg)
 }
 
+/// The throttle of the aircraft's level trim at its cruise airspeed (the hand launch's).
+pub fn level_trim_throttle(aircraft: &Aircraft) -> anyhow::Result<f32> {
+    use crate::analysis::trim::{not_trimmed, trim_with, TrimTarget};
+    let target = TrimTarget::level().at_airspeed(aircraft.cruise_airspeed_mps());
+    let trim = trim_with(&crate::plant::params::ModelParams::new(aircraft), &target);
+    anyhow::ensure!(trim.converged, "{}", not_trimmed(&trim));
+    Ok(trim.throttle as f32)
+}
+
 /// Runs `sim-host fly`: flies, prints through `emit` and writes the files asked for.
 pub fn fly_command(
     aircraft: &Aircraft,
@@ -102,6 +115,7 @@ pub fn fly_command(
 ) -> anyhow::Result<()> {
     let base = match &a.mission {
         Some(m) => mission_config(aircraft, m)?,
+        None if a.stick_doublets => stick_doublets(level_trim_throttle(aircraft)?),
         None => FlightConfig::default(),
     };
     let mut cfg = FlightConfig {
