@@ -8,8 +8,9 @@
 //! (`HIL_ACTUATOR_CONTROLS`, the surface commands held until the next). Samples count while
 //! the autopilot is armed and the aircraft is 5 m or more above the lowest height of the
 //! armed flight (the runway): the ground's forces are not the models'. The log holds no
-//! wind, so the angle of attack is read from the ground velocity: a log flown in wind gives
-//! the pitch model a wrong angle of attack (the vehicle, which estimates the wind, does not).
+//! wind: the flight's steady wind is read from it (the ground velocity less the airspeed
+//! along the nose, averaged), and the angle of attack is the velocity's through it. Gusts are
+//! not: in turbulence the angle of attack carries them as noise.
 
 use crate::aircraft::Aircraft;
 use crate::commands::linearize::linearize_report_at;
@@ -20,7 +21,7 @@ use anyhow::{bail, Context};
 use common::actuators::Surfaces;
 use common::gcs::{COMPONENT_ID, SYSTEM_ID};
 use common::link::framing::FrameParser;
-use common::math::frames::{course_and_speed, ned_to_body, AirData, Euler};
+use common::math::frames::{body_to_ned, course_and_speed, ned_to_body, AirData, Euler};
 use common::math::{RAD2DEG, STANDARD_GRAVITY};
 use common::tuning::identify::{Axis, AxisError, Identifier, IdentifyConfig, Sample};
 use mavlink::dialects::common::MavMessage;
@@ -78,6 +79,8 @@ pub struct IdentifyReport {
     pub samples: usize,
     /// Their span, s.
     pub flown_s: f64,
+    /// The steady wind read from the log (the angle of attack is taken through it), NED, m/s.
+    pub wind_ned_mps: [f64; 3],
     /// Per axis, in the design's order.
     pub axes: Vec<AxisReport>,
     /// The printed tables.
@@ -95,11 +98,14 @@ impl IdentifyReport {
     }
 }
 
-/// One sample of the log with its time and height.
+/// One sample of the log with its time and height, and the attitude and ground velocity its
+/// angle of attack is read from once the wind is known.
 struct Timed {
     time_us: u64,
     alt_m: f64,
     armed: bool,
+    attitude: UnitQuaternion<f64>,
+    v_ned: Vector3<f64>,
     sample: Sample,
 }
 
@@ -107,7 +113,7 @@ struct Timed {
 /// answer to it.
 fn samples(bytes: &[u8]) -> Vec<Timed> {
     let mut parser = FrameParser::new();
-    let mut truth: Option<(u64, Sample, f64)> = None;
+    let mut truth: Option<(u64, Sample, f64, UnitQuaternion<f64>, Vector3<f64>)> = None;
     let mut out = Vec::new();
     for (_, frame) in read_tlog(bytes) {
         parser.push(&frame, |f| match f.message {
@@ -123,9 +129,6 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                 let (course, gs) = course_and_speed(&v);
                 let va = f64::from(d.true_airspeed) / 100.0;
                 let climb = -v.z;
-                // The log holds no wind: the angle of attack is the ground velocity's, exact
-                // in still air (the aircraft file's linearisation is of still air too).
-                let air = AirData::from_body_velocity(&ned_to_body(&q, &v));
                 let s = Sample {
                     p: d.rollspeed,
                     q: d.pitchspeed,
@@ -134,19 +137,19 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                     theta: e.theta as f32,
                     airspeed: va as f32,
                     ay: (f64::from(d.yacc) * STANDARD_GRAVITY / 1000.0) as f32,
-                    alpha: air.alpha as f32,
                     climb_rate: climb as f32,
                     course: course as f32,
                     ground_speed: gs as f32,
                     ..Sample::default()
                 };
-                truth = Some((d.time_usec, s, f64::from(d.alt) / 1000.0));
+                truth = Some((d.time_usec, s, f64::from(d.alt) / 1000.0, q, v));
             }
             MavMessage::HIL_ACTUATOR_CONTROLS(d)
                 if (f.header.system_id, f.header.component_id)
                     == (u32::from(SYSTEM_ID), COMPONENT_ID) =>
             {
-                let Some((t, s, alt)) = truth.filter(|(t, ..)| *t == d.time_usec) else {
+                let Some((t, s, alt, attitude, v_ned)) = truth.filter(|(t, ..)| *t == d.time_usec)
+                else {
                     return;
                 };
                 let c = Surfaces::from_px4_controls([
@@ -159,6 +162,8 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                     time_us: t,
                     alt_m: alt,
                     armed: d.mode.bits() & 128 != 0,
+                    attitude,
+                    v_ned,
                     sample: Sample {
                         aileron: c.aileron,
                         elevator: c.elevator,
@@ -171,6 +176,24 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
         });
     }
     out
+}
+
+/// The flight's steady horizontal wind, NED, m/s: the mean of the ground velocity less the
+/// airspeed along the body's nose. The log holds no wind, and the angle of attack is read from
+/// the velocity through the air; the nose's direction leaves out the angle of attack's and
+/// the sideslip's share of the airspeed (tenths of a m/s), and the wind's vertical part is
+/// taken as none.
+fn steady_wind(flown: &[&Timed]) -> Vector3<f64> {
+    let n = flown.len().max(1) as f64;
+    let sum = flown.iter().fold(Vector3::zeros(), |acc, t| {
+        let air = body_to_ned(
+            &t.attitude,
+            &Vector3::new(f64::from(t.sample.airspeed), 0.0, 0.0),
+        );
+        acc + (t.v_ned - air)
+    });
+    let w = sum / n;
+    Vector3::new(w.x, w.y, 0.0)
 }
 
 /// Fits the log at `path`; `airspeed` overrides the reference airspeed (the flown mean).
@@ -204,6 +227,20 @@ pub fn identify_log(
             flown.len()
         );
     }
+    let wind = steady_wind(&flown);
+    let flown: Vec<Timed> = flown
+        .into_iter()
+        .map(|t| {
+            let air = AirData::from_body_velocity(&ned_to_body(&t.attitude, &(t.v_ned - wind)));
+            Timed {
+                sample: Sample {
+                    alpha: air.alpha as f32,
+                    ..t.sample
+                },
+                ..*t
+            }
+        })
+        .collect();
     let va_ref = airspeed.unwrap_or_else(|| {
         flown
             .iter()
@@ -302,10 +339,12 @@ pub fn identify_log(
     }
     let mut t = Table::new(
         format!(
-            "Reduced models identified from {} ({} s flown, coefficients at {} m/s; servo time constant {} s), beside the aircraft file's linearisation at that airspeed",
+            "Reduced models identified from {} ({} s flown, coefficients at {} m/s, steady wind N {} E {} m/s; servo time constant {} s), beside the aircraft file's linearisation at that airspeed",
             path.display(),
             sig(span, 3),
             sig(va_ref, 3),
+            sig(wind.x, 2),
+            sig(wind.y, 2),
             sig(servo_tau, 2)
         ),
         &["axis", "coefficient", "identified", "std. error", "linearised", "difference", "R^2", "excitation (sd)"],
@@ -345,6 +384,7 @@ pub fn identify_log(
         servo_tau_s: servo_tau,
         samples: flown.len(),
         flown_s: span,
+        wind_ned_mps: [wind.x, wind.y, wind.z],
         axes,
         tables: vec![t],
     })
