@@ -100,6 +100,7 @@ impl IdentifyReport {
 
 /// One sample of the log with its time and height, and the attitude and ground velocity its
 /// angle of attack is read from once the wind is known.
+#[derive(Clone, Copy)]
 struct Timed {
     time_us: u64,
     alt_m: f64,
@@ -113,7 +114,8 @@ struct Timed {
 /// answer to it.
 fn samples(bytes: &[u8]) -> Vec<Timed> {
     let mut parser = FrameParser::new();
-    let mut truth: Option<(u64, Sample, f64, UnitQuaternion<f64>, Vector3<f64>)> = None;
+    // The last truth frame, waiting for the autopilot's answer to it.
+    let mut truth: Option<Timed> = None;
     let mut out = Vec::new();
     for (_, frame) in read_tlog(bytes) {
         parser.push(&frame, |f| match f.message {
@@ -142,14 +144,20 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                     ground_speed: gs as f32,
                     ..Sample::default()
                 };
-                truth = Some((d.time_usec, s, f64::from(d.alt) / 1000.0, q, v));
+                truth = Some(Timed {
+                    time_us: d.time_usec,
+                    alt_m: f64::from(d.alt) / 1000.0,
+                    armed: false,
+                    attitude: q,
+                    v_ned: v,
+                    sample: s,
+                });
             }
             MavMessage::HIL_ACTUATOR_CONTROLS(d)
                 if (f.header.system_id, f.header.component_id)
                     == (u32::from(SYSTEM_ID), COMPONENT_ID) =>
             {
-                let Some((t, s, alt, attitude, v_ned)) = truth.filter(|(t, ..)| *t == d.time_usec)
-                else {
+                let Some(t) = truth.filter(|t| t.time_us == d.time_usec) else {
                     return;
                 };
                 let c = Surfaces::from_px4_controls([
@@ -159,17 +167,14 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                     d.controls[3],
                 ]);
                 out.push(Timed {
-                    time_us: t,
-                    alt_m: alt,
                     armed: d.mode.bits() & 128 != 0,
-                    attitude,
-                    v_ned,
                     sample: Sample {
                         aileron: c.aileron,
                         elevator: c.elevator,
                         throttle: c.throttle,
-                        ..s
+                        ..t.sample
                     },
+                    ..t
                 });
             }
             _ => {}
