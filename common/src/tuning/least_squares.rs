@@ -71,8 +71,8 @@ impl<const N: usize> LeastSquares<N> {
         if !y.is_finite() || x.iter().any(|v| !v.is_finite()) {
             return false;
         }
-        let (mut x, y_in) = (*x, y);
-        let mut y = y;
+        // `x` and `y` are rotated into the factor; what is left of `y` is the row's residual.
+        let (mut x, mut resid) = (*x, y);
         for i in 0..N {
             let (a, b) = (self.r[(i, i)], x[i]);
             if b == 0.0 {
@@ -88,12 +88,12 @@ impl<const N: usize> LeastSquares<N> {
                 x[j] = c * xj - s * rij;
             }
             let zi = self.z[i];
-            self.z[i] = c * zi + s * y;
-            y = c * y - s * zi;
+            self.z[i] = c * zi + s * resid;
+            resid = c * resid - s * zi;
         }
-        self.rss += y * y;
-        self.y_sum += y_in;
-        self.y_sq += y_in * y_in;
+        self.rss += resid * resid;
+        self.y_sum += y;
+        self.y_sq += y * y;
         self.rows += 1;
         true
     }
@@ -108,16 +108,10 @@ impl<const N: usize> LeastSquares<N> {
         if (0..N).any(|i| self.r[(i, i)].abs() <= 1e-6 * scale) {
             return None;
         }
-        let mut coef = SVector::<f32, N>::zeros();
-        for i in (0..N).rev() {
-            let mut s = self.z[i];
-            for j in i + 1..N {
-                s -= self.r[(i, j)] * coef[j];
-            }
-            coef[i] = s / self.r[(i, i)];
-        }
-        // (X^T X)^-1 = R^-1 R^-T: each coefficient's variance is a row of R^-1 squared.
-        let inv = self.r.try_inverse()?;
+        // R^-1 by nalgebra's back substitution: the coefficients are R^-1 Q^T y, and
+        // (X^T X)^-1 = R^-1 R^-T gives each coefficient's variance as a row of R^-1 squared.
+        let inv = self.r.solve_upper_triangular(&SMatrix::<f32, N, N>::identity())?;
+        let coef = inv * self.z;
         let dof = (self.rows - N as u32) as f32;
         let sigma2 = self.rss / dof;
         let mut std_err = SVector::<f32, N>::zeros();
