@@ -110,7 +110,9 @@ impl<const N: usize> LeastSquares<N> {
         }
         // R^-1 by nalgebra's back substitution: the coefficients are R^-1 Q^T y, and
         // (X^T X)^-1 = R^-1 R^-T gives each coefficient's variance as a row of R^-1 squared.
-        let inv = self.r.solve_upper_triangular(&SMatrix::<f32, N, N>::identity())?;
+        let inv = self
+            .r
+            .solve_upper_triangular(&SMatrix::<f32, N, N>::identity())?;
         let coef = inv * self.z;
         let dof = (self.rows - N as u32) as f32;
         let sigma2 = self.rss / dof;

@@ -189,20 +189,13 @@ pub fn design_at(
     // Pitch: predicted on the linear short period.
     let q_de = &super::transfer::thesis_transfer_functions(&lin).q_over_de;
     let theta_de = q_de.series(&tf(&[1.0], &[1.0, 0.0]));
-    let trim = Trim {
-        aileron: trim.aileron,
-        rudder: trim.rudder,
-        elevator: trim.elevator,
-        throttle: trim.throttle,
-        theta: trim.theta,
-    };
     let plant = Plant {
         coefficients,
         theta_de,
         servo_bandwidth_hz: aircraft.actuators.bandwidth_Hz,
         g,
     };
-    design_loops(inputs, plant, Some(trim))
+    design_loops(inputs, plant, Some(&trim))
 }
 
 /// What the loops are designed on.
@@ -212,15 +205,6 @@ struct Plant {
     theta_de: TransferFunction,
     servo_bandwidth_hz: f64,
     g: f64,
-}
-
-/// The trim the gains are flown about, rad (throttle 0..1).
-struct Trim {
-    aileron: f64,
-    rudder: f64,
-    elevator: f64,
-    throttle: f64,
-    theta: f64,
 }
 
 /// The reduced models a design from flight data starts from (`sim-host identify`): no
@@ -276,8 +260,12 @@ pub fn design_from_model(model: &ReducedModel, inputs: &DesignInputs) -> anyhow:
     design_loops(inputs, plant, None)
 }
 
-/// The loops, inner to outer, on `plant`; `trim` `None` keeps the base set's trims.
-fn design_loops(inputs: &DesignInputs, plant: Plant, trim: Option<Trim>) -> anyhow::Result<Design> {
+/// The loops, inner to outer, on `plant`, flown about `trim` (`None`: the base set's trims).
+fn design_loops(
+    inputs: &DesignInputs,
+    plant: Plant,
+    trim: Option<&TrimResult>,
+) -> anyhow::Result<Design> {
     let Plant {
         coefficients,
         theta_de,
