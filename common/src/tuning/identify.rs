@@ -170,7 +170,7 @@ impl Axis {
     /// deviation, in the input's unit: rad, or throttle) that counts as an excitation. A
     /// quarter of a degree of surface is what a servo's dead band and the sensors' noise
     /// leave unresolved; the kinematic loops are excited by bank and pitch changes.
-    fn input(self) -> (&'static str, f32) {
+    pub fn input(self) -> (&'static str, f32) {
         match self {
             Axis::Roll => ("aileron", 0.25 * crate::math::DEG),
             Axis::Pitch => ("elevator", 0.25 * crate::math::DEG),

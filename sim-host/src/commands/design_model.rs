@@ -5,6 +5,7 @@
 use crate::analysis::design::inputs::DesignInputs;
 use crate::analysis::design::{design_from_model, Design, ReducedModel};
 use crate::analysis::reduced::ReducedCoefficients;
+use crate::commands::identify::IdentifyReport;
 use crate::report::table::Table;
 use crate::report::{sig, sig_or_dash};
 use anyhow::{anyhow, bail, Context};
@@ -77,57 +78,26 @@ impl ModelDesignReport {
     }
 }
 
-/// Reads the model of a `sim-host identify --json` report.
+/// Reads the model of a `sim-host identify --json` report (its [`IdentifyReport`]).
 pub fn read_model(path: &Path) -> anyhow::Result<ReducedModel> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let v: serde_json::Value = serde_json::from_str(&text).with_context(|| {
+    let r: IdentifyReport = serde_json::from_str(&text).with_context(|| {
         format!(
-            "{}: not JSON (a `sim-host identify --json` report)",
+            "{}: not a `sim-host identify --json` report",
             path.display()
         )
     })?;
-    let number = |key: &str| -> anyhow::Result<f64> {
-        v.get(key)
-            .and_then(serde_json::Value::as_f64)
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| anyhow!("{}: key `{key}` is missing or not a number", path.display()))
-    };
-    let va = number("airspeed_ref_mps")?;
-    let tau = number("servo_tau_s")?;
-    if va <= 0.0 || tau <= 0.0 {
+    let (va, tau) = (r.airspeed_ref_mps, r.servo_tau_s);
+    if !(va.is_finite() && va > 0.0 && tau.is_finite() && tau > 0.0) {
         bail!(
             "{}: `airspeed_ref_mps` {va} and `servo_tau_s` {tau} must be positive",
             path.display()
         );
     }
-    let axes = v
-        .get("axes")
-        .and_then(serde_json::Value::as_array)
-        .ok_or_else(|| anyhow!("{}: key `axes` is missing", path.display()))?;
-    let coefficient = |axis: &str, name: &str| -> anyhow::Result<f64> {
-        let a = axes
-            .iter()
-            .find(|a| a.get("axis").and_then(serde_json::Value::as_str) == Some(axis))
-            .ok_or_else(|| anyhow!("{}: no `{axis}` axis", path.display()))?;
-        if let Some(e) = a.get("error").and_then(serde_json::Value::as_str) {
-            bail!("{}: the {axis} axis has no model ({e})", path.display());
-        }
-        a.get("coefficients")
-            .and_then(serde_json::Value::as_array)
-            .and_then(|cs| {
-                cs.iter()
-                    .find(|c| c.get("name").and_then(serde_json::Value::as_str) == Some(name))
-            })
-            .and_then(|c| c.get("value"))
-            .and_then(serde_json::Value::as_f64)
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| {
-                anyhow!(
-                    "{}: `{axis}.{name}` is missing or not a number",
-                    path.display()
-                )
-            })
+    let coefficient = |axis: &str, name: &str| {
+        r.coefficient(axis, name)
+            .map_err(|e| anyhow!("{}: {e}", path.display()))
     };
     Ok(ReducedModel {
         va,

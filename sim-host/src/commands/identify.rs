@@ -26,14 +26,14 @@ use common::math::{RAD2DEG, STANDARD_GRAVITY};
 use common::tuning::identify::{Axis, AxisError, Identifier, IdentifyConfig, Sample};
 use mavlink::dialects::common::MavMessage;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// Height above the armed flight's lowest point from which a sample counts as flown, m.
 const AIRBORNE_M: f64 = 5.0;
 
 /// One coefficient: identified, and the linearisation's where it has one.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Coefficient {
     /// Beard and McLain's name (or the kinematic gain's).
     pub name: String,
@@ -48,14 +48,15 @@ pub struct Coefficient {
 }
 
 /// One axis: its fit, or why there is none.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AxisReport {
     /// `roll`, `pitch`, `airspeed`, `course`, `altitude`.
     pub axis: String,
     /// The input the axis is excited by.
     pub input: String,
-    /// Its standard deviation over the flight (deg of surface or bank, or throttle).
-    pub input_sd: f64,
+    /// Its standard deviation over the flight (deg of surface or bank, or throttle; `None`
+    /// where the fit failed for another reason).
+    pub input_sd: Option<f64>,
     /// Share of the state's rate the model explains.
     pub r2: Option<f64>,
     /// Sample pairs fitted.
@@ -67,7 +68,7 @@ pub struct AxisReport {
 }
 
 /// What `sim-host identify` reports.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IdentifyReport {
     /// The log read.
     pub log: String,
@@ -89,6 +90,24 @@ pub struct IdentifyReport {
 }
 
 impl IdentifyReport {
+    /// The identified value of `axis`'s coefficient `name`: an error naming the axis when it
+    /// has no model, or the coefficient when the axis lacks it.
+    pub fn coefficient(&self, axis: &str, name: &str) -> Result<f64, String> {
+        let a = self
+            .axes
+            .iter()
+            .find(|a| a.axis == axis)
+            .ok_or_else(|| format!("no `{axis}` axis"))?;
+        if let Some(e) = &a.error {
+            return Err(format!("the {axis} axis has no model ({e})"));
+        }
+        a.coefficients
+            .iter()
+            .find(|c| c.name == name && c.value.is_finite())
+            .map(|c| c.value)
+            .ok_or_else(|| format!("`{axis}.{name}` is missing or not a number"))
+    }
+
     /// The axes without a fit, with the reason.
     pub fn failures(&self) -> Vec<String> {
         self.axes
@@ -280,18 +299,14 @@ pub fn identify_log(
     };
     let mut axes = Vec::new();
     for axis in Axis::ALL {
-        let (input, scale) = match axis {
-            Axis::Airspeed => ("throttle", 1.0),
-            Axis::Course => ("bank", RAD2DEG),
-            Axis::Altitude => ("pitch", RAD2DEG),
-            Axis::Roll => ("aileron", RAD2DEG),
-            Axis::Pitch => ("elevator", RAD2DEG),
-        };
+        // Angles are reported in degrees, the throttle as it is.
+        let (input, _) = axis.input();
+        let scale = if axis == Axis::Airspeed { 1.0 } else { RAD2DEG };
         let report = match id.fit(axis) {
             Ok(f) => AxisReport {
                 axis: axis.name().into(),
                 input: input.into(),
-                input_sd: f64::from(f.input_sd * scale),
+                input_sd: Some(f64::from(f.input_sd * scale)),
                 r2: Some(f64::from(f.r2)),
                 rows: f.rows,
                 coefficients: axis
@@ -306,6 +321,8 @@ pub fn identify_log(
                             value,
                             std_err: f64::from(*e),
                             reference,
+                            // Relative to the signed reference (not `report::pct`'s
+                            // magnitude): -3 % is a coefficient 3 % smaller in size.
                             diff_pct: reference
                                 .filter(|r| r.abs() > 1e-9)
                                 .map(|r| 100.0 * (value - r) / r),
@@ -317,7 +334,7 @@ pub fn identify_log(
             Err(e) => {
                 let (sd, error) = match e {
                     AxisError::NotExcited { sd, needed, .. } => (
-                        f64::from(sd * scale),
+                        Some(f64::from(sd * scale)),
                         format!(
                             "not excited: the {input} varied {} (standard deviation), at least {} needed",
                             sig(f64::from(sd * scale), 2),
@@ -325,7 +342,7 @@ pub fn identify_log(
                         ),
                     ),
                     AxisError::Singular => (
-                        f64::NAN,
+                        None,
                         "its regressors never varied independently of each other".into(),
                     ),
                 };
@@ -356,7 +373,9 @@ pub fn identify_log(
     );
     for a in &axes {
         let unit = if a.input == "throttle" { "" } else { " deg" };
-        let excitation = format!("{}{unit} {}", sig(a.input_sd, 2), a.input);
+        let excitation = a
+            .input_sd
+            .map_or("-".into(), |sd| format!("{}{unit} {}", sig(sd, 2), a.input));
         if let Some(e) = &a.error {
             t.row([
                 a.axis.clone(),

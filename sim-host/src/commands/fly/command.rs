@@ -98,7 +98,7 @@ pub fn mission_config(aircraft: &Aircraft, which: &Path) -> anyhow::Result<Fligh
     Ok(cfg)
 }
 
-/// The throttle of the aircraft's level trim at its cruise airspeed (the hand launch's).
+/// The throttle of the aircraft's level trim at its cruise airspeed.
 pub fn level_trim_throttle(aircraft: &Aircraft) -> anyhow::Result<f32> {
     use crate::analysis::trim::{not_trimmed, trim_with, TrimTarget};
     let target = TrimTarget::level().at_airspeed(aircraft.cruise_airspeed_mps());
