@@ -118,7 +118,7 @@ impl CommandService {
                 None => unknown_mode(d.custom_mode, out),
             }
         } else {
-            out.text_str(
+            out.texts_mut().push_str(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 "Mode refused: only custom modes",
             );
@@ -161,7 +161,7 @@ impl CommandService {
             MavCmd::MAV_CMD_DO_SET_MODE => {
                 let base = c.p[0] as u32;
                 if base & MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED.bits() as u32 == 0 {
-                    out.text_str(
+                    out.texts_mut().push_str(
                         MavSeverity::MAV_SEVERITY_WARNING,
                         "Mode refused: only custom modes",
                     );
@@ -376,7 +376,7 @@ impl CommandService {
             }
             if !forced {
                 if !v.boot_complete {
-                    out.text_str(
+                    out.texts_mut().push_str(
                         MavSeverity::MAV_SEVERITY_CRITICAL,
                         "Arming denied: system still starting",
                     );
@@ -399,7 +399,7 @@ impl CommandService {
                 LandedState::InAir | LandedState::Takeoff | LandedState::Landing
             );
             if flying && !forced {
-                out.text_str(
+                out.texts_mut().push_str(
                     MavSeverity::MAV_SEVERITY_CRITICAL,
                     "Disarming denied: not landed",
                 );
@@ -419,14 +419,14 @@ impl CommandService {
         out: &mut Outbox,
     ) -> MavResult {
         if mode == FlightMode::Mission && plan.mission.is_empty() {
-            out.text_str(
+            out.texts_mut().push_str(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 "Mode Mission refused: no mission",
             );
             return MavResult::MAV_RESULT_DENIED;
         }
         if mode == FlightMode::Return && !v.home.valid {
-            out.text_str(
+            out.texts_mut().push_str(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 "Mode Return refused: no home position",
             );
@@ -607,7 +607,7 @@ impl CommandService {
         let result = if saved {
             MavResult::MAV_RESULT_ACCEPTED
         } else {
-            out.text_str(
+            out.texts_mut().push_str(
                 MavSeverity::MAV_SEVERITY_ERROR,
                 "Parameters not saved: flash error",
             );

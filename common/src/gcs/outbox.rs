@@ -102,11 +102,6 @@ impl Outbox {
         self.texts.push_line(severity, line.clone());
     }
 
-    /// Queues a status text for every station.
-    pub fn text_str(&mut self, severity: MavSeverity, text: &str) {
-        self.texts.push_str(severity, text);
-    }
-
     /// The status-text queue.
     pub fn texts_mut(&mut self) -> &mut TextQueue {
         &mut self.texts

@@ -18,7 +18,7 @@ pub mod topics;
 
 use crate::params::ParamStore;
 use crate::ulog::topic::{Format, Topic};
-use crate::ulog::{self, Cursor, Level, TooLong};
+use crate::ulog::{self, Level, TooLong};
 use ring::ByteRing;
 use topics::*;
 
@@ -251,14 +251,7 @@ impl Logger {
         // The fields where the message will hold them, the rest in `write_encoded`: inlined
         // here, the encoding of a sample is its fields' stores at known places.
         let mut b = [0u8; MESSAGE_MAX];
-        let fields = match b.get_mut(ulog::DATA_HEADER_LEN..) {
-            Some(rest) => {
-                let mut c = Cursor::new(rest);
-                sample.encode(&mut c);
-                c.finish()
-            }
-            None => Err(TooLong),
-        };
+        let fields = ulog::data_fields(&mut b, |c| sample.encode(c));
         self.write_encoded(now_us, T::ID, fields, &mut b);
     }
 

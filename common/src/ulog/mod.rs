@@ -196,6 +196,15 @@ pub fn data(
 /// and the timestamp.
 pub const DATA_HEADER_LEN: usize = MSG_HEADER_LEN + 2 + 8;
 
+/// Writes a sample's fields where a data message holds them in `buf` (from
+/// [`DATA_HEADER_LEN`] on), for [`data_in_place`] to put the header in front: their length,
+/// or [`TooLong`].
+pub fn data_fields(buf: &mut [u8], fields: impl FnOnce(&mut Cursor<'_>)) -> Result<usize, TooLong> {
+    let mut c = Cursor::new(buf.get_mut(DATA_HEADER_LEN..).ok_or(TooLong)?);
+    fields(&mut c);
+    c.finish()
+}
+
 /// [`data`] with the fields already in place: they are `fields` bytes from
 /// [`DATA_HEADER_LEN`] on in `buf` (or did not fit: [`TooLong`]), and the message's header,
 /// id and timestamp go in front of them. The bytes are [`data`]'s; a caller that encodes its

@@ -73,14 +73,7 @@ fn a_sample_encoded_in_place_is_the_same_message() {
         let whole = &mut whole[..len];
         let buf = &mut buf[..len];
         let expected = data(whole, 3, 1_000_000, fields);
-        let encoded = match buf.get_mut(DATA_HEADER_LEN..) {
-            Some(rest) => {
-                let mut c = Cursor::new(rest);
-                fields(&mut c);
-                c.finish()
-            }
-            None => Err(TooLong),
-        };
+        let encoded = data_fields(buf, fields);
         let n = data_in_place(buf, 3, 1_000_000, encoded);
         assert_eq!(n, expected, "buffer of {len}");
         if let Ok(n) = n {
