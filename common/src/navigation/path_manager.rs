@@ -14,9 +14,9 @@
 //! H(z, n) = { p : (p - z) . n >= 0 }  half-plane switching, robust to missing a radius
 //! ```
 //!
-//! The radius R is `NAV_TURN_RAD`, widened to the turn at 35 deg of bank over ground when the
-//! leg's airspeed and the estimated wind ask for more: `(V_a + W)^2 / (g tan 35 deg)`, laid out
-//! when the leg begins.
+//! The radius R is `NAV_TURN_RAD`, widened to the turn at `NAV_TURN_BNK_DEG` of bank over
+//! ground when the leg's airspeed and the estimated wind ask for more: `(V_a + W)^2 / (g tan
+//! bank)`, laid out when the leg begins.
 //!
 //! Geometry is horizontal; the line's altitude runs from one waypoint's altitude to the next
 //! (the guidance interpolates it) and a fillet is flown at its corner waypoint's altitude.
@@ -31,6 +31,7 @@
 //! The caller shifts the window by one after each `reached` event.
 
 use crate::guidance::{OrbitDirection, Path};
+use crate::math::RAD2DEG;
 use crate::param;
 use crate::params::{independent, Group, ParamDef};
 use nalgebra::{Vector2, Vector3};
@@ -41,21 +42,38 @@ use nalgebra::{Vector2, Vector3};
 /// `22^2 / (g tan 35)` is 70 m. A 50 m fillet held the bank on its limit downwind and let one
 /// gust carry the aircraft 20 m outside the corner. Faster, or in more wind, a corner is
 /// widened to that turn ([`PathManager::fillet_radius`]): a 135 deg corner flown at 20 m/s
-/// with 5 m/s behind was overshot by 58 m on the 70 m fillet.
+/// with 5 m/s behind was overshot by 58 m on the 70 m fillet. Another aircraft's is
+/// `(NAV_ASPD + 5)^2 / (g tan NAV_TURN_BNK_DEG)` the same way.
 pub const PARAMS: Group<PathParams> = Group {
     name: "Path manager",
-    params: &[param!(
-        ParamDef::real(
-        "NAV_TURN_RAD",
-        70.0,
-        5.0,
-        TURN_RADIUS_MAX,
-        "m",
-        "Smallest fillet radius at waypoint corners; a corner is widened to the turn at 35 deg of bank over ground, (airspeed + wind)^2 / (g tan 35 deg), when that is wider",
-    ),
-        PathParams => turn_radius
-    )],
-    base: || PathParams { turn_radius: 0.0 },
+    params: &[
+        param!(
+            ParamDef::real(
+                "NAV_TURN_RAD",
+                70.0,
+                5.0,
+                TURN_RADIUS_MAX,
+                "m",
+                "Smallest fillet radius at waypoint corners; a corner is widened to the turn at NAV_TURN_BNK_DEG over ground, (airspeed + wind)^2 / (g tan bank), when that is wider",
+            ),
+            PathParams => turn_radius
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TURN_BNK_DEG",
+                TURN_BANK_DEG,
+                5.0,
+                80.0,
+                "deg",
+                "Bank a corner's turn is laid out for (LIM_ROLL_DEG less room for gusts)",
+            ),
+            PathParams => turn_bank, scale RAD2DEG
+        ),
+    ],
+    base: || PathParams {
+        turn_radius: 0.0,
+        turn_bank: 0.0,
+    },
     check: independent,
 };
 
@@ -65,6 +83,8 @@ pub const PARAMS: Group<PathParams> = Group {
 pub struct PathParams {
     /// Fillet radius, m.
     pub turn_radius: f32,
+    /// `NAV_TURN_BNK_DEG`: bank a fillet is laid out for, rad.
+    pub turn_bank: f32,
 }
 
 impl Default for PathParams {
@@ -79,9 +99,10 @@ pub const WINDOW: usize = 3;
 /// Turns under this angle are flown through without a fillet, rad (1 deg).
 const STRAIGHT_ON: f32 = 1.0 * core::f32::consts::PI / 180.0;
 
-/// Bank a fillet is laid out for, rad: the 45-degree limit less room for gusts and the course
-/// loop (`NAV_TURN_RAD`'s default is this turn at 22 m/s over ground).
-pub const TURN_BANK: f32 = 35.0 * core::f32::consts::PI / 180.0;
+/// `NAV_TURN_BNK_DEG`'s default, deg: the Ultra Stick's 45-degree roll limit less room for
+/// gusts and the course loop (`NAV_TURN_RAD`'s default is this turn at 22 m/s over ground).
+/// Another aircraft takes its own `LIM_ROLL_DEG` less the same 10 deg.
+const TURN_BANK_DEG: f32 = 35.0;
 /// Widest fillet, m: `NAV_TURN_RAD`'s upper bound, and the most the wind and airspeed may ask for.
 pub const TURN_RADIUS_MAX: f32 = 500.0;
 
@@ -123,6 +144,8 @@ pub struct PathStep {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathManager {
     turn_radius: f32,
+    /// Bank the fillets are laid out for, rad.
+    turn_bank: f32,
     /// The leg being flown (its end's id and position), to notice when the caller changes it.
     leg: Option<(u16, Vector3<f32>)>,
     segment: Segment,
@@ -151,20 +174,23 @@ fn in_half_plane(p: Vector2<f32>, z: Vector2<f32>, n: Vector2<f32>) -> bool {
 }
 
 impl PathManager {
-    /// A manager rounding corners with this radius, m (clamped to at least 1 m).
+    /// A manager rounding corners with this radius, m (clamped to at least 1 m), and laying
+    /// them out for `NAV_TURN_BNK_DEG`'s default bank.
     pub fn new(turn_radius: f32) -> Self {
         let turn_radius = sane_radius(turn_radius);
         Self {
             turn_radius,
+            turn_bank: TURN_BANK_DEG / RAD2DEG,
             leg: None,
             segment: Segment::Straight,
             leg_radius: turn_radius,
         }
     }
 
-    /// Takes new settings (the fillet radius, clamped to at least 1 m).
+    /// Takes new settings (the fillet radius, clamped to at least 1 m, and the bank).
     pub fn configure(&mut self, p: &PathParams) {
         self.turn_radius = sane_radius(p.turn_radius);
+        self.turn_bank = p.turn_bank;
     }
 
     /// The fillet radius, m.
@@ -184,13 +210,14 @@ impl PathManager {
     }
 
     /// The fillet radius for a corner flown at up to `airspeed` (m/s) in a wind of
-    /// `wind_speed` (m/s): `NAV_TURN_RAD`, or the turn over ground at [`TURN_BANK`] with the
-    /// wind behind, `(airspeed + wind)^2 / (g tan 35 deg)`, if that is wider (at most
+    /// `wind_speed` (m/s): `NAV_TURN_RAD`, or the turn over ground at `NAV_TURN_BNK_DEG` with
+    /// the wind behind, `(airspeed + wind)^2 / (g tan bank)`, if that is wider (at most
     /// [`TURN_RADIUS_MAX`]). A non-finite or negative speed counts as none.
     pub fn fillet_radius(&self, airspeed: f32, wind_speed: f32) -> f32 {
         let speed = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
         let over_ground = speed(airspeed) + speed(wind_speed);
-        let needed = over_ground * over_ground / (crate::math::GRAVITY * libm::tanf(TURN_BANK));
+        let needed =
+            over_ground * over_ground / (crate::math::GRAVITY * libm::tanf(self.turn_bank));
         self.turn_radius.max(needed.min(TURN_RADIUS_MAX))
     }
 
@@ -389,6 +416,14 @@ mod tests {
         assert_eq!(m.fillet_radius(15.0, f32::NAN), 70.0);
         assert_eq!(m.fillet_radius(f32::INFINITY, 5.0), 70.0);
         assert_eq!(m.fillet_radius(200.0, 0.0), TURN_RADIUS_MAX);
+        // An aircraft whose roll limit is 35 deg lays its turns out for 25 deg: 136.7 m.
+        let mut p = PathParams::default();
+        PARAMS
+            .set(&mut p, "NAV_TURN_BNK_DEG", 25.0)
+            .expect("in range");
+        let mut low = m;
+        low.configure(&p);
+        assert_abs_diff_eq!(low.fillet_radius(20.0, 5.0), 136.7, epsilon = 0.1);
         let fast = |id| Waypoint {
             airspeed: 20.0,
             ..wp(id, 0.0, 0.0, 50.0)

@@ -1369,13 +1369,19 @@ fn given_the_truth_the_flare_starts_at_the_true_height() {
 
 /// A landed aircraft that keeps rolling (sailing along the runway before a crosswind, its tail
 /// wheel a keel) is disarmed `NAV_LND_DISARM_S` (30 s) after the touchdown once its airspeed
-/// is under 10 m/s, where it cannot fly off with its surfaces at rest; faster through the air,
-/// it stays armed and steered; slower than 3 m/s over ground it is disarmed at once.
+/// is under 10 m/s (10/11 of `NAV_LIFTOFF_ASPD`), where it cannot fly off with its surfaces at
+/// rest; faster through the air, it stays armed and steered; slower than 3 m/s over ground it
+/// is disarmed at once. An aircraft that lifts off at 22 m/s is disarmed under 20 m/s.
 #[test]
 fn a_landed_aircraft_still_rolling_is_disarmed_after_the_roll_out_time_when_it_cannot_fly() {
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
-    let landed_after = |speed: f32, seconds: f32| {
+    let landed_after_with = |liftoff: f32, speed: f32, seconds: f32| {
         let mut nav = navigator();
+        let mut p = *nav.params();
+        EXEC_PARAMS
+            .set(&mut p, "NAV_LIFTOFF_ASPD", liftoff)
+            .expect("in range");
+        nav.set_params(&p);
         let mut plane = land_here_until(&mut nav, &items, Phase::Landed);
         // Rolling on along the runway at `speed` over ground and through the air.
         plane.k.pos.z = 0.0;
@@ -1390,6 +1396,7 @@ fn a_landed_aircraft_still_rolling_is_disarmed_after_the_roll_out_time_when_it_c
         }
         (landed, nav.params().land_disarm_s)
     };
+    let landed_after = |speed, seconds| landed_after_with(11.0, speed, seconds);
     let (early, limit) = landed_after(8.0, 29.0);
     assert_eq!(limit, 30.0);
     assert!(!early, "disarmed 29 s after the touchdown at 8 m/s");
@@ -1402,6 +1409,14 @@ fn a_landed_aircraft_still_rolling_is_disarmed_after_the_roll_out_time_when_it_c
         "disarmed at 12 m/s of airspeed"
     );
     assert!(landed_after(2.5, 0.1).0, "armed at a walking pace");
+    assert!(
+        landed_after_with(22.0, 19.0, 31.0).0,
+        "armed at 19 of 22 m/s"
+    );
+    assert!(
+        !landed_after_with(22.0, 21.0, 31.0).0,
+        "disarmed at 21 of 22 m/s"
+    );
 }
 
 /// The flare banks less than the approach near the ground: at 0.85 m the approach would allow

@@ -38,7 +38,7 @@ use crate::control::autopilot::Commands;
 use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::guidance::Path;
-use crate::math::{clamp, DEG};
+use crate::math::clamp;
 use nalgebra::Vector3;
 
 /// Largest height the approach's integral may add to or take off the glide slope, m, and the
@@ -57,11 +57,12 @@ const ROLLING_SPEED: f32 = 5.0;
 /// landed fixed wing under 5 m/s).
 const STOPPED_SPEED: f32 = 3.0;
 
-/// Airspeed under which a landed aircraft still rolling may be disarmed, m/s: at 10 m/s the
-/// three-point attitude's C_L of about 0.9 lifts 17 N of the 19 N weight, so the aircraft
-/// cannot fly off with its surfaces at rest. Disarmed at 14.6 m/s, it rotated past the
-/// three-point attitude and hopped a metre into the air.
-const DISARM_AIRSPEED: f32 = 10.0;
+/// Airspeed under which a landed aircraft still rolling may be disarmed, as a fraction of
+/// `NAV_LIFTOFF_ASPD`: there the wing at its attitude on the wheels lifts (10/11)^2, 83 %, of
+/// the weight, so the aircraft cannot fly off with its surfaces at rest (10 m/s on the Ultra
+/// Stick). Disarmed at 14.6 m/s, it rotated past the three-point attitude and hopped a metre
+/// into the air.
+const DISARM_LIFTOFF: f32 = 10.0 / 11.0;
 
 /// Time on the ground that makes a touchdown, s.
 const TOUCHDOWN_S: f32 = 1.0;
@@ -80,26 +81,26 @@ const BOUNCE_CLIMB: f32 = 0.3;
 /// turbulence landings, `docs/NAVIGATION.md`).
 const REFLARE_SINK: f32 = 0.6;
 
-/// Pitch held on the roll-out once slow, rad: above the taildragger's three-point attitude
-/// (8.7 deg on the Ultra Stick), so the elevator holds the tail wheel down for steering, as a
-/// pilot holds the stick back. Pitch 0 there (the wheel landing's attitude) has the pitch loop
-/// wind up against the tail wheel in a headwind and, once the tail lifts, put the nose onto
-/// the propeller.
-const TAIL_DOWN_PITCH: f32 = 10.0 * DEG;
-/// Airspeeds between which the roll-out's pitch goes from [`TAIL_DOWN_PITCH`] to the wheel
-/// landing's 0, m/s. Fast, the low attitude keeps the wing's lift under the weight (at 13 m/s
-/// the three-point attitude's C_L of about 0.9 on 0.31 m^2 lifts 29 N, against 19 N); at 6
-/// m/s the three-point attitude lifts a third of the weight.
-const TAIL_DOWN_AIRSPEEDS: (f32, f32) = (6.0, 9.0);
+/// Airspeeds between which the roll-out's pitch goes from `NAV_GND_PTCH_DEG` to the wheel
+/// landing's 0, as fractions of `NAV_LIFTOFF_ASPD`: there the wing at the attitude on the
+/// wheels lifts (6/11)^2 and (9/11)^2 of the weight, 30 % and 67 % (6 and 9 m/s on the Ultra
+/// Stick). Faster, the low attitude keeps the wing's lift under the weight (at 13 m/s the
+/// Ultra Stick's three-point attitude lifts 29 N against its 19 N).
+const TAIL_DOWN_LIFTOFF: (f32, f32) = (6.0 / 11.0, 9.0 / 11.0);
 
-/// The roll-out's pitch at `airspeed` (m/s); the tail down when the airspeed is unknown, as
-/// the aircraft has stopped flying.
-fn rollout_pitch(airspeed: f32) -> f32 {
-    let (slow, fast) = TAIL_DOWN_AIRSPEEDS;
+/// The roll-out's pitch at `airspeed` (m/s): `NAV_GND_PTCH_DEG` once slow, so that the
+/// elevator holds the steered wheel on the ground (the taildragger's tail wheel, held down
+/// as a pilot holds the stick back; pitch 0 there, the wheel landing's attitude, has the pitch
+/// loop wind up against the tail wheel in a headwind and, once the tail lifts, put the nose
+/// onto the propeller); that pitch also when the airspeed is unknown, as the aircraft has
+/// stopped flying.
+fn rollout_pitch(p: &NavParams, airspeed: f32) -> f32 {
+    let (slow, fast) = TAIL_DOWN_LIFTOFF;
+    let (slow, fast) = (slow * p.liftoff_airspeed, fast * p.liftoff_airspeed);
     if !airspeed.is_finite() {
-        return TAIL_DOWN_PITCH;
+        return p.ground_pitch;
     }
-    TAIL_DOWN_PITCH * ((fast - airspeed) / (fast - slow)).clamp(0.0, 1.0)
+    p.ground_pitch * ((fast - airspeed) / (fast - slow)).clamp(0.0, 1.0)
 }
 
 /// Height at which the bank the flare allows has widened to 90 deg, m (`NAV_GND_RLL_M` when
@@ -120,11 +121,6 @@ const GO_AROUNDS_MAX: u8 = 2;
 /// Height a flaring aircraft must climb back to, as a multiple of the flare height, for the
 /// flare to count as ballooned (a gust has lifted it out of the flare): it goes around.
 const BALLOON_FLARES: f32 = 2.0;
-/// Least airspeed at which a landing goes around by itself, m/s: at its three-point attitude
-/// the Ultra Stick's wing (C_L about 0.8) carries its 19 N from about 11 m/s, so it can climb
-/// away. Slower, it is rolling (an estimated height tenths of a metre off may say otherwise),
-/// and full throttle there put one aircraft of 1000 on its nose.
-const GO_AROUND_AIRSPEED: f32 = 11.0;
 /// Least height above the land point a go-around climbs to, m.
 const GO_AROUND_MIN_M: f32 = 15.0;
 
@@ -440,7 +436,11 @@ impl Landing {
             // lifted by a gust out of the flare: go around.
             let long = p.land_abort > 0.0 && -signed_to_go > p.land_abort;
             let airborne = hagl > p.touchdown_alt;
-            let flying = state.airspeed >= GO_AROUND_AIRSPEED;
+            // From `NAV_LIFTOFF_ASPD` up the wing lifts the weight even at the attitude on
+            // the wheels, so the aircraft can climb away; slower, it is rolling (an estimated
+            // height tenths of a metre off may say otherwise), and full throttle there put one
+            // aircraft of 1000 on its nose.
+            let flying = state.airspeed >= p.liftoff_airspeed;
             if flying
                 && self.rollout_s == 0.0
                 && (long && airborne || hagl > BALLOON_FLARES * flare_top)
@@ -504,7 +504,11 @@ impl Landing {
                 let pitch = if self.touched {
                     0.0
                 } else if sink.is_finite() {
-                    clamp(p.flare_pitch + p.flare_k * (sink - aim), floor, 15.0 * DEG)
+                    clamp(
+                        p.flare_pitch + p.flare_k * (sink - aim),
+                        floor,
+                        p.flare_pitch_max,
+                    )
                 } else {
                     p.flare_pitch
                 };
@@ -556,13 +560,49 @@ pub(super) fn roll_out(f: &Flight, course: f32, rollout_s: &mut f32, out: &mut N
     // minutes; disarmed, it weathervanes and stops.
     *rollout_s += f.dt;
     out.landed = state.ground_speed() < STOPPED_SPEED
-        || (*rollout_s >= f.params.land_disarm_s && state.airspeed < DISARM_AIRSPEED);
+        || (*rollout_s >= f.params.land_disarm_s
+            && state.airspeed < DISARM_LIFTOFF * f.params.liftoff_airspeed);
     out.commands = Some(Commands {
         roll: RollMode::Roll(0.0),
         yaw: f.steer(course),
         lon: LonMode::Pitch {
-            pitch: rollout_pitch(state.airspeed),
+            pitch: rollout_pitch(f.params, state.airspeed),
             throttle: 0.0,
         },
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::DEG;
+
+    /// At the Ultra Stick's `NAV_LIFTOFF_ASPD` (11 m/s) the fractions give the airspeeds the
+    /// landing was flown with, bit for bit: the disarm under 10 m/s, the tail held down from
+    /// 9 m/s and fully under 6 m/s (at `NAV_GND_PTCH_DEG`, 10 deg). An aircraft lifting off at
+    /// 22 m/s holds its tail down under 12 and 18 m/s.
+    #[test]
+    fn the_landing_s_airspeeds_are_fractions_of_the_lift_off_airspeed() {
+        let p = NavParams::default();
+        assert_eq!(p.liftoff_airspeed, 11.0);
+        assert_eq!(DISARM_LIFTOFF * p.liftoff_airspeed, 10.0);
+        let (slow, fast) = TAIL_DOWN_LIFTOFF;
+        assert_eq!(
+            (slow * p.liftoff_airspeed, fast * p.liftoff_airspeed),
+            (6.0, 9.0)
+        );
+        assert_eq!(p.ground_pitch, 10.0 * DEG);
+        assert_eq!(rollout_pitch(&p, 5.0), 10.0 * DEG);
+        assert_eq!(rollout_pitch(&p, f32::NAN), 10.0 * DEG);
+        assert_eq!(rollout_pitch(&p, 9.5), 0.0);
+        assert!((rollout_pitch(&p, 7.5) - 5.0 * DEG).abs() < 1e-6);
+        let big = NavParams {
+            liftoff_airspeed: 22.0,
+            ground_pitch: 2.0 * DEG,
+            ..p
+        };
+        assert!((rollout_pitch(&big, 12.0) - 2.0 * DEG).abs() < 1e-6);
+        assert!((rollout_pitch(&big, 15.0) - 1.0 * DEG).abs() < 1e-6);
+        assert_eq!(rollout_pitch(&big, 18.0), 0.0);
+    }
 }

@@ -217,6 +217,17 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_FLR_PMAX_DEG",
+                15.0,
+                0.0,
+                30.0,
+                "deg",
+                "Largest flare pitch (under the stall's and a tail strike's)",
+            ),
+            NavParams => flare_pitch_max, unit DEG
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_FLR_SINK",
                 0.4,
                 0.05,
@@ -266,7 +277,7 @@ pub const PARAMS: Group<NavParams> = Group {
                 0.0,
                 500.0,
                 "m",
-                "Go around when the flare is still in the air, at 11 m/s or more, this far past the land point (0: never)",
+                "Go around when the flare is still in the air, at NAV_LIFTOFF_ASPD or more, this far past the land point (0: never)",
             ),
             NavParams => land_abort
         ),
@@ -397,6 +408,28 @@ pub const PARAMS: Group<NavParams> = Group {
             ),
             NavParams => tip_ground_bank, unit DEG
         ),
+        param!(
+            ParamDef::real(
+                "NAV_GND_PTCH_DEG",
+                10.0,
+                -10.0,
+                30.0,
+                "deg",
+                "Roll-out pitch once slow (a taildragger: its three-point attitude or above)",
+            ),
+            NavParams => ground_pitch, unit DEG
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_LIFTOFF_ASPD",
+                11.0,
+                3.0,
+                40.0,
+                "m/s",
+                "Airspeed at which the wing at NAV_GND_PTCH_DEG lifts the weight",
+            ),
+            NavParams => liftoff_airspeed
+        ),
     ],
     base: || ZERO,
     check: consistent,
@@ -453,6 +486,10 @@ pub struct NavParams {
     pub land_gust_k: f32,
     /// Flare pitch, rad.
     pub flare_pitch: f32,
+    /// `NAV_FLR_PMAX_DEG`: largest pitch the flare commands, rad: below the stall's angle of
+    /// attack, and on a tricycle gear below the pitch at which the tail strikes the runway
+    /// with the main wheels on it.
+    pub flare_pitch_max: f32,
     /// Touchdown sink rate, m/s.
     pub flare_sink: f32,
     /// Flare pitch gain, rad per m/s.
@@ -473,6 +510,18 @@ pub struct NavParams {
     pub wing_span: f32,
     /// Bank at which a wing tip touches the ground on the wheels, rad.
     pub tip_ground_bank: f32,
+    /// `NAV_GND_PTCH_DEG`: pitch the roll-out holds once slow, rad. Above a taildragger's
+    /// three-point attitude (8.7 deg on the Ultra Stick) the elevator holds the tail wheel down
+    /// for steering; the roll-out brings the pitch to it from the wheel landing's 0 between 6/11
+    /// and 9/11 of [`NavParams::liftoff_airspeed`].
+    pub ground_pitch: f32,
+    /// `NAV_LIFTOFF_ASPD`: airspeed at which the wing at [`NavParams::ground_pitch`] lifts the
+    /// weight, m/s: `sqrt(2 m g / (rho S C_L))` with the lift coefficient at that attitude
+    /// (the Ultra Stick's 0.80 at its 8.7 deg: 11.2 m/s). The landing's thresholds are fractions
+    /// of it, where that attitude lifts a known share of the weight: a go-around from it up
+    /// (the wing carries the weight), the disarm while rolling below 10/11 of it (83 % of the
+    /// weight), the tail held down below 9/11 (67 %) and fully below 6/11 (30 %).
+    pub liftoff_airspeed: f32,
     /// Approach integral gain on the height error, 1/s.
     pub approach_i: f32,
     /// Largest height the approach's command lies below the present height, m.
@@ -506,6 +555,7 @@ const ZERO: NavParams = NavParams {
     land_wind_k: 0.0,
     land_gust_k: 0.0,
     flare_pitch: 0.0,
+    flare_pitch_max: 0.0,
     flare_sink: 0.0,
     flare_k: 0.0,
     touchdown_alt: 0.0,
@@ -516,6 +566,8 @@ const ZERO: NavParams = NavParams {
     ground_roll_height: 0.0,
     wing_span: 0.0,
     tip_ground_bank: 0.0,
+    ground_pitch: 0.0,
+    liftoff_airspeed: 0.0,
     approach_i: 0.0,
     approach_dive: 0.0,
     flare_past_k: 0.0,
@@ -567,8 +619,12 @@ impl NavParams {
     }
 }
 
-/// Airspeeds in order: cruise and approach inside the settable range.
+/// Airspeeds in order: cruise and approach inside the settable range; the flare's pitch at
+/// the touchdown sink within its largest.
 fn consistent(p: &NavParams) -> Result<(), &'static str> {
+    if p.flare_pitch > p.flare_pitch_max {
+        return Err("NAV_FLR_PMAX_DEG");
+    }
     if p.airspeed_min >= p.airspeed_max {
         return Err("NAV_ASPD_MIN");
     }
