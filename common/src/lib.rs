@@ -26,8 +26,8 @@
 //! - [`actuators`]: surface commands, their limits and their PX4 normalised form.
 //!
 //! Beside the tick, reading what it flew:
-//! - [`tuning`]: the reduced models identified from flight data, for the design by successive
-//!   loop closure.
+//! - [`tuning`]: the reduced models identified from flight data, and the design by successive
+//!   loop closure on them, in steps of bounded work.
 //!
 //! Beside the tick:
 //! - [`params`]: how each stage declares its parameters, and the one store of their values.

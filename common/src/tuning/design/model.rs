@@ -1,0 +1,103 @@
+//! What a design starts from: Beard and McLain's reduced coefficients at one airspeed, the
+//! servos' bandwidth and gravity.
+
+/// Engine pole a design takes where none was identified, 1/s: two orders of magnitude above
+/// the airspeed loops, so the throttle acts as at once (the margins it predicts are then an
+/// upper bound).
+pub const QUASI_STEADY_ENGINE_POLE: f32 = 100.0;
+
+/// Pitch attitude per elevator as a rational function of `s`,
+/// `(num[0] s + num[1]) / (den[0] s^3 + den[1] s^2 + den[2] s + den[3])`: what the pitch loop's
+/// phase margin (and so its gain) and the outer loops through it are judged on.
+///
+/// The reduced short period `a_theta3 / (s^2 + a_theta1 s + a_theta2)`
+/// ([`PitchResponse::short_period`]) is what a design from identified models has; a design
+/// from an aircraft file may judge on the linear model's two-state short period with its free
+/// integrator, `(b1 s + b0) / (s (s^2 + a1 s + a0))`, instead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PitchResponse {
+    /// Numerator coefficients, highest power first (`s^1`, `s^0`).
+    pub num: [f32; 2],
+    /// Denominator coefficients, highest power first (`s^3` .. `s^0`).
+    pub den: [f32; 4],
+}
+
+impl PitchResponse {
+    /// `a_theta3 / (s^2 + a_theta1 s + a_theta2)`.
+    pub fn short_period(a_theta1: f32, a_theta2: f32, a_theta3: f32) -> Self {
+        Self {
+            num: [0.0, a_theta3],
+            den: [0.0, 1.0, a_theta1, a_theta2],
+        }
+    }
+
+    /// Whether every coefficient is finite and the denominator is not zero.
+    pub fn is_finite(&self) -> bool {
+        self.num.iter().chain(&self.den).all(|c| c.is_finite())
+            && self.den.iter().any(|&c| c != 0.0)
+    }
+}
+
+/// The reduced models a design starts from (Beard and McLain's names and signs: the Minnesota
+/// model's, a positive aileron rolls left so `a_phi2 < 0`, a positive elevator pitches down so
+/// `a_theta3 < 0`).
+///
+/// ```text
+/// roll      phi / da      = a_phi2 / (s (s + a_phi1))
+/// pitch     theta / de    = a_theta3 / (s^2 + a_theta1 s + a_theta2)   (or `pitch_response`)
+/// airspeed  Va / theta    = -g / (s + a_v1)
+///           Va / throttle = a_v2 engine_pole / ((s + a_v1) (s + engine_pole))
+/// course    chi / phi     = (g / va) / s,     altitude   h / theta = va / s
+/// ```
+///
+/// No sideslip model: the sideslip loop keeps the base set's gains.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DesignModel {
+    /// Airspeed the coefficients hold at, m/s.
+    pub va: f32,
+    /// Roll damping, 1/s.
+    pub a_phi1: f32,
+    /// Roll acceleration per radian of combined aileron, 1/s^2.
+    pub a_phi2: f32,
+    /// Pitch damping, 1/s.
+    pub a_theta1: f32,
+    /// Pitch stiffness, 1/s^2.
+    pub a_theta2: f32,
+    /// Pitch acceleration per radian of elevator, 1/s^2.
+    pub a_theta3: f32,
+    /// Airspeed damping, 1/s.
+    pub a_v1: f32,
+    /// Steady airspeed acceleration per unit throttle, m/s^2.
+    pub a_v2: f32,
+    /// The engine speed's pole, 1/s (`None`: not identified, taken as
+    /// [`QUASI_STEADY_ENGINE_POLE`]).
+    pub engine_pole: Option<f32>,
+    /// The surface servos' bandwidth, Hz (a first-order lag with its pole there).
+    pub servo_bandwidth_hz: f32,
+    /// Gravity, m/s^2.
+    pub g: f32,
+    /// What the pitch loop is judged on (`None`: the reduced short period of `a_theta1`,
+    /// `a_theta2`, `a_theta3`, as a design from identified models has it).
+    pub pitch_response: Option<PitchResponse>,
+}
+
+impl DesignModel {
+    /// The engine pole the design takes, 1/s.
+    pub fn engine_pole(&self) -> f32 {
+        self.engine_pole.unwrap_or(QUASI_STEADY_ENGINE_POLE)
+    }
+
+    /// The pitch response the design judges on.
+    pub fn pitch_response(&self) -> PitchResponse {
+        self.pitch_response.unwrap_or_else(|| {
+            PitchResponse::short_period(self.a_theta1, self.a_theta2, self.a_theta3)
+        })
+    }
+
+    /// The servo's pole, rad/s.
+    pub fn servo_pole(&self) -> f32 {
+        2.0 * core::f32::consts::PI * self.servo_bandwidth_hz
+    }
+}
