@@ -1,0 +1,119 @@
+//! The on-board design (`common::tuning::design`: `f32`, a coarse sweep refined at each
+//! crossing, the gain limit by bisection over its 1 % steps) against the host's design on the
+//! same reduced models (`sim-host design --model`: `f64` polynomials, a 4,000-point sweep).
+
+use common::control::gains::DESIGNED;
+use common::tuning::design::{self as onboard, DesignModel, Loop};
+use sim_host::aircraft::Aircraft;
+use sim_host::analysis::design::{design_at, design_from_model, DesignInputs, ReducedModel};
+use sim_host::analysis::reduced::ReducedCoefficients;
+
+/// The Ultra Stick 25e's reduced models at 18.5 m/s (the stick flight's airspeed): roll and
+/// pitch from its aero data, airspeed and the engine's pole from its linear model, as
+/// `sim-host design --airspeed 18.5` takes them; no sideslip model, as identified ones have.
+fn ultrastick_at_18_5() -> ReducedModel {
+    let aircraft = Aircraft::ultrastick25e().expect("built-in aircraft");
+    let c = design_at(&aircraft, &DesignInputs::default(), 18.5)
+        .expect("design")
+        .coefficients;
+    ReducedModel {
+        va: c.va,
+        coefficients: ReducedCoefficients {
+            a_phi1: c.a_phi1,
+            a_phi2: c.a_phi2,
+            a_theta1: c.a_theta1,
+            a_theta2: c.a_theta2,
+            a_theta3: c.a_theta3,
+            a_v1: c.a_v1,
+            a_v2: c.a_v2,
+            a_v3: f64::NAN,
+            a_beta1: f64::NAN,
+            a_beta2: f64::NAN,
+        },
+        engine_pole: Some(c.engine_pole),
+        servo_bandwidth_hz: aircraft.actuators.bandwidth_Hz,
+        g: aircraft.environment.g_mps2,
+    }
+}
+
+/// The same model as the vehicle holds it.
+fn on_board(m: &ReducedModel) -> DesignModel {
+    let c = &m.coefficients;
+    DesignModel {
+        va: m.va as f32,
+        a_phi1: c.a_phi1 as f32,
+        a_phi2: c.a_phi2 as f32,
+        a_theta1: c.a_theta1 as f32,
+        a_theta2: c.a_theta2 as f32,
+        a_theta3: c.a_theta3 as f32,
+        a_v1: c.a_v1 as f32,
+        a_v2: c.a_v2 as f32,
+        engine_pole: m.engine_pole.map(|p| p as f32),
+        servo_bandwidth_hz: m.servo_bandwidth_hz as f32,
+        g: m.g as f32,
+        pitch_response: None,
+    }
+}
+
+/// The host design's loop of that name.
+fn host_name(l: Loop) -> &'static str {
+    match l {
+        Loop::Roll => "roll attitude",
+        Loop::Course => "course",
+        Loop::Pitch => "pitch attitude",
+        Loop::Altitude => "altitude",
+        Loop::AirspeedPitch => "airspeed (commanded pitch)",
+        Loop::AirspeedThrottle => "airspeed (throttle)",
+    }
+}
+
+#[test]
+fn the_onboard_design_of_the_25e_at_18_5_mps_gives_the_hosts_gains_within_1_percent_and_its_margins(
+) {
+    let model = ultrastick_at_18_5();
+    let host = design_from_model(&model, &DesignInputs::default()).expect("host design");
+    let board = onboard::design(&on_board(&model), &Default::default(), &DESIGNED)
+        .expect("on-board design");
+    println!(
+        "| loop | parameter | host | on board | difference | GM host (dB) | on board | PM host (deg) | on board |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for l in Loop::ALL {
+        let h = host
+            .loops
+            .iter()
+            .find(|h| h.name.starts_with(host_name(l)))
+            .expect("host loop");
+        let b = board.loops.get(l);
+        let ours = [b.gains.kp, b.gains.ki, b.gains.kd];
+        for ((name, want, _), got) in h.gains.iter().zip(ours) {
+            let got = f64::from(got);
+            println!(
+                "| {} | {name} | {want:.6} | {got:.6} | {:+.1e} | {:.3} | {:.3} | {:.3} | {:.3} |",
+                l.name(),
+                (got - want) / want,
+                h.margins.gain_margin_db.unwrap_or(f64::NAN),
+                b.margins.gain_margin_db.unwrap_or(f32::NAN),
+                h.margins.phase_margin_deg.unwrap_or(f64::NAN),
+                b.margins.phase_margin_deg.unwrap_or(f32::NAN),
+            );
+            assert!(
+                ((got - want) / want).abs() < 0.01,
+                "{name}: {got} on board, {want} on the host"
+            );
+        }
+        let (hg, bg) = (h.margins.gain_margin_db, b.margins.gain_margin_db);
+        let (hp, bp) = (h.margins.phase_margin_deg, b.margins.phase_margin_deg);
+        assert_eq!(hg.is_some(), bg.is_some(), "{}", l.name());
+        assert!(
+            (hg.unwrap_or(0.0) - f64::from(bg.unwrap_or(0.0))).abs() < 0.5,
+            "{}: gain margin {hg:?} on the host, {bg:?} on board",
+            l.name()
+        );
+        assert!(
+            (hp.unwrap_or(0.0) - f64::from(bp.unwrap_or(0.0))).abs() < 1.0,
+            "{}: phase margin {hp:?} on the host, {bp:?} on board",
+            l.name()
+        );
+    }
+}
