@@ -65,7 +65,7 @@ fn coefficient(report: &serde_json::Value, axis: &str, name: &str) -> (f64, f64)
 }
 
 /// Roll damping and aileron power from the closed-loop turns and corrections of an ordinary
-/// flight: within 15 % of the linearisation (measured: -6.3 % and -3.6 %), the fit explaining
+/// flight: within 15 % of the linearisation (measured: -6.2 % and -3.6 %), the fit explaining
 /// over 95 % of the roll acceleration.
 #[test]
 fn the_roll_model_of_the_thesis_flight_is_the_aircraft_files_within_15_percent() {

@@ -1,12 +1,17 @@
 //! The on-board design (`common::tuning::design`: `f32`, a coarse sweep refined at each
-//! crossing, the gain limit by bisection over its 1 % steps) against the host's design on the
-//! same reduced models (`sim-host design --model`: `f64` polynomials, a 4,000-point sweep).
+//! crossing, the gain limit by bisection over its 1 % steps) against the host's on the same
+//! reduced models (`sim-host design --model`). The host takes its gains from the on-board
+//! design; its margins are its own (`f64` polynomials, a 4,000-point sweep), and so is the
+//! check here that the attitude gains are where the host's margins put the 1 % step.
 
 use common::control::gains::DESIGNED;
 use common::tuning::design::{self as onboard, DesignModel, Loop};
+use nalgebra::Complex;
 use sim_host::aircraft::Aircraft;
 use sim_host::analysis::design::{design_at, design_from_model, DesignInputs, ReducedModel};
+use sim_host::analysis::lti::margins;
 use sim_host::analysis::reduced::ReducedCoefficients;
+use sim_host::analysis::transfer::TransferFunction;
 
 /// The Ultra Stick 25e's reduced models at 18.5 m/s (the stick flight's airspeed): roll and
 /// pitch from its aero data, airspeed and the engine's pole from its linear model, as
@@ -116,4 +121,51 @@ fn the_onboard_design_of_the_25e_at_18_5_mps_gives_the_hosts_gains_within_1_perc
             l.name()
         );
     }
+}
+
+/// The host's phase margin (deg) of an attitude loop: PID (`kd s^2 + kp s + ki) / s` on
+/// `plant`, the 8 Hz servo and 50 ms of delay.
+fn host_phase_margin(kp: f64, ki: f64, kd: f64, plant: &TransferFunction) -> f64 {
+    let l = TransferFunction::new(&[kd, kp, ki], &[1.0, 0.0]).series(plant);
+    let ws = 2.0 * std::f64::consts::PI * 8.0;
+    let at = move |w: f64| {
+        let s = Complex::new(0.0, w);
+        l.eval(w) * ws / (s + ws) * Complex::new(0.0, -0.05 * w).exp()
+    };
+    margins(at, 1e-3, 1e3).phase_margin_deg.unwrap_or(f64::NAN)
+}
+
+#[test]
+fn the_onboard_attitude_gains_of_the_25e_are_where_the_hosts_own_margins_put_the_1_percent_step() {
+    let model = ultrastick_at_18_5();
+    let c = &model.coefficients;
+    let board = onboard::design(&on_board(&model), &Default::default(), &DESIGNED)
+        .expect("on-board design");
+    // Roll: Appendix C's kp lowered by 1 % steps; the integrator's zero at wn / 50, the damper
+    // kept. The on-board gain keeps 45 deg by the host's f64 margins, one step higher does not.
+    let roll_plant = TransferFunction::new(&[c.a_phi2], &[1.0, c.a_phi1, 0.0]);
+    let kd = f64::from(board.loops.roll.gains.kd);
+    let roll_pm = |kp: f64| {
+        let ki = kp * (c.a_phi2 * kp).sqrt() * 0.02;
+        host_phase_margin(kp, ki, kd, &roll_plant)
+    };
+    let kp = f64::from(board.loops.roll.gains.kp);
+    let (here, above) = (roll_pm(kp), roll_pm(kp / 0.99));
+    println!("roll: kp {kp}, phase margin {here:.3} deg there, {above:.3} one step higher");
+    assert!(
+        here >= 45.0 && above < 45.0,
+        "{here} at {kp}, {above} above"
+    );
+    // Pitch: the rule's 25 / 20 deg already keeps 45 deg on the reduced short period.
+    let pitch_plant = TransferFunction::new(&[c.a_theta3], &[1.0, c.a_theta1, c.a_theta2]);
+    let p = board.loops.pitch.gains;
+    assert_eq!(p.kp, -1.25);
+    let here = host_phase_margin(
+        f64::from(p.kp),
+        f64::from(p.ki),
+        f64::from(p.kd),
+        &pitch_plant,
+    );
+    println!("pitch: kp -1.25, phase margin {here:.3} deg");
+    assert!(here >= 45.0, "{here}");
 }

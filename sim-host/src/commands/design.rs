@@ -4,7 +4,7 @@
 use super::Format;
 use crate::aircraft::Aircraft;
 use crate::analysis::design::inputs::DesignInputs;
-use crate::analysis::design::{describe_poles, design_at, Design};
+use crate::analysis::design::{decimal, describe_poles, design_at, Design};
 use crate::analysis::references::apply_to;
 use crate::analysis::sampled::{scaled_at, SampledLoop, SampledLoops};
 use crate::report::table::Table;
@@ -169,7 +169,7 @@ pub fn design_report_at(aircraft: &Aircraft, va_mps: f64) -> anyhow::Result<Desi
     let model = SampledLoops::at_level_airspeed(
         aircraft,
         va_mps,
-        inputs.sample_time_s,
+        decimal(inputs.sample_time_s),
         inputs.delay_periods(),
     )?;
     let sampled: Vec<(String, Vec<SampledLoop>)> = [
@@ -243,7 +243,7 @@ fn scaling_report(
         let model = SampledLoops::at_level_airspeed(
             aircraft,
             va,
-            inputs.sample_time_s,
+            decimal(inputs.sample_time_s),
             inputs.delay_periods(),
         )?;
         rows.push((

@@ -10,22 +10,18 @@ use crate::report::table::Table;
 use crate::report::{sig, sig_or_dash};
 use anyhow::{anyhow, bail, Context};
 use common::math::STANDARD_GRAVITY;
+use common::tuning::design::{judge_margins, Loop, Margins};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Gain margin every loop must keep, dB (MIL-F-9490D's 6 dB).
-pub const GAIN_MARGIN_MIN_DB: f64 = 6.0;
-
-/// Phase margin an outer loop must keep, deg: the classical lower bound for a loop whose
-/// bandwidth the design already separates from the inner loop's; the inner attitude loops
-/// keep the design's own target (`DesignInputs::inner_phase_margin_deg`, 45 deg).
-pub const OUTER_PHASE_MARGIN_MIN_DEG: f64 = 30.0;
-
-/// Whether a loop of the design is an inner (attitude) loop.
-fn inner(name: &str) -> bool {
-    name.contains("attitude")
-}
+/// The margins every loop must keep, as the vehicle judges them: the on-board design's
+/// (`common::tuning::design::judge`: 6 dB of gain margin, MIL-F-9490D's; 45 deg of phase
+/// margin for the attitude loops, the design's own target, and 30 deg for the outer loops,
+/// whose bandwidth the design already separates).
+pub use common::tuning::design::{
+    GAIN_MARGIN_MIN_DB, INNER_PHASE_MARGIN_MIN_DEG, OUTER_PHASE_MARGIN_MIN_DEG,
+};
 
 /// One loop's margins against the targets.
 #[derive(Clone, Debug, Serialize)]
@@ -119,9 +115,9 @@ pub fn read_model(path: &Path) -> anyhow::Result<ReducedModel> {
     })
 }
 
-/// Designs on `model` and checks each loop's margins: at least [`GAIN_MARGIN_MIN_DB`], and
-/// the design's own phase-margin target (`DesignInputs::inner_phase_margin_deg`) for the
-/// attitude loops, [`OUTER_PHASE_MARGIN_MIN_DEG`] for the others.
+/// Designs on `model` and checks each loop's margins (the host's, from its dense sweep) by the
+/// vehicle's own verdict: at least [`GAIN_MARGIN_MIN_DB`], and [`INNER_PHASE_MARGIN_MIN_DEG`]
+/// for the attitude loops, [`OUTER_PHASE_MARGIN_MIN_DEG`] for the others.
 pub fn design_model_report(model: &ReducedModel) -> anyhow::Result<ModelDesignReport> {
     let inputs = DesignInputs::default();
     let design = design_from_model(model, &inputs)?;
@@ -130,22 +126,19 @@ pub fn design_model_report(model: &ReducedModel) -> anyhow::Result<ModelDesignRe
         .iter()
         .map(|l| {
             let (gm, pm) = (l.margins.gain_margin_db, l.margins.phase_margin_deg);
-            let pm_min = if inner(&l.name) {
-                inputs.inner_phase_margin_deg
-            } else {
-                OUTER_PHASE_MARGIN_MIN_DEG
+            let margins = Margins {
+                gain_margin_db: gm.map(|g| g as f32),
+                phase_crossover_radps: l.margins.phase_crossover_radps.map(|w| w as f32),
+                phase_margin_deg: pm.map(|p| p as f32),
+                gain_crossover_radps: l.margins.gain_crossover_radps.map(|w| w as f32),
             };
-            let failure = match (gm, pm) {
-                (Some(g), _) if g.is_nan() || g < GAIN_MARGIN_MIN_DB => Some(format!(
-                    "gain margin {} dB, at least {GAIN_MARGIN_MIN_DB} needed",
-                    sig(g, 3)
-                )),
-                (_, Some(p)) if p.is_nan() || p < pm_min => Some(format!(
-                    "phase margin {} deg, at least {pm_min} needed",
-                    sig(p, 3)
-                )),
-                _ => None,
-            };
+            // The sideslip loop, designed on the host only, is judged as an outer loop.
+            let pm_min = l
+                .onboard
+                .map_or(OUTER_PHASE_MARGIN_MIN_DEG, Loop::phase_margin_min_deg);
+            let failure = judge_margins(&margins, pm_min)
+                .err()
+                .map(|reason| reason.to_string());
             MarginCheck {
                 name: l.name.clone(),
                 gain_margin_db: gm,

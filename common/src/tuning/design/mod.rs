@@ -66,7 +66,7 @@ pub use margins::Margins;
 pub use model::{DesignModel, PitchResponse, QUASI_STEADY_ENGINE_POLE};
 pub use rules::{Rules, GAIN_STEP, GAIN_STEPS};
 pub use transfer::LoopGains;
-pub use verdict::{judge, DesignFailure, Loop, Reason};
+pub use verdict::{judge, judge_margins, DesignFailure, Loop, Reason};
 
 #[cfg(test)]
 mod tests;

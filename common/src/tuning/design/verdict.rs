@@ -153,16 +153,21 @@ impl fmt::Display for DesignFailure {
     }
 }
 
-/// Whether `margins` meet `loop_`'s targets: at least [`GAIN_MARGIN_MIN_DB`] of gain margin
-/// where the phase crosses -180 deg (none crossing: unbounded), and a gain crossover with at
-/// least the loop's phase margin. The gain margin is judged first.
+/// Whether `margins` meet `loop_`'s targets ([`judge_margins`] with the loop's phase margin).
 pub fn judge(loop_: Loop, margins: &Margins) -> Result<(), Reason> {
+    judge_margins(margins, loop_.phase_margin_min_deg())
+}
+
+/// Whether `margins` meet the targets: at least [`GAIN_MARGIN_MIN_DB`] of gain margin where the
+/// phase crosses -180 deg (none crossing: unbounded), and a gain crossover with at least
+/// `phase_margin_min_deg` of phase margin. The gain margin is judged first.
+pub fn judge_margins(margins: &Margins, phase_margin_min_deg: f32) -> Result<(), Reason> {
     if let Some(gm) = margins.gain_margin_db {
         if gm.is_nan() || gm < GAIN_MARGIN_MIN_DB {
             return Err(Reason::GainMargin(gm));
         }
     }
-    let min_deg = loop_.phase_margin_min_deg();
+    let min_deg = phase_margin_min_deg;
     match margins.phase_margin_deg {
         None => Err(Reason::NoCrossover),
         Some(deg) if deg.is_nan() || deg < min_deg => Err(Reason::PhaseMargin { deg, min_deg }),

@@ -4,6 +4,7 @@
 use crate::analysis::lti::{margins, Margins};
 use crate::analysis::metrics::step_metrics;
 use crate::analysis::transfer::{poly_add, poly_mul, poly_roots, TransferFunction};
+use common::tuning::design::Loop;
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -12,6 +13,10 @@ use serde::Serialize;
 pub struct LoopDesign {
     /// Loop name.
     pub name: String,
+    /// The on-board design's loop it is (`None`: the sideslip loop, designed on the host
+    /// only).
+    #[serde(skip)]
+    pub onboard: Option<Loop>,
     /// Gains as (parameter, ours, thesis "designed").
     pub gains: Vec<(String, f64, f64)>,
     /// Natural frequency the design aims at, rad/s.
@@ -77,6 +82,7 @@ pub(super) fn closed(forward: &TransferFunction, feedback: &TransferFunction) ->
 /// `loop_gain`.
 pub(super) fn predict(
     name: &str,
+    onboard: Option<Loop>,
     gains: Vec<(String, f64, f64)>,
     wn: f64,
     closed_loop: &TransferFunction,
@@ -88,6 +94,7 @@ pub(super) fn predict(
     let m = step_metrics(&t, &y, 0.0, 1.0, 0.0, t_end + dt);
     LoopDesign {
         name: name.into(),
+        onboard,
         gains,
         wn_radps: wn,
         poles: closed_loop.poles().iter().map(|p| [p.re, p.im]).collect(),
@@ -96,19 +103,6 @@ pub(super) fn predict(
         settling_time_s: m.settling_time_s,
         margins: margins(loop_gain, 1e-3, 1e3),
     }
-}
-
-/// The largest gain, at most `k` in size, whose loop keeps `pm_deg` of phase margin (1 % steps
-/// down; the delay costs phase in proportion to the crossover frequency).
-pub(super) fn limit_gain(k: f64, pm_deg: f64, pm: impl Fn(f64) -> Option<f64>) -> f64 {
-    let mut g = k;
-    for _ in 0..400 {
-        if pm(g).is_some_and(|m| m >= pm_deg) {
-            return g;
-        }
-        g *= 0.99;
-    }
-    g
 }
 
 /// Cancels pole-zero pairs that coincide (the pitch loop's closed form repeats factors).

@@ -1,44 +1,25 @@
 //! Gain design by successive loop closure (thesis chapter 3 and Appendix C, after Beard and
-//! McLain), from the aircraft data and the linear model at the level trim.
+//! McLain), from the aircraft data and the linear model at the level trim, or from identified
+//! reduced models alone.
 //!
-//! Each loop is designed on a reduced model with the inner loops taken as closed, then judged
-//! on that same reduced model with the inner loops as designed (closed-loop poles, rise time,
-//! overshoot), and its stability margins are computed with what the design formulas leave out:
-//! the 8 Hz servo and the flight software's delay (two 20 ms samples plus half a sample of
-//! zero-order hold, 50 ms in all), and on the altitude and airspeed loops the 2 rad/s feedback
-//! low-pass.
+//! The rules and the attitude gains' limit by phase margin are the on-board design's
+//! (`common::tuning::design`, whose documentation states each rule and why it departs from
+//! Appendix C where it does): the host runs that same code, in `f32`, on the reduced models
+//! it forms, and adds what only the host predicts. Each loop is then judged on that same
+//! reduced model with the inner loops as designed (closed-loop poles, rise time, overshoot),
+//! and its stability margins are computed again from a dense `f64` sweep with what the
+//! design formulas leave out: the 8 Hz servo and the flight software's delay (two 20 ms
+//! samples plus half a sample of zero-order hold, 50 ms in all), and on the altitude and
+//! airspeed loops the 2 rad/s feedback low-pass.
 //!
-//! Loops and design rules (`zeta` = 0.707 throughout):
-//! - roll (PID on aileron): `wn_phi = sqrt(|a_phi2| da_max sqrt(1 - zeta^2) / e_phi_max)`,
-//!   `kp = wn^2 / a_phi2`, `kd = (2 zeta wn - a_phi1) / a_phi2` (Appendix C, with its
-//!   `da_max` = 45 deg and `e_phi_max` = 15 deg). That `kp` keeps only ~6 deg of phase
-//!   margin once the servo and the 50 ms delay are in the loop, so the computed set keeps
-//!   Appendix C's damper and lowers `kp` until the margin is 45 deg (the thesis's own table
-//!   value, -1.1216, sits near that point); `ki` puts the integrator zero at `wn / 50` (the
-//!   thesis picks it on a root locus without a stated rule);
-//! - course (PI on commanded roll): `kp = 2 zeta wn Va / g` (Appendix C) with
-//!   `wn_chi = wn_phi / 15` rather than Appendix C's `/ 10`: with the servo, the delay and the
-//!   roll loop's own 17 % overshoot in the nonlinear runs, `/ 10` overshot a 30 deg heading
-//!   step by 11 % (docs/RESULTS.md), `/ 15` by about 1 %; Appendix C's `ki = wn^2 Va / g` places the integrator zero at
-//!   `wn / (2 zeta)`, inside the loop's bandwidth, which costs ~20 % overshoot against the
-//!   5 % requirement, so the integrators of the loops whose plant already integrates (course,
-//!   altitude) put their zero at 1/20 of the proportional bandwidth `2 zeta wn` instead
-//!   (the thesis's own tables use nearly no integral action there); the loops on type-0
-//!   plants (sideslip, both airspeed loops) keep the pole-placement `ki = wn^2 / a2`, whose
-//!   zero lies well above `wn` because `2 zeta wn - a1` is small;
-//! - sideslip (PI on rudder): `wn_beta = wn_phi / 20`, `kp = (2 zeta wn - a_beta1) / a_beta2`;
-//! - pitch (PID on elevator): `kp = sign(a_theta3) de_max / e_theta_max` (25 deg of elevator
-//!   for the 20 deg pitch-command range), `wn_theta = sqrt(a_theta2 + kp a_theta3)`,
-//!   `kd = (2 zeta wn - a_theta1) / a_theta3`, then `kp` limited by the same 45 deg phase
-//!   margin; the inner integrators put their zero at `wn / 50`;
-//! - altitude (PI on commanded pitch), airspeed by pitch and airspeed by throttle: the thesis
-//!   separates them from the pitch loop by bandwidth, but all three see their feedback through
-//!   the 2 rad/s low-pass, so their natural frequency is also kept a factor of 4 (airspeed)
-//!   or 16 (altitude) below it: the altitude loop also couples with the airspeed-by-throttle
-//!   loop through the energy exchange of a climb, which the linear prediction leaves out, and
-//!   at a factor of 8 it overshot a 5 m step by 14 % on the nonlinear plant, at 16 by 4 %;
-//!   `kp`, `ki` from the same pole placement on `h/theta = Va/s`, `Va/theta = -g/(s + a_V1)`
-//!   and the throttle-to-airspeed model with the engine-speed lag.
+//! From the aircraft file, the roll and pitch rules take Beard and McLain's coefficients from
+//! the aero data, and the pitch loop is limited and predicted on the linear model's two-state
+//! short period `q / de` (with its free integrator to `theta`); from identified models, on the
+//! reduced short period `a_theta3 / (s^2 + a_theta1 s + a_theta2)`.
+//!
+//! The host alone designs the sideslip loop (PI on rudder), where there is a sideslip model
+//! (the aircraft file's): `wn_beta = wn_phi / 20`, `kp = (2 zeta wn - a_beta1) / a_beta2`,
+//! `ki = wn^2 / a_beta2`.
 
 pub mod inputs;
 pub mod loops;
@@ -52,7 +33,11 @@ use crate::aircraft::Aircraft;
 use crate::plant::params::ModelParams;
 use common::control::gains::{GainSet, DESIGNED};
 use common::math::atmosphere::standard_atmosphere;
-use loops::{closed, gain, limit_gain, predict, reduce, tf, through_inner, with_actuation};
+use common::tuning::design::{
+    DesignModel, Designer, Loop, LoopDesign as OnboardLoop, PitchResponse, Rules, Step,
+    QUASI_STEADY_ENGINE_POLE,
+};
+use loops::{closed, gain, predict, reduce, tf, through_inner, with_actuation};
 use nalgebra::Complex;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -224,11 +209,6 @@ pub struct ReducedModel {
     pub g: f64,
 }
 
-/// Engine pole a design takes where none was identified, 1/s: two orders of magnitude above
-/// the airspeed loops, so the throttle acts as at once (the margins it predicts are then an
-/// upper bound).
-const QUASI_STEADY_ENGINE_POLE: f64 = 100.0;
-
 /// Designs every loop on a reduced model alone: the pitch loop predicted on its reduced
 /// short period `a_theta3 / (s^2 + a_theta1 s + a_theta2)`, the sideslip loop not designed (no
 /// sideslip model: the base set's gains stay), the trims left to the aircraft's own.
@@ -248,7 +228,9 @@ pub fn design_from_model(model: &ReducedModel, inputs: &DesignInputs) -> anyhow:
         a_theta3: m.a_theta3,
         a_v1: m.a_v1,
         a_v2: m.a_v2,
-        engine_pole: model.engine_pole.unwrap_or(QUASI_STEADY_ENGINE_POLE),
+        engine_pole: model
+            .engine_pole
+            .unwrap_or(f64::from(QUASI_STEADY_ENGINE_POLE)),
     };
     let theta_de = tf(&[m.a_theta3], &[1.0, m.a_theta1, m.a_theta2]);
     let plant = Plant {
@@ -260,7 +242,41 @@ pub fn design_from_model(model: &ReducedModel, inputs: &DesignInputs) -> anyhow:
     design_loops(inputs, plant, None)
 }
 
+/// `theta_de` as the on-board design takes it: at most a first-order numerator over a cubic.
+fn pitch_response(t: &TransferFunction) -> anyhow::Result<PitchResponse> {
+    fn padded<const N: usize>(c: &[f64]) -> Option<[f32; N]> {
+        let first = c.iter().position(|x| *x != 0.0).unwrap_or(c.len());
+        let c = &c[first..];
+        let mut out = [0.0f32; N];
+        let start = N.checked_sub(c.len())?;
+        for (o, x) in out[start..].iter_mut().zip(c) {
+            *o = *x as f32;
+        }
+        Some(out)
+    }
+    match (padded::<2>(&t.num), padded::<4>(&t.den)) {
+        (Some(num), Some(den)) => Ok(PitchResponse { num, den }),
+        _ => anyhow::bail!(
+            "the pitch response {} is of higher order than the design takes",
+            t.format(4)
+        ),
+    }
+}
+
+/// An `f32` design input as the decimal it was written as (`0.02`, not the `f32`'s
+/// 0.0199999995...), for the host's `f64` predictions.
+pub fn decimal(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
 /// The loops, inner to outer, on `plant`, flown about `trim` (`None`: the base set's trims).
+///
+/// The gains are the on-board design's (`common::tuning::design`: the same rules and the same
+/// gain limit, in `f32`), run to its end on the plant's reduced models with the pitch loop
+/// judged on `theta_de`; this adds the host's own predictions of each loop (closed-loop poles,
+/// step figures, and margins from a dense `f64` sweep) and the sideslip loop where there is a
+/// sideslip model. A loop that misses its margins is designed and predicted all the same: the
+/// margins are judged by [`crate::commands::design_model`].
 fn design_loops(
     inputs: &DesignInputs,
     plant: Plant,
@@ -278,57 +294,82 @@ fn design_loops(
         a_phi2,
         a_beta1,
         a_beta2,
-        a_theta1,
-        a_theta2,
-        a_theta3,
         a_v1,
         a_v2,
         engine_pole,
         ..
     } = coefficients;
-    let z = inputs.zeta;
+    let z = decimal(inputs.zeta);
+    let d = &DESIGNED;
+
+    // The gains: the on-board design on this plant.
+    let model = DesignModel {
+        va: va as f32,
+        a_phi1: a_phi1 as f32,
+        a_phi2: a_phi2 as f32,
+        a_theta1: coefficients.a_theta1 as f32,
+        a_theta2: coefficients.a_theta2 as f32,
+        a_theta3: coefficients.a_theta3 as f32,
+        a_v1: a_v1 as f32,
+        a_v2: a_v2 as f32,
+        engine_pole: Some(engine_pole as f32),
+        servo_bandwidth_hz: servo_bandwidth_hz as f32,
+        g: g as f32,
+        pitch_response: Some(pitch_response(&theta_de)?),
+    };
+    let mut designer = Designer::new(&model, inputs, d);
+    let designed = loop {
+        match designer.step() {
+            Step::Pending => {}
+            Step::Done(designed) => break designed,
+            Step::Failed(f) => match designer.designed() {
+                // Every loop designed, one missed its margins: predicted all the same.
+                Some(designed) => break designed,
+                None => anyhow::bail!("the design stopped: {f}"),
+            },
+        }
+    };
+    let onboard = designed.loops;
+    let pid = |l: &OnboardLoop| {
+        (
+            f64::from(l.gains.kp),
+            f64::from(l.gains.ki),
+            f64::from(l.gains.kd),
+            f64::from(l.wn_radps),
+        )
+    };
 
     // What the formulas leave out: servo and delay.
     let servo_w = 2.0 * PI * servo_bandwidth_hz;
-    let tau = (inputs.delay_samples + 0.5) * inputs.sample_time_s;
+    let tau = (decimal(inputs.delay_samples) + 0.5) * decimal(inputs.sample_time_s);
     let servo_delay = move |w: f64| {
         let s = Complex::new(0.0, w);
         servo_w / (s + servo_w) * Complex::new(0.0, -w * tau).exp()
     };
-    let lp = DESIGNED.longitudinal.feedback_lpf_pole as f64;
+    let lp = d.longitudinal.feedback_lpf_pole as f64;
     let filter = tf(&[lp], &[1.0, lp]);
-    let d = &DESIGNED;
     let mut loops = Vec::new();
 
     // --- Roll.
-    let wn_appendix_c = (a_phi2.abs() * inputs.roll_aileron_max_deg * (1.0 - z * z).sqrt()
-        / inputs.roll_error_max_deg)
-        .sqrt();
     let roll_plant = tf(&[a_phi2], &[1.0, a_phi1, 0.0]);
-    // The rate damper as Appendix C designs it; the attitude gain then as high as the phase
-    // margin with servo and delay allows (Appendix C's own value leaves almost none).
-    let roll_kd = (2.0 * z * wn_appendix_c - a_phi1) / a_phi2;
-    let roll_gains = |kp: f64| {
-        let wn = (a_phi2 * kp).max(0.0).sqrt();
-        (kp, kp * wn * inputs.integrator_zero_fraction, roll_kd)
-    };
-    let roll_pm = |kp: f64| {
-        let (kp, ki, kd) = roll_gains(kp);
-        let l = tf(&[kd, kp, ki], &[1.0, 0.0]).series(&roll_plant);
-        margins(move |w| l.eval(w) * servo_delay(w), 1e-3, 1e3).phase_margin_deg
-    };
-    let kp_appendix_c = wn_appendix_c * wn_appendix_c / a_phi2;
-    let (roll_kp, roll_ki, roll_kd) = roll_gains(limit_gain(
-        kp_appendix_c,
-        inputs.inner_phase_margin_deg,
-        roll_pm,
-    ));
-    let wn_phi = (a_phi2 * roll_kp).sqrt();
+    let (roll_kp, roll_ki, roll_kd, wn_phi) = pid(&onboard.roll);
+    // Appendix C's own design, before the gain is limited by the margin with servo and delay.
+    let rules = Rules::new(&model, inputs, d);
+    let kp_appendix_c = rules.roll_kp_appendix_c();
+    let appendix_c_pid = rules.roll(kp_appendix_c);
     let appendix_c = AppendixC {
-        wn_phi: wn_appendix_c,
-        roll_kp: kp_appendix_c,
-        roll_kd,
-        phase_margin_deg: roll_pm(kp_appendix_c),
+        wn_phi: f64::from(rules.roll_wn_appendix_c()),
+        roll_kp: f64::from(kp_appendix_c),
+        roll_kd: f64::from(appendix_c_pid.kd),
+        phase_margin_deg: {
+            let (kp, ki, kd) = (
+                f64::from(appendix_c_pid.kp),
+                f64::from(appendix_c_pid.ki),
+                f64::from(appendix_c_pid.kd),
+            );
+            let l = tf(&[kd, kp, ki], &[1.0, 0.0]).series(&roll_plant);
+            margins(move |w| l.eval(w) * servo_delay(w), 1e-3, 1e3).phase_margin_deg
+        },
     };
     let roll_pid = tf(&[roll_kd, roll_kp, roll_ki], &[1.0, 0.0]);
     let roll_cl = tf(
@@ -353,6 +394,7 @@ fn design_loops(
     };
     loops.push(predict(
         "roll attitude (aileron)",
+        Some(Loop::Roll),
         vec![
             gain("RLL_KP", roll_kp, d.lateral.roll_kp),
             gain("RLL_KI", roll_ki, d.lateral.roll_ki),
@@ -365,15 +407,14 @@ fn design_loops(
     ));
 
     // --- Course.
-    let wn_chi = wn_phi / inputs.course_separation;
-    let course_kp = 2.0 * z * wn_chi * va / g;
-    let course_ki = course_kp * 2.0 * z * wn_chi * inputs.outer_integrator_fraction;
+    let (course_kp, course_ki, _, wn_chi) = pid(&onboard.course);
     let course_pi = tf(&[course_kp, course_ki], &[1.0, 0.0]);
     let kin = tf(&[g / va], &[1.0, 0.0]);
     let course_fwd = course_pi.series(&roll_cl).series(&kin);
     let course_cl = course_fwd.closed_loop();
     loops.push(predict(
         "course (commanded roll)",
+        Some(Loop::Course),
         vec![
             gain("CRS_KP", course_kp, d.lateral.course_kp),
             gain("CRS_KI", course_ki, d.lateral.course_ki),
@@ -389,8 +430,8 @@ fn design_loops(
         20.0,
     ));
 
-    // --- Sideslip (where there is a sideslip model).
-    let wn_beta = wn_phi / inputs.sideslip_separation;
+    // --- Sideslip (where there is a sideslip model; the on-board design has none).
+    let wn_beta = wn_phi / decimal(inputs.sideslip_separation);
     let sideslip = a_beta1.is_finite() && a_beta2.is_finite();
     let (slip_kp, slip_ki) = if sideslip {
         (
@@ -405,6 +446,7 @@ fn design_loops(
         let slip_loop = tf(&[slip_kp, slip_ki], &[1.0, 0.0]).series(&slip_plant);
         loops.push(predict(
             "sideslip (rudder)",
+            None,
             vec![
                 gain("SLIP_KP", slip_kp, d.lateral.slip_kp),
                 gain("SLIP_KI", slip_ki, d.lateral.slip_ki),
@@ -416,26 +458,8 @@ fn design_loops(
         ));
     }
 
-    // --- Pitch: designed on the reduced model, predicted on `theta_de`.
-    let kp_nominal = a_theta3.signum() * inputs.pitch_elevator_max_deg / inputs.pitch_error_max_deg;
-    let wn_nominal = (a_theta2 + kp_nominal * a_theta3).max(0.0).sqrt();
-    // The damper from the nominal design, the attitude gain limited by the phase margin.
-    let pitch_kd = (2.0 * z * wn_nominal - a_theta1) / a_theta3;
-    let pitch_gains = |kp: f64| {
-        let wn = (a_theta2 + kp * a_theta3).max(0.0).sqrt();
-        (kp, kp * wn * inputs.integrator_zero_fraction, pitch_kd)
-    };
-    let pitch_pm = |kp: f64| {
-        let (kp, ki, kd) = pitch_gains(kp);
-        let l = tf(&[kd, kp, ki], &[1.0, 0.0]).series(&theta_de);
-        margins(move |w| l.eval(w) * servo_delay(w), 1e-3, 1e3).phase_margin_deg
-    };
-    let (pitch_kp, pitch_ki, pitch_kd) = pitch_gains(limit_gain(
-        kp_nominal,
-        inputs.inner_phase_margin_deg,
-        pitch_pm,
-    ));
-    let wn_theta = (a_theta2 + pitch_kp * a_theta3).max(0.0).sqrt();
+    // --- Pitch: predicted on `theta_de`.
+    let (pitch_kp, pitch_ki, pitch_kd, wn_theta) = pid(&onboard.pitch);
     let pitch_pid = tf(&[pitch_kd, pitch_kp, pitch_ki], &[1.0, 0.0]);
     let pitch_loop = pitch_pid.series(&theta_de);
     let pitch_pi_fwd = tf(&[pitch_kp, pitch_ki], &[1.0, 0.0]).series(&theta_de);
@@ -460,6 +484,7 @@ fn design_loops(
     };
     loops.push(predict(
         "pitch attitude (elevator)",
+        Some(Loop::Pitch),
         vec![
             gain("PTCH_KP", pitch_kp, d.longitudinal.pitch_kp),
             gain("PTCH_KI", pitch_ki, d.longitudinal.pitch_ki),
@@ -471,18 +496,14 @@ fn design_loops(
         4.0,
     ));
 
-    let slow_wn =
-        |wn_inner: f64, separation: f64| (wn_inner / separation).min(lp / inputs.filter_separation);
-
     // --- Altitude by pitch.
-    let wn_h = (wn_theta / inputs.altitude_separation).min(lp / inputs.altitude_filter_separation);
-    let alt_kp = 2.0 * z * wn_h / va;
-    let alt_ki = alt_kp * 2.0 * z * wn_h * inputs.outer_integrator_fraction;
+    let (alt_kp, alt_ki, _, wn_h) = pid(&onboard.altitude);
     let alt_pi = tf(&[alt_kp, alt_ki], &[1.0, 0.0]);
     let climb = tf(&[va], &[1.0, 0.0]);
     let alt_fwd = alt_pi.series(&pitch_cl).series(&climb);
     loops.push(predict(
         "altitude (commanded pitch)",
+        Some(Loop::Altitude),
         vec![
             gain("ALT_KP", alt_kp, d.longitudinal.alt_kp),
             gain("ALT_KI", alt_ki, d.longitudinal.alt_ki),
@@ -494,14 +515,13 @@ fn design_loops(
     ));
 
     // --- Airspeed by pitch (climb and descent regimes).
-    let wn_v2 = slow_wn(wn_theta, inputs.altitude_separation);
-    let aspd_pitch_kp = (a_v1 - 2.0 * z * wn_v2) / g;
-    let aspd_pitch_ki = -wn_v2 * wn_v2 / g;
+    let (aspd_pitch_kp, aspd_pitch_ki, _, wn_v2) = pid(&onboard.airspeed_pitch);
     let v_theta = tf(&[-g], &[1.0, a_v1]);
     let ap_pi = tf(&[aspd_pitch_kp, aspd_pitch_ki], &[1.0, 0.0]);
     let ap_fwd = ap_pi.series(&pitch_cl).series(&v_theta);
     loops.push(predict(
         "airspeed (commanded pitch)",
+        Some(Loop::AirspeedPitch),
         vec![
             gain("ASPD_PTCH_KP", aspd_pitch_kp, d.longitudinal.aspd_pitch_kp),
             gain("ASPD_PTCH_KI", aspd_pitch_ki, d.longitudinal.aspd_pitch_ki),
@@ -513,9 +533,7 @@ fn design_loops(
     ));
 
     // --- Airspeed by throttle (altitude-hold regime).
-    let wn_v = lp / inputs.filter_separation;
-    let aspd_thr_kp = (2.0 * z * wn_v - a_v1) / a_v2;
-    let aspd_thr_ki = wn_v * wn_v / a_v2;
+    let (aspd_thr_kp, aspd_thr_ki, _, wn_v) = pid(&onboard.airspeed_throttle);
     let v_dt = tf(
         &[a_v2 * engine_pole],
         &[1.0, a_v1 + engine_pole, a_v1 * engine_pole],
@@ -524,6 +542,7 @@ fn design_loops(
     let at_fwd = at_pi.series(&v_dt);
     loops.push(predict(
         "airspeed (throttle)",
+        Some(Loop::AirspeedThrottle),
         vec![
             gain("ASPD_THR_KP", aspd_thr_kp, d.longitudinal.aspd_thr_kp),
             gain("ASPD_THR_KI", aspd_thr_ki, d.longitudinal.aspd_thr_ki),
@@ -537,25 +556,11 @@ fn design_loops(
         40.0,
     ));
 
-    let mut gains = *d;
-    let lat = &mut gains.lateral;
-    lat.roll_kp = roll_kp as f32;
-    lat.roll_ki = roll_ki as f32;
-    lat.roll_rate_kd = roll_kd as f32;
-    lat.course_kp = course_kp as f32;
-    lat.course_ki = course_ki as f32;
-    lat.slip_kp = slip_kp as f32;
-    lat.slip_ki = slip_ki as f32;
-    let lon_g = &mut gains.longitudinal;
-    lon_g.pitch_kp = pitch_kp as f32;
-    lon_g.pitch_ki = pitch_ki as f32;
-    lon_g.pitch_rate_kd = pitch_kd as f32;
-    lon_g.alt_kp = alt_kp as f32;
-    lon_g.alt_ki = alt_ki as f32;
-    lon_g.aspd_pitch_kp = aspd_pitch_kp as f32;
-    lon_g.aspd_pitch_ki = aspd_pitch_ki as f32;
-    lon_g.aspd_thr_kp = aspd_thr_kp as f32;
-    lon_g.aspd_thr_ki = aspd_thr_ki as f32;
+    // The on-board design's set (the base's with its loops' gains), with the sideslip loop
+    // and the trims where this design has them.
+    let mut gains = designed.gains;
+    gains.lateral.slip_kp = slip_kp as f32;
+    gains.lateral.slip_ki = slip_ki as f32;
     if let Some(trim) = trim {
         gains.lateral.trim_aileron = trim.aileron as f32;
         gains.lateral.trim_rudder = trim.rudder as f32;
@@ -568,7 +573,7 @@ fn design_loops(
         anyhow::bail!("the computed gains are outside their parameter bounds: {e}");
     }
     Ok(Design {
-        inputs: inputs.clone(),
+        inputs: *inputs,
         coefficients,
         appendix_c,
         loops,

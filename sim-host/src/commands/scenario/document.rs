@@ -5,8 +5,8 @@ use super::claims::{claims, f, findings, first_seg, CLIMB_WINDOW_S};
 use super::gains::COMPUTED;
 use super::run::ScenarioReport;
 use crate::aircraft::Aircraft;
-use crate::analysis::design::design;
 use crate::analysis::design::inputs::DesignInputs;
+use crate::analysis::design::{decimal, design};
 use crate::analysis::sampled::plant::out;
 use crate::analysis::sampled::{Arrangement, LatLaw, LoopCase, SampledLoop, SampledLoops, CASES};
 use crate::report::sig;
@@ -197,9 +197,11 @@ fn prediction_vs_flight(report: &ScenarioReport, aircraft: &Aircraft) -> String 
         return String::new();
     };
     let inputs = &d.inputs;
-    let Ok(model) =
-        SampledLoops::at_level_trim(aircraft, inputs.sample_time_s, inputs.delay_periods())
-    else {
+    let Ok(model) = SampledLoops::at_level_trim(
+        aircraft,
+        decimal(inputs.sample_time_s),
+        inputs.delay_periods(),
+    ) else {
         return String::new();
     };
     // The tests feed the course loop the heading (the thesis's still-air assumption), so its
