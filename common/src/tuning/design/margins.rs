@@ -6,9 +6,10 @@
 //! bracketed by [`REFINE_STEPS`] bisections (geometric midpoints), then placed by linear
 //! interpolation in `ln w` inside the last bracket. At several crossings the worst margin is
 //! reported. The same reading as the host's `margins` (a 4,000-point sweep with 60 bisections),
-//! on about a twentieth of the points: the phase is followed without the delay's `-w tau`
-//! (added in closed form: the module `transfer`), which would otherwise turn by more than half
-//! a turn between two samples above some 100 rad/s.
+//! on some 270 points: the phase is followed from sample to sample without the delay's
+//! `-w tau` (added in closed form: the module `transfer`), which alone turns by up to 170 deg
+//! between two samples near 1000 rad/s, too near the half turn beyond which a sampled phase
+//! cannot be followed.
 
 use super::transfer::{Plant, Transfer};
 use core::f32::consts::{LN_10, PI, TAU};
