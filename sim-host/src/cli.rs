@@ -228,6 +228,10 @@ pub(crate) enum Command {
         /// Airspeed the coefficients are given at, m/s (default: the flown samples' mean).
         #[arg(long, value_name = "M/S", value_parser = positive_airspeed, allow_negative_numbers = true)]
         airspeed: Option<f64>,
+        /// Only the samples between these times of the log, s (the simulated time of `sim-host
+        /// fly`, as its texts and commands are timed): `--window 19:67`.
+        #[arg(long, value_name = "FROM:TO", value_parser = parse_window)]
+        window: Option<(f64, f64)>,
         #[command(flatten)]
         out: Output,
     },
@@ -363,6 +367,11 @@ pub(crate) struct FlyArgs {
     /// throttle; `sim-host identify OUT/simlink.tlog` fits the models (docs/AUTOTUNE.md).
     #[arg(long, conflicts_with = "mission")]
     pub(crate) stick_doublets: bool,
+    /// Autotune in the air first, as QGroundControl's autotune button does
+    /// (MAV_CMD_DO_AUTOTUNE_ENABLE), from the firmware's default gains, then fly the thesis's
+    /// script on the gains it designed (docs/AUTOTUNE.md).
+    #[arg(long, conflicts_with_all = ["mission", "stick_doublets", "gains"])]
+    pub(crate) autotune: bool,
     /// Fly a mission from the runway instead of the thesis's script: a QGroundControl `.plan`
     /// or `QGC WPL 110` file (mission and geofence are uploaded), or `default` for the
     /// built-in take-off, rectangle, orbit, return and landing, or `runway-120` / `runway-250`
@@ -402,6 +411,7 @@ impl FlyArgs {
             json: self.json,
             mission: self.mission,
             stick_doublets: self.stick_doublets,
+            autotune: self.autotune,
             params: self.params,
         }
     }
@@ -497,4 +507,23 @@ fn parse_wind(s: &str) -> Result<[f64; 3], String> {
             "wind `{s}`: expected three finite numbers N,E,D in m/s"
         )),
     }
+}
+
+/// `FROM:TO`, seconds, `FROM < TO`.
+fn parse_window(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("`{s}`: expected FROM:TO in seconds"))?;
+    let num = |x: &str| {
+        x.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("`{x}` in `{s}` is not a number of seconds"))
+    };
+    let (from, to) = (num(a)?, num(b)?);
+    if from >= to {
+        return Err(format!("`{s}`: FROM must come before TO"));
+    }
+    Ok((from, to))
 }

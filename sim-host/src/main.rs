@@ -53,9 +53,10 @@ fn run() -> anyhow::Result<ExitCode> {
         Some(Command::Identify {
             file,
             airspeed,
+            window,
             out,
         }) => {
-            let r = commands::identify::identify_log(&file, &aircraft, airspeed)?;
+            let r = commands::identify::identify_log(&file, &aircraft, airspeed, window)?;
             if out.json {
                 emit(&to_json(&r)?)?;
             } else {

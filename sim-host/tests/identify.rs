@@ -143,7 +143,7 @@ fn stick_flight_in(dir: &Path, wind_ned: [f64; 3]) -> sim_host::commands::identi
         ..FlyOptions::default()
     };
     fly_report(&aircraft, &cfg, &opts).expect("flight");
-    sim_host::commands::identify::identify_log(&dir.join("simlink.tlog"), &aircraft, None)
+    sim_host::commands::identify::identify_log(&dir.join("simlink.tlog"), &aircraft, None, None)
         .expect("identify")
 }
 

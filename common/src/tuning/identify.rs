@@ -53,7 +53,12 @@ pub struct Sample {
     pub q: f32,
     /// Yaw rate, rad/s.
     pub r: f32,
-    /// Lateral specific force (the accelerometer's y), m/s^2.
+    /// The sideslip's lateral force: the lateral specific force (accelerometer y, m/s^2)
+    /// where it is clean, as a simulator's truth is, or anything in proportion to it (the
+    /// vehicle gives `sideslip * airspeed^2`, rad m^2/s^2: a real accelerometer's noise, 0.6
+    /// m/s^2 on the 25e's, is larger than the signal, and least squares read it as a smaller
+    /// roll term and put `a_phi1` 15 % high). Only its fitted coefficient's scale depends on
+    /// which.
     pub ay: f32,
     /// Roll, rad.
     pub phi: f32,
@@ -86,6 +91,49 @@ pub struct IdentifyConfig {
     pub servo_tau_s: f32,
     /// Fastest a surface moves, rad/s (0: no limit).
     pub servo_rate_radps: f32,
+    /// Time constant of the low-pass the airspeed equation's regressors and rate go through
+    /// together before the fit, s (0: none). The same linear filter on both sides of a linear
+    /// equation leaves it true, and takes out of the airspeed's rate the noise its
+    /// differences take from a pitot's (the rate of a 50 Hz difference of the 25e's airspeed
+    /// sensor's noise swamps the airspeed's own: R^2 0.09 unfiltered); the airspeed's own
+    /// time constant (about 4 s) lies far below the corner.
+    pub airspeed_filter_tau_s: f32,
+}
+
+/// The airspeed pre-filter the vehicle fits its own sensors through, s.
+pub const AIRSPEED_FILTER_TAU_S: f32 = 0.5;
+
+/// One equation's rows through the pre-filter.
+#[derive(Clone, Copy, Debug)]
+struct Prefilter<const N: usize> {
+    row: SVector<f32, N>,
+    rate: f32,
+    started: bool,
+}
+
+impl<const N: usize> Prefilter<N> {
+    fn new() -> Self {
+        Self {
+            row: SVector::zeros(),
+            rate: 0.0,
+            started: false,
+        }
+    }
+
+    /// The row and rate after the filter, `k` the step's share of the way to the input.
+    fn pass(&mut self, k: f32, row: SVector<f32, N>, rate: f32) -> (SVector<f32, N>, f32) {
+        if !self.started || k >= 1.0 {
+            // Starting from the first row: the filter's free response then obeys the same
+            // equation as its input.
+            self.started = true;
+            self.row = row;
+            self.rate = rate;
+        } else {
+            self.row += (row - self.row) * k;
+            self.rate += k * (rate - self.rate);
+        }
+        (self.row, self.rate)
+    }
 }
 
 /// Sub-steps a servo is followed with over one interval: the rate limit makes the motion
@@ -109,7 +157,9 @@ pub(super) fn servo(c: &IdentifyConfig, from: f32, cmd: f32, dt_s: f32) -> (f32,
     };
     let (mut x, mut sum) = (from, 0.0);
     for _ in 0..SERVO_STEPS {
-        let step = (k * (cmd - x)).clamp(-max_step, max_step);
+        // Not `clamp`: it panics (and brings float formatting into the image) on bounds it
+        // cannot order, as a NaN rate would give.
+        let step = (k * (cmd - x)).max(-max_step).min(max_step);
         // The sub-step's mean: the exponential's where unclamped, the ramp's where clamped.
         let mean = if step.abs() < max_step {
             cmd + (x - cmd) * c.servo_tau_s / h * k
@@ -124,6 +174,7 @@ pub(super) fn servo(c: &IdentifyConfig, from: f32, cmd: f32, dt_s: f32) -> (f32,
 
 /// The loops the models are fitted for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Axis {
     Roll,
     Pitch,
@@ -249,6 +300,7 @@ pub struct Identifier {
     speed: LeastSquares<5>,
     course: LeastSquares<2>,
     altitude: LeastSquares<2>,
+    speed_filter: Prefilter<5>,
     inputs: [Spread; 5],
 }
 
@@ -268,6 +320,7 @@ impl Identifier {
             speed: LeastSquares::new(),
             course: LeastSquares::new(),
             altitude: LeastSquares::new(),
+            speed_filter: Prefilter::new(),
             inputs: [Spread::default(); 5],
         }
     }
@@ -276,6 +329,7 @@ impl Identifier {
     /// between are not the model's: on the ground, in a failsafe, or missing).
     pub fn break_chain(&mut self) {
         self.prev = None;
+        self.speed_filter = Prefilter::new();
     }
 
     /// Takes in the sample `dt_s` after the previous one. An interval that is not a positive
@@ -301,10 +355,11 @@ impl Identifier {
         .iter()
         .all(|v| v.is_finite());
         if !finite {
-            self.prev = None;
+            self.break_chain();
             return;
         }
         let Some(a) = self.prev.filter(|_| dt_s > 0.0 && dt_s <= MAX_INTERVAL_S) else {
+            self.break_chain();
             self.prev = Some(*s);
             self.surfaces = [s.aileron, s.elevator];
             return;
@@ -340,10 +395,17 @@ impl Identifier {
             ]),
             rate(|x| x.q),
         );
-        self.speed.push(
-            &SVector::from([-(va - self.config.airspeed_ref), thr, -theta, alpha, 1.0]),
+        let k = if self.config.airspeed_filter_tau_s > 0.0 {
+            1.0 - libm::expf(-dt_s / self.config.airspeed_filter_tau_s)
+        } else {
+            1.0
+        };
+        let (row, y) = self.speed_filter.pass(
+            k,
+            SVector::from([-(va - self.config.airspeed_ref), thr, -theta, alpha, 1.0]),
             rate(|x| x.airspeed),
         );
+        self.speed.push(&row, y);
         let vg = mid(|x| x.ground_speed);
         if vg > 1.0 {
             self.course.push(

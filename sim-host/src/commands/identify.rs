@@ -6,8 +6,9 @@
 //! sim`, or any PX4-interface simulator's recorded the same way): the truth's attitude, rates,
 //! velocity and airspeed (`HIL_STATE_QUATERNION`) and the autopilot's answer to each frame
 //! (`HIL_ACTUATOR_CONTROLS`, the surface commands held until the next). Samples count while
-//! the autopilot is armed and the aircraft is 5 m or more above the lowest height of the
-//! armed flight (the runway): the ground's forces are not the models'. The log holds no
+//! the autopilot is armed and, in a flight armed standing on a runway, the aircraft is 5 m or
+//! more above the lowest height of the armed flight (the runway): the ground's forces are not
+//! the models'. The log holds no
 //! wind: the flight's steady wind is read from it (the ground velocity less the airspeed
 //! along the nose, averaged), and the angle of attack is the velocity's through it. Gusts are
 //! not: in turbulence the angle of attack carries them as noise.
@@ -31,6 +32,9 @@ use std::path::Path;
 
 /// Height above the armed flight's lowest point from which a sample counts as flown, m.
 const AIRBORNE_M: f64 = 5.0;
+
+/// Airspeed under which an armed aircraft stands on the ground, m/s.
+const STANDING_MPS: f32 = 3.0;
 
 /// One coefficient: identified, and the linearisation's where it has one.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -220,11 +224,14 @@ fn steady_wind(flown: &[&Timed]) -> Vector3<f64> {
     Vector3::new(w.x, w.y, 0.0)
 }
 
-/// Fits the log at `path`; `airspeed` overrides the reference airspeed (the flown mean).
+/// Fits the log at `path`; `airspeed` overrides the reference airspeed (the flown mean);
+/// `window` keeps the samples between two times of the log's clock, s (the simulated time
+/// of `sim-host fly`).
 pub fn identify_log(
     path: &Path,
     aircraft: &Aircraft,
     airspeed: Option<f64>,
+    window: Option<(f64, f64)>,
 ) -> anyhow::Result<IdentifyReport> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
     let all = samples(&bytes);
@@ -235,14 +242,25 @@ pub fn identify_log(
             path.display()
         );
     }
-    let ground = all
+    // A flight armed at rest stood on a runway: its lowest height is the ground. One armed
+    // already flying (the simulator's hand launch) never touched it.
+    let on_runway = all
         .iter()
-        .filter(|s| s.armed)
-        .map(|s| s.alt_m)
-        .fold(f64::INFINITY, f64::min);
+        .any(|s| s.armed && s.sample.airspeed < STANDING_MPS);
+    let ground = if on_runway {
+        all.iter()
+            .filter(|s| s.armed)
+            .map(|s| s.alt_m)
+            .fold(f64::INFINITY, f64::min)
+    } else {
+        f64::NEG_INFINITY
+    };
+    let within = |t: &Timed| {
+        window.is_none_or(|(from, to)| (from..=to).contains(&(t.time_us as f64 * 1e-6)))
+    };
     let flown: Vec<&Timed> = all
         .iter()
-        .filter(|s| s.armed && s.alt_m >= ground + AIRBORNE_M)
+        .filter(|s| s.armed && s.alt_m >= ground + AIRBORNE_M && within(s))
         .collect();
     if flown.len() < 50 {
         bail!(
@@ -277,6 +295,7 @@ pub fn identify_log(
         airspeed_ref: va_ref as f32,
         servo_tau_s: servo_tau as f32,
         servo_rate_radps: aircraft.actuators.rate_limit_radps as f32,
+        airspeed_filter_tau_s: 0.0,
     });
     let mut last: Option<u64> = None;
     for s in &flown {
