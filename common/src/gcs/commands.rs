@@ -11,6 +11,7 @@ use super::peer::Peer;
 use super::streams::{Scheduler, Stream};
 use super::telemetry;
 use super::texts::Line;
+use super::tune::TuneService;
 use crate::decimal::trimmed;
 use crate::navigation::plan::MissionStore;
 use crate::vehicle::modes::FlightMode;
@@ -48,12 +49,19 @@ pub struct CommandService {
     storage_request: Option<Peer>,
     /// A `MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN` reboot the board owes.
     reboot_request: bool,
+    /// The autotune a station started, owed its final answer.
+    tune: TuneService,
 }
 
 impl CommandService {
     /// Nothing requested, nothing owed.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Answers the station whose autotune ended (see [`TuneService::poll`]).
+    pub(crate) fn poll_autotune(&mut self, v: &VehicleSnapshot, now_us: u64, out: &mut Outbox) {
+        self.tune.poll(v, now_us, out);
     }
 
     /// Takes the requests accepted since the last call.
@@ -155,6 +163,12 @@ impl CommandService {
             metadata,
             out,
         } = cx;
+        if cfg!(feature = "autotune") && c.cmd == MavCmd::MAV_CMD_DO_AUTOTUNE_ENABLE {
+            let (result, progress, ask) = self.tune.command(c.p[0] > 0.5, v, now_us, from, out);
+            self.requests.autotune = ask.or(self.requests.autotune);
+            out.ack_progress(c.cmd, result, progress, from);
+            return;
+        }
         let mut after = After::new();
         let result = match c.cmd {
             MavCmd::MAV_CMD_COMPONENT_ARM_DISARM => self.arm_disarm(&c, v, out),

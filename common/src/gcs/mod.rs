@@ -40,6 +40,7 @@ pub mod signing;
 pub mod streams;
 pub mod telemetry;
 pub mod texts;
+pub mod tune;
 
 /// The system and component a message is addressed to, as the `mavlink` crate's
 /// `target_system_id` and `target_component_id` answer, for the messages the autopilot's
@@ -214,6 +215,12 @@ impl GroundLink {
     /// [`GroundLink::dropped`].
     pub fn send_statustext(&mut self, severity: MavSeverity, text: &str) {
         self.outbox.texts_mut().push_str(severity, text);
+    }
+
+    /// Tells every station what the autotune reported, in words.
+    pub fn send_tune_report(&mut self, r: &crate::tuning::autotune::Report) {
+        let (severity, line) = tune::words(r);
+        self.outbox.text(severity, &line);
     }
 
     /// The station whose `MAV_CMD_PREFLIGHT_STORAGE` waits for the board's save (answered
@@ -458,6 +465,7 @@ impl GroundLink {
         mut out_raw: F,
     ) {
         self.signing.tick(now_us);
+        self.commands.poll_autotune(v, now_us, &mut self.outbox);
         let intended = self.commands.intended_mode(v);
         while let Some((p, dest)) = self.outbox.pop() {
             if let Pending::Unsupported { command, to } = p {

@@ -21,6 +21,8 @@ pub(crate) enum Pending {
     Ack {
         command: MavCmd,
         result: MavResult,
+        /// How far a command `IN_PROGRESS` is, percent (0 otherwise).
+        progress: u8,
         to: Peer,
     },
     /// `COMMAND_ACK` for a command id the dialect does not know.
@@ -87,10 +89,16 @@ impl Outbox {
 
     /// Queues a `COMMAND_ACK` to the station that sent the command.
     pub fn ack(&mut self, command: MavCmd, result: MavResult, to: Peer) {
+        self.ack_progress(command, result, 0, to);
+    }
+
+    /// Queues a `COMMAND_ACK` with its progress, percent.
+    pub fn ack_progress(&mut self, command: MavCmd, result: MavResult, progress: u8, to: Peer) {
         self.push_to(
             Pending::Ack {
                 command,
                 result,
+                progress,
                 to,
             },
             to.dest(),

@@ -111,11 +111,12 @@ pub(crate) fn emit<F: FnMut(Dest, MavMessage)>(
         Pending::Ack {
             command,
             result,
+            progress,
             to,
         } => out(MavMessage::COMMAND_ACK(COMMAND_ACK_DATA {
             command,
             result,
-            progress: 0,
+            progress,
             result_param2: 0,
             target_system: to.system,
             target_component: to.component,

@@ -16,6 +16,7 @@ use crate::navigation::validate::PlanRules;
 use crate::param;
 use crate::params::store::{ParamStore, Registry};
 use crate::params::{Group, ParamDef};
+use crate::tuning::autotune::Status;
 use crate::vehicle::modes::{FlightMode, ModeSet};
 use crate::vehicle::requests::ArmRequest;
 use crate::vehicle::snapshot::*;
@@ -2767,4 +2768,135 @@ fn the_targets_of_every_message_the_dialect_reads_are_the_crates() {
             "message {id}"
         );
     }
+}
+
+fn autotune_cmd(enable: bool) -> MavMessage {
+    let p1 = if enable { 1.0 } else { 0.0 };
+    cmd_long(
+        MavCmd::MAV_CMD_DO_AUTOTUNE_ENABLE,
+        [p1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    )
+}
+
+/// The autotune's answers with their progress.
+fn autotune_acks(out: &[MavMessage]) -> Vec<(MavResult, u8)> {
+    out.iter()
+        .filter_map(|m| match m {
+            MavMessage::COMMAND_ACK(a) if a.command == MavCmd::MAV_CMD_DO_AUTOTUNE_ENABLE => {
+                Some((a.result, a.progress))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Flying Altitude, armed, in the air.
+fn airborne() -> VehicleSnapshot {
+    VehicleSnapshot {
+        armed: true,
+        landed: LandedState::InAir,
+        mode: FlightMode::Altitude,
+        ..healthy()
+    }
+}
+
+/// Autotune is refused, with the reason as a STATUSTEXT and nothing asked of the vehicle, on
+/// the ground, in the navigator's modes, in a failsafe and with the GPS or the airspeed
+/// sensor failed (as PX4 refuses it outside its stabilised modes).
+#[test]
+fn autotune_is_refused_on_the_ground_in_a_mission_in_a_failsafe_and_with_a_failed_sensor() {
+    type Spoil = fn(&mut VehicleSnapshot);
+    let cases: [(Spoil, &str); 5] = [
+        (
+            |v| v.landed = LandedState::OnGround,
+            "Autotune refused: not in the air",
+        ),
+        (
+            |v| v.mode = FlightMode::Mission,
+            "Autotune refused: fly Stabilized, Altitude or Hold",
+        ),
+        (|v| v.failsafe = true, "Autotune refused: failsafe active"),
+        (
+            |v| v.health.gps_ok = false,
+            "Autotune refused: GPS or airspeed failed",
+        ),
+        (
+            |v| v.health.airspeed_ok = false,
+            "Autotune refused: GPS or airspeed failed",
+        ),
+    ];
+    for (spoil, why) in cases {
+        let mut l = link();
+        let mut v = airborne();
+        spoil(&mut v);
+        let out = exchange(&mut l, &v, 0, autotune_cmd(true));
+        assert_eq!(
+            autotune_acks(&out),
+            [(MavResult::MAV_RESULT_DENIED, 0)],
+            "{why}"
+        );
+        assert_eq!(texts(&out), [why]);
+        assert_eq!(l.take_requests().autotune, None, "{why}");
+    }
+}
+
+/// QGroundControl's autotune: the first command starts it (`IN_PROGRESS`, 0), the same
+/// command every second after asks how far it is (`IN_PROGRESS` with the vehicle's progress,
+/// no second start), and its end is told to the station that started it unasked (ACCEPTED,
+/// progress 100); a poll already on its way gets the same answer, not a new autotune.
+#[test]
+fn autotune_starts_once_answers_polls_with_progress_and_tells_its_end() {
+    let mut l = link();
+    let mut v = airborne();
+    let out = exchange(&mut l, &v, 0, autotune_cmd(true));
+    assert_eq!(
+        autotune_acks(&out),
+        [(MavResult::MAV_RESULT_IN_PROGRESS, 0)]
+    );
+    assert_eq!(l.take_requests().autotune, Some(true));
+    // The previous autotune's end, still in the snapshot, is not this one's.
+    v.autotune = Status::Failed;
+    assert!(autotune_acks(&poll(&mut l, &v, 20_000)).is_empty());
+    v.autotune = Status::Running(27);
+    let out = exchange(&mut l, &v, 1_000_000, autotune_cmd(true));
+    assert_eq!(
+        autotune_acks(&out),
+        [(MavResult::MAV_RESULT_IN_PROGRESS, 27)]
+    );
+    assert_eq!(l.take_requests().autotune, None, "not started twice");
+    v.autotune = Status::Succeeded;
+    let out = poll(&mut l, &v, 2_000_000);
+    assert_eq!(autotune_acks(&out), [(MavResult::MAV_RESULT_ACCEPTED, 100)]);
+    assert!(
+        autotune_acks(&poll(&mut l, &v, 2_100_000)).is_empty(),
+        "told once"
+    );
+    let out = exchange(&mut l, &v, 2_500_000, autotune_cmd(true));
+    assert_eq!(autotune_acks(&out), [(MavResult::MAV_RESULT_ACCEPTED, 100)]);
+    assert_eq!(l.take_requests().autotune, None);
+    // Later, the same command is a new autotune.
+    let out = exchange(&mut l, &v, 9_000_000, autotune_cmd(true));
+    assert_eq!(
+        autotune_acks(&out),
+        [(MavResult::MAV_RESULT_IN_PROGRESS, 0)]
+    );
+    assert_eq!(l.take_requests().autotune, Some(true));
+}
+
+/// An autotune that ends without gains is told as FAILED; param1 = 0 is accepted and asks the
+/// vehicle to stop (or to put back the gains the last one replaced).
+#[test]
+fn a_failed_autotune_is_told_as_failed_and_a_disable_is_passed_on() {
+    let mut l = link();
+    let mut v = airborne();
+    exchange(&mut l, &v, 0, autotune_cmd(true));
+    l.take_requests();
+    v.autotune = Status::Running(45);
+    poll(&mut l, &v, 500_000);
+    v.autotune = Status::Failed;
+    let out = poll(&mut l, &v, 1_000_000);
+    assert_eq!(autotune_acks(&out), [(MavResult::MAV_RESULT_FAILED, 0)]);
+    let out = exchange(&mut l, &v, 9_000_000, autotune_cmd(false));
+    assert_eq!(autotune_acks(&out), [(MavResult::MAV_RESULT_ACCEPTED, 0)]);
+    assert_eq!(l.take_requests().autotune, Some(false));
 }

@@ -62,7 +62,7 @@ pub enum Severity {
 }
 
 /// What the vehicle has to tell its ground station.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Notice {
     /// A status text.
@@ -74,6 +74,8 @@ pub enum Notice {
         /// The item just finished.
         reached: Option<u16>,
     },
+    /// The autotune's progress or result (the link words it).
+    Tune(crate::tuning::autotune::Report),
 }
 
 /// Notices kept until the vehicle's owner collects them (more are dropped).

@@ -32,6 +32,7 @@ pub mod params;
 pub mod report;
 pub mod requests;
 pub mod snapshot;
+pub mod tune;
 
 #[cfg(test)]
 mod tests;
@@ -49,6 +50,7 @@ use crate::navigation::validate::{MissionLimits, PlanRules};
 use crate::navigation::{fence, navigator, path_manager, validate};
 use crate::params::ParamStore;
 use crate::sensors::{BatterySample, GpsFix, ManualInput, RangeSample, SensorFrame};
+use crate::tuning::autotune::Autotune;
 use crate::{failsafe, guidance};
 use clock::{Clock, ClockStats, Step};
 use commander::{
@@ -134,6 +136,11 @@ pub struct Vehicle {
     loops: LoopCommands,
     /// The last frame was refused for its time.
     refusing: bool,
+    autotune: Autotune,
+    /// The mode the running autotune started in.
+    tune_mode: FlightMode,
+    /// The gains the last autotune replaced, for a revert.
+    tuned_from: Option<GainSet>,
 }
 
 impl Default for Vehicle {
@@ -182,6 +189,9 @@ impl Vehicle {
             surfaces: trim_surfaces(&GainSet::default()),
             loops: LoopCommands::OFF,
             refusing: false,
+            autotune: Autotune::new(),
+            tune_mode: FlightMode::Manual,
+            tuned_from: None,
         }
     }
 
@@ -290,6 +300,7 @@ impl Vehicle {
                 let p = self.navigator.params();
                 (p.airspeed_min, p.airspeed_max)
             },
+            autotune: self.autotune.status(),
         };
         report::snapshot(&self.estimator.state(), &self.commander, &extras)
     }
@@ -395,6 +406,9 @@ impl Vehicle {
         let e = self.estimator.state();
         let home = self.commander.apply(r, &e, &mut self.navigator);
         self.move_home(home);
+        if let Some(enable) = r.autotune {
+            self.request_autotune(enable);
+        }
     }
 
     /// Hands a home the commander decided to the estimator, which holds it (the one place
@@ -467,7 +481,7 @@ impl Vehicle {
         });
         self.move_home(out.home);
         let m = self.measurements(&e);
-        match out.demand {
+        match self.step_autotune(dt, out.demand) {
             Demand::Surfaces(s) => {
                 self.surfaces = s;
                 self.loops = LoopCommands::OFF;
@@ -483,6 +497,7 @@ impl Vehicle {
                 };
             }
         }
+        self.observe_autotune(dt);
     }
 
     fn measurements(&self, e: &EstimatedState) -> Measurements {

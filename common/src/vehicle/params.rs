@@ -94,6 +94,8 @@ pub const REGISTRY: Registry = &[
     &failsafe::PARAMS,
     &super::land_detector::PARAMS,
     &crate::logger::params::PARAMS,
+    &crate::tuning::autotune::params::PARAMS,
+    &crate::tuning::autotune::params::IDENTIFIED,
     &PARAMS,
 ];
 

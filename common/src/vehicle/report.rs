@@ -24,6 +24,8 @@ pub struct Extras {
     pub battery: Battery,
     /// Airspeeds the vehicle may be asked to hold, m/s (the navigator's settings).
     pub airspeed_range_m_s: (f32, f32),
+    /// Where the autotune stands.
+    pub autotune: crate::tuning::autotune::Status,
 }
 
 /// The modes the vehicle can fly with this estimate: each mode's [`Needs`] from the table of
@@ -113,6 +115,7 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         mission_state,
         cpu_load: 0.0,
         clock: x.clock,
+        autotune: x.autotune,
     }
 }
 

@@ -35,6 +35,9 @@ pub struct VehicleRequests {
     pub manual: Option<ManualInput>,
     /// Give up the landing being flown (`MAV_CMD_DO_GO_AROUND`).
     pub go_around: bool,
+    /// Start (`true`) or stop an autotune, or put back the gains the last one replaced
+    /// (`false`) (`MAV_CMD_DO_AUTOTUNE_ENABLE`).
+    pub autotune: Option<bool>,
 }
 
 /// An altitude the ground station asked for.

@@ -193,6 +193,8 @@ pub struct VehicleSnapshot {
     pub cpu_load: f32,
     /// What the vehicle's clock refused of the sensor frames' timestamps.
     pub clock: super::clock::ClockStats,
+    /// Where the autotune stands.
+    pub autotune: crate::tuning::autotune::Status,
 }
 
 impl VehicleSnapshot {

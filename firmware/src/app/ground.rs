@@ -251,6 +251,7 @@ impl GroundPort {
                 Notice::Mission { current, reached } => {
                     self.link.mission_progress(current, reached)
                 }
+                Notice::Tune(r) => self.link.send_tune_report(&r),
             }
         }
         let snapshot = snapshot.unwrap_or_else(|| vehicle.snapshot());

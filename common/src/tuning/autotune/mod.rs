@@ -1,0 +1,499 @@
+//! The autotune the vehicle flies (`MAV_CMD_DO_AUTOTUNE_ENABLE`): it excites each loop in turn
+//! within its limits, fits the thesis's reduced models to what it flew, designs the gains on
+//! them by successive loop closure and hands them over once every loop meets its margins.
+//!
+//! ```text
+//! Level ─► Roll ─► Level ─► Pitch ─► Level ─► Throttle ─► Level ─► fit ─► design ─► gains
+//!   └──────────── any limit, mode change, failsafe, the station: abort, gains kept ──────┘
+//! ```
+//!
+//! It flies the aircraft itself: wings level at the altitude and airspeed it started at
+//! (the altitude-holding law), the roll excitation on the roll command, the pitch and throttle
+//! excitation on the pitch-attitude law with the level flight's pitch and throttle. Nothing
+//! here reads a clock or a sensor: the vehicle hands it the estimate and the surfaces each
+//! control tick and flies what it answers.
+
+pub mod excite;
+pub mod params;
+
+#[cfg(test)]
+mod tests;
+
+use super::design::{self, DesignFailure, DesignInputs, DesignModel, Designer};
+use super::identify::{
+    Axis, AxisError, AxisFit, Identifier, IdentifyConfig, Sample, AIRSPEED_FILTER_TAU_S,
+};
+use crate::actuators::Surfaces;
+use crate::control::autopilot::{Commands, GainSet};
+use crate::control::lateral::{RollMode, RUDDER};
+use crate::control::longitudinal::LonMode;
+use crate::estimator::EstimatedState;
+use crate::math::RAD2DEG;
+use excite::Stage;
+use params::{AutotuneParams, UNIDENTIFIED};
+
+/// Share of the abort limits the excitation uses: a 3-2-1-1 on a closed loop overshoots its
+/// command by the loop's own overshoot (17 % for the roll loop), and the turbulence adds its
+/// own, so 0.4 leaves the aircraft more than twice the excitation's room to its limit.
+pub const EXCITATION_SHARE: f32 = 0.4;
+
+/// Why an autotune stopped before its end; the values are what broke the limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Abort {
+    /// Bank beyond `ATUN_BANK_MAX`, deg.
+    Bank(f32),
+    /// Pitch beyond `ATUN_PITCH_MAX` from level, deg.
+    Pitch(f32),
+    /// Height lost below the start beyond `ATUN_HGT_LOSS`, m.
+    HeightLoss(f32),
+    /// Airspeed outside the navigator's range, m/s.
+    Airspeed(f32),
+    /// The station or the pilot chose another mode.
+    ModeChanged,
+    /// A failsafe was raised.
+    Failsafe,
+    /// On the ground, or disarmed.
+    Landed,
+    /// The GPS or the airspeed sensor failed.
+    Sensors,
+    /// The station asked it to stop.
+    Station,
+}
+
+/// Why an autotune flown to its end gave no gains.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Failure {
+    /// An axis's input did not vary enough (the excitation was held back by a limit).
+    NotExcited(Axis),
+    /// An axis's regressors never varied independently.
+    Singular(Axis),
+    /// An axis's model explained too little of what was flown: the axis and its R^2.
+    PoorFit(Axis, f32),
+    /// The design on the models failed a loop's margins or bounds.
+    Design(DesignFailure),
+}
+
+/// What the autotune has to tell the station.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Report {
+    /// Started (the level flight it starts from).
+    Started,
+    /// A stage of the excitation began.
+    Stage(Stage),
+    /// An axis's model: its first three coefficients (in [`Axis::coefficients`]' order) and
+    /// its R^2.
+    Fitted(Axis, [f32; 3], f32),
+    /// The design met every margin; the gains were handed over.
+    Applied,
+    /// Stopped before its end; the gains as they were.
+    Aborted(Abort),
+    /// Flown to its end without gains; the gains as they were.
+    Failed(Failure),
+}
+
+/// Where the autotune stands, for the station's progress.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Status {
+    /// Never run since boot.
+    #[default]
+    Idle,
+    /// Running: its progress, 0-99, in QGroundControl's bands (under 20 starting, 20-39 roll,
+    /// 40-59 pitch, 60-79 the third axis (here the throttle), 80-99 fitting and designing).
+    Running(u8),
+    /// The last one applied its gains.
+    Succeeded,
+    /// The last one aborted or failed.
+    Failed,
+}
+
+/// What the vehicle tells the autotune each control tick besides the estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Situation {
+    /// The mode it started in is still flown.
+    pub mode_kept: bool,
+    /// A failsafe is raised.
+    pub failsafe: bool,
+    /// Armed and in the air.
+    pub flying: bool,
+    /// The airspeed range it must stay in, m/s.
+    pub airspeed_range: (f32, f32),
+}
+
+/// What the autotune answers a control tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Tick {
+    /// Fly these instead of the mode's commands.
+    pub commands: Option<Commands>,
+    /// Tell the station.
+    pub report: Option<Report>,
+    /// The designed gains and the model they came from: apply them.
+    pub gains: Option<(GainSet, DesignModel)>,
+}
+
+/// Where the level flight it started from is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Start {
+    alt_m: f32,
+    airspeed: f32,
+    /// Pitch and throttle of level flight: followed (slowly) in the level stages.
+    pitch: f32,
+    throttle: f32,
+}
+
+// The designer in place, not boxed: no heap, and one autotune per vehicle.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+enum Phase {
+    Idle,
+    /// Flying the timeline, `t_s` into it.
+    Flying {
+        t_s: f32,
+    },
+    /// Fitting axis `next` of [`FITTED`] (one a tick: a solve is a few thousand
+    /// instructions, the design's steps follow).
+    Fitting {
+        next: usize,
+    },
+    Designing(Designer),
+}
+
+/// About the steps a design takes (199 for the 25e), for the progress reported.
+const DESIGN_STEPS: f32 = 200.0;
+
+/// The axes the design needs, in the order they are fitted.
+const FITTED: [Axis; 3] = [Axis::Roll, Axis::Pitch, Axis::Airspeed];
+
+/// Time constant of the level pitch and throttle's average, s: longer than the altitude
+/// loop's oscillation, shorter than a level stage.
+const LEVEL_TC_S: f32 = 1.0;
+
+/// The autotune.
+#[derive(Clone, Debug)]
+pub struct Autotune {
+    phase: Phase,
+    status: Status,
+    identifier: Identifier,
+    start: Start,
+    stage: Option<Stage>,
+    /// The model as fitted so far.
+    model: DesignModel,
+}
+
+impl Default for Autotune {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Autotune {
+    /// Not running.
+    pub fn new() -> Self {
+        Self {
+            phase: Phase::Idle,
+            status: Status::Idle,
+            identifier: Identifier::new(IdentifyConfig {
+                airspeed_ref: 1.0,
+                servo_tau_s: 0.0,
+                servo_rate_radps: 0.0,
+                airspeed_filter_tau_s: 0.0,
+            }),
+            start: Start {
+                alt_m: 0.0,
+                airspeed: 0.0,
+                pitch: 0.0,
+                throttle: 0.0,
+            },
+            stage: None,
+            model: UNIDENTIFIED,
+        }
+    }
+
+    /// Where it stands.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+
+    /// Running (flying its excitation, fitting or designing).
+    pub fn running(&self) -> bool {
+        !matches!(self.phase, Phase::Idle)
+    }
+
+    /// Starts from level flight at `e`'s altitude, holding `airspeed` (m/s), from the
+    /// surfaces `s` flown now.
+    pub fn start(&mut self, e: &EstimatedState, airspeed: f32, s: &Surfaces, p: &AutotuneParams) {
+        let tau = 1.0 / (2.0 * core::f32::consts::PI * p.servo_bw_hz);
+        self.identifier = Identifier::new(IdentifyConfig {
+            airspeed_ref: airspeed,
+            servo_tau_s: tau,
+            servo_rate_radps: p.servo_rate,
+            airspeed_filter_tau_s: AIRSPEED_FILTER_TAU_S,
+        });
+        self.start = Start {
+            alt_m: e.alt_amsl_m,
+            airspeed,
+            pitch: e.euler.theta,
+            throttle: s.throttle,
+        };
+        self.stage = None;
+        self.model = DesignModel {
+            va: airspeed,
+            servo_bandwidth_hz: p.servo_bw_hz,
+            ..UNIDENTIFIED
+        };
+        self.phase = Phase::Flying { t_s: 0.0 };
+        self.status = Status::Running(0);
+    }
+
+    /// The gains it designed were refused where they were to be applied: it failed.
+    pub fn refused(&mut self) {
+        self.status = Status::Failed;
+    }
+
+    /// Stops it for `why` (nothing if it is not running).
+    pub fn abort(&mut self, why: Abort) -> Option<Report> {
+        if !self.running() {
+            return None;
+        }
+        self.phase = Phase::Idle;
+        self.status = Status::Failed;
+        Some(Report::Aborted(why))
+    }
+
+    /// What the tick flew: `sample` of the estimate at the tick's time with the surfaces the
+    /// loops commanded then (held until the next), `dt` s after the last. The models read
+    /// each command against the motion it makes after it, so the sample is taken after the
+    /// loops' step, not before.
+    pub fn observe(&mut self, dt: f32, sample: &Sample) {
+        if matches!(self.phase, Phase::Flying { .. }) {
+            self.identifier.push(dt, sample);
+        }
+    }
+
+    /// One control tick, `dt` s after the last: `e` the estimate, `s` the surfaces flown
+    /// over the interval, `base` the gains flown now.
+    pub fn step(
+        &mut self,
+        dt: f32,
+        e: &EstimatedState,
+        s: &Surfaces,
+        situation: &Situation,
+        p: &AutotuneParams,
+        base: &GainSet,
+    ) -> Tick {
+        if let Some(why) = self.broken(e, situation, p) {
+            return Tick {
+                report: self.abort(why),
+                ..Tick::default()
+            };
+        }
+        let phase = core::mem::replace(&mut self.phase, Phase::Idle);
+        let (phase, mut tick) = match phase {
+            Phase::Idle => (Phase::Idle, Tick::default()),
+            Phase::Flying { t_s } => self.fly(t_s, dt, e, s, p),
+            Phase::Fitting { next } => self.fit(next, p, base),
+            Phase::Designing(mut d) => match d.step() {
+                design::Step::Pending => {
+                    let share = d.steps() as f32 / DESIGN_STEPS;
+                    self.status = Status::Running(85 + (share.min(1.0) * 14.0) as u8);
+                    (Phase::Designing(d), Tick::default())
+                }
+                design::Step::Done(g) => {
+                    self.status = Status::Succeeded;
+                    let tick = Tick {
+                        report: Some(Report::Applied),
+                        gains: Some((g.gains, self.model)),
+                        ..Tick::default()
+                    };
+                    (Phase::Idle, tick)
+                }
+                design::Step::Failed(f) => self.fail(Failure::Design(f)),
+            },
+        };
+        self.phase = phase;
+        if self.running() && tick.commands.is_none() {
+            tick.commands = Some(self.level());
+        }
+        tick
+    }
+
+    /// The limit broken, if one is.
+    fn broken(&self, e: &EstimatedState, c: &Situation, p: &AutotuneParams) -> Option<Abort> {
+        if !self.running() {
+            return None;
+        }
+        let pitch_change = e.euler.theta - self.start.pitch;
+        let lost = self.start.alt_m - e.alt_amsl_m;
+        let (lo, hi) = c.airspeed_range;
+        // A failed sensor raises its failsafe in the same tick: named first, as the cause.
+        if !c.flying {
+            Some(Abort::Landed)
+        } else if !e.health.gps.healthy || !e.health.pitot.healthy {
+            Some(Abort::Sensors)
+        } else if c.failsafe {
+            Some(Abort::Failsafe)
+        } else if !c.mode_kept {
+            Some(Abort::ModeChanged)
+        } else if e.euler.phi.abs() > p.bank_max {
+            Some(Abort::Bank(e.euler.phi * RAD2DEG))
+        } else if pitch_change.abs() > p.pitch_max {
+            Some(Abort::Pitch(pitch_change * RAD2DEG))
+        } else if lost > p.height_loss_m {
+            Some(Abort::HeightLoss(lost))
+        } else if !(lo..=hi).contains(&e.airspeed) {
+            Some(Abort::Airspeed(e.airspeed))
+        } else {
+            None
+        }
+    }
+
+    /// Wings level at the start's altitude and airspeed.
+    fn level(&self) -> Commands {
+        Commands {
+            roll: RollMode::Roll(0.0),
+            yaw: RUDDER,
+            lon: LonMode::Altitude {
+                altitude: self.start.alt_m,
+                airspeed: self.start.airspeed,
+            },
+        }
+    }
+
+    /// A tick of the excitation's timeline.
+    fn fly(
+        &mut self,
+        t_s: f32,
+        dt: f32,
+        e: &EstimatedState,
+        s: &Surfaces,
+        p: &AutotuneParams,
+    ) -> (Phase, Tick) {
+        let Some((stage, into_s, share)) = excite::at(t_s) else {
+            self.status = Status::Running(80);
+            return (Phase::Fitting { next: 0 }, Tick::default());
+        };
+        let report = if self.stage != Some(stage) {
+            self.stage = Some(stage);
+            Some(if t_s == 0.0 {
+                Report::Started
+            } else {
+                Report::Stage(stage)
+            })
+        } else {
+            None
+        };
+        // QGroundControl's bands: the stage in its 20-wide band, the level stages between.
+        let band = |first: f32| first + 19.0 * ((share * 80.0 - first) / 20.0).clamp(0.0, 1.0);
+        let progress = match stage {
+            Stage::Level => share * 80.0,
+            Stage::Roll => band(20.0),
+            Stage::Pitch => band(40.0),
+            Stage::Throttle => band(60.0),
+        };
+        self.status = Status::Running((progress as u8).min(79));
+        let pitch_cmd = |offset: f32| LonMode::Pitch {
+            pitch: self.start.pitch + offset,
+            throttle: self.start.throttle,
+        };
+        let commands = match stage {
+            Stage::Level => {
+                // The level pitch and throttle, averaged, for the pitch-attitude stages.
+                let k = (dt / LEVEL_TC_S).clamp(0.0, 1.0);
+                if e.euler.theta.is_finite() && s.throttle.is_finite() {
+                    self.start.pitch += k * (e.euler.theta - self.start.pitch);
+                    self.start.throttle += k * (s.throttle - self.start.throttle);
+                }
+                self.level()
+            }
+            Stage::Roll => Commands {
+                roll: RollMode::Roll(EXCITATION_SHARE * p.bank_max * excite::doublets(into_s)),
+                ..self.level()
+            },
+            Stage::Pitch => Commands {
+                lon: pitch_cmd(EXCITATION_SHARE * p.pitch_max * excite::doublets(into_s)),
+                ..self.level()
+            },
+            Stage::Throttle => Commands {
+                lon: LonMode::Pitch {
+                    pitch: self.start.pitch,
+                    throttle: (self.start.throttle + p.throttle_step * excite::steps(into_s))
+                        .clamp(0.0, 1.0),
+                },
+                ..self.level()
+            },
+        };
+        let tick = Tick {
+            commands: Some(commands),
+            report,
+            gains: None,
+        };
+        (Phase::Flying { t_s: t_s + dt }, tick)
+    }
+
+    /// Fits the next axis; after the last, starts the design.
+    fn fit(&mut self, next: usize, p: &AutotuneParams, base: &GainSet) -> (Phase, Tick) {
+        let Some(&axis) = FITTED.get(next) else {
+            let model = self.model;
+            self.status = Status::Running(85);
+            return (
+                Phase::Designing(Designer::new(&model, &DesignInputs::THESIS, base)),
+                Tick::default(),
+            );
+        };
+        let fit: AxisFit = match self.identifier.fit(axis) {
+            Ok(f) => f,
+            Err(AxisError::NotExcited { .. }) => return self.fail(Failure::NotExcited(axis)),
+            Err(AxisError::Singular) => return self.fail(Failure::Singular(axis)),
+        };
+        // A NaN R^2 is a poor fit too.
+        if fit.r2.is_nan() || fit.r2 < p.r2_min {
+            return self.fail(Failure::PoorFit(axis, fit.r2));
+        }
+        let [a, b, c, ..] = fit.coef;
+        let m = &mut self.model;
+        match axis {
+            Axis::Roll => (m.a_phi1, m.a_phi2) = (a, b),
+            Axis::Pitch => (m.a_theta1, m.a_theta2, m.a_theta3) = (a, b, c),
+            _ => (m.a_v1, m.a_v2) = (a, b),
+        }
+        let tick = Tick {
+            report: Some(Report::Fitted(axis, [a, b, c], fit.r2)),
+            ..Tick::default()
+        };
+        (Phase::Fitting { next: next + 1 }, tick)
+    }
+
+    fn fail(&mut self, why: Failure) -> (Phase, Tick) {
+        self.status = Status::Failed;
+        let tick = Tick {
+            report: Some(Report::Failed(why)),
+            ..Tick::default()
+        };
+        (Phase::Idle, tick)
+    }
+}
+
+/// What the models read, from the estimate and the surfaces flown. The sideslip's lateral
+/// force is read through the estimated sideslip (`beta Va^2`, as the force goes), not the
+/// accelerometer, whose noise is larger than that force ([`Sample::ay`]).
+pub fn sample(e: &EstimatedState, s: &Surfaces) -> Sample {
+    Sample {
+        p: e.body_rates.x,
+        q: e.body_rates.y,
+        r: e.body_rates.z,
+        ay: e.sideslip * e.airspeed * e.airspeed,
+        phi: e.euler.phi,
+        theta: e.euler.theta,
+        airspeed: e.airspeed,
+        alpha: e.alpha,
+        climb_rate: -e.vel_ned.z,
+        course: e.course,
+        ground_speed: e.ground_speed,
+        aileron: s.aileron,
+        elevator: s.elevator,
+        throttle: s.throttle,
+    }
+}
