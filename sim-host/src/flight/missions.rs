@@ -411,3 +411,66 @@ pub fn stick_doublets(throttle: f32) -> FlightConfig {
         ..FlightConfig::default()
     }
 }
+
+/// When the autotune flight's station presses autotune, s after arming: once the take-off
+/// from the simulator's hand launch has settled into level flight.
+pub const AUTOTUNE_AT_S: f64 = 10.0;
+
+/// Time the autotune flight leaves the autotune before the thesis's script, s: its timeline
+/// (48 s), the fit and the design, and some level flight.
+pub const AUTOTUNE_FOR_S: f64 = 70.0;
+
+/// The parameters the autotune flight's station reads before the autotune and after it:
+/// the gains the design sets and the coefficients it identified.
+pub const AUTOTUNE_PARAMS: [&str; 22] = [
+    "RLL_KP",
+    "RLL_KI",
+    "RLL_RATE_KD",
+    "CRS_KP",
+    "CRS_KI",
+    "PTCH_KP",
+    "PTCH_KI",
+    "PTCH_RATE_KD",
+    "ALT_KP",
+    "ALT_KI",
+    "ASPD_PTCH_KP",
+    "ASPD_PTCH_KI",
+    "ASPD_THR_KP",
+    "ASPD_THR_KI",
+    "ASPD_SCL_REF",
+    "ATUN_A_PHI1",
+    "ATUN_A_PHI2",
+    "ATUN_A_THT1",
+    "ATUN_A_THT2",
+    "ATUN_A_THT3",
+    "ATUN_A_V1",
+    "ATUN_A_V2",
+];
+
+/// The thesis's script flown after an autotune, as a QGroundControl user flies it: Hold from
+/// the hand launch, autotune ([`AUTOTUNE_AT_S`]), then the script [`AUTOTUNE_FOR_S`] later;
+/// the station reads [`AUTOTUNE_PARAMS`] before the autotune and before the script.
+pub fn autotune_then_thesis() -> FlightConfig {
+    let mut script = Script::thesis();
+    for step in script.steps.iter_mut().skip(1) {
+        step.after_arm_s += AUTOTUNE_AT_S + AUTOTUNE_FOR_S;
+    }
+    let read = || Action::ReadParams(AUTOTUNE_PARAMS.iter().map(|p| p.to_string()).collect());
+    let at = |after_arm_s, action| ScriptStep {
+        after_arm_s,
+        action,
+    };
+    script.steps.splice(
+        1..1,
+        [
+            at(AUTOTUNE_AT_S - 1.0, read()),
+            at(AUTOTUNE_AT_S, Action::Autotune(true)),
+            at(AUTOTUNE_AT_S + AUTOTUNE_FOR_S - 1.0, read()),
+        ],
+    );
+    FlightConfig {
+        duration_s: script.length_s(),
+        script,
+        ..FlightConfig::default()
+    }
+}

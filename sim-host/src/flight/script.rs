@@ -18,7 +18,7 @@ use common::link::framing::{FrameParser, Sender};
 use common::vehicle::modes::FlightMode;
 use mavlink::dialects::common::{
     MavCmd, MavLandedState, MavMessage, MavMissionResult, MavMissionType, MavParamType, MavResult,
-    MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA, PARAM_SET_DATA,
+    MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA, PARAM_REQUEST_READ_DATA, PARAM_SET_DATA,
 };
 use serde::Serialize;
 
@@ -60,6 +60,10 @@ pub enum Action {
     Return,
     /// `MAV_CMD_DO_SET_MODE` AUTO.LOITER: circle here.
     Loiter,
+    /// `MAV_CMD_DO_AUTOTUNE_ENABLE`: start (`true`) or stop / revert (`false`) the autotune.
+    Autotune(bool),
+    /// `PARAM_REQUEST_READ` of each parameter named, its `PARAM_VALUE` recorded.
+    ReadParams(Vec<String>),
     /// Stop sending heartbeats (the ground link is lost).
     Silence,
     /// Send heartbeats again, the first at once (the ground link is back).
@@ -157,6 +161,8 @@ pub struct GroundStation {
     pub uploads: Vec<(String, f64, String)>,
     /// MISSION_ITEM_REACHED: time, item.
     pub reached: Vec<(f64, u16)>,
+    /// Parameters read (PARAM_VALUE): time, name, value.
+    pub params_read: Vec<(f64, String, f32)>,
     /// The landed state of EXTENDED_SYS_STATE each time it changed: time, state.
     pub landed_states: Vec<(f64, MavLandedState)>,
     uploaded: bool,
@@ -185,6 +191,7 @@ impl GroundStation {
             texts: Vec::new(),
             uploads: Vec::new(),
             reached: Vec::new(),
+            params_read: Vec::new(),
             landed_states: Vec::new(),
             uploaded: false,
             next_heartbeat_s: 0.0,
@@ -287,8 +294,13 @@ impl GroundStation {
                         break;
                     }
                     self.next_step += 1;
-                    match step.action {
+                    match &step.action {
                         Action::Silence => self.silent = true,
+                        Action::ReadParams(names) => {
+                            for name in names.clone() {
+                                self.read_param(t_s, &name, link, onboard);
+                            }
+                        }
                         Action::Resume => {
                             self.silent = false;
                             self.next_heartbeat_s = t_s;
@@ -361,7 +373,14 @@ impl GroundStation {
                     [1.0, f32::from(main), f32::from(sub), 0.0]
                 }),
             ),
-            Action::Silence | Action::Resume => return None,
+            Action::Autotune(on) => (
+                if on { "autotune" } else { "autotune off" }.into(),
+                command(
+                    MavCmd::MAV_CMD_DO_AUTOTUNE_ENABLE,
+                    [if on { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
+                ),
+            ),
+            Action::Silence | Action::Resume | Action::ReadParams(_) => return None,
         })
     }
 
@@ -428,6 +447,29 @@ impl GroundStation {
     ) -> Vec<MavMessage> {
         let raw = self.sender.encode(msg);
         self.send_bytes(t_s, link, onboard, raw.raw_bytes(), wait)
+    }
+
+    /// `PARAM_REQUEST_READ` of `name`; its `PARAM_VALUE`, when one comes, is recorded.
+    fn read_param<T: Transport, O: Onboard<T>>(
+        &mut self,
+        t_s: f64,
+        name: &str,
+        link: &mut Lockstep<T>,
+        onboard: &mut O,
+    ) {
+        let msg = MavMessage::PARAM_REQUEST_READ(PARAM_REQUEST_READ_DATA {
+            param_index: -1,
+            target_system: 1,
+            target_component: 1,
+            param_id: name.into(),
+        });
+        let is_it = |m: &MavMessage| matches!(m, MavMessage::PARAM_VALUE(v) if v.param_id.to_str().is_ok_and(|id| id == name));
+        let mut done = is_it;
+        let answer = self.exchange(t_s, link, onboard, &msg, Await::Answer(&mut done));
+        if let Some(MavMessage::PARAM_VALUE(v)) = answer.iter().find(|m| is_it(m)) {
+            self.params_read
+                .push((t_s, name.to_string(), v.param_value));
+        }
     }
 
     fn command<T: Transport, O: Onboard<T>>(

@@ -134,6 +134,8 @@ pub struct FlightSummary {
     pub commands: Vec<CommandRecord>,
     /// The autopilot's STATUSTEXT messages.
     pub texts: Vec<(f64, String)>,
+    /// Parameters the script read: time, name, value.
+    pub params_read: Vec<(f64, String, f32)>,
     /// The landed state the station read in EXTENDED_SYS_STATE, each time it changed: time,
     /// state (`ON_GROUND`, `TAKEOFF`, `IN_AIR`, `LANDING`, `UNDEFINED`).
     pub landed_states: Vec<(f64, String)>,
@@ -386,6 +388,7 @@ pub(crate) fn summarise(cfg: &FlightConfig, samples: &[Sample], f: &FlightFacts)
             .unwrap_or_default(),
         commands: f.gcs.map(|g| g.commands.clone()).unwrap_or_default(),
         texts: f.gcs.map(|g| g.texts.clone()).unwrap_or_default(),
+        params_read: f.gcs.map(|g| g.params_read.clone()).unwrap_or_default(),
         landed_states: f
             .gcs
             .map(|g| {

@@ -2,6 +2,7 @@
 //! subcommand: the flight built from the options, flown (once more on the truth for
 //! `--report`, once more with the host build for `--compare-host`), printed and written.
 
+use super::autotune::autotune_report;
 use super::flight::fly_report;
 use super::options::{FlyOptions, LinkKind};
 use super::results::results_markdown;
@@ -14,7 +15,7 @@ use crate::commands::{render, Format};
 use crate::environment::wind::Turbulence;
 use crate::flight::config::{FaultWindow, FlightConfig};
 use crate::flight::missions::{
-    default_mission, other_runway_missions, runway_mission, stick_doublets,
+    autotune_then_thesis, default_mission, other_runway_missions, runway_mission, stick_doublets,
 };
 use crate::link::profile::ProfileWindow;
 use crate::link::qemu::QemuConfig;
@@ -66,6 +67,8 @@ pub struct FlyCommand {
     pub mission: Option<PathBuf>,
     /// Fly the stick doublets of an identification flight instead of the thesis's script.
     pub stick_doublets: bool,
+    /// Autotune in the air first, then fly the thesis's script on its gains.
+    pub autotune: bool,
     /// Parameters set before arming, name and value.
     pub params: Vec<(String, f32)>,
 }
@@ -116,6 +119,7 @@ pub fn fly_command(
     let base = match &a.mission {
         Some(m) => mission_config(aircraft, m)?,
         None if a.stick_doublets => stick_doublets(level_trim_throttle(aircraft)?),
+        None if a.autotune => autotune_then_thesis(),
         None => FlightConfig::default(),
     };
     let mut cfg = FlightConfig {
@@ -160,7 +164,7 @@ pub fn fly_command(
         // The thesis's scripted flight flies the gains designed here; a mission flies the
         // firmware's defaults, as `sim-host navigation` and a fresh autopilot do.
         upload_gains: match (a.gains, &a.mission) {
-            (None, None) => Some(computed_gain_set(aircraft)?),
+            (None, None) if !a.autotune => Some(computed_gain_set(aircraft)?),
             _ => None,
         },
         use_truth: a.truth,
@@ -173,6 +177,30 @@ pub fn fly_command(
         anyhow::bail!("--profile profiles the MCU image: it needs --link qemu");
     }
     let r = fly_report(aircraft, &cfg, &opts)?;
+    // The same script on the default gains, for the autotune's side-by-side table.
+    let tuned = if a.autotune {
+        let thesis = FlightConfig::default();
+        let plain_cfg = FlightConfig {
+            script: thesis.script,
+            duration_s: thesis.duration_s,
+            progress: false,
+            ..cfg.clone()
+        };
+        let plain_opts = FlyOptions {
+            out: Some(a.out.join("default-gains")),
+            plots: false,
+            ..opts.clone()
+        };
+        let plain = fly_report(aircraft, &plain_cfg, &plain_opts)?;
+        let report = autotune_report(aircraft, &r.outcome, &plain.outcome)?;
+        // The tables as docs/AUTOTUNE.md shows them.
+        let path = a.out.join("autotune.md");
+        std::fs::write(&path, render(&report.tables(), Format::Markdown))
+            .with_context(|| format!("cannot write `{}`", path.display()))?;
+        Some(report)
+    } else {
+        None
+    };
     if let Some(p) = &r.mcu_profile {
         let path = a.out.join("profile.md");
         std::fs::write(&path, p.markdown(usize::MAX))
@@ -203,10 +231,19 @@ pub fn fly_command(
                 }
                 emit(&to_json(&doc)?)?
             }
-            (None, None) => emit(&to_json(&r.outcome.summary)?)?,
+            (None, None) => {
+                let mut doc = serde_json::to_value(&r.outcome.summary)?;
+                if let (Some(t), Some(o)) = (&tuned, doc.as_object_mut()) {
+                    o.insert("autotune".into(), serde_json::to_value(t)?);
+                }
+                emit(&to_json(&doc)?)?
+            }
         }
     } else {
         emit(&render(&summary_tables(&r.outcome), Format::Text))?;
+        if let Some(t) = &tuned {
+            emit(&render(&t.tables(), Format::Text))?;
+        }
         if let Some(c) = &compared {
             emit(&render(&[c.table(&r.outcome, opts.link)], Format::Text))?;
         }

@@ -5,6 +5,7 @@
 //! over that transport ([`flight`]), the tables printed after it ([`tables`]), the document of
 //! `--report` ([`results`]) and the command as the command line runs it ([`command`]).
 
+pub mod autotune;
 pub mod command;
 pub mod flight;
 pub mod options;
