@@ -149,14 +149,16 @@ struct Start {
 #[derive(Clone, Debug)]
 enum Phase {
     Idle,
-    /// Flying the timeline, `t_s` into it.
+    /// Flying the timeline, `t_s` into it, fitting what it flies.
     Flying {
         t_s: f32,
+        id: Identifier,
     },
     /// Fitting axis `next` of [`FITTED`] (one a tick: a solve is a few thousand
     /// instructions, the design's steps follow).
     Fitting {
         next: usize,
+        id: Identifier,
     },
     Designing(Designer),
 }
@@ -174,9 +176,10 @@ const LEVEL_TC_S: f32 = 1.0;
 /// The autotune.
 #[derive(Clone, Debug)]
 pub struct Autotune {
+    /// What it does now; the identifier and the designer, each in its phase, share their
+    /// memory (the application's 40 KiB).
     phase: Phase,
     status: Status,
-    identifier: Identifier,
     start: Start,
     stage: Option<Stage>,
     /// The model as fitted so far.
@@ -195,12 +198,6 @@ impl Autotune {
         Self {
             phase: Phase::Idle,
             status: Status::Idle,
-            identifier: Identifier::new(IdentifyConfig {
-                airspeed_ref: 1.0,
-                servo_tau_s: 0.0,
-                servo_rate_radps: 0.0,
-                airspeed_filter_tau_s: 0.0,
-            }),
             start: Start {
                 alt_m: 0.0,
                 airspeed: 0.0,
@@ -226,7 +223,7 @@ impl Autotune {
     /// surfaces `s` flown now.
     pub fn start(&mut self, e: &EstimatedState, airspeed: f32, s: &Surfaces, p: &AutotuneParams) {
         let tau = 1.0 / (2.0 * core::f32::consts::PI * p.servo_bw_hz);
-        self.identifier = Identifier::new(IdentifyConfig {
+        let id = Identifier::new(IdentifyConfig {
             airspeed_ref: airspeed,
             servo_tau_s: tau,
             servo_rate_radps: p.servo_rate,
@@ -244,7 +241,7 @@ impl Autotune {
             servo_bandwidth_hz: p.servo_bw_hz,
             ..UNIDENTIFIED
         };
-        self.phase = Phase::Flying { t_s: 0.0 };
+        self.phase = Phase::Flying { t_s: 0.0, id };
         self.status = Status::Running(0);
     }
 
@@ -268,8 +265,8 @@ impl Autotune {
     /// each command against the motion it makes after it, so the sample is taken after the
     /// loops' step, not before.
     pub fn observe(&mut self, dt: f32, sample: &Sample) {
-        if matches!(self.phase, Phase::Flying { .. }) {
-            self.identifier.push(dt, sample);
+        if let Phase::Flying { id, .. } = &mut self.phase {
+            id.push(dt, sample);
         }
     }
 
@@ -293,8 +290,8 @@ impl Autotune {
         let phase = core::mem::replace(&mut self.phase, Phase::Idle);
         let (phase, mut tick) = match phase {
             Phase::Idle => (Phase::Idle, Tick::default()),
-            Phase::Flying { t_s } => self.fly(t_s, dt, e, s, p),
-            Phase::Fitting { next } => self.fit(next, p, base),
+            Phase::Flying { t_s, id } => self.fly(t_s, id, dt, e, s, p),
+            Phase::Fitting { next, id } => self.fit(next, id, p, base),
             Phase::Designing(mut d) => match d.step() {
                 design::Step::Pending => {
                     let share = d.steps() as f32 / DESIGN_STEPS;
@@ -366,6 +363,7 @@ impl Autotune {
     fn fly(
         &mut self,
         t_s: f32,
+        id: Identifier,
         dt: f32,
         e: &EstimatedState,
         s: &Surfaces,
@@ -373,7 +371,7 @@ impl Autotune {
     ) -> (Phase, Tick) {
         let Some((stage, into_s, share)) = excite::at(t_s) else {
             self.status = Status::Running(80);
-            return (Phase::Fitting { next: 0 }, Tick::default());
+            return (Phase::Fitting { next: 0, id }, Tick::default());
         };
         let report = if self.stage != Some(stage) {
             self.stage = Some(stage);
@@ -430,11 +428,17 @@ impl Autotune {
             report,
             gains: None,
         };
-        (Phase::Flying { t_s: t_s + dt }, tick)
+        (Phase::Flying { t_s: t_s + dt, id }, tick)
     }
 
     /// Fits the next axis; after the last, starts the design.
-    fn fit(&mut self, next: usize, p: &AutotuneParams, base: &GainSet) -> (Phase, Tick) {
+    fn fit(
+        &mut self,
+        next: usize,
+        id: Identifier,
+        p: &AutotuneParams,
+        base: &GainSet,
+    ) -> (Phase, Tick) {
         let Some(&axis) = FITTED.get(next) else {
             let model = self.model;
             self.status = Status::Running(85);
@@ -443,7 +447,7 @@ impl Autotune {
                 Tick::default(),
             );
         };
-        let fit: AxisFit = match self.identifier.fit(axis) {
+        let fit: AxisFit = match id.fit(axis) {
             Ok(f) => f,
             Err(AxisError::NotExcited { .. }) => return self.fail(Failure::NotExcited(axis)),
             Err(AxisError::Singular) => return self.fail(Failure::Singular(axis)),
@@ -463,7 +467,7 @@ impl Autotune {
             report: Some(Report::Fitted(axis, [a, b, c], fit.r2)),
             ..Tick::default()
         };
-        (Phase::Fitting { next: next + 1 }, tick)
+        (Phase::Fitting { next: next + 1, id }, tick)
     }
 
     fn fail(&mut self, why: Failure) -> (Phase, Tick) {

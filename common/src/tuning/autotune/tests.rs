@@ -206,7 +206,15 @@ fn a_model_whose_design_fails_its_margins_hands_over_no_gains() {
         servo_bandwidth_hz: 8.0,
         ..UNIDENTIFIED
     };
-    a.phase = Phase::Fitting { next: FITTED.len() };
+    a.phase = Phase::Fitting {
+        next: FITTED.len(),
+        id: Identifier::new(IdentifyConfig {
+            airspeed_ref: 17.0,
+            servo_tau_s: 0.02,
+            servo_rate_radps: 0.0,
+            airspeed_filter_tau_s: 0.0,
+        }),
+    };
     let (e, p) = (level(), p());
     let mut last = None;
     for _ in 0..400 {
