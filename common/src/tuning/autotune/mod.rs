@@ -300,9 +300,15 @@ impl Autotune {
                 }
                 design::Step::Done(g) => {
                     self.status = Status::Succeeded;
+                    // Designed at the airspeed flown: where the loops scale with the airspeed,
+                    // this is the one at which they hold as designed.
+                    let mut gains = g.gains;
+                    if gains.scaling_airspeed > 0.0 {
+                        gains.scaling_airspeed = self.model.va;
+                    }
                     let tick = Tick {
                         report: Some(Report::Applied),
-                        gains: Some((g.gains, self.model)),
+                        gains: Some((gains, self.model)),
                         ..Tick::default()
                     };
                     (Phase::Idle, tick)
