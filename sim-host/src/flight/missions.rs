@@ -420,9 +420,9 @@ pub const AUTOTUNE_AT_S: f64 = 10.0;
 /// (48 s), the fit and the design, and some level flight.
 pub const AUTOTUNE_FOR_S: f64 = 70.0;
 
-/// The parameters the autotune flight's station reads before the autotune and after it:
-/// the gains the design sets and the coefficients it identified.
-pub const AUTOTUNE_PARAMS: [&str; 22] = [
+/// The gains the design sets, which the autotune flight's station reads before the autotune
+/// and after it, with the coefficients it identified (the `ATUN_A_*` parameters).
+pub const AUTOTUNE_GAINS: [&str; 15] = [
     "RLL_KP",
     "RLL_KI",
     "RLL_RATE_KD",
@@ -438,24 +438,29 @@ pub const AUTOTUNE_PARAMS: [&str; 22] = [
     "ASPD_THR_KP",
     "ASPD_THR_KI",
     "ASPD_SCL_REF",
-    "ATUN_A_PHI1",
-    "ATUN_A_PHI2",
-    "ATUN_A_THT1",
-    "ATUN_A_THT2",
-    "ATUN_A_THT3",
-    "ATUN_A_V1",
-    "ATUN_A_V2",
 ];
+
+/// What the autotune flight's station reads: [`AUTOTUNE_GAINS`], then the identified
+/// coefficients' parameters as the vehicle declares them.
+pub fn autotune_params() -> Vec<String> {
+    let identified = common::tuning::autotune::params::IDENTIFIED.params.iter();
+    AUTOTUNE_GAINS
+        .iter()
+        .copied()
+        .chain(identified.map(|p| p.def.name))
+        .map(String::from)
+        .collect()
+}
 
 /// The thesis's script flown after an autotune, as a QGroundControl user flies it: Hold from
 /// the hand launch, autotune ([`AUTOTUNE_AT_S`]), then the script [`AUTOTUNE_FOR_S`] later;
-/// the station reads [`AUTOTUNE_PARAMS`] before the autotune and before the script.
+/// the station reads [`autotune_params`] before the autotune and before the script.
 pub fn autotune_then_thesis() -> FlightConfig {
     let mut script = Script::thesis();
     for step in script.steps.iter_mut().skip(1) {
         step.after_arm_s += AUTOTUNE_AT_S + AUTOTUNE_FOR_S;
     }
-    let read = || Action::ReadParams(AUTOTUNE_PARAMS.iter().map(|p| p.to_string()).collect());
+    let read = || Action::ReadParams(autotune_params());
     let at = |after_arm_s, action| ScriptStep {
         after_arm_s,
         action,
