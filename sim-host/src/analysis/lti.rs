@@ -151,6 +151,8 @@ pub fn margins(l: impl Fn(f64) -> Complex<f64>, w_min: f64, w_max: f64) -> Margi
         let p = l(w).arg().to_degrees();
         let p = match prev {
             Some(q) => q + ((p - q + 180.0).rem_euclid(360.0) - 180.0),
+            // Where a loop's phase starts at low frequency (0 or -90 deg per integrator).
+            None if p > 0.0 => p - 360.0,
             None => p,
         };
         phase.push(p);
@@ -163,7 +165,8 @@ pub fn margins(l: impl Fn(f64) -> Complex<f64>, w_min: f64, w_max: f64) -> Margi
             let w = bisect(|w| l(w).norm() - 1.0, ws[i], ws[i + 1]);
             let ph = phase[i]
                 + (phase[i + 1] - phase[i]) * ((w / ws[i]).ln() / (ws[i + 1] / ws[i]).ln());
-            let pm = (ph + 180.0 + 180.0).rem_euclid(360.0) - 180.0;
+            // Not wrapped: the phase as followed from low frequency (common's margins).
+            let pm = ph + 180.0;
             if out.phase_margin_deg.is_none_or(|m| pm < m) {
                 out.phase_margin_deg = Some(pm);
                 out.gain_crossover_radps = Some(w);

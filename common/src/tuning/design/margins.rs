@@ -137,12 +137,15 @@ impl Sweep {
     }
 
     /// `L` at `w`, its residual phase taken on the branch nearest `near` (the previous
-    /// sample's, or the bracket's end).
+    /// sample's, or the bracket's end); the sweep's first sample's in `(-360, 0]` deg, where a
+    /// loop's phase starts at low frequency (0 for a proportional loop, -90 deg per
+    /// integrator), so that the phase followed from there is the Bode plot's.
     fn sample(&self, p: &Plant, w: f32, near: Option<f32>) -> Sample {
         let l = self.transfer.eval(p, w);
         let arg = libm::atan2f(l.im, l.re);
         let residual = match near {
             Some(r) => r + wrap(arg - r),
+            None if arg > 0.0 => arg - TAU,
             None => arg,
         };
         Sample {
@@ -234,8 +237,12 @@ impl Sweep {
         let m = &mut self.margins;
         match b.crossing {
             Crossing::Gain => {
-                // The phase above -180 deg, wrapped into [-180, 180) deg.
-                let pm = wrap(at(b.lo.phase, b.hi.phase) + PI).to_degrees();
+                // The phase above -180 deg as followed from low frequency, not wrapped: a
+                // crossing where a damper's lead has taken the phase above 0 (a lightly
+                // damped short period's resonance crossed twice) has more than 180 deg of
+                // margin, not a negative one; one where a delay has taken it below -540 deg
+                // has a negative margin, not a positive one.
+                let pm = (at(b.lo.phase, b.hi.phase) + PI).to_degrees();
                 if m.phase_margin_deg.is_none_or(|worst| pm < worst) {
                     m.phase_margin_deg = Some(pm);
                     m.gain_crossover_radps = Some(w);

@@ -44,7 +44,14 @@ fn reference_phase_margin(l: impl Fn(f64) -> Z) -> Option<f64> {
     let n = 20_000;
     let w = |k: usize| 1e-3 * libm::pow(1e6, k as f64 / n as f64);
     let mut worst: Option<f64> = None;
-    let (mut w0, mut p0) = (w(0), arg(l(w(0))));
+    // The phase followed from where a loop's starts, in (-360, 0] deg.
+    let a0 = arg(l(w(0)));
+    let a0 = if a0 > 0.0 {
+        a0 - 2.0 * core::f64::consts::PI
+    } else {
+        a0
+    };
+    let (mut w0, mut p0) = (w(0), a0);
     for k in 1..=n {
         let w1 = w(k);
         let a = arg(l(w1));
@@ -62,8 +69,7 @@ fn reference_phase_margin(l: impl Fn(f64) -> Z) -> Option<f64> {
             }
             let t = libm::log(lo / w0) / libm::log(w1 / w0);
             let phase = (p0 + t * (p1 - p0)).to_degrees();
-            let pm = libm::fmod(phase + 180.0 + 3600.0, 360.0);
-            let pm = if pm >= 180.0 { pm - 360.0 } else { pm };
+            let pm = phase + 180.0;
             worst = Some(worst.map_or(pm, |m: f64| m.min(pm)));
         }
         (w0, p0) = (w1, p1);
@@ -131,6 +137,30 @@ fn a_known_third_order_loop_keeps_9_54_db_and_32_6_deg() {
     assert!((m.phase_crossover_radps.unwrap_or(0.0) - 2f32.sqrt()).abs() < 1e-3);
     assert!((pm - 32.61).abs() < 0.05, "{m:?}");
     assert!((m.gain_crossover_radps.unwrap_or(0.0) - 0.7494).abs() < 1e-3);
+}
+
+#[test]
+fn a_lightly_damped_short_period_crossed_three_times_keeps_the_last_crossings_39_8_deg() {
+    // The Aerosonde's reduced short period at 25 m/s (a_theta1 5.07, a_theta2 95.6, a_theta3
+    // -34.55: zeta 0.26), PID kp -1.25, ki -0.2875, kd -0.336, the 8 Hz servo, 50 ms: |L|
+    // crosses 1 at 0.115, 5.27 and 16.07 rad/s with the phase at -63.9, +11.4 and -140.2 deg
+    // (numpy, 200,000 points): margins 116.1, 191.4 and 39.8 deg. Wrapped into [-180, 180),
+    // the middle one read -168.6 deg and failed a stable loop.
+    let mut p = third_order(0.05);
+    p.pitch = PitchResponse::short_period(5.07, 95.6, -34.55);
+    p.servo_pole = 2.0 * core::f32::consts::PI * 8.0;
+    let gains = LoopGains {
+        kp: -1.25,
+        ki: -0.2875,
+        kd: -0.336,
+    };
+    let m = margins_of(Transfer::Pitch(gains), &p);
+    let pm = m.phase_margin_deg.unwrap_or(0.0);
+    assert!((pm - 39.8).abs() < 0.3, "{m:?}");
+    assert!(
+        (m.gain_crossover_radps.unwrap_or(0.0) - 16.07).abs() < 0.1,
+        "{m:?}"
+    );
 }
 
 #[test]
