@@ -98,6 +98,7 @@ fn identified(samples: &[Sample], servo_tau: f32) -> Identifier {
         servo_tau_s: servo_tau,
         servo_rate_radps: 0.0,
         airspeed_filter_tau_s: 0.0,
+        attitude_filter_tau_s: 0.0,
     });
     for s in samples {
         id.push(0.02, s);
@@ -241,6 +242,7 @@ fn bad_time_steps_and_values_start_a_new_stretch_and_leave_the_fit_as_it_was() {
         servo_tau_s: SERVO_TAU,
         servo_rate_radps: 0.0,
         airspeed_filter_tau_s: 0.0,
+        attitude_filter_tau_s: 0.0,
     });
     for (k, s) in data.iter().enumerate() {
         match k {
@@ -274,6 +276,7 @@ fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
         servo_tau_s: SERVO_TAU,
         servo_rate_radps: 0.0,
         airspeed_filter_tau_s: 0.0,
+        attitude_filter_tau_s: 0.0,
     });
     let mut va = VA_REF;
     for k in 0..3000 {
@@ -316,6 +319,7 @@ fn the_course_kinematics_of_banked_turns_give_a_gain_of_one() {
         servo_tau_s: SERVO_TAU,
         servo_rate_radps: 0.0,
         airspeed_filter_tau_s: 0.0,
+        attitude_filter_tau_s: 0.0,
     });
     let mut chi = 0.0f32;
     for k in 0..2000 {
@@ -348,6 +352,7 @@ fn a_full_stick_command_moves_the_surface_at_the_rate_limit_and_a_small_one_on_i
         servo_tau_s: SERVO_TAU,
         servo_rate_radps: 150.0 * DEG,
         airspeed_filter_tau_s: 0.0,
+        attitude_filter_tau_s: 0.0,
     };
     let (end, mean) = super::identify::servo(&c, 0.0, 45.0 * DEG, 0.02);
     assert!((end - 3.0 * DEG).abs() < 1e-5 && (mean - 1.5 * DEG).abs() < 1e-5);

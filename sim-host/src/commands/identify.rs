@@ -296,6 +296,7 @@ pub fn identify_log(
         servo_tau_s: servo_tau as f32,
         servo_rate_radps: aircraft.actuators.rate_limit_radps as f32,
         airspeed_filter_tau_s: 0.0,
+        attitude_filter_tau_s: 0.0,
     });
     let mut last: Option<u64> = None;
     for s in &flown {

@@ -22,6 +22,7 @@ mod tests;
 use super::design::{self, DesignFailure, DesignInputs, DesignModel, Designer};
 use super::identify::{
     Axis, AxisError, AxisFit, Identifier, IdentifyConfig, Sample, AIRSPEED_FILTER_TAU_S,
+    ATTITUDE_FILTER_TAU_S,
 };
 use crate::actuators::Surfaces;
 use crate::control::autopilot::{Commands, GainSet};
@@ -228,6 +229,7 @@ impl Autotune {
             servo_tau_s: tau,
             servo_rate_radps: p.servo_rate,
             airspeed_filter_tau_s: AIRSPEED_FILTER_TAU_S,
+            attitude_filter_tau_s: ATTITUDE_FILTER_TAU_S,
         });
         self.start = Start {
             alt_m: e.alt_amsl_m,

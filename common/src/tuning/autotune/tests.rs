@@ -213,6 +213,7 @@ fn a_model_whose_design_fails_its_margins_hands_over_no_gains() {
             servo_tau_s: 0.02,
             servo_rate_radps: 0.0,
             airspeed_filter_tau_s: 0.0,
+            attitude_filter_tau_s: 0.0,
         }),
     };
     let (e, p) = (level(), p());
