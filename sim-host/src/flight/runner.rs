@@ -169,8 +169,10 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         None => None,
     };
 
-    // Trimmed, level, 100 m above home, 17 m/s (TrimTarget::level is at 100 m AGL).
-    let level = TrimTarget::level();
+    // Trimmed, level, 100 m above home (TrimTarget::level is at 100 m AGL), at the aircraft's
+    // cruise airspeed (the 25e's 17 m/s): a hand launch starts there, and a take-off from the
+    // runway holds the trim's surfaces until the autopilot takes over.
+    let level = TrimTarget::level().at_airspeed(aircraft.cruise_airspeed_mps());
     let trim = trim_with(&params, &level);
     if !trim.converged {
         return Err(FlightError::Config(format!(
@@ -194,7 +196,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         ),
         None => {
             // Trimmed in the air mass: the steady wind carries the aircraft, so the airspeed
-            // is the trim's 17 m/s whatever the wind.
+            // is the trim's whatever the wind.
             let mut start = trim.state;
             start.vel_body += ned_to_body(&start.attitude, &Vector3::from(cfg.wind_ned));
             (Plant::from_params(params.clone(), start), trim.controls)
