@@ -2900,3 +2900,41 @@ fn a_failed_autotune_is_told_as_failed_and_a_disable_is_passed_on() {
     assert_eq!(autotune_acks(&out), [(MavResult::MAV_RESULT_ACCEPTED, 0)]);
     assert_eq!(l.take_requests().autotune, Some(false));
 }
+
+/// A design that misses a margin is told in one STATUSTEXT with the loop, the margin and its
+/// target (the longest loop name with the longest figures among them), within the 50
+/// characters of the message.
+#[test]
+fn a_design_failure_fits_one_statustext_with_its_loop_margin_and_target() {
+    use crate::tuning::autotune::{Failure, Report};
+    use crate::tuning::design::{DesignFailure, Loop, Reason};
+    let failed = |reason| {
+        let r = Report::Failed(Failure::Design(DesignFailure {
+            loop_: Some(Loop::AirspeedThrottle),
+            reason,
+        }));
+        tune::words(&r).1.as_str().to_string()
+    };
+    assert_eq!(
+        failed(Reason::PhaseMargin {
+            deg: -137.1,
+            min_deg: 30.0
+        }),
+        "Autotune failed: aspd-thr: PM -137.1 deg < 30"
+    );
+    assert_eq!(
+        failed(Reason::GainMargin(-33.4)),
+        "Autotune failed: aspd-thr: GM -33.4 dB < 6"
+    );
+    for l in Loop::ALL {
+        let r = Report::Failed(Failure::Design(DesignFailure {
+            loop_: Some(l),
+            reason: Reason::PhaseMargin {
+                deg: -137.1,
+                min_deg: 45.0,
+            },
+        }));
+        let text = tune::words(&r).1;
+        assert!(text.as_str().ends_with("deg < 45"), "{}", text.as_str());
+    }
+}

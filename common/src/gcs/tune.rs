@@ -226,8 +226,10 @@ fn design_words(l: &mut Line<TEXT_MAX>, d: &DesignFailure) {
         Reason::NoCrossover => {
             l.str("no crossover");
         }
-        Reason::GainMargin(db) => below(l, "gain margin", db, " dB", GAIN_MARGIN_MIN_DB),
-        Reason::PhaseMargin { deg, min_deg } => below(l, "phase margin", deg, " deg", min_deg),
+        // GM and PM, as control engineers write them: the words "phase margin" took the
+        // target off the end of a 50-character STATUSTEXT for the longer loops' names.
+        Reason::GainMargin(db) => below(l, "GM", db, " dB", GAIN_MARGIN_MIN_DB),
+        Reason::PhaseMargin { deg, min_deg } => below(l, "PM", deg, " deg", min_deg),
         Reason::GainSet(GainError::OutOfBounds(what)) => {
             l.str(what).str(" out of bounds");
         }
