@@ -101,11 +101,13 @@ impl Vehicle {
         if let Some(r) = tick.report {
             self.commander.notify(Notice::Tune(r));
         }
-        if let Some((gains, identified)) = tick.gains {
+        if let Some(identified) = tick.identified {
             let names = params::IDENTIFIED.params.iter();
             let values = names.map(|q| (q.def.name, (q.get)(&identified)));
-            // Out of the parameters' bounds only for a model the design would refuse.
+            // Out of the parameters' bounds only for a model the design then refuses.
             let _ = self.params.set_all(values);
+        }
+        if let Some(gains) = tick.gains {
             if self.set_gains(&gains, "Autotune: gains applied") {
                 self.tuned_from = Some(base);
             } else {

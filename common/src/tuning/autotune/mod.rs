@@ -131,8 +131,11 @@ pub struct Tick {
     pub commands: Option<Commands>,
     /// Tell the station.
     pub report: Option<Report>,
-    /// The designed gains and the model they came from: apply them.
-    pub gains: Option<(GainSet, DesignModel)>,
+    /// The model identified, once every axis is fitted: publish it (whatever the design
+    /// then makes of it).
+    pub identified: Option<DesignModel>,
+    /// The designed gains: apply them.
+    pub gains: Option<GainSet>,
 }
 
 /// Where the level flight it started from is.
@@ -310,7 +313,7 @@ impl Autotune {
                     }
                     let tick = Tick {
                         report: Some(Report::Applied),
-                        gains: Some((gains, self.model)),
+                        gains: Some(gains),
                         ..Tick::default()
                     };
                     (Phase::Idle, tick)
@@ -434,7 +437,7 @@ impl Autotune {
         let tick = Tick {
             commands: Some(commands),
             report,
-            gains: None,
+            ..Tick::default()
         };
         (Phase::Flying { t_s: t_s + dt, id }, tick)
     }
@@ -450,9 +453,13 @@ impl Autotune {
         let Some(&axis) = FITTED.get(next) else {
             let model = self.model;
             self.status = Status::Running(85);
+            let tick = Tick {
+                identified: Some(model),
+                ..Tick::default()
+            };
             return (
                 Phase::Designing(Designer::new(&model, &DesignInputs::THESIS, base)),
-                Tick::default(),
+                tick,
             );
         };
         let fit: AxisFit = match id.fit(axis) {
