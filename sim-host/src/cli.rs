@@ -385,6 +385,39 @@ pub(crate) struct FlyArgs {
     /// repeatable: `--param NAV_LND_SLP_DEG=6`.
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     pub(crate) params: Vec<(String, f32)>,
+    /// Set the parameters of a QGroundControl parameter file (`.params`: tab-separated
+    /// vehicle, component, name, value, type; `#` comments) before arming, in its order, as
+    /// QGroundControl's "Load from file" does; `--param` values follow them.
+    #[arg(long = "params", value_name = "FILE.params", value_parser = parse_params_file)]
+    pub(crate) params_file: Option<ParamsFile>,
+}
+
+/// The parameters of a `.params` file, in its order.
+#[derive(Clone, Debug)]
+pub(crate) struct ParamsFile(Vec<(String, f32)>);
+
+/// Reads a QGroundControl parameter file, each value checked as [`parse_param`] checks one:
+/// an error names the file, the line, the parameter and the value.
+fn parse_params_file(path: &str) -> Result<ParamsFile, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = line.split('\t').collect();
+        let (Some(name), Some(value)) = (fields.get(2), fields.get(3)) else {
+            return Err(format!(
+                "{path}:{}: `{line}`: expected vehicle, component, name, value and type, tab-separated",
+                n + 1
+            ));
+        };
+        let p = parse_param(&format!("{name}={value}"))
+            .map_err(|e| format!("{path}:{}: {e}", n + 1))?;
+        out.push(p);
+    }
+    Ok(ParamsFile(out))
 }
 
 impl FlyArgs {
@@ -412,7 +445,13 @@ impl FlyArgs {
             mission: self.mission,
             stick_doublets: self.stick_doublets,
             autotune: self.autotune,
-            params: self.params,
+            params: self
+                .params_file
+                .map(|f| f.0)
+                .unwrap_or_default()
+                .into_iter()
+                .chain(self.params)
+                .collect(),
         }
     }
 }
