@@ -82,7 +82,7 @@ fn lowest(o: &FlightOutcome, from_s: f64, to_s: f64) -> f64 {
 /// From the firmware's default gains, in still air, the autotune identifies the 25e's roll
 /// and pitch from its own estimates: roll damping and aileron power and the pitch damping
 /// and elevator power within 15 % of the linearisation at the same 17 m/s (measured: +4.5 %,
-/// +0.9 %, +3.9 %, -1.4 %), the pitch stiffness within 20 % (measured -16 %: the estimator's
+/// +0.8 %, +2.3 %, -3.3 %), the pitch stiffness within 20 % (measured -18 %: the estimator's
 /// vertical velocity, through the angle of attack it gives, is the cause, docs/AUTOTUNE.md);
 /// every fit explains at least 70 % of what it fits; the gains are applied.
 #[test]
