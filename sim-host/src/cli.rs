@@ -369,8 +369,10 @@ pub(crate) struct FlyArgs {
     pub(crate) stick_doublets: bool,
     /// Autotune in the air first, as QGroundControl's autotune button does
     /// (MAV_CMD_DO_AUTOTUNE_ENABLE), from the firmware's default gains, then fly the thesis's
-    /// script on the gains it designed (docs/AUTOTUNE.md).
-    #[arg(long, conflicts_with_all = ["mission", "stick_doublets", "gains"])]
+    /// script on the gains it designed; with --mission, take off from the runway (Takeoff),
+    /// autotune in Hold, then fly the mission to its landing. Each beside the same flown on
+    /// the default gains (docs/AUTOTUNE.md).
+    #[arg(long, conflicts_with_all = ["stick_doublets", "gains"])]
     pub(crate) autotune: bool,
     /// Fly a mission from the runway instead of the thesis's script: a QGroundControl `.plan`
     /// or `QGC WPL 110` file (mission and geofence are uploaded), or `default` for the

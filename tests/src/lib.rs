@@ -76,6 +76,25 @@ pub fn tool_available(name: &str) -> bool {
     found
 }
 
+/// Whether python3 with pymavlink is here: false (skipped) outside CI, a failure under CI.
+pub fn pymavlink_available() -> bool {
+    if !tool_available("python3") {
+        return false;
+    }
+    let have = Command::new("python3")
+        .args(["-c", "import pymavlink"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "pymavlink is required under CI (.ci/run installs it)"
+        );
+        eprintln!("SKIPPED: pymavlink is not installed (pip install pymavlink)");
+    }
+    have
+}
+
 /// Builds `sim-host` (release) with its `mcu-libm` feature, the host build computing sines,
 /// arctangents and exponentials with the libm crate as the MCU image does, into
 /// `target/mcu-libm`; returns the binary's path.

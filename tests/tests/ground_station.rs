@@ -589,26 +589,6 @@ fn a_request_behind_a_corrupt_length_in_its_datagram_is_answered_at_once() {
     assert_eq!(value, Some(17.0), "answered within a second, not held");
 }
 
-/// Whether python3 with pymavlink is here; false (skipped) outside CI, a failure under CI.
-fn have_pymavlink() -> bool {
-    if !system_tests::tool_available("python3") {
-        return false;
-    }
-    let have_pymavlink = std::process::Command::new("python3")
-        .args(["-c", "import pymavlink"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !have_pymavlink {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "pymavlink is required under CI (.ci/run installs it)"
-        );
-        eprintln!("SKIPPED: pymavlink is not installed (pip install pymavlink)");
-        return false;
-    }
-    true
-}
-
 /// Runs one of `tests/interop/`'s pymavlink scripts against a fresh SITL vehicle; false when
 /// pymavlink is missing outside CI (skipped), a failed assertion when a check fails.
 fn pymavlink_script(name: &str) -> bool {
@@ -618,7 +598,7 @@ fn pymavlink_script(name: &str) -> bool {
 /// [`pymavlink_script`] with the vehicle's logs in `logs`, passed as the script's second
 /// argument; what it printed, `None` when skipped.
 fn pymavlink_script_with(name: &str, logs: Option<&std::path::Path>) -> Option<String> {
-    if !have_pymavlink() {
+    if !system_tests::pymavlink_available() {
         return None;
     }
     let gps = Arc::new(AtomicBool::new(true));
@@ -708,7 +688,7 @@ fn pymavlink_sees_the_pack_s_voltage_current_and_charge_in_sys_status_and_batter
 fn pymavlink_reads_the_flights_tlog_as_a_ground_stations_log_of_both_directions() {
     // A short scripted flight writes out/…/flight.tlog; pymavlink's own log reader checks it
     // (see the script's docstring).
-    if !have_pymavlink() {
+    if !system_tests::pymavlink_available() {
         return;
     }
     let dir = tempfile::tempdir().expect("temporary directory");

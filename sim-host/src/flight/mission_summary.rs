@@ -112,11 +112,16 @@ pub fn share_on_stop_pct(throttle: &[f64]) -> f64 {
     100.0 * on as f64 / throttle.len() as f64
 }
 
-/// Figures of a mission flight. `land_point` is the NAV_LAND item north and east of home.
+/// Figures of a mission flight. `land_point` is the NAV_LAND item north and east of home;
+/// the errors and the flight time count over the samples from `from_s` on (the mission's
+/// part of a flight that flew something else first; `-inf`: the whole flight), in home's
+/// datum as set at arming; `energy_j` is the motor's over the same part.
+#[allow(clippy::too_many_arguments)]
 pub fn mission_summary(
     mission: &[mavlink::dialects::common::MISSION_ITEM_INT_DATA],
     land_point: Option<(f64, f64)>,
-    samples: &[Sample],
+    flight: &[Sample],
+    from_s: f64,
     reached: &[u16],
     touchdown: Option<&Touchdown>,
     energy_j: f64,
@@ -138,6 +143,8 @@ pub fn mission_summary(
         })
         .map(|i| i.seq)
         .collect();
+    let datum = HomeDatum::of(flight);
+    let samples = &flight[flight.partition_point(|s| s.t < from_s)..];
     let leg: Vec<f64> = samples
         .iter()
         .filter(|s| s.armed && s.straight && s.nav_phase == Phase::Waypoint as u8)
@@ -161,7 +168,6 @@ pub fn mission_summary(
     let cruising = samples.iter().filter(|s| {
         s.armed && (s.nav_phase == Phase::Waypoint as u8 || s.nav_phase == Phase::Loiter as u8)
     });
-    let datum = HomeDatum::of(samples);
     let (alt, va): (Vec<f64>, Vec<f64>) = cruising
         .clone()
         .map(|s| (s.sp_alt - datum.truth_alt(s), s.sp_airspeed - s.airspeed))

@@ -2,7 +2,7 @@
 //! positions, built from offsets in metres from the simulator's home (the runway).
 
 use super::config::{FlightConfig, RcSticks};
-use super::script::{Action, Script, ScriptStep, PX4_STABILIZED};
+use super::script::{Action, Script, ScriptStep, PX4_POSCTL, PX4_STABILIZED};
 use common::math::geodetic::{offset_point, GeoPoint};
 use mavlink::dialects::common::{MavCmd, MavFrame, MavMissionType, MISSION_ITEM_INT_DATA};
 
@@ -440,16 +440,37 @@ pub const AUTOTUNE_GAINS: [&str; 15] = [
     "ASPD_SCL_REF",
 ];
 
-/// What the autotune flight's station reads: [`AUTOTUNE_GAINS`], then the identified
-/// coefficients' parameters as the vehicle declares them.
+/// What the vehicle's design ran on beside the identified coefficients, which the autotune
+/// flight's station reads as well: the servo it fitted through and the feedback filter of the
+/// outer loops (the host recomputes the design's margins from them).
+pub const AUTOTUNE_DESIGN_INPUTS: [&str; 2] = ["SERVO_BW", "FB_LPF_POLE"];
+
+/// What the autotune flight's station reads: [`AUTOTUNE_GAINS`], [`AUTOTUNE_DESIGN_INPUTS`],
+/// then the identified coefficients' parameters as the vehicle declares them.
 pub fn autotune_params() -> Vec<String> {
     let identified = common::tuning::autotune::params::IDENTIFIED.params.iter();
     AUTOTUNE_GAINS
         .iter()
+        .chain(&AUTOTUNE_DESIGN_INPUTS)
         .copied()
         .chain(identified.map(|p| p.def.name))
         .map(String::from)
         .collect()
+}
+
+/// The station's autotune pressed at `at_s` after arming: [`autotune_params`] read a second
+/// before, the autotune, and the same read a second before [`AUTOTUNE_FOR_S`] has passed.
+fn autotune_steps(at_s: f64) -> [ScriptStep; 3] {
+    let read = || Action::ReadParams(autotune_params());
+    let at = |after_arm_s, action| ScriptStep {
+        after_arm_s,
+        action,
+    };
+    [
+        at(at_s - 1.0, read()),
+        at(at_s, Action::Autotune(true)),
+        at(at_s + AUTOTUNE_FOR_S - 1.0, read()),
+    ]
 }
 
 /// The thesis's script flown after an autotune, as a QGroundControl user flies it: Hold from
@@ -460,22 +481,52 @@ pub fn autotune_then_thesis() -> FlightConfig {
     for step in script.steps.iter_mut().skip(1) {
         step.after_arm_s += AUTOTUNE_AT_S + AUTOTUNE_FOR_S;
     }
-    let read = || Action::ReadParams(autotune_params());
-    let at = |after_arm_s, action| ScriptStep {
-        after_arm_s,
-        action,
-    };
-    script.steps.splice(
-        1..1,
-        [
-            at(AUTOTUNE_AT_S - 1.0, read()),
-            at(AUTOTUNE_AT_S, Action::Autotune(true)),
-            at(AUTOTUNE_AT_S + AUTOTUNE_FOR_S - 1.0, read()),
-        ],
-    );
+    script.steps.splice(1..1, autotune_steps(AUTOTUNE_AT_S));
     FlightConfig {
         duration_s: script.length_s(),
         script,
         ..FlightConfig::default()
+    }
+}
+
+/// When the autotune-then-mission flight's station switches to Hold, s after arming on the
+/// runway: the take-off it started a second after arming has climbed to `NAV_RTL_ALT`
+/// (60 m) some 21 s after arming, and circles there.
+pub const HOLD_AFTER_ARM_S: f64 = 30.0;
+
+/// When that station presses autotune, s after arming: 5 s of Hold after the circle, the
+/// wings level.
+pub const AUTOTUNE_AFTER_TAKEOFF_S: f64 = HOLD_AFTER_ARM_S + 5.0;
+
+/// When that station starts the mission, s after arming: [`AUTOTUNE_FOR_S`] after the
+/// autotune was pressed.
+pub const MISSION_AFTER_AUTOTUNE_S: f64 = AUTOTUNE_AFTER_TAKEOFF_S + AUTOTUNE_FOR_S;
+
+/// A mission flight (`runway_mission`'s, or a mission file's) flown after an autotune, as a
+/// QGroundControl user flies it: the mission uploaded and the autopilot armed on the runway
+/// as for the mission, then Takeoff (`MAV_CMD_NAV_TAKEOFF`, QGroundControl's Takeoff action)
+/// a second after arming, Hold once in the air ([`HOLD_AFTER_ARM_S`]), autotune
+/// ([`AUTOTUNE_AFTER_TAKEOFF_S`]; [`autotune_params`] read before it and once it is done),
+/// then `MAV_CMD_MISSION_START` ([`MISSION_AFTER_AUTOTUNE_S`]): the whole mission, its
+/// take-off item (already above its height) included, flown on the gains the autotune
+/// applied, to the landing and the disarm. The mission's figures count from its start.
+pub fn autotune_then_mission(mission: FlightConfig) -> FlightConfig {
+    let at = |after_arm_s, action| ScriptStep {
+        after_arm_s,
+        action,
+    };
+    let mut steps = vec![
+        at(1.0, Action::Takeoff),
+        at(HOLD_AFTER_ARM_S, Action::Mode(PX4_POSCTL)),
+    ];
+    steps.extend(autotune_steps(AUTOTUNE_AFTER_TAKEOFF_S));
+    steps.push(at(MISSION_AFTER_AUTOTUNE_S, Action::MissionStart));
+    FlightConfig {
+        duration_s: mission.duration_s + MISSION_AFTER_AUTOTUNE_S,
+        script: Script {
+            steps,
+            ..mission.script
+        },
+        ..mission
     }
 }

@@ -254,6 +254,9 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     // in gusts lifts off at its three-point attitude; see `FlightSummary::lifted_after_disarm`).
     let mut armed_touchdown = None;
     let mut energy_j = 0.0;
+    // The motor's energy when the mission started: a mission started in the air is measured
+    // from there (`mission_window`).
+    let mut energy_at_mission_j = None;
     let mut ended = Ending::Duration;
     let mut failure = None;
     for k in 0..frames {
@@ -308,6 +311,13 @@ pub fn fly<T: Transport, O: Onboard<T>>(
         )));
 
         serve_stations(t_s, gcs.as_mut(), bridge.as_mut(), link, onboard);
+        if energy_at_mission_j.is_none()
+            && gcs
+                .as_ref()
+                .is_some_and(|g| g.mission_started_s().is_some())
+        {
+            energy_at_mission_j = Some(energy_j);
+        }
         let answer = match link.exchange(time_us, &msgs) {
             Ok(a) => a,
             Err(e) if cfg.until_link_closes && closed(&e) => {
@@ -446,13 +456,16 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     summary.lifted_after_disarm = lifted.map(|t| touchdown_summary(t, land_point));
     if let Some(g) = gcs.as_ref().filter(|_| !cfg.script.mission.is_empty()) {
         let reached: Vec<u16> = g.reached.iter().map(|r| r.1).collect();
+        let from_s = mission_window(&samples, g.mission_started_s(), home_alt);
+        let energy_before_j = energy_at_mission_j.filter(|_| from_s.is_finite());
         let mut m = mission_summary(
             &cfg.script.mission,
             land_point,
             &samples,
+            from_s,
             &reached,
             landing,
-            energy_j,
+            energy_j - energy_before_j.unwrap_or(0.0),
             frame_s,
         );
         // The aircraft's file places the CG (a campaign, which shifts it, judges its flights
@@ -524,6 +537,20 @@ fn truth_frame(time_us: u64, t: &Truth, plant: &Plant, alt_amsl: f64) -> HIL_STA
         yacc: mg(t.specific_force_body.y),
         zacc: mg(t.specific_force_body.z),
     }
+}
+
+/// Height above home over which an aircraft counts as in the air when its mission starts, m.
+const IN_THE_AIR_M: f64 = 5.0;
+
+/// From when a mission's figures count, s: from its start (`started_s`, the station's
+/// accepted `MAV_CMD_MISSION_START`) when the aircraft was already in the air then, after a
+/// take-off, a hand launch or an autotune flown in another mode; else from the beginning
+/// (`-inf`), the runway's take-off being the mission's own.
+fn mission_window(samples: &[Sample], started_s: Option<f64>, home_alt: f64) -> f64 {
+    started_s
+        .and_then(|t| samples.iter().find(|s| s.t >= t))
+        .filter(|s| s.alt - home_alt > IN_THE_AIR_M)
+        .map_or(f64::NEG_INFINITY, |s| s.t)
 }
 
 /// The landing the autopilot flew and, apart from it, a touchdown after the wind lifted the

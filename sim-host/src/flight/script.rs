@@ -56,6 +56,9 @@ pub enum Action {
     Turn(f32),
     /// `MAV_CMD_MISSION_START`: fly the uploaded mission from its current item.
     MissionStart,
+    /// `MAV_CMD_NAV_TAKEOFF` (QGroundControl's Takeoff action): the Takeoff mode, a runway
+    /// take-off along the present heading to `NAV_RTL_ALT`, then a circle there.
+    Takeoff,
     /// `MAV_CMD_NAV_RETURN_TO_LAUNCH`.
     Return,
     /// `MAV_CMD_DO_SET_MODE` AUTO.LOITER: circle here.
@@ -165,6 +168,8 @@ pub struct GroundStation {
     pub params_read: Vec<(f64, String, f32)>,
     /// The landed state of EXTENDED_SYS_STATE each time it changed: time, state.
     pub landed_states: Vec<(f64, MavLandedState)>,
+    /// When the autopilot first accepted `MAV_CMD_MISSION_START`, s.
+    mission_started_s: Option<f64>,
     uploaded: bool,
     next_heartbeat_s: f64,
     silent: bool,
@@ -193,6 +198,7 @@ impl GroundStation {
             reached: Vec::new(),
             params_read: Vec::new(),
             landed_states: Vec::new(),
+            mission_started_s: None,
             uploaded: false,
             next_heartbeat_s: 0.0,
             silent: false,
@@ -231,6 +237,11 @@ impl GroundStation {
     /// When the autopilot accepted arming, s.
     pub fn armed_at_s(&self) -> Option<f64> {
         self.armed_at_s
+    }
+
+    /// When the autopilot first accepted the mission's start (`MAV_CMD_MISSION_START`), s.
+    pub fn mission_started_s(&self) -> Option<f64> {
+        self.mission_started_s
     }
 
     /// The script.
@@ -305,9 +316,13 @@ impl GroundStation {
                             self.silent = false;
                             self.next_heartbeat_s = t_s;
                         }
-                        _ => {
-                            if let Some((what, msg)) = self.encode(&step.action.clone()) {
-                                self.command(t_s, &what, link, onboard, &msg);
+                        action => {
+                            let start = *action == Action::MissionStart;
+                            if let Some((what, msg)) = self.encode(&action.clone()) {
+                                let r = self.command(t_s, &what, link, onboard, &msg);
+                                if start && r == Some(MavResult::MAV_RESULT_ACCEPTED) {
+                                    self.mission_started_s.get_or_insert(t_s);
+                                }
                             }
                         }
                     }
@@ -361,6 +376,10 @@ impl GroundStation {
             Action::MissionStart => (
                 "mission start".into(),
                 command(MavCmd::MAV_CMD_MISSION_START, [0.0; 4]),
+            ),
+            Action::Takeoff => (
+                "takeoff".into(),
+                command(MavCmd::MAV_CMD_NAV_TAKEOFF, [0.0; 4]),
             ),
             Action::Return => (
                 "return".into(),

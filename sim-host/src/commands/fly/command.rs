@@ -15,7 +15,8 @@ use crate::commands::{render, Format};
 use crate::environment::wind::Turbulence;
 use crate::flight::config::{FaultWindow, FlightConfig};
 use crate::flight::missions::{
-    autotune_then_thesis, default_mission, other_runway_missions, runway_mission, stick_doublets,
+    autotune_then_mission, autotune_then_thesis, default_mission, other_runway_missions,
+    runway_mission, stick_doublets,
 };
 use crate::link::profile::ProfileWindow;
 use crate::link::qemu::QemuConfig;
@@ -67,7 +68,8 @@ pub struct FlyCommand {
     pub mission: Option<PathBuf>,
     /// Fly the stick doublets of an identification flight instead of the thesis's script.
     pub stick_doublets: bool,
-    /// Autotune in the air first, then fly the thesis's script on its gains.
+    /// Autotune in the air first, then fly the thesis's script (or, with `mission`, the
+    /// mission) on its gains.
     pub autotune: bool,
     /// Parameters set before arming, name and value.
     pub params: Vec<(String, f32)>,
@@ -116,33 +118,44 @@ pub fn fly_command(
     a: FlyCommand,
     emit: impl Fn(&str) -> anyhow::Result<()>,
 ) -> anyhow::Result<()> {
-    let base = match &a.mission {
+    // What the flight flies without the autotune; with it, the same on the default gains is
+    // flown as well, for the side-by-side tables.
+    let plain = match &a.mission {
         Some(m) => mission_config(aircraft, m)?,
         None if a.stick_doublets => stick_doublets(level_trim_throttle(aircraft)?),
-        None if a.autotune => autotune_then_thesis(),
         None => FlightConfig::default(),
     };
-    let mut cfg = FlightConfig {
-        wind_ned: a.wind_ned,
-        turbulence: a.turbulence,
-        seed: a.seed,
-        realtime: a.realtime,
-        speed: a.speed,
-        progress: true,
-        dt_s: a.dt_s,
-        // With --realtime, QGroundControl can watch: telemetry to 14550, as from PX4 SITL.
-        ground_link: a
-            .realtime
-            .then(|| ("127.0.0.1:18570".into(), "127.0.0.1:14550".into())),
-        // Ctrl-C ends the flight as flown so far (and QEMU with it).
-        stop: Some(stop_on_ctrl_c()),
-        ..base
+    let base = match (&a.mission, a.autotune) {
+        (Some(_), true) => autotune_then_mission(plain.clone()),
+        (None, true) => autotune_then_thesis(),
+        (_, false) => plain.clone(),
     };
-    cfg.faults.extend(a.faults.iter().copied());
-    if let Some(d) = a.duration_s {
-        cfg.duration_s = d;
-    }
-    cfg.script.params.extend(a.params.iter().cloned());
+    // Ctrl-C ends the flight as flown so far (and QEMU with it).
+    let stop = stop_on_ctrl_c();
+    let configure = |base: FlightConfig| {
+        let mut cfg = FlightConfig {
+            wind_ned: a.wind_ned,
+            turbulence: a.turbulence,
+            seed: a.seed,
+            realtime: a.realtime,
+            speed: a.speed,
+            progress: true,
+            dt_s: a.dt_s,
+            // With --realtime, QGroundControl can watch: telemetry to 14550, as from PX4 SITL.
+            ground_link: a
+                .realtime
+                .then(|| ("127.0.0.1:18570".into(), "127.0.0.1:14550".into())),
+            stop: Some(stop),
+            ..base
+        };
+        cfg.faults.extend(a.faults.iter().copied());
+        if let Some(d) = a.duration_s {
+            cfg.duration_s = d;
+        }
+        cfg.script.params.extend(a.params.iter().cloned());
+        cfg
+    };
+    let cfg = configure(base);
     if let Some(g) = a.gains {
         let names: Vec<&str> = common::control::gains::NAMED
             .iter()
@@ -177,14 +190,12 @@ pub fn fly_command(
         anyhow::bail!("--profile profiles the MCU image: it needs --link qemu");
     }
     let r = fly_report(aircraft, &cfg, &opts)?;
-    // The same script on the default gains, for the autotune's side-by-side table.
+    // The same script or mission on the default gains, for the autotune's side-by-side
+    // tables.
     let tuned = if a.autotune {
-        let thesis = FlightConfig::default();
         let plain_cfg = FlightConfig {
-            script: thesis.script,
-            duration_s: thesis.duration_s,
             progress: false,
-            ..cfg.clone()
+            ..configure(plain)
         };
         let plain_opts = FlyOptions {
             out: Some(a.out.join("default-gains")),
