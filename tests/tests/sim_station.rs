@@ -656,13 +656,12 @@ fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_s
         "touchdown {distance:.1} m from the landing point at {:.1} s, sink {:.2} m/s; {:.1} s flown in {:.1} s",
         td.time_s, td.sink_rate_mps, s.sim_s, s.wall_s
     );
-    // On the runway's centre line at under docs/NAVIGATION.md's 1.5 m/s of sink; short of the
-    // point by more than its 20 m on the autotuned gains, as in `fly --autotune --mission
-    // default` (docs/AUTOTUNE.md), so the distance is reported, not held to that target.
+    // docs/NAVIGATION.md's landing targets on the autotuned gains: within 20 m of the point
+    // (measured 7.2 m), under 1.5 m/s of sink, on the runway's centre line.
     let across = td.east_m - land.1;
     assert!(
-        td.sink_rate_mps < 1.5 && across.abs() < 5.0,
-        "{td:?}, {across:.1} m off the centre line"
+        distance < 20.0 && td.sink_rate_mps < 1.5 && across.abs() < 5.0,
+        "{td:?}, {distance:.1} m from the point, {across:.1} m off the centre line"
     );
     assert!(!r.outcome.samples.last().expect("samples").armed);
 }

@@ -458,7 +458,7 @@ impl Autotune {
                 ..Tick::default()
             };
             return (
-                Phase::Designing(Designer::new(&model, &DesignInputs::THESIS, base)),
+                Phase::Designing(Designer::new(&model, &DesignInputs::AUTOTUNE, base)),
                 tick,
             );
         };

@@ -165,7 +165,7 @@ fn margins_on_host(before: &Values, after: &Values, airspeed: f64) -> Option<Des
         // The parameters read that are not gains (the servo, the coefficients) are no error.
         let _ = base.set_param(name, *value as f32);
     }
-    let mut designer = Designer::new(&model, &DesignInputs::THESIS, &base);
+    let mut designer = Designer::new(&model, &DesignInputs::AUTOTUNE, &base);
     // Bounded: every step evaluates points or finishes (`common::tuning::design::design`).
     while designer.step() == Step::Pending {}
     let mut diff_max: Option<f64> = None;
