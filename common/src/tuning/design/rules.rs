@@ -27,18 +27,10 @@ impl Rules {
     pub fn new(model: &DesignModel, inputs: &DesignInputs, base: &GainSet) -> Self {
         Self {
             plant: Plant {
-                va: model.va,
-                a_phi1: model.a_phi1,
-                a_phi2: model.a_phi2,
-                a_theta1: model.a_theta1,
-                a_theta2: model.a_theta2,
-                a_theta3: model.a_theta3,
+                model: *model,
                 pitch: model.pitch_response(),
-                a_v1: model.a_v1,
-                a_v2: model.a_v2,
                 engine_pole: model.engine_pole(),
                 servo_pole: model.servo_pole(),
-                g: model.g,
                 lp: base.longitudinal.feedback_lpf_pole,
                 tau: inputs.delay_s(),
             },
@@ -56,7 +48,9 @@ impl Rules {
         let i = &self.inputs;
         let z = self.zeta();
         libm::sqrtf(
-            libm::fabsf(self.plant.a_phi2) * i.roll_aileron_max_deg * libm::sqrtf(1.0 - z * z)
+            libm::fabsf(self.plant.model.a_phi2)
+                * i.roll_aileron_max_deg
+                * libm::sqrtf(1.0 - z * z)
                 / i.roll_error_max_deg,
         )
     }
@@ -64,23 +58,24 @@ impl Rules {
     /// Appendix C's roll gain, `wn_phi^2 / a_phi2`: where the limit by phase margin starts.
     pub fn roll_kp_appendix_c(&self) -> f32 {
         let wn = self.roll_wn_appendix_c();
-        wn * wn / self.plant.a_phi2
+        wn * wn / self.plant.model.a_phi2
     }
 
     /// Appendix C's rate damper, `(2 zeta wn_phi - a_phi1) / a_phi2`, kept whatever `kp`.
     fn roll_kd(&self) -> f32 {
-        (2.0 * self.zeta() * self.roll_wn_appendix_c() - self.plant.a_phi1) / self.plant.a_phi2
+        (2.0 * self.zeta() * self.roll_wn_appendix_c() - self.plant.model.a_phi1)
+            / self.plant.model.a_phi2
     }
 
     /// The roll natural frequency `kp` gives, `sqrt(a_phi2 kp)`, rad/s (NaN for a `kp` of the
     /// wrong sign).
     pub fn roll_wn(&self, kp: f32) -> f32 {
-        libm::sqrtf(self.plant.a_phi2 * kp)
+        libm::sqrtf(self.plant.model.a_phi2 * kp)
     }
 
     /// The roll loop's gains at `kp`: the integrator's zero at `wn` times the inner fraction.
     pub fn roll(&self, kp: f32) -> LoopGains {
-        let wn = libm::sqrtf((self.plant.a_phi2 * kp).max(0.0));
+        let wn = libm::sqrtf((self.plant.model.a_phi2 * kp).max(0.0));
         LoopGains {
             kp,
             ki: kp * wn * self.inputs.integrator_zero_fraction,
@@ -92,7 +87,7 @@ impl Rules {
     /// zero at the outer fraction of `2 zeta wn_chi`. Gains and `wn_chi`.
     pub fn course(&self, wn_phi: f32) -> (LoopGains, f32) {
         let wn = wn_phi / self.inputs.course_separation;
-        let kp = 2.0 * self.zeta() * wn * self.plant.va / self.plant.g;
+        let kp = 2.0 * self.zeta() * wn * self.plant.model.va / self.plant.model.g;
         let ki = kp * 2.0 * self.zeta() * wn * self.inputs.outer_integrator_fraction;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
@@ -101,13 +96,14 @@ impl Rules {
     /// margin starts.
     pub fn pitch_kp_nominal(&self) -> f32 {
         let i = &self.inputs;
-        libm::copysignf(1.0, self.plant.a_theta3) * i.pitch_elevator_max_deg / i.pitch_error_max_deg
+        libm::copysignf(1.0, self.plant.model.a_theta3) * i.pitch_elevator_max_deg
+            / i.pitch_error_max_deg
     }
 
     /// The pitch natural frequency `kp` gives, `sqrt(a_theta2 + kp a_theta3)` (0 where that
     /// is negative), rad/s.
     pub fn pitch_wn(&self, kp: f32) -> f32 {
-        libm::sqrtf((self.plant.a_theta2 + kp * self.plant.a_theta3).max(0.0))
+        libm::sqrtf((self.plant.model.a_theta2 + kp * self.plant.model.a_theta3).max(0.0))
     }
 
     /// The pitch loop's gains at `kp`: the damper from the nominal design,
@@ -115,7 +111,8 @@ impl Rules {
     /// fraction.
     pub fn pitch(&self, kp: f32) -> LoopGains {
         let wn_nominal = self.pitch_wn(self.pitch_kp_nominal());
-        let kd = (2.0 * self.zeta() * wn_nominal - self.plant.a_theta1) / self.plant.a_theta3;
+        let kd = (2.0 * self.zeta() * wn_nominal - self.plant.model.a_theta1)
+            / self.plant.model.a_theta3;
         LoopGains {
             kp,
             ki: kp * self.pitch_wn(kp) * self.inputs.integrator_zero_fraction,
@@ -130,7 +127,7 @@ impl Rules {
         let i = &self.inputs;
         let wn =
             (wn_theta / i.altitude_separation).min(self.plant.lp / i.altitude_filter_separation);
-        let kp = 2.0 * self.zeta() * wn / self.plant.va;
+        let kp = 2.0 * self.zeta() * wn / self.plant.model.va;
         let ki = kp * 2.0 * self.zeta() * wn * i.outer_integrator_fraction;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
@@ -141,8 +138,8 @@ impl Rules {
         let i = &self.inputs;
         let p = &self.plant;
         let wn = (wn_theta / i.altitude_separation).min(p.lp / i.filter_separation);
-        let kp = (p.a_v1 - 2.0 * self.zeta() * wn) / p.g;
-        let ki = -wn * wn / p.g;
+        let kp = (p.model.a_v1 - 2.0 * self.zeta() * wn) / p.model.g;
+        let ki = -wn * wn / p.model.g;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
 
@@ -152,8 +149,8 @@ impl Rules {
     pub fn airspeed_throttle(&self) -> (LoopGains, f32) {
         let p = &self.plant;
         let wn = p.lp / self.inputs.filter_separation;
-        let kp = (2.0 * self.zeta() * wn - p.a_v1) / p.a_v2;
-        let ki = wn * wn / p.a_v2;
+        let kp = (2.0 * self.zeta() * wn - p.model.a_v1) / p.model.a_v2;
+        let ki = wn * wn / p.model.a_v2;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
 }

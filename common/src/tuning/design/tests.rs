@@ -94,18 +94,23 @@ fn roll_loop(m: &DesignModel, kp: f64, ki: f64, kd: f64) -> impl Fn(f64) -> Z {
 /// the feedback pole far away, and `tau` of delay: a loop whose margins are known.
 fn third_order(tau: f32) -> Plant {
     Plant {
-        va: 1.0,
-        a_phi1: 0.0,
-        a_phi2: 0.0,
-        a_theta1: 0.0,
-        a_theta2: 0.0,
-        a_theta3: 0.0,
+        model: DesignModel {
+            va: 1.0,
+            a_phi1: 0.0,
+            a_phi2: 0.0,
+            a_theta1: 0.0,
+            a_theta2: 0.0,
+            a_theta3: 0.0,
+            a_v1: 1.0,
+            a_v2: 1.0,
+            engine_pole: Some(2.0),
+            servo_bandwidth_hz: 1.0 / (2.0 * core::f32::consts::PI),
+            g: 1.0,
+            pitch_response: None,
+        },
         pitch: PitchResponse::short_period(0.0, 0.0, 0.0),
-        a_v1: 1.0,
-        a_v2: 1.0,
         engine_pole: 2.0,
         servo_pole: 1.0,
-        g: 1.0,
         lp: 1e5,
         tau,
     }

@@ -12,7 +12,7 @@
 //! coarse sweep to the next, where the delay's `-w tau` (50 rad at 1000 rad/s) is added in
 //! closed form. The inner loops' own delay, inside `1 / (1 + L_inner)`, stays in.
 
-use super::model::PitchResponse;
+use super::model::{DesignModel, PitchResponse};
 use nalgebra::Complex;
 
 /// A complex number in `f32`.
@@ -82,33 +82,19 @@ pub(super) fn sin_cos(x: f32) -> (f32, f32) {
     }
 }
 
-/// The plant the loops close around, checked finite and in range before any loop is built.
+/// The plant the loops close around: the model, checked finite and in range before any loop
+/// is built, with what the loops take of it resolved (its pitch response, engine and servo
+/// poles) and the feedback low-pass and delay the design adds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Plant {
-    /// Airspeed, m/s.
-    pub va: f32,
-    /// Roll damping, 1/s.
-    pub a_phi1: f32,
-    /// Roll control power, 1/s^2.
-    pub a_phi2: f32,
-    /// Pitch damping, 1/s (the pitch rules').
-    pub a_theta1: f32,
-    /// Pitch stiffness, 1/s^2 (the pitch rules').
-    pub a_theta2: f32,
-    /// Pitch control power, 1/s^2 (the pitch rules').
-    pub a_theta3: f32,
+    /// The reduced models.
+    pub model: DesignModel,
     /// Pitch attitude per elevator, what the pitch loop is judged on.
     pub pitch: PitchResponse,
-    /// Airspeed damping, 1/s.
-    pub a_v1: f32,
-    /// Airspeed per throttle, m/s^2.
-    pub a_v2: f32,
     /// Engine pole, 1/s.
     pub engine_pole: f32,
     /// Servo pole, rad/s.
     pub servo_pole: f32,
-    /// Gravity, m/s^2.
-    pub g: f32,
     /// The altitude and airspeed feedback low-pass's pole, rad/s.
     pub lp: f32,
     /// Delay, s.
@@ -118,7 +104,7 @@ pub(super) struct Plant {
 impl Plant {
     /// `phi / da = a_phi2 / (s (s + a_phi1))`.
     fn roll(&self, s: C) -> C {
-        C::from(self.a_phi2) / (s * (s + self.a_phi1))
+        C::from(self.model.a_phi2) / (s * (s + self.model.a_phi1))
     }
 
     /// `theta / de`, by Horner's rule.
@@ -196,19 +182,20 @@ impl Transfer {
             Transfer::Roll(g) => g.pid(s) * p.roll(s) * p.servo(s),
             Transfer::Course { course, roll } => {
                 let roll = p.closed(roll, p.roll(s), s, p.delay(w));
-                course.pi(s) * roll * (p.g / p.va) / s
+                course.pi(s) * roll * (p.model.g / p.model.va) / s
             }
             Transfer::Pitch(g) => g.pid(s) * p.pitch(s) * p.servo(s),
             Transfer::Altitude { altitude, pitch } => {
                 let pitch = p.closed(pitch, p.pitch(s), s, p.delay(w));
-                altitude.pi(s) * pitch * p.va / s * p.filter(s)
+                altitude.pi(s) * pitch * p.model.va / s * p.filter(s)
             }
             Transfer::AirspeedPitch { airspeed, pitch } => {
                 let pitch = p.closed(pitch, p.pitch(s), s, p.delay(w));
-                airspeed.pi(s) * pitch * C::from(-p.g) / (s + p.a_v1) * p.filter(s)
+                airspeed.pi(s) * pitch * C::from(-p.model.g) / (s + p.model.a_v1) * p.filter(s)
             }
             Transfer::AirspeedThrottle(g) => {
-                let engine = C::from(p.a_v2 * p.engine_pole) / ((s + p.a_v1) * (s + p.engine_pole));
+                let engine = C::from(p.model.a_v2 * p.engine_pole)
+                    / ((s + p.model.a_v1) * (s + p.engine_pole));
                 g.pi(s) * engine * p.filter(s)
             }
         }
