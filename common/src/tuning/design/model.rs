@@ -96,6 +96,20 @@ impl DesignModel {
         })
     }
 
+    /// The coefficients a design takes from identification, under Beard and McLain's names
+    /// (as the linearisation's reports name them), in the order of the design.
+    pub fn coefficients(&self) -> [(&'static str, f32); 7] {
+        [
+            ("a_phi1", self.a_phi1),
+            ("a_phi2", self.a_phi2),
+            ("a_theta1", self.a_theta1),
+            ("a_theta2", self.a_theta2),
+            ("a_theta3", self.a_theta3),
+            ("a_V1", self.a_v1),
+            ("a_V2", self.a_v2),
+        ]
+    }
+
     /// The servo's pole, rad/s.
     pub fn servo_pole(&self) -> f32 {
         2.0 * core::f32::consts::PI * self.servo_bandwidth_hz

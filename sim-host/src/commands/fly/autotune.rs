@@ -14,19 +14,30 @@ use crate::flight::FlightOutcome;
 use crate::report::table::Table;
 use crate::report::{sig, sig_or_dash};
 use common::control::autopilot::GainSet;
+use common::tuning::autotune::params::{IDENTIFIED, UNIDENTIFIED};
 use common::tuning::design::{judge, DesignInputs, DesignModel, Designer, Loop, Step};
 use serde::Serialize;
 
-/// The identified coefficients' parameters and the names the linearisation gives them.
-const IDENTIFIED: [(&str, &str); 7] = [
-    ("ATUN_A_PHI1", "a_phi1"),
-    ("ATUN_A_PHI2", "a_phi2"),
-    ("ATUN_A_THT1", "a_theta1"),
-    ("ATUN_A_THT2", "a_theta2"),
-    ("ATUN_A_THT3", "a_theta3"),
-    ("ATUN_A_V1", "a_V1"),
-    ("ATUN_A_V2", "a_V2"),
-];
+/// The model the vehicle identified, read back from its `ATUN_A_*` parameters (by the
+/// vehicle's own declarations of them) at `airspeed`, with the servo it fitted through
+/// (`SERVO_BW`); `None` while any is unset (0).
+fn identified_model(after: &Values, airspeed: f64) -> Option<DesignModel> {
+    let get = |name: &str| {
+        after
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| *v as f32)
+    };
+    let mut model = DesignModel {
+        va: airspeed as f32,
+        servo_bandwidth_hz: get("SERVO_BW")?,
+        ..UNIDENTIFIED
+    };
+    for q in IDENTIFIED.params {
+        (q.set)(&mut model, get(q.def.name).filter(|v| *v != 0.0)?);
+    }
+    Some(model)
+}
 
 /// One identified coefficient beside the linearisation's.
 #[derive(Clone, Debug, Serialize)]
@@ -145,21 +156,7 @@ fn readings(o: &FlightOutcome) -> (Values, Values) {
 fn margins_on_host(before: &Values, after: &Values, airspeed: f64) -> Option<DesignMargins> {
     let get =
         |set: &Values, name: &str| set.iter().find(|(n, _)| n == name).map(|(_, v)| *v as f32);
-    let id = |name| get(after, name).filter(|v| *v != 0.0);
-    let model = DesignModel {
-        va: airspeed as f32,
-        a_phi1: id("ATUN_A_PHI1")?,
-        a_phi2: id("ATUN_A_PHI2")?,
-        a_theta1: id("ATUN_A_THT1")?,
-        a_theta2: id("ATUN_A_THT2")?,
-        a_theta3: id("ATUN_A_THT3")?,
-        a_v1: id("ATUN_A_V1")?,
-        a_v2: id("ATUN_A_V2")?,
-        engine_pole: None,
-        servo_bandwidth_hz: get(after, "SERVO_BW")?,
-        g: common::math::GRAVITY,
-        pitch_response: None,
-    };
+    let model = identified_model(after, airspeed)?;
     let mut base = GainSet::FLIGHT;
     for (name, value) in before {
         // The parameters read that are not gains (the servo, the coefficients) are no error.
@@ -233,13 +230,14 @@ pub fn autotune_report(
         |set: &[(String, f64)], name: &str| set.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     let airspeed = value(&after, "ASPD_SCL_REF").unwrap_or(aircraft.cruise_airspeed_mps());
     let lin = linearize_report_at(aircraft, "level", airspeed)?.reduced;
-    let identified = IDENTIFIED
+    let identified = identified_model(&after, airspeed)
         .iter()
-        .filter_map(|(param, name)| {
-            let v = value(&after, param).filter(|v| *v != 0.0)?;
-            let r = lin.named().iter().find(|(n, _)| n == name)?.1;
+        .flat_map(|m| m.coefficients())
+        .filter_map(|(name, v)| {
+            let v = f64::from(v);
+            let r = lin.named().iter().find(|(n, _)| *n == name)?.1;
             Some(Identified {
-                name: (*name).into(),
+                name: name.into(),
                 value: v,
                 linearised: r,
                 diff_pct: 100.0 * (v - r) / r,
