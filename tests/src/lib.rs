@@ -66,14 +66,7 @@ pub fn tool_available(name: &str) -> bool {
         .output()
         .map(|o| o.status.success())
         .unwrap_or(false);
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "{name} is required under CI (.ci/run installs it)"
-        );
-        eprintln!("SKIPPED: {name} is not installed");
-    }
-    found
+    required(found, name, "")
 }
 
 /// Whether python3 with pymavlink is here: false (skipped) outside CI, a failure under CI.
@@ -85,14 +78,20 @@ pub fn pymavlink_available() -> bool {
         .args(["-c", "import pymavlink"])
         .status()
         .is_ok_and(|s| s.success());
-    if !have {
+    required(have, "pymavlink", " (pip install pymavlink)")
+}
+
+/// `found`, after failing under CI where `what` is missing, or telling that the test is
+/// skipped (with how to install it, `install`) outside it.
+fn required(found: bool, what: &str, install: &str) -> bool {
+    if !found {
         assert!(
             std::env::var_os("CI").is_none(),
-            "pymavlink is required under CI (.ci/run installs it)"
+            "{what} is required under CI (.ci/run installs it)"
         );
-        eprintln!("SKIPPED: pymavlink is not installed (pip install pymavlink)");
+        eprintln!("SKIPPED: {what} is not installed{install}");
     }
-    have
+    found
 }
 
 /// Builds `sim-host` (release) with its `mcu-libm` feature, the host build computing sines,
