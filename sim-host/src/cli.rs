@@ -468,8 +468,8 @@ pub(crate) struct SimArgs {
     /// Address the simulator listens on for tcp and udp.
     #[arg(long, default_value = "127.0.0.1:4560")]
     pub(crate) bind: String,
-    /// Start trimmed in level flight 100 m above home at 17 m/s (a hand launch) instead of
-    /// at rest on the runway at home, heading north.
+    /// Start trimmed in level flight 100 m above home at the aircraft's cruise airspeed (a
+    /// hand launch) instead of at rest on the runway at home, heading north.
     #[arg(long)]
     pub(crate) air_start: bool,
     /// Pace the simulation to the wall clock (for a pilot in QGroundControl).

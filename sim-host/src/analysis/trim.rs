@@ -64,6 +64,12 @@ impl TrimTarget {
         Self::new("level", "I straight and level", 0.0, 0.0, 0.0)
     }
 
+    /// Straight and level at `aircraft`'s cruise airspeed (`[performance]
+    /// cruise_airspeed_mps`; the 25e's 17 m/s, as [`TrimTarget::level`]), 100 m.
+    pub fn cruise(aircraft: &Aircraft) -> Self {
+        Self::level().at_airspeed(aircraft.cruise_airspeed_mps())
+    }
+
     /// Thesis Table 2.3 II: 5 deg climb.
     pub fn climb() -> Self {
         Self::new("climb", "II climb, gamma 5 deg", 5.0, 0.0, 0.0)

@@ -172,7 +172,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
     // Trimmed, level, 100 m above home (TrimTarget::level is at 100 m AGL), at the aircraft's
     // cruise airspeed (the 25e's 17 m/s): a hand launch starts there, and a take-off from the
     // runway holds the trim's surfaces until the autopilot takes over.
-    let level = TrimTarget::level().at_airspeed(aircraft.cruise_airspeed_mps());
+    let level = TrimTarget::cruise(aircraft);
     let trim = trim_with(&params, &level);
     if !trim.converged {
         return Err(FlightError::Config(format!(

@@ -106,7 +106,7 @@ pub fn mission_config(aircraft: &Aircraft, which: &Path) -> anyhow::Result<Fligh
 /// The throttle of the aircraft's level trim at its cruise airspeed.
 pub fn level_trim_throttle(aircraft: &Aircraft) -> anyhow::Result<f32> {
     use crate::analysis::trim::{not_trimmed, trim_with, TrimTarget};
-    let target = TrimTarget::level().at_airspeed(aircraft.cruise_airspeed_mps());
+    let target = TrimTarget::cruise(aircraft);
     let trim = trim_with(&crate::plant::params::ModelParams::new(aircraft), &target);
     anyhow::ensure!(trim.converged, "{}", not_trimmed(&trim));
     Ok(trim.throttle as f32)
