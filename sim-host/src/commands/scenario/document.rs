@@ -6,7 +6,7 @@ use super::gains::COMPUTED;
 use super::run::ScenarioReport;
 use crate::aircraft::Aircraft;
 use crate::analysis::design::inputs::DesignInputs;
-use crate::analysis::design::{decimal, design};
+use crate::analysis::design::{decimal, design_at};
 use crate::analysis::sampled::plant::out;
 use crate::analysis::sampled::{Arrangement, LatLaw, LoopCase, SampledLoop, SampledLoops, CASES};
 use crate::report::sig;
@@ -110,7 +110,10 @@ pub fn results_markdown(report: &ScenarioReport, command: &str, aircraft: &Aircr
     s.push_str("# Closed-loop results: the tests of thesis chapter 4 on the nonlinear plant\n\n");
     s.push_str(&block(PROSE, "intro", &[("command", command)]));
     s.push_str("\n\n");
-    s.push_str(include_str!("setup.md"));
+    // Kept wrapped as written (not a template block, whose paragraphs become single lines).
+    s.push_str(
+        &include_str!("setup.md").replace("{airspeed}", &report.trim_airspeed_mps.to_string()),
+    );
     s.push_str("\n## Scenarios\n\n| scenario | loop | command | length (s) |\n|---|---|---|---|\n");
     for sc in SCENARIOS {
         let steps: Vec<String> = sc
@@ -193,12 +196,14 @@ pub fn results_markdown(report: &ScenarioReport, command: &str, aircraft: &Aircr
 /// steps: the reduced models of the design (`sim-host design`) and the full linear model
 /// sampled at the autopilot's rate ([`SampledLoops`]).
 fn prediction_vs_flight(report: &ScenarioReport, aircraft: &Aircraft) -> String {
-    let Ok(d) = design(aircraft, &DesignInputs::default()) else {
+    let va = report.trim_airspeed_mps;
+    let Ok(d) = design_at(aircraft, &DesignInputs::default(), va) else {
         return String::new();
     };
     let inputs = &d.inputs;
-    let Ok(model) = SampledLoops::at_level_trim(
+    let Ok(model) = SampledLoops::at_level_airspeed(
         aircraft,
+        va,
         decimal(inputs.sample_time_s),
         inputs.delay_periods(),
     ) else {
@@ -281,6 +286,7 @@ mod tests {
     #[test]
     fn a_report_without_runs_still_states_every_claim() {
         let report = ScenarioReport {
+            trim_airspeed_mps: 17.0,
             trim_pitch_deg: 3.0,
             results: Vec::new(),
             files: Vec::new(),

@@ -2,12 +2,12 @@
 //! aircraft flown, or a gain file.
 
 use crate::aircraft::Aircraft;
-use crate::analysis::design::computed_gain_set;
+use crate::analysis::design::computed_gain_set_at;
 use anyhow::Context;
 use common::control::gains::{GainSet, NAMES};
 
-/// Name of the gain set designed from the linear model of the aircraft flown
-/// ([`computed_gain_set`]).
+/// Name of the gain set designed from the linear model of the aircraft flown, at the trim
+/// airspeed ([`computed_gain_set_at`]).
 pub const COMPUTED: &str = "computed";
 
 /// Name of the flight defaults with the altitude modes flown by the total energy control
@@ -64,14 +64,20 @@ pub fn gain_file(path: &std::path::Path) -> anyhow::Result<GainSet> {
     Ok(g)
 }
 
-/// The gain set of this name for `aircraft` (only [`COMPUTED`] depends on the aircraft); a
-/// name ending in `.toml` is a gain file.
+/// The gain set of this name for `aircraft` at its cruise airspeed: [`gain_set_at`].
 pub fn gain_set(aircraft: &Aircraft, name: &str) -> anyhow::Result<GainSet> {
+    gain_set_at(aircraft, name, aircraft.cruise_airspeed_mps())
+}
+
+/// The gain set of this name for `aircraft` flown at `va_mps` (only [`COMPUTED`] depends on
+/// the aircraft and the airspeed: it is designed at the level trim there); a name ending in
+/// `.toml` is a gain file.
+pub fn gain_set_at(aircraft: &Aircraft, name: &str, va_mps: f64) -> anyhow::Result<GainSet> {
     if name.ends_with(".toml") {
         return gain_file(std::path::Path::new(name));
     }
     if name == COMPUTED {
-        return computed_gain_set(aircraft).context("designing the computed gain set");
+        return computed_gain_set_at(aircraft, va_mps).context("designing the computed gain set");
     }
     if name == FLIGHT_TECS {
         let mut g = GainSet::FLIGHT;

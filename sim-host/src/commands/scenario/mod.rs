@@ -19,10 +19,10 @@ use std::path::Path;
 pub use claims::CLIMB_WINDOW_S;
 pub use document::results_markdown;
 pub use gains::{
-    gain_file, gain_set, gain_set_names, known_gain_set_names, UnknownGainSet, COMPUTED,
-    FLIGHT_TECS,
+    gain_file, gain_set, gain_set_at, gain_set_names, known_gain_set_names, UnknownGainSet,
+    COMPUTED, FLIGHT_TECS,
 };
-pub use run::{check_noise, fly, level_trim, ScenarioReport, ScenarioResult};
+pub use run::{check_noise, fly, level_trim, level_trim_at, ScenarioReport, ScenarioResult};
 pub use tables::{metrics_table, write_result};
 
 /// Noise sigma of the noisy half of `scenario all` (thesis: 1e-3 rad on angles, 1e-3 m on
@@ -53,13 +53,31 @@ impl Default for ScenarioOptions {
     }
 }
 
-/// Runs scenario `name` (or `all`: every scenario without noise and with
-/// [`ScenarioOptions::noise_sigma`], or [`THESIS_NOISE_SIGMA`] when that is 0) for every gain
-/// set of `opts`; writes CSV, PNG and JSON files into `out_dir` if given.
+/// [`scenario_report_at`] from the level trim at `aircraft`'s cruise airspeed.
 pub fn scenario_report(
     aircraft: &Aircraft,
     name: &str,
     opts: &ScenarioOptions,
+    out_dir: Option<&Path>,
+) -> anyhow::Result<ScenarioReport> {
+    scenario_report_at(
+        aircraft,
+        name,
+        opts,
+        aircraft.cruise_airspeed_mps(),
+        out_dir,
+    )
+}
+
+/// Runs scenario `name` (or `all`: every scenario without noise and with
+/// [`ScenarioOptions::noise_sigma`], or [`THESIS_NOISE_SIGMA`] when that is 0) for every gain
+/// set of `opts`, from the level trim at `va_mps`; writes CSV, PNG and JSON files into
+/// `out_dir` if given.
+pub fn scenario_report_at(
+    aircraft: &Aircraft,
+    name: &str,
+    opts: &ScenarioOptions,
+    va_mps: f64,
     out_dir: Option<&Path>,
 ) -> anyhow::Result<ScenarioReport> {
     let sigma = check_noise(opts.noise_sigma)?;
@@ -83,12 +101,14 @@ pub fn scenario_report(
             gain_set_names().join(", ")
         );
     }
+    // Trimmed before the gains: the computed set's design trims there too, and its error
+    // would name the design rather than the scenarios.
+    let trim = level_trim_at(aircraft, va_mps)?;
     let sets = opts
         .gains
         .iter()
-        .map(|n| Ok((n.clone(), gain_set(aircraft, n)?)))
+        .map(|n| Ok((n.clone(), gain_set_at(aircraft, n, va_mps)?)))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let trim = level_trim(aircraft)?;
     if let Some(dir) = out_dir {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output directory `{}`", dir.display()))?;
@@ -126,6 +146,7 @@ pub fn scenario_report(
     bar.finish_and_clear();
     let tables = results.iter().map(metrics_table).collect();
     Ok(ScenarioReport {
+        trim_airspeed_mps: trim.target.va_mps,
         trim_pitch_deg: trim.theta.to_degrees(),
         results,
         files,

@@ -1,7 +1,7 @@
 //! Flying one scenario with every gain set, and what the runs give.
 
 use crate::aircraft::Aircraft;
-use crate::analysis::trim::{trim, TrimResult, TrimTarget};
+use crate::analysis::trim::{not_trimmed, trim, TrimResult, TrimTarget};
 use crate::report::table::Table;
 use crate::scenario::metrics::{run_metrics, RunMetrics};
 use crate::scenario::sim::{simulate, Run, SimConfig};
@@ -49,7 +49,9 @@ impl ScenarioResult {
 /// All results of a command, the files written and the printed tables.
 #[derive(Clone, Debug, Serialize)]
 pub struct ScenarioReport {
-    /// Pitch of the level trim every run starts from, deg.
+    /// Airspeed of the level trim every run starts from, m/s.
+    pub trim_airspeed_mps: f64,
+    /// Pitch of that trim, deg.
     pub trim_pitch_deg: f64,
     /// Per scenario and noise level.
     pub results: Vec<ScenarioResult>,
@@ -77,14 +79,17 @@ pub fn check_noise(sigma: f64) -> anyhow::Result<f64> {
     Ok(sigma)
 }
 
-/// The level trim every scenario starts from (17 m/s, 100 m).
+/// The level trim the scenarios start from when flown at the thesis's airspeed (17 m/s, 100 m).
 pub fn level_trim(aircraft: &Aircraft) -> anyhow::Result<TrimResult> {
-    let tr = trim(aircraft, &TrimTarget::level());
+    level_trim_at(aircraft, TrimTarget::level().va_mps)
+}
+
+/// The level trim at `va_mps` (100 m) the scenarios start from; an airspeed the aircraft
+/// cannot be trimmed at is an error naming it.
+pub fn level_trim_at(aircraft: &Aircraft, va_mps: f64) -> anyhow::Result<TrimResult> {
+    let tr = trim(aircraft, &TrimTarget::level().at_airspeed(va_mps));
     if !tr.converged {
-        bail!(
-            "level trim did not converge (residual {:.3e})",
-            tr.residual_norm
-        );
+        bail!("{}; cannot fly the scenarios", not_trimmed(&tr));
     }
     Ok(tr)
 }
