@@ -3,8 +3,8 @@
 use crate::aircraft::Aircraft;
 use crate::analysis::doublet::{run, DoubletConfig, DoubletRun, Surface, OUTPUT_INFO};
 use crate::analysis::linearize::linearize;
-use crate::analysis::references::{THESIS_DOUBLET_LAT, THESIS_DOUBLET_LON};
-use crate::analysis::trim::{trim_with, TrimTarget};
+use crate::analysis::references::{apply_to, THESIS_DOUBLET_LAT, THESIS_DOUBLET_LON};
+use crate::analysis::trim::{not_trimmed, trim_with, TrimResult, TrimTarget};
 use crate::plant::params::ModelParams;
 use crate::report::csv_out::write_csv;
 use crate::report::plot::{Figure, Panel, Series};
@@ -17,6 +17,8 @@ use std::path::{Path, PathBuf};
 /// The three doublets and where their files went.
 #[derive(Clone, Debug, Serialize)]
 pub struct DoubletReport {
+    /// The level trim the doublets start from and the linear model is taken at.
+    pub trim: TrimResult,
     /// Elevator, aileron and rudder runs.
     pub runs: Vec<DoubletRun>,
     /// Files written (CSV and PNG).
@@ -39,7 +41,7 @@ impl DoubletReport {
 const LON_OUTPUTS: [&str; 4] = ["airspeed", "alpha", "theta", "q"];
 const LAT_OUTPUTS: [&str; 4] = ["beta", "p", "r", "phi"];
 
-fn figure(run: &DoubletRun) -> Figure {
+fn figure(run: &DoubletRun, va_mps: f64) -> Figure {
     let t: Vec<f64> = run.samples.iter().map(|s| s.t).collect();
     let names = if run.surface == Surface::Elevator {
         LON_OUTPUTS
@@ -85,7 +87,7 @@ fn figure(run: &DoubletRun) -> Figure {
     }
     Figure::new(
         format!(
-            "{} doublet {:.1} deg from level trim: nonlinear vs linear",
+            "{} doublet {:.1} deg from level trim at {va_mps} m/s: nonlinear vs linear",
             run.surface.name(),
             run.config.amplitude_rad * deg
         ),
@@ -94,7 +96,7 @@ fn figure(run: &DoubletRun) -> Figure {
     )
 }
 
-fn write_run(run: &DoubletRun, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+fn write_run(run: &DoubletRun, va_mps: f64, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let mut headers = vec!["t_s".to_string(), format!("{}_deg", run.surface.name())];
     for prefix in ["nonlinear", "linear"] {
         for (name, unit, _) in OUTPUT_INFO {
@@ -116,24 +118,34 @@ fn write_run(run: &DoubletRun, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let csv = dir.join(format!("doublet_{}.csv", run.surface.name()));
     write_csv(&csv, &headers, &rows)?;
     let png = dir.join(format!("doublet_{}.png", run.surface.name()));
-    figure(run).save_png(&png)?;
+    figure(run, va_mps).save_png(&png)?;
     Ok(vec![csv, png])
 }
 
-/// Runs the three doublets from level trim; writes CSV and PNG files into `out_dir` if given.
+/// [`doublet_report_at`] about the level trim at `aircraft`'s cruise airspeed.
 pub fn doublet_report(
     aircraft: &Aircraft,
     cfg: &DoubletConfig,
     out_dir: Option<&Path>,
 ) -> anyhow::Result<DoubletReport> {
+    doublet_report_at(aircraft, cfg, aircraft.cruise_airspeed_mps(), out_dir)
+}
+
+/// Runs the three doublets from the level trim at `va_mps`, the linear model taken there;
+/// writes CSV and PNG files into `out_dir` if given. The thesis's Tables 3.1 and 3.2 are
+/// quoted only where they apply (the Ultra Stick 25e at 17 m/s).
+pub fn doublet_report_at(
+    aircraft: &Aircraft,
+    cfg: &DoubletConfig,
+    va_mps: f64,
+    out_dir: Option<&Path>,
+) -> anyhow::Result<DoubletReport> {
     let p = ModelParams::new(aircraft);
-    let trim = trim_with(&p, &TrimTarget::level());
+    let trim = trim_with(&p, &TrimTarget::level().at_airspeed(va_mps));
     if !trim.converged {
-        bail!(
-            "level trim did not converge (residual {:.3e})",
-            trim.residual_norm
-        );
+        bail!("{}; cannot run the doublets", not_trimmed(&trim));
     }
+    let refs = apply_to(aircraft, va_mps);
     let lin = linearize(&p, &trim);
     let mut runs = Vec::new();
     let mut files = Vec::new();
@@ -144,7 +156,7 @@ pub fn doublet_report(
     for s in [Surface::Elevator, Surface::Aileron, Surface::Rudder] {
         let r = run(aircraft, &trim, &lin, s, cfg);
         if let Some(dir) = out_dir {
-            files.extend(write_run(&r, dir)?);
+            files.extend(write_run(&r, va_mps, dir)?);
         }
         runs.push(r);
     }
@@ -173,7 +185,7 @@ pub fn doublet_report(
             let thesis = THESIS_DOUBLET_LON
                 .iter()
                 .chain(THESIS_DOUBLET_LAT.iter())
-                .find(|x| x.0 == *name)
+                .find(|x| refs && x.0 == *name)
                 .filter(|_| (r.surface == Surface::Elevator) == LON_OUTPUTS.contains(name))
                 .map(|x| {
                     if x.1 > 0.0 {
@@ -196,6 +208,7 @@ pub fn doublet_report(
         }
     }
     Ok(DoubletReport {
+        trim,
         runs,
         files,
         tables: vec![t],
