@@ -90,8 +90,11 @@ pub(crate) enum Command {
         #[command(flatten)]
         out: Output,
     },
-    /// Linear-versus-nonlinear elevator, aileron and rudder doublets from level trim.
+    /// Linear-versus-nonlinear elevator, aileron and rudder doublets from the level trim at
+    /// the trim airspeed.
     Doublet {
+        #[command(flatten)]
+        speed: Airspeed,
         /// Directory for the CSV and PNG files.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -111,7 +114,9 @@ pub(crate) enum Command {
         fmt: Output,
     },
     /// Closed-loop tests of thesis chapter 4 on the nonlinear plant (servos, 50 Hz autopilot,
-    /// 2-sample input delay, optional sensor noise), for several gain sets.
+    /// 2-sample input delay, optional sensor noise), for several gain sets, from the level trim
+    /// at the trim airspeed: the altitude tests hold that airspeed, the airspeed step is +1 m/s
+    /// from it, and the computed set is designed there.
     Scenario {
         /// Scenario name, or `all` (every scenario, without noise and with noise 1e-3).
         name: String,
@@ -125,6 +130,8 @@ pub(crate) enum Command {
         /// Noise seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        #[command(flatten)]
+        speed: Airspeed,
         /// Directory for the CSV, PNG and JSON files.
         #[arg(long, default_value = "out/scenarios")]
         out: PathBuf,

@@ -83,6 +83,7 @@ fn run() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Some(Command::Doublet {
+            speed,
             out,
             amplitude_deg,
             half_period_s,
@@ -101,7 +102,12 @@ fn run() -> anyhow::Result<ExitCode> {
                 dt_s > 0.0 && duration_s > 0.0 && half_period_s > 0.0 && amplitude_deg.is_finite(),
                 "doublet: --dt-s, --duration-s and --half-period-s must be positive, --amplitude-deg finite"
             );
-            let r = commands::doublet::doublet_report(&aircraft, &cfg, Some(&out))?;
+            let r = commands::doublet::doublet_report_at(
+                &aircraft,
+                &cfg,
+                speed.or_cruise(&aircraft),
+                Some(&out),
+            )?;
             if fmt.json {
                 emit(&to_json(&r)?)?;
             } else {
@@ -117,6 +123,7 @@ fn run() -> anyhow::Result<ExitCode> {
             gains,
             noise,
             seed,
+            speed,
             out,
             results,
             fmt,
@@ -132,7 +139,13 @@ fn run() -> anyhow::Result<ExitCode> {
                 seed,
                 progress: true,
             };
-            let r = commands::scenario::scenario_report(&aircraft, &name, &opts, Some(&out))?;
+            let r = commands::scenario::scenario_report_at(
+                &aircraft,
+                &name,
+                &opts,
+                speed.or_cruise(&aircraft),
+                Some(&out),
+            )?;
             if let Some(path) = &results {
                 let cmdline = std::env::args().skip(1).collect::<Vec<_>>().join(" ");
                 let md = commands::scenario::results_markdown(

@@ -10,8 +10,9 @@ use sim_host::commands::scenario::{
 use sim_host::scenario::metrics::RunMetrics;
 use sim_host::scenario::sim::SimConfig;
 use sim_host::scenario::{Scenario, SCENARIOS};
-use std::process::Command;
 use std::sync::OnceLock;
+
+mod support;
 
 fn aircraft() -> &'static Aircraft {
     static A: OnceLock<Aircraft> = OnceLock::new();
@@ -218,12 +219,7 @@ fn unknown_scenario_and_gain_set_name_the_valid_ones() {
 }
 
 fn cli(args: &[&str]) -> (bool, String) {
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_sim-host"))
-        .args(args)
-        .args(["--out", dir.path().to_str().unwrap()])
-        .output()
-        .unwrap();
+    let (out, _dir) = support::sim_host(args);
     (
         out.status.success(),
         String::from_utf8_lossy(&out.stderr).into_owned(),

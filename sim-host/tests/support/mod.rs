@@ -107,3 +107,15 @@ pub fn default_of(name: &str) -> f64 {
         .map(|d| f64::from(d.default))
         .unwrap_or_else(|| panic!("no parameter {name}"))
 }
+
+/// Runs the `sim-host` binary with `args`, its files (`--out`) into a fresh directory, kept
+/// while the returned one is held.
+pub fn sim_host(args: &[&str]) -> (std::process::Output, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_sim-host"))
+        .args(args)
+        .args(["--out", dir.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    (out, dir)
+}
