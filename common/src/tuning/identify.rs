@@ -42,6 +42,7 @@
 use super::least_squares::{Fit, LeastSquares};
 use crate::math::frames::wrap_pi;
 use crate::math::GRAVITY;
+use nalgebra::SVector;
 
 /// One sample of what the models read: SI units, radians, surfaces in the Minnesota signs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -113,42 +114,36 @@ pub const AIRSPEED_FILTER_TAU_S: f32 = 0.5;
 /// The roll and pitch pre-filter the vehicle fits its own sensors through, s.
 pub const ATTITUDE_FILTER_TAU_S: f32 = 0.03;
 
-/// One equation's rows through the pre-filter (as many regressors as its fit has).
+/// One equation's rows through the pre-filter.
 #[derive(Clone, Copy, Debug)]
-struct Prefilter {
-    row: [f32; COEFS],
+struct Prefilter<const N: usize> {
+    row: SVector<f32, N>,
     rate: f32,
     started: bool,
 }
 
-impl Prefilter {
+impl<const N: usize> Prefilter<N> {
     fn new() -> Self {
         Self {
-            row: [0.0; COEFS],
+            row: SVector::zeros(),
             rate: 0.0,
             started: false,
         }
     }
 
-    /// Passes `row` and `rate` through the filter, `k` the step's share of the way to the
-    /// input, and takes what comes out into `fit`.
-    fn pass_into(&mut self, fit: &mut LeastSquares, k: f32, row: &[f32], rate: f32) {
-        let n = row.len().min(COEFS);
+    /// The row and rate after the filter, `k` the step's share of the way to the input.
+    fn pass(&mut self, k: f32, row: SVector<f32, N>, rate: f32) -> (SVector<f32, N>, f32) {
         if !self.started || k >= 1.0 {
             // Starting from the first row: the filter's free response then obeys the same
             // equation as its input.
             self.started = true;
-            for (f, x) in self.row.iter_mut().zip(row) {
-                *f = *x;
-            }
+            self.row = row;
             self.rate = rate;
         } else {
-            for (f, x) in self.row.iter_mut().zip(row) {
-                *f += k * (*x - *f);
-            }
+            self.row += (row - self.row) * k;
             self.rate += k * (rate - self.rate);
         }
-        fit.push(self.row.get(..n).unwrap_or(&[]), self.rate);
+        (self.row, self.rate)
     }
 }
 
@@ -259,7 +254,7 @@ impl Axis {
 }
 
 /// Most coefficients an axis has.
-pub const COEFS: usize = super::least_squares::MAX;
+pub const COEFS: usize = 8;
 
 /// One axis's fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -321,14 +316,14 @@ pub struct Identifier {
     prev: Option<Sample>,
     /// Where the servos hold the aileron and elevator at `prev`, rad.
     surfaces: [f32; 2],
-    roll: LeastSquares,
-    pitch: LeastSquares,
-    speed: LeastSquares,
-    course: LeastSquares,
-    altitude: LeastSquares,
-    roll_filter: Prefilter,
-    pitch_filter: Prefilter,
-    speed_filter: Prefilter,
+    roll: LeastSquares<6>,
+    pitch: LeastSquares<8>,
+    speed: LeastSquares<5>,
+    course: LeastSquares<2>,
+    altitude: LeastSquares<2>,
+    roll_filter: Prefilter<6>,
+    pitch_filter: Prefilter<8>,
+    speed_filter: Prefilter<5>,
     inputs: [Spread; 5],
 }
 
@@ -343,11 +338,11 @@ impl Identifier {
             config,
             prev: None,
             surfaces: [0.0; 2],
-            roll: LeastSquares::new(Axis::Roll.coefficients().len()),
-            pitch: LeastSquares::new(Axis::Pitch.coefficients().len()),
-            speed: LeastSquares::new(Axis::Airspeed.coefficients().len()),
-            course: LeastSquares::new(Axis::Course.coefficients().len()),
-            altitude: LeastSquares::new(Axis::Altitude.coefficients().len()),
+            roll: LeastSquares::new(),
+            pitch: LeastSquares::new(),
+            speed: LeastSquares::new(),
+            course: LeastSquares::new(),
+            altitude: LeastSquares::new(),
             roll_filter: Prefilter::new(),
             pitch_filter: Prefilter::new(),
             speed_filter: Prefilter::new(),
@@ -411,16 +406,15 @@ impl Identifier {
         let (phi, theta, alpha) = (mid(|x| x.phi), mid(|x| x.theta), mid(|x| x.alpha));
         let (ay, thr) = (mid(|x| x.ay), a.throttle);
         let k = share(dt_s, self.config.attitude_filter_tau_s);
-        self.roll_filter.pass_into(
-            &mut self.roll,
+        let (row, y) = self.roll_filter.pass(
             k,
-            &[-v * p, v2 * da, v * r, ay, thr, v2],
+            SVector::from([-v * p, v2 * da, v * r, ay, thr, v2]),
             rate(|x| x.p),
         );
-        self.pitch_filter.pass_into(
-            &mut self.pitch,
+        self.roll.push(&row, y);
+        let (row, y) = self.pitch_filter.pass(
             k,
-            &[
+            SVector::from([
                 -v * q,
                 -v2 * alpha,
                 v2 * de,
@@ -429,24 +423,25 @@ impl Identifier {
                 r,
                 mid(|x| x.p * x.r),
                 mid(|x| x.r * x.r - x.p * x.p),
-            ],
+            ]),
             rate(|x| x.q),
         );
-        self.speed_filter.pass_into(
-            &mut self.speed,
+        self.pitch.push(&row, y);
+        let (row, y) = self.speed_filter.pass(
             share(dt_s, self.config.airspeed_filter_tau_s),
-            &[-(va - self.config.airspeed_ref), thr, -theta, alpha, 1.0],
+            SVector::from([-(va - self.config.airspeed_ref), thr, -theta, alpha, 1.0]),
             rate(|x| x.airspeed),
         );
+        self.speed.push(&row, y);
         let vg = mid(|x| x.ground_speed);
         if vg > 1.0 {
             self.course.push(
-                &[GRAVITY * libm::tanf(phi) / vg, 1.0],
+                &SVector::from([GRAVITY * libm::tanf(phi) / vg, 1.0]),
                 wrap_pi(s.course - a.course) / dt_s,
             );
         }
         self.altitude
-            .push(&[va * theta, 1.0], mid(|x| x.climb_rate));
+            .push(&SVector::from([va * theta, 1.0]), mid(|x| x.climb_rate));
         for (spread, x) in self.inputs.iter_mut().zip([da, de, thr, phi, theta]) {
             spread.push(x);
         }
@@ -468,18 +463,13 @@ impl Identifier {
             return Err(AxisError::NotExcited { input, sd, needed });
         }
         let fit = match axis {
-            Axis::Roll => self.roll.solve(),
-            Axis::Pitch => self.pitch.solve(),
-            Axis::Airspeed => self.speed.solve(),
-            Axis::Course => self.course.solve(),
-            Axis::Altitude => self.altitude.solve(),
+            Axis::Roll => self.roll.solve().map(widen),
+            Axis::Pitch => self.pitch.solve().map(widen),
+            Axis::Airspeed => self.speed.solve().map(widen),
+            Axis::Course => self.course.solve().map(widen),
+            Axis::Altitude => self.altitude.solve().map(widen),
         };
-        let Fit {
-            coef,
-            std_err,
-            r2,
-            rows,
-        } = fit.ok_or(AxisError::Singular)?;
+        let (coef, std_err, r2, rows) = fit.ok_or(AxisError::Singular)?;
         Ok(AxisFit {
             coef,
             std_err,
@@ -488,4 +478,16 @@ impl Identifier {
             input_sd: sd,
         })
     }
+}
+
+/// A fit's figures in the fixed places of [`AxisFit`].
+fn widen<const N: usize>(f: Fit<N>) -> ([f32; COEFS], [f32; COEFS], f32, u32) {
+    let (mut coef, mut err) = ([0.0; COEFS], [0.0; COEFS]);
+    for (i, (c, e)) in f.coef.iter().zip(f.std_err.iter()).enumerate().take(COEFS) {
+        if let (Some(cs), Some(es)) = (coef.get_mut(i), err.get_mut(i)) {
+            *cs = *c;
+            *es = *e;
+        }
+    }
+    (coef, err, f.r2, f.rows)
 }

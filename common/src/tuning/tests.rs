@@ -1,6 +1,7 @@
 use super::identify::{Axis, AxisError, Identifier, IdentifyConfig, Sample};
 use super::least_squares::LeastSquares;
 use crate::math::{DEG, GRAVITY};
+use nalgebra::SVector;
 
 /// The 25e's roll and pitch coefficients at 17 m/s (`docs/GAIN-DESIGN.md`, from its aero
 /// data) and a 20 ms servo (its file's 8 Hz bandwidth).
@@ -111,10 +112,10 @@ fn within(x: f32, want: f32, rel: f32) -> bool {
 
 #[test]
 fn a_line_is_fitted_exactly_and_its_errors_vanish() {
-    let mut ls = LeastSquares::new(2);
+    let mut ls = LeastSquares::<2>::new();
     for i in 0..50 {
         let x = i as f32 * 0.1;
-        assert!(ls.push(&[x, 1.0], 3.0 * x - 2.0));
+        assert!(ls.push(&SVector::from([x, 1.0]), 3.0 * x - 2.0));
     }
     let f = ls.solve().expect("fit");
     assert!((f.coef[0] - 3.0).abs() < 1e-4 && (f.coef[1] + 2.0).abs() < 1e-4);
@@ -125,7 +126,7 @@ fn a_line_is_fitted_exactly_and_its_errors_vanish() {
 /// `sigma / sqrt(sum (x - mean)^2)` for the slope.
 #[test]
 fn the_slopes_standard_error_is_the_noises_spread_over_the_regressors_spread() {
-    let mut ls = LeastSquares::new(2);
+    let mut ls = LeastSquares::<2>::new();
     let mut seed = 12345u32;
     let mut sxx = 0.0f32;
     for i in 0..400 {
@@ -134,7 +135,7 @@ fn the_slopes_standard_error_is_the_noises_spread_over_the_regressors_spread() {
         // A uniform noise of +-0.1 (sigma 0.0577), from a linear congruential generator.
         seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
         let e = (seed >> 8) as f32 / 16_777_216.0 * 0.2 - 0.1;
-        ls.push(&[x, 1.0], 2.0 * x + e);
+        ls.push(&SVector::from([x, 1.0]), 2.0 * x + e);
     }
     let f = ls.solve().expect("fit");
     let want = 0.2 / libm::sqrtf(12.0) / libm::sqrtf(sxx);
@@ -148,15 +149,15 @@ fn the_slopes_standard_error_is_the_noises_spread_over_the_regressors_spread() {
 
 #[test]
 fn a_regressor_that_never_varies_alone_leaves_no_fit_and_a_bad_row_is_left_out() {
-    let mut ls = LeastSquares::new(2);
+    let mut ls = LeastSquares::<2>::new();
     for i in 0..20 {
         let x = i as f32;
-        ls.push(&[x, 2.0 * x], x);
+        ls.push(&SVector::from([x, 2.0 * x]), x);
     }
     assert!(ls.solve().is_none());
-    let mut ls = LeastSquares::new(2);
-    assert!(!ls.push(&[f32::NAN, 1.0], 1.0));
-    assert!(!ls.push(&[1.0, 1.0], f32::INFINITY));
+    let mut ls = LeastSquares::<2>::new();
+    assert!(!ls.push(&SVector::from([f32::NAN, 1.0]), 1.0));
+    assert!(!ls.push(&SVector::from([1.0, 1.0]), f32::INFINITY));
     assert_eq!(ls.rows(), 0);
 }
 
