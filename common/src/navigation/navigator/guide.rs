@@ -133,11 +133,18 @@ impl Flight<'_> {
 
     /// Tail-wheel steering towards `course` (rad): on the runway the heading is the course.
     pub fn steer(&self, course: f32) -> YawMode {
-        let err = wrap_pi(course - self.state.heading);
+        let k = self.params.steer_k;
+        // The error only as far as it can move the wheel (0.27 rad at the default gain): beyond
+        // it the wheel is at its stop anyway, and the error's full size would outweigh the
+        // yaw-rate term and flip the wheel at every half turn of a spin (in moderate
+        // turbulence at 2-5 m/s, an aircraft pirouetted at 150 deg/s for 20 s with the wheel
+        // swapping stops each second). Held there, the yaw-rate term stops the spin.
+        let reach = if k > 0.0 { STEER_MAX / k } else { 0.0 };
+        let err = wrap_pi(course - self.state.heading).max(-reach).min(reach);
         // Positive rudder (trailing edge left) turns the nose left. A taildragger's centre of
         // gravity behind its main wheels makes it swing further once it swings: the yaw-rate
         // term opposes the swing before the heading error has grown.
-        let d = -self.params.steer_k * err + self.params.steer_d * self.state.yaw_rate;
+        let d = -k * err + self.params.steer_d * self.state.yaw_rate;
         YawMode::Rudder(if d.is_finite() {
             d.clamp(-STEER_MAX, STEER_MAX)
         } else {
@@ -149,6 +156,46 @@ impl Flight<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The tail wheel in a ground loop: swinging right at 150 deg/s, the wheel stays against
+    /// the swing whether the course lies just left or just right of the tail (the
+    /// heading error's size, clamped to the wheel's reach, no longer flips it at the half
+    /// turn); at rest the error alone steers, as before, the same wheel for any error beyond
+    /// its reach.
+    #[test]
+    fn a_spinning_aircraft_s_tail_wheel_stays_against_the_spin_at_the_half_turn() {
+        let p = NavParams::default();
+        let g = crate::guidance::Guidance::default();
+        let wheel = |heading_err_deg: f32, yaw_rate: f32| {
+            let state = NavState {
+                heading: 0.0,
+                yaw_rate,
+                ..NavState::default()
+            };
+            let f = Flight {
+                params: &p,
+                guidance: &g,
+                state: &state,
+                dt: 0.02,
+                cruise: 17.0,
+                gust: 0.0,
+            };
+            match f.steer(heading_err_deg.to_radians()) {
+                YawMode::Rudder(r) => r,
+                other => panic!("{other:?}"),
+            }
+        };
+        let spin = 150f32.to_radians();
+        for err in [179.0, -179.0, 90.0, -90.0] {
+            // Positive: the nose pushed left, against the swing to the right; at least the
+            // yaw-rate term (0.3 s x 2.62 rad/s) less the error's full reach (0.4).
+            let r = wheel(err, spin);
+            assert!(r > 0.385 && r <= STEER_MAX, "course {err} deg off: {r}");
+        }
+        assert_eq!(wheel(170.0, 0.0), -STEER_MAX);
+        assert_eq!(wheel(-170.0, 0.0), STEER_MAX);
+        assert!((wheel(5.0, 0.0) + p.steer_k * 5f32.to_radians()).abs() < 1e-6);
+    }
 
     /// The bank allowed on a course close to the ground: `NAV_GND_RLL_DEG` (5 deg) on it, widening
     /// linearly to 90 deg at `NAV_GND_RLL_M` (3 m), where the roll limit alone governs.
