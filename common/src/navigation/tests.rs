@@ -604,17 +604,7 @@ fn a_take_off_given_up_on_its_roll_rolls_out_wings_level_with_the_throttle_close
         let speed = plane.state().ground_speed();
         let (out, stage) = step_plane(&mut nav, &mut plane, &items);
         steps += 1;
-        assert_eq!(
-            (out.phase, stage),
-            (Phase::TakeoffAbort, GroundStage::Touchdown)
-        );
-        let c = out.commands.expect("commands");
-        assert_eq!(c.roll, RollMode::Roll(0.0), "wings level");
-        assert!(
-            matches!(c.lon, LonMode::Pitch { throttle, .. } if throttle == 0.0),
-            "throttle closed: {:?}",
-            c.lon
-        );
+        assert_given_up(&out, stage);
         assert!(
             plane.k.pos.x.abs() < 0.5 && plane.k.pos.z == 0.0,
             "on the runway's line: {:?}",
@@ -627,6 +617,101 @@ fn a_take_off_given_up_on_its_roll_rolls_out_wings_level_with_the_throttle_close
         assert!(steps < 2000, "still rolling at {speed} m/s");
     }
     assert_eq!(out_reached_none(&mut nav, &mut plane, &items), None);
+}
+
+/// A ground loop on the roll: the heading swung off the runway's line. With `NAV_TKO_HDG_DEG`
+/// set to 60 deg, up to 60 deg off the roll goes on (a tail-dragger weathervaning in a gust
+/// steers back); past it the take-off is given up on that step, as a failsafe would give it
+/// up: the station told why, the throttle closed, the wings level, rolled out to a stop. A
+/// failsafe after it finds nothing left to give up.
+#[test]
+fn a_take_off_roll_swung_past_nav_tko_hdg_deg_off_its_line_is_given_up_with_the_throttle_closed() {
+    let items = takeoff_east();
+    let mut nav = navigator();
+    let mut p = *nav.params();
+    EXEC_PARAMS
+        .set(&mut p, "NAV_TKO_HDG_DEG", 60.0)
+        .expect("in range");
+    nav.set_params(&p);
+    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    plane.k.airspeed = 0.0;
+    nav.start_mission(0);
+    for _ in 0..20 {
+        assert_eq!(
+            step_plane(&mut nav, &mut plane, &items).0.phase,
+            Phase::TakeoffRoll
+        );
+    }
+    for off_deg in [-59.0f32, 59.0] {
+        plane.k.heading = (90.0 + off_deg).to_radians();
+        let (out, _) = step_plane(&mut nav, &mut plane, &items);
+        assert_eq!(out.phase, Phase::TakeoffRoll, "{off_deg} deg off");
+        assert!(out.warnings.is_empty());
+    }
+    plane.k.heading = (90.0 - 61.0f32).to_radians();
+    let (out, stage) = step_plane(&mut nav, &mut plane, &items);
+    assert_given_up(&out, stage);
+    assert_eq!(out.warnings.as_slice(), &[NavWarning::TakeoffOffLine]);
+    assert!(!nav.abort_takeoff(), "already given up");
+}
+
+/// By default (`NAV_TKO_HDG_DEG` 0) a swing off the line does not give the take-off up: in the
+/// campaign's tailwinds of up to 12 m/s the tail-dragger weathervanes 60 to 120 deg in the
+/// roll's first seconds and then flies (docs/NAVIGATION.md).
+#[test]
+fn by_default_a_take_off_roll_swung_120_deg_off_its_line_rolls_on() {
+    let items = takeoff_east();
+    let mut nav = navigator();
+    assert_eq!(nav.params().takeoff_heading_max, 0.0);
+    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    plane.k.airspeed = 0.0;
+    nav.start_mission(0);
+    step_plane(&mut nav, &mut plane, &items);
+    plane.k.heading = (90.0 + 120.0f32).to_radians();
+    let (out, _) = step_plane(&mut nav, &mut plane, &items);
+    assert_eq!(out.phase, Phase::TakeoffRoll);
+    assert!(out.warnings.is_empty());
+}
+
+/// A roll that never reaches the rotation airspeed (`NAV_TKO_VR`, here held at 5 m/s: a
+/// brake binding, a headwind the engine cannot beat, a wrong propeller) is given up once it
+/// has lasted `NAV_TKO_ROLL_S` (20 s), not before.
+#[test]
+fn a_take_off_roll_short_of_its_rotation_airspeed_for_20_s_is_given_up() {
+    let items = takeoff_east();
+    let mut nav = navigator();
+    assert_eq!(nav.params().takeoff_roll_max, 20.0);
+    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    nav.start_mission(0);
+    let mut t = 0.0;
+    let out = loop {
+        plane.k.airspeed = 5.0;
+        let (out, _) = step_plane(&mut nav, &mut plane, &items);
+        t += DT;
+        if out.phase != Phase::TakeoffRoll {
+            break out;
+        }
+        assert!(t < 21.0, "still rolling at {t} s");
+    };
+    assert!((t - 20.0).abs() <= 2.0 * DT, "given up at {t} s");
+    assert_eq!(out.phase, Phase::TakeoffAbort);
+    assert_eq!(out.warnings.as_slice(), &[NavWarning::TakeoffTooSlow]);
+}
+
+/// A step of a take-off given up: its roll-out, a touchdown for a failsafe, wings level, the
+/// throttle closed.
+fn assert_given_up(out: &NavOutput, stage: GroundStage) {
+    assert_eq!(
+        (out.phase, stage),
+        (Phase::TakeoffAbort, GroundStage::Touchdown)
+    );
+    let c = out.commands.expect("commands");
+    assert_eq!(c.roll, RollMode::Roll(0.0), "wings level");
+    assert!(
+        matches!(c.lon, LonMode::Pitch { throttle, .. } if throttle == 0.0),
+        "throttle closed: {:?}",
+        c.lon
+    );
 }
 
 /// The aborted take-off reports no item reached, however long it stands: the mission was not

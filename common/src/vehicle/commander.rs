@@ -760,6 +760,9 @@ impl Commander {
             }
             if out.phase == Phase::Complete || out.phase == Phase::Landed {
                 self.mission_state = MissionRunState::Complete;
+            } else if out.phase == Phase::TakeoffAbort {
+                // As after a failsafe's abort: the mission waits for the station.
+                self.mission_state = MissionRunState::Paused;
             }
         }
         for w in &out.warnings {

@@ -96,6 +96,12 @@ pub enum NavWarning {
     },
     /// The mission is empty.
     NoMission,
+    /// The take-off roll left the runway's line by more than `NAV_TKO_HDG_DEG` and was given
+    /// up.
+    TakeoffOffLine,
+    /// The take-off roll did not reach the rotation airspeed in `NAV_TKO_ROLL_S` and was
+    /// given up.
+    TakeoffTooSlow,
 }
 
 impl NavWarning {
@@ -107,6 +113,8 @@ impl NavWarning {
             NavWarning::JumpLoop { .. } => "Mission: DO_JUMP loop, nothing to fly; ended",
             NavWarning::UnsupportedSpeed { .. } => "Mission: speed change not supported, skipped",
             NavWarning::NoMission => "Mission: nothing to fly",
+            NavWarning::TakeoffOffLine => "Take-off aborted: off the runway's line",
+            NavWarning::TakeoffTooSlow => "Take-off aborted: no rotation speed in time",
         }
     }
 }

@@ -140,6 +140,28 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
+                "NAV_TKO_ROLL_S",
+                20.0,
+                0.0,
+                120.0,
+                "s",
+                "Take-off roll given up (throttle closed, rolled out to a stop, disarmed) when the rotation airspeed is not reached in this time (0: never)",
+            ),
+            NavParams => takeoff_roll_max
+        ),
+        param!(
+            ParamDef::real(
+                "NAV_TKO_HDG_DEG",
+                0.0,
+                0.0,
+                180.0,
+                "deg",
+                "Take-off roll given up (throttle closed, rolled out to a stop, disarmed) when the heading swings off the runway's line by more than this beyond where it stood at the roll's start, a ground loop (0: never; off by default, docs/NAVIGATION.md)",
+            ),
+            NavParams => takeoff_heading_max, unit DEG
+        ),
+        param!(
+            ParamDef::real(
                 "NAV_LND_SLP_DEG",
                 5.0,
                 1.0,
@@ -472,6 +494,11 @@ pub struct NavParams {
     pub land_use_rng: bool,
     /// `NAV_TKO_RAMP_S`: time of the take-off roll's throttle ramp, s.
     pub takeoff_ramp: f32,
+    /// `NAV_TKO_ROLL_S`: longest take-off roll before the rotation airspeed, s (0: no limit).
+    pub takeoff_roll_max: f32,
+    /// `NAV_TKO_HDG_DEG`: largest heading off the runway's line on the take-off roll, rad (0:
+    /// no limit).
+    pub takeoff_heading_max: f32,
     /// Glide slope, rad.
     pub glide_slope: f32,
     /// Approach airspeed, m/s.
@@ -545,6 +572,8 @@ const ZERO: NavParams = NavParams {
     takeoff_airspeed: 0.0,
     takeoff_clear: 0.0,
     takeoff_ramp: 0.0,
+    takeoff_roll_max: 0.0,
+    takeoff_heading_max: 0.0,
     land_disarm_s: 0.0,
     land_abort: 0.0,
     land_use_rng: false,

@@ -12,11 +12,15 @@
 //! A failsafe on the roll, below the rotation airspeed, gives the take-off up
 //! (`Takeoff::abort`): the throttle closed, wings level, the tail wheel steering along the
 //! runway's line, the roll-out of a landing (`land::roll_out`) to a stop, and the
-//! disarm. Past the rotation the aircraft is committed: a failsafe waits until the climb has
-//! reached `NAV_TKO_CLR_M` (`Takeoff::ground_stage`).
+//! disarm. So does the roll itself when it goes wrong, as a pilot closes the throttle: no
+//! rotation airspeed within `NAV_TKO_ROLL_S` (in moderate turbulence at 2-5 m/s of airspeed, a
+//! tail-dragger pirouetted on its runway at full throttle for 20 s and more), and, when it is
+//! set, a heading swung off the runway's line by more than `NAV_TKO_HDG_DEG` beyond where it
+//! stood when the roll began. Past the rotation the aircraft is committed: a failsafe waits
+//! until the climb has reached `NAV_TKO_CLR_M` (`Takeoff::ground_stage`).
 
 use super::guide::{course_near_runway, horizontal_dist, Flight, Orbit};
-use super::io::{GroundStage, NavOutput, NavState, Phase};
+use super::io::{GroundStage, NavOutput, NavState, NavWarning, Phase};
 use super::land::roll_out;
 use super::params::NavParams;
 use crate::control::autopilot::Commands;
@@ -24,6 +28,7 @@ use crate::control::lateral::{RollMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::Home;
 use crate::guidance::Path;
+use crate::math::frames::wrap_pi;
 use crate::navigation::items::Place;
 use nalgebra::Vector3;
 
@@ -44,6 +49,9 @@ pub(super) struct Takeoff {
     climbed: f32,
     /// Given up on the runway: the time rolled out since, s.
     aborted: Option<f32>,
+    /// How far off the runway's course the aircraft stood when the roll began, rad (0 but
+    /// for a line to the item, `NAV_TKO_TO_ITEM`): a ground loop is a swing beyond it.
+    start_off: f32,
 }
 
 impl Takeoff {
@@ -77,6 +85,7 @@ impl Takeoff {
             roll_s: 0.0,
             climbed: 0.0,
             aborted: None,
+            start_off: wrap_pi(state.heading - course).abs(),
         }
     }
 
@@ -88,6 +97,19 @@ impl Takeoff {
             return true;
         }
         false
+    }
+
+    /// Why the roll must be given up now, if it must: a ground loop, or a roll too long.
+    fn gone_wrong(&self, state: &NavState, p: &NavParams) -> Option<NavWarning> {
+        let off = wrap_pi(state.heading - self.course).abs();
+        // Not `>` on a NaN start: a heading unknown at the start takes no abort for it.
+        if p.takeoff_heading_max > 0.0 && off > p.takeoff_heading_max + self.start_off {
+            Some(NavWarning::TakeoffOffLine)
+        } else if p.takeoff_roll_max > 0.0 && self.roll_s > p.takeoff_roll_max {
+            Some(NavWarning::TakeoffTooSlow)
+        } else {
+            None
+        }
     }
 
     /// Where the take-off stands for a failsafe (`NAV_TKO_CLR_M` is `clear`, m).
@@ -125,6 +147,12 @@ impl Takeoff {
         let far = self.start + Vector3::new(dn, de, 0.0) * 1000.0;
         let line = Path::line_between(&self.start, &far, f.cruise);
         out.target = Some(far);
+        if self.rolling && self.aborted.is_none() {
+            if let Some(why) = self.gone_wrong(state, p) {
+                self.aborted = Some(0.0);
+                out.warn(why);
+            }
+        }
         if let Some(rolled) = &mut self.aborted {
             out.phase = Phase::TakeoffAbort;
             let course = line
