@@ -351,6 +351,42 @@ fn a_share_of_the_aircraft_carry_a_rangefinder_and_the_oracle_only_sets_sim_use_
     );
 }
 
+/// `[station] autotune` flies each flight's own draws with the autotune before the mission, as
+/// a QGroundControl user flies it: Takeoff a second after arming, Hold, the autotune pressed,
+/// the mission started last; the same parameters (nothing tuned by the station), and the
+/// plain campaign presses none of it.
+#[test]
+fn the_station_s_autotune_key_flies_the_same_draws_with_takeoff_hold_autotune_then_the_mission() {
+    use sim_host::flight::missions::{AUTOTUNE_AFTER_TAKEOFF_S, MISSION_AFTER_AUTOTUNE_S};
+    use sim_host::flight::script::Action;
+    let plain = campaign(10, 1, MissionChoice::Default);
+    let spec = CampaignSpec::from_toml_str("[station]\nautotune = true\n", Path::new("x")).unwrap();
+    let tuned = Campaign {
+        spec,
+        ..plain.clone()
+    };
+    let (a, b) = (plain.plan(4), tuned.plan(4));
+    assert_eq!(a.draws, b.draws);
+    assert_eq!(a.config.script.params, b.config.script.params);
+    let when = |p: &sim_host::campaign::record::Plan, f: &dyn Fn(&Action) -> bool| {
+        p.config
+            .script
+            .steps
+            .iter()
+            .filter(|s| f(&s.action))
+            .map(|s| s.after_arm_s)
+            .collect::<Vec<_>>()
+    };
+    let takeoff = |x: &Action| matches!(x, Action::Takeoff);
+    let autotune = |x: &Action| matches!(x, Action::Autotune(true));
+    let start = |x: &Action| matches!(x, Action::MissionStart);
+    assert!(when(&a, &takeoff).is_empty() && when(&a, &autotune).is_empty());
+    assert_eq!(when(&b, &takeoff), [1.0]);
+    assert_eq!(when(&b, &autotune), [AUTOTUNE_AFTER_TAKEOFF_S]);
+    assert_eq!(when(&b, &start).last(), Some(&MISSION_AFTER_AUTOTUNE_S));
+    assert!(b.config.duration_s >= a.config.duration_s + MISSION_AFTER_AUTOTUNE_S);
+}
+
 /// Two flights, and beside them the same two with the first one's verdict turned over: the
 /// pairing counts that flight as passing on one side only, every group's counts add up to
 /// its flights, the changed key is named, and a campaign of another seed is refused.

@@ -9,7 +9,7 @@ use super::verdict::Criterion;
 use crate::aircraft::Aircraft;
 use crate::environment::wind::along_runway;
 use crate::flight::config::FlightConfig;
-use crate::flight::missions::runway_mission;
+use crate::flight::missions::{autotune_then_mission, runway_mission};
 use crate::flight::runner::FlightOutcome;
 use crate::flight::strikes::propeller_hub_m;
 use crate::plant::ModelParams;
@@ -248,6 +248,9 @@ impl Campaign {
             config.script.params.push(("SIM_USE_TRUTH".into(), 2.0));
         }
         config.script.fence = mission.fence;
+        if self.spec.station.autotune {
+            config = autotune_then_mission(config);
+        }
         Plan {
             index,
             flight_seed,

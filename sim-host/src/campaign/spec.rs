@@ -198,6 +198,16 @@ pub struct OracleSpec {
     pub flare_on_truth: bool,
 }
 
+/// What the scripted ground station does besides the mission: what a user would do.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct StationSpec {
+    /// Each flight autotunes before its mission, as a QGroundControl user does it
+    /// (`flight::missions::autotune_then_mission`): Takeoff a second after arming, Hold,
+    /// `MAV_CMD_DO_AUTOTUNE_ENABLE`, then the mission on the gains it applied.
+    pub autotune: bool,
+}
+
 /// Everything a campaign disperses.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
@@ -224,6 +234,8 @@ pub struct CampaignSpec {
     pub rangefinder: RangefinderSpec,
     /// Truth given to the autopilot.
     pub oracle: OracleSpec,
+    /// The ground station's part.
+    pub station: StationSpec,
 }
 
 impl Default for AeroSpec {
