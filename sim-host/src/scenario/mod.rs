@@ -127,7 +127,7 @@ pub struct Scenario {
 
 /// Airspeed of the thesis's level trim (Table 2.3), m/s: what the altitude-mode scenarios
 /// hold when flown from that trim (they hold the airspeed of the trim they start from).
-pub const AIRSPEED_MPS: f64 = 17.0;
+pub const AIRSPEED_MPS: f64 = crate::aircraft::DEFAULT_TRIM_AIRSPEED_MPS;
 
 /// Every scenario, in thesis order (Figures 4-1 to 4-15).
 pub const SCENARIOS: &[Scenario] = &[

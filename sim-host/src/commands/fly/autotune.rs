@@ -22,12 +22,7 @@ use serde::Serialize;
 /// vehicle's own declarations of them) at `airspeed`, with the servo it fitted through
 /// (`SERVO_BW`); `None` while any is unset (0).
 fn identified_model(after: &Values, airspeed: f64) -> Option<DesignModel> {
-    let get = |name: &str| {
-        after
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, v)| *v as f32)
-    };
+    let get = |name: &str| value(after, name).map(|v| v as f32);
     let mut model = DesignModel {
         va: airspeed as f32,
         servo_bandwidth_hz: get("SERVO_BW")?,
@@ -131,6 +126,11 @@ pub struct AutotuneReport {
 /// Parameter values by name.
 type Values = Vec<(String, f64)>;
 
+/// The value of parameter `name` in `set`, if it was read.
+fn value(set: &Values, name: &str) -> Option<f64> {
+    set.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+}
+
 /// The values of the parameters the station read at its first and last reading.
 fn readings(o: &FlightOutcome) -> (Values, Values) {
     let reads = &o.summary.params_read;
@@ -154,8 +154,6 @@ fn readings(o: &FlightOutcome) -> (Values, Values) {
 /// (`SERVO_BW`) and, as the base set, the gains read before the autotune (`FB_LPF_POLE`
 /// among them) over the flight defaults. `None` when nothing was identified.
 fn margins_on_host(before: &Values, after: &Values, airspeed: f64) -> Option<DesignMargins> {
-    let get =
-        |set: &Values, name: &str| set.iter().find(|(n, _)| n == name).map(|(_, v)| *v as f32);
     let model = identified_model(after, airspeed)?;
     let mut base = GainSet::FLIGHT;
     for (name, value) in before {
@@ -172,7 +170,7 @@ fn margins_on_host(before: &Values, after: &Values, airspeed: f64) -> Option<Des
             let d = designer.loop_design(l)?;
             let g = [d.gains.kp, d.gains.ki, d.gains.kd];
             for (name, host) in l.params().iter().zip(g) {
-                if let Some(applied) = get(after, name).filter(|v| *v != 0.0) {
+                if let Some(applied) = value(after, name).map(|v| v as f32).filter(|v| *v != 0.0) {
                     let pct = 100.0 * f64::from((host - applied) / applied).abs();
                     diff_max = Some(diff_max.map_or(pct, |m| m.max(pct)));
                 }
@@ -226,8 +224,6 @@ pub fn autotune_report(
     plain: &FlightOutcome,
 ) -> anyhow::Result<AutotuneReport> {
     let (before, after) = readings(tuned);
-    let value =
-        |set: &[(String, f64)], name: &str| set.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     let airspeed = value(&after, "ASPD_SCL_REF").unwrap_or(aircraft.cruise_airspeed_mps());
     let lin = linearize_report_at(aircraft, "level", airspeed)?.reduced;
     let identified = identified_model(&after, airspeed)
