@@ -45,6 +45,9 @@ pub struct ReducedCoefficients {
     pub a_v2: f64,
     /// Airspeed acceleration per radian of pitch, negated, m/s^2.
     pub a_v3: f64,
+    /// The flight path's pole behind the pitch (the heave damping, `-Z_w`: the angle of
+    /// attack's rate per radian of it at constant airspeed, negated), 1/s.
+    pub a_gamma: f64,
     /// Sideslip damping, 1/s.
     pub a_beta1: f64,
     /// Sideslip rate per radian of rudder, 1/s.
@@ -53,7 +56,7 @@ pub struct ReducedCoefficients {
 
 impl ReducedCoefficients {
     /// Name and value of each coefficient, in the book's order.
-    pub fn named(&self) -> [(&'static str, f64); 10] {
+    pub fn named(&self) -> [(&'static str, f64); 11] {
         [
             ("a_phi1", self.a_phi1),
             ("a_phi2", self.a_phi2),
@@ -63,6 +66,7 @@ impl ReducedCoefficients {
             ("a_V1", self.a_v1),
             ("a_V2", self.a_v2),
             ("a_V3", self.a_v3),
+            ("a_gamma", self.a_gamma),
             ("a_beta1", self.a_beta1),
             ("a_beta2", self.a_beta2),
         ]
@@ -85,6 +89,10 @@ pub fn from_linearization(lin: &Linearization, trim: &TrimResult) -> ReducedCoef
     let a_v2 = va_dot(&|r| quasi_b(r, super::linearize::iu::THROTTLE));
     let a_v3 = -va_dot(&|r| quasi(r, ix::THETA));
     let q_per_alpha = va * (-sa * a[(ix::Q, ix::U)] + ca * a[(ix::Q, ix::W)]);
+    // The angle of attack turned at constant airspeed, (du, dw) = Va (-sin, cos) dalpha, and
+    // its rate read across the airspeed, (-sin, cos) (u', w') / Va.
+    let turned = |r: usize| -sa * quasi(r, ix::U) + ca * quasi(r, ix::W);
+    let alpha_dot_per_alpha = -sa * turned(ix::U) + ca * turned(ix::W);
     let lat = &lin.lat;
     // Lateral order v, p, r, phi, psi; inputs left aileron, right aileron, rudder.
     ReducedCoefficients {
@@ -96,6 +104,7 @@ pub fn from_linearization(lin: &Linearization, trim: &TrimResult) -> ReducedCoef
         a_v1,
         a_v2,
         a_v3,
+        a_gamma: -alpha_dot_per_alpha,
         a_beta1: -lat.a[(0, 0)],
         a_beta2: lat.b[(0, 2)] / va,
     }
@@ -150,6 +159,7 @@ pub fn closed_form(aircraft: &Aircraft, trim: &TrimResult) -> ReducedCoefficient
         a_v1: rho * va * s * cd / mass - dt_dva / mass,
         a_v2: dt_dthr / mass,
         a_v3: aircraft.environment.g_mps2 * (trim.theta - trim.alpha).cos(),
+        a_gamma: rho * va * s * (aero.lift.CL_alpha + cd) / (2.0 * mass),
         a_beta1: -rho * va * s * aero.side.CY_beta / (2.0 * mass),
         a_beta2: rho * va * s * aero.side.CY_dr / (2.0 * mass),
     }

@@ -106,6 +106,7 @@ pub fn read_model(path: &Path) -> anyhow::Result<ReducedModel> {
             a_v1: coefficient("airspeed", "a_V1")?,
             a_v2: coefficient("airspeed", "a_V2")?,
             a_v3: coefficient("airspeed", "a_V3")?,
+            a_gamma: f64::NAN,
             a_beta1: f64::NAN,
             a_beta2: f64::NAN,
         },

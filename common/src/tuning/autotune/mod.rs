@@ -171,7 +171,7 @@ enum Phase {
 const DESIGN_STEPS: f32 = 200.0;
 
 /// The axes the design needs, in the order they are fitted.
-const FITTED: [Axis; 3] = [Axis::Roll, Axis::Pitch, Axis::Airspeed];
+const FITTED: [Axis; 4] = [Axis::Roll, Axis::Pitch, Axis::Airspeed, Axis::FlightPath];
 
 /// Time constant of the level pitch and throttle's average, s: longer than the altitude
 /// loop's oscillation, shorter than a level stage.
@@ -476,6 +476,7 @@ impl Autotune {
         match axis {
             Axis::Roll => (m.a_phi1, m.a_phi2) = (a, b),
             Axis::Pitch => (m.a_theta1, m.a_theta2, m.a_theta3) = (a, b, c),
+            Axis::FlightPath => m.a_gamma = a,
             _ => (m.a_v1, m.a_v2) = (a, b),
         }
         let tick = Tick {

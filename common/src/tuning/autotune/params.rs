@@ -18,6 +18,7 @@ pub const UNIDENTIFIED: DesignModel = DesignModel {
     a_theta3: 0.0,
     a_v1: 0.0,
     a_v2: 0.0,
+    a_gamma: 0.0,
     engine_pole: None,
     servo_bandwidth_hz: 0.0,
     g: GRAVITY,
@@ -129,6 +130,10 @@ pub const IDENTIFIED: Group<DesignModel> = Group {
         param!(
             ParamDef::real("ATUN_A_V2", 0.0, -1e3, 1e3, "m/s^2", "Identified a_V2"),
             DesignModel => a_v2
+        ),
+        param!(
+            ParamDef::real("ATUN_A_GAM", 0.0, -1e3, 1e3, "1/s", "Identified a_gamma"),
+            DesignModel => a_gamma
         ),
     ],
     base: || UNIDENTIFIED,

@@ -9,7 +9,11 @@
 //! the step is found by bisection over the step index, about 11 margin computations, and it
 //! is the same step wherever the margin falls as the gain rises (which the delay makes it do:
 //! a higher gain crosses over higher, where the delay takes more phase). Each outer loop's
-//! gains follow from the loop inside it in closed form; then its margins are computed once.
+//! gains follow from the loop inside it in closed form at its rule's natural frequency; where
+//! that misses the loop's margins (the lags the rules leave out: the inner loop's integrator,
+//! the flight path's lag behind the pitch, the feedback filter, the delay), the natural
+//! frequency is lowered by the same 1 % steps, found the same way, until they are met, as
+//! the thesis widens the bandwidth separation of a loop whose margins are short.
 //!
 //! A loop that misses its margins ([`judge`]) does not stop the design: the loops outside it
 //! are still designed, so that every loop's gains and margins can be shown
@@ -114,19 +118,30 @@ pub enum Step {
     Failed(DesignFailure),
 }
 
-/// The limit of an attitude loop's gain: the smallest step index whose gain keeps the phase
-/// margin, found by bisection.
+/// The limit of a loop's gain (an attitude loop's) or natural frequency (an outer loop's, as
+/// a share of its rule's): the smallest step index whose design keeps the margin, found by
+/// bisection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Search {
-    /// The rule's gain (step 0).
-    kp0: f32,
+    /// The rule's gain, or 1 (step 0).
+    x0: f32,
     /// The highest step known to miss the margin.
     failing: Option<u16>,
     /// The lowest step known to keep it, with its margins.
     passing: Option<(u16, Margins)>,
     /// The step whose margins are being computed.
     probe: u16,
+    /// Steps between probes while none has kept the margin: 0 goes straight to the last
+    /// step (an attitude loop's margin falls as its gain rises, all the way), an outer loop's
+    /// scan walks down by this many (its margins come back only over a band of natural
+    /// frequencies: far enough below its rule's, the pole placement's gain changes sign
+    /// where the plant's own damping exceeds what it asks for, and the margins fall again).
+    scan: u16,
 }
+
+/// Steps an outer loop's scan walks down by before its bisection: 10 % of its natural
+/// frequency a probe.
+const SCAN_STEPS: u16 = 10;
 
 /// Where a search goes next.
 enum Next {
@@ -144,22 +159,23 @@ impl Search {
             (None, Some((n, m))) => Next::Chosen(n, Some(m)),
             // None keeps it: the last step's gain is judged, and fails.
             (Some(f), None) if f.saturating_add(1) >= GAIN_STEPS => Next::Chosen(GAIN_STEPS, None),
-            (Some(_), None) => Next::Probe(GAIN_STEPS - 1),
+            (Some(_), None) if self.scan == 0 => Next::Probe(GAIN_STEPS - 1),
+            (Some(f), None) => Next::Probe(f.saturating_add(self.scan).min(GAIN_STEPS - 1)),
             (Some(f), Some((n, m))) if n <= f.saturating_add(1) => Next::Chosen(n, Some(m)),
             (Some(f), Some((n, _))) => Next::Probe(f + (n - f) / 2),
         }
     }
 
-    /// The gain `n` steps down.
-    fn kp(&self, n: u16) -> f32 {
-        self.kp0 * libm::powf(GAIN_STEP, f32::from(n))
+    /// The gain or share `n` steps down.
+    fn at(&self, n: u16) -> f32 {
+        self.x0 * libm::powf(GAIN_STEP, f32::from(n))
     }
 }
 
 /// What the designer is doing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Stage {
-    /// Computing the margins of one step of an attitude loop's gain.
+    /// Computing the margins of one step of a loop's gain or natural frequency.
     Limit {
         loop_: Loop,
         search: Search,
@@ -215,53 +231,6 @@ fn finite(loop_: Loop, d: &LoopDesign) -> Result<(), DesignFailure> {
     match bad {
         Some(name) => Err(failure(loop_, Reason::NotFinite(name))),
         None => Ok(()),
-    }
-}
-
-/// The limit of `loop_`'s gain begun: its rule's gain probed first.
-fn limit(rules: &Rules, loop_: Loop) -> Stage {
-    let kp0 = match loop_ {
-        Loop::Roll => rules.roll_kp_appendix_c(),
-        _ => rules.pitch_kp_nominal(),
-    };
-    let search = Search {
-        kp0,
-        failing: None,
-        passing: None,
-        probe: 0,
-    };
-    probe(rules, loop_, search, 0)
-}
-
-/// The margins of step `n` of `loop_`'s gain begun.
-fn probe(rules: &Rules, loop_: Loop, mut search: Search, n: u16) -> Stage {
-    search.probe = n;
-    let d = attitude(rules, loop_, search.kp(n));
-    if let Err(f) = finite(loop_, &d) {
-        return Stage::Over(Err(f));
-    }
-    let transfer = match loop_ {
-        Loop::Roll => Transfer::Roll(d.gains),
-        _ => Transfer::Pitch(d.gains),
-    };
-    Stage::Limit {
-        loop_,
-        search,
-        sweep: Sweep::new(transfer),
-    }
-}
-
-/// An attitude loop's gains and natural frequency at `kp`.
-fn attitude(rules: &Rules, loop_: Loop, kp: f32) -> LoopDesign {
-    let r = rules;
-    let (gains, wn_radps) = match loop_ {
-        Loop::Roll => (r.roll(kp), r.roll_wn(kp)),
-        _ => (r.pitch(kp), r.pitch_wn(kp)),
-    };
-    LoopDesign {
-        gains,
-        wn_radps,
-        margins: Margins::default(),
     }
 }
 
@@ -352,20 +321,21 @@ impl Designer {
     pub fn new(model: &DesignModel, inputs: &DesignInputs, base: &GainSet) -> Self {
         let lp = base.longitudinal.feedback_lpf_pole;
         let rules = Rules::new(model, inputs, base);
-        let stage = match check(model, inputs, lp) {
-            Ok(()) => limit(&rules, Loop::Roll),
-            Err(f) => Stage::Over(Err(f)),
-        };
-        Self {
+        let mut designer = Self {
             rules,
             base: *base,
             loops: Loops::default(),
             designed: None,
             missed: None,
-            stage,
+            stage: Stage::Finish,
             evaluations: 0,
             steps: 0,
-        }
+        };
+        designer.stage = match check(model, inputs, lp) {
+            Ok(()) => designer.limit(Loop::Roll),
+            Err(f) => Stage::Over(Err(f)),
+        };
+        designer
     }
 
     /// Does at most [`POINTS_PER_STEP`] points' worth of the design.
@@ -409,22 +379,83 @@ impl Designer {
         self.steps
     }
 
+    /// `loop_`'s design at `x`: an attitude loop's at the gain `x`, an outer loop's at `x`
+    /// times its rule's natural frequency, from the loops inside it as designed.
+    fn candidate(&self, loop_: Loop, x: f32) -> LoopDesign {
+        let (r, l) = (&self.rules, &self.loops);
+        let (gains, wn_radps) = match loop_ {
+            Loop::Roll => (r.roll(x), r.roll_wn(x)),
+            Loop::Pitch => (r.pitch(x), r.pitch_wn(x)),
+            Loop::Course => r.course(l.roll.wn_radps, x),
+            Loop::Altitude => r.altitude(l.pitch.wn_radps, x),
+            Loop::AirspeedPitch => r.airspeed_pitch(l.pitch.wn_radps, x),
+            Loop::AirspeedThrottle => r.airspeed_throttle(x),
+        };
+        LoopDesign {
+            gains,
+            wn_radps,
+            margins: Margins::default(),
+        }
+    }
+
+    /// The limit of `loop_`'s gain or natural frequency begun: its rule's probed first.
+    fn limit(&self, loop_: Loop) -> Stage {
+        let (x0, scan) = match loop_ {
+            Loop::Roll => (self.rules.roll_kp_appendix_c(), 0),
+            Loop::Pitch => (self.rules.pitch_kp_nominal(), 0),
+            _ => (1.0, SCAN_STEPS),
+        };
+        let search = Search {
+            x0,
+            failing: None,
+            passing: None,
+            probe: 0,
+            scan,
+        };
+        self.probe(loop_, search, 0)
+    }
+
+    /// The margins of step `n` of `loop_`'s search begun.
+    fn probe(&self, loop_: Loop, mut search: Search, n: u16) -> Stage {
+        search.probe = n;
+        let d = self.candidate(loop_, search.at(n));
+        if let Err(f) = finite(loop_, &d) {
+            return Stage::Over(Err(f));
+        }
+        Stage::Limit {
+            loop_,
+            search,
+            sweep: Sweep::new(self.transfer(loop_, &d)),
+        }
+    }
+
+    /// Whether `margins` keep `loop_`'s search going down: an attitude loop's phase margin
+    /// under [`DesignInputs::inner_phase_margin_deg`], an outer loop's targets missed.
+    fn keeps(&self, loop_: Loop, margins: &Margins) -> bool {
+        match loop_ {
+            Loop::Roll | Loop::Pitch => {
+                let pm_min = self.rules.inputs.inner_phase_margin_deg;
+                margins.phase_margin_deg.is_some_and(|pm| pm >= pm_min)
+            }
+            _ => judge(loop_, margins).is_ok(),
+        }
+    }
+
     /// Where the design goes once a sweep has given `margins`.
     fn swept(&mut self, margins: Margins) -> Stage {
         match self.stage {
             Stage::Limit {
                 loop_, mut search, ..
             } => {
-                let pm_min = self.rules.inputs.inner_phase_margin_deg;
-                if margins.phase_margin_deg.is_some_and(|pm| pm >= pm_min) {
+                if self.keeps(loop_, &margins) {
                     search.passing = Some((search.probe, margins));
                 } else {
                     search.failing = Some(search.probe);
                 }
                 match search.next() {
-                    Next::Probe(n) => probe(&self.rules, loop_, search, n),
+                    Next::Probe(n) => self.probe(loop_, search, n),
                     Next::Chosen(n, known) => {
-                        let design = attitude(&self.rules, loop_, search.kp(n));
+                        let design = self.candidate(loop_, search.at(n));
                         match known {
                             Some(margins) => self.designed_loop(loop_, design, margins),
                             None => self.judge(loop_, design),
@@ -442,8 +473,17 @@ impl Designer {
         if let Err(f) = finite(loop_, &design) {
             return Stage::Over(Err(f));
         }
+        Stage::Judge {
+            loop_,
+            design,
+            sweep: Sweep::new(self.transfer(loop_, &design)),
+        }
+    }
+
+    /// `loop_`'s transfer with `design`'s gains, inside it the loops as designed.
+    fn transfer(&self, loop_: Loop, design: &LoopDesign) -> Transfer {
         let l = &self.loops;
-        let transfer = match loop_ {
+        match loop_ {
             Loop::Roll => Transfer::Roll(design.gains),
             Loop::Course => Transfer::Course {
                 course: design.gains,
@@ -459,11 +499,6 @@ impl Designer {
                 pitch: l.pitch.gains,
             },
             Loop::AirspeedThrottle => Transfer::AirspeedThrottle(design.gains),
-        };
-        Stage::Judge {
-            loop_,
-            design,
-            sweep: Sweep::new(transfer),
         }
     }
 
@@ -475,21 +510,12 @@ impl Designer {
         if let Err(reason) = judge(loop_, &margins) {
             self.missed = self.missed.or(Some(failure(loop_, reason)));
         }
-        let (r, l) = (&self.rules, &self.loops);
-        let outer = |(gains, wn_radps)| LoopDesign {
-            gains,
-            wn_radps,
-            margins: Margins::default(),
-        };
         match loop_ {
-            Loop::Roll => self.judge(Loop::Course, outer(r.course(l.roll.wn_radps))),
-            Loop::Course => limit(&self.rules, Loop::Pitch),
-            Loop::Pitch => self.judge(Loop::Altitude, outer(r.altitude(l.pitch.wn_radps))),
-            Loop::Altitude => self.judge(
-                Loop::AirspeedPitch,
-                outer(r.airspeed_pitch(l.pitch.wn_radps)),
-            ),
-            Loop::AirspeedPitch => self.judge(Loop::AirspeedThrottle, outer(r.airspeed_throttle())),
+            Loop::Roll => self.limit(Loop::Course),
+            Loop::Course => self.limit(Loop::Pitch),
+            Loop::Pitch => self.limit(Loop::Altitude),
+            Loop::Altitude => self.limit(Loop::AirspeedPitch),
+            Loop::AirspeedPitch => self.limit(Loop::AirspeedThrottle),
             Loop::AirspeedThrottle => Stage::Finish,
         }
     }

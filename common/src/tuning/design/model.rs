@@ -48,8 +48,17 @@ impl PitchResponse {
 /// pitch     theta / de    = a_theta3 / (s^2 + a_theta1 s + a_theta2)   (or `pitch_response`)
 /// airspeed  Va / theta    = -g / (s + a_v1)
 ///           Va / throttle = a_v2 engine_pole / ((s + a_v1) (s + engine_pole))
-/// course    chi / phi     = (g / va) / s,     altitude   h / theta = va / s
+/// course    chi / phi     = (g / va) / s
+/// flight    gamma / theta = a_gamma / (s + a_gamma)      (1 where a_gamma is 0)
+/// altitude  h / gamma     = va / s
 /// ```
+///
+/// The flight path's lag behind the pitch is left out of the book's altitude and airspeed
+/// models (`h / theta = va / s`): the lift that turns the flight path is built by the angle of
+/// attack, which the pitch must first open. Its pole, `a_gamma = rho Va S (CL_alpha + CD) /
+/// (2 m)` (the heave damping, `-Z_w`), is some 8 rad/s on the 25e at 17 m/s and 3.5 on the
+/// Aerosonde at 25: within an octave of their altitude loops' crossover, whose margins it
+/// takes 15 to 30 degrees of.
 ///
 /// No sideslip model: the sideslip loop keeps the base set's gains.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -71,6 +80,9 @@ pub struct DesignModel {
     pub a_v1: f32,
     /// Steady airspeed acceleration per unit throttle, m/s^2.
     pub a_v2: f32,
+    /// The flight path's pole behind the pitch, 1/s (0: not modelled, the flight path
+    /// follows the pitch at once as the book's altitude model has it).
+    pub a_gamma: f32,
     /// The engine speed's pole, 1/s (`None`: not identified, taken as
     /// [`QUASI_STEADY_ENGINE_POLE`]).
     pub engine_pole: Option<f32>,
@@ -98,7 +110,7 @@ impl DesignModel {
 
     /// The coefficients a design takes from identification, under Beard and McLain's names
     /// (as the linearisation's reports name them), in the order of the design.
-    pub fn coefficients(&self) -> [(&'static str, f32); 7] {
+    pub fn coefficients(&self) -> [(&'static str, f32); 8] {
         [
             ("a_phi1", self.a_phi1),
             ("a_phi2", self.a_phi2),
@@ -107,6 +119,7 @@ impl DesignModel {
             ("a_theta3", self.a_theta3),
             ("a_V1", self.a_v1),
             ("a_V2", self.a_v2),
+            ("a_gamma", self.a_gamma),
         ]
     }
 

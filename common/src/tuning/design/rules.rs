@@ -83,10 +83,10 @@ impl Rules {
         }
     }
 
-    /// Course, `wn_chi = wn_phi / separation`: `kp = 2 zeta wn_chi Va / g`, the integrator's
-    /// zero at the outer fraction of `2 zeta wn_chi`. Gains and `wn_chi`.
-    pub fn course(&self, wn_phi: f32) -> (LoopGains, f32) {
-        let wn = wn_phi / self.inputs.course_separation;
+    /// Course, `wn_chi = wn_phi / separation` (times `share`): `kp = 2 zeta wn_chi Va / g`,
+    /// the integrator's zero at the outer fraction of `2 zeta wn_chi`. Gains and `wn_chi`.
+    pub fn course(&self, wn_phi: f32, share: f32) -> (LoopGains, f32) {
+        let wn = share * wn_phi / self.inputs.course_separation;
         let kp = 2.0 * self.zeta() * wn * self.plant.model.va / self.plant.model.g;
         let ki = kp * 2.0 * self.zeta() * wn * self.inputs.outer_integrator_fraction;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
@@ -120,35 +120,36 @@ impl Rules {
         }
     }
 
-    /// Altitude on `h / theta = Va / s`: `wn_h` the lower of `wn_theta / separation` and the
-    /// feedback pole over its separation; `kp = 2 zeta wn_h / Va`, the integrator's zero at the
-    /// outer fraction of `2 zeta wn_h`. Gains and `wn_h`.
-    pub fn altitude(&self, wn_theta: f32) -> (LoopGains, f32) {
+    /// Altitude on `h / theta = Va / s` (the flight path's lag left to the margins): `wn_h` the lower of `wn_theta / separation` and the
+    /// feedback pole over its separation (times `share`); `kp = 2 zeta wn_h / Va`, the
+    /// integrator's zero at the outer fraction of `2 zeta wn_h`. Gains and `wn_h`.
+    pub fn altitude(&self, wn_theta: f32, share: f32) -> (LoopGains, f32) {
         let i = &self.inputs;
-        let wn =
-            (wn_theta / i.altitude_separation).min(self.plant.lp / i.altitude_filter_separation);
+        let wn = share
+            * (wn_theta / i.altitude_separation).min(self.plant.lp / i.altitude_filter_separation);
         let kp = 2.0 * self.zeta() * wn / self.plant.model.va;
         let ki = kp * 2.0 * self.zeta() * wn * i.outer_integrator_fraction;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
 
     /// Airspeed by pitch on `Va / theta = -g / (s + a_V1)`, by pole placement at the lower of
-    /// `wn_theta / separation` and the feedback pole over the filter separation. Gains and `wn`.
-    pub fn airspeed_pitch(&self, wn_theta: f32) -> (LoopGains, f32) {
+    /// `wn_theta / separation` and the feedback pole over the filter separation (times
+    /// `share`). Gains and `wn`.
+    pub fn airspeed_pitch(&self, wn_theta: f32, share: f32) -> (LoopGains, f32) {
         let i = &self.inputs;
         let p = &self.plant;
-        let wn = (wn_theta / i.altitude_separation).min(p.lp / i.filter_separation);
+        let wn = share * (wn_theta / i.altitude_separation).min(p.lp / i.filter_separation);
         let kp = (p.model.a_v1 - 2.0 * self.zeta() * wn) / p.model.g;
         let ki = -wn * wn / p.model.g;
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
 
     /// Airspeed by throttle on `Va / throttle = a_V2 / (s + a_V1)` (the engine's lag left to
-    /// the margins), by pole placement at the feedback pole over the filter separation. Gains
-    /// and `wn`.
-    pub fn airspeed_throttle(&self) -> (LoopGains, f32) {
+    /// the margins), by pole placement at the feedback pole over the filter separation (times
+    /// `share`). Gains and `wn`.
+    pub fn airspeed_throttle(&self, share: f32) -> (LoopGains, f32) {
         let p = &self.plant;
-        let wn = p.lp / self.inputs.filter_separation;
+        let wn = share * p.lp / self.inputs.filter_separation;
         let kp = (2.0 * self.zeta() * wn - p.model.a_v1) / p.model.a_v2;
         let ki = wn * wn / p.model.a_v2;
         (LoopGains { kp, ki, kd: 0.0 }, wn)

@@ -114,6 +114,17 @@ impl Plant {
         (s * n1 + n0) / (((s * d3 + d2) * s + d1) * s + d0)
     }
 
+    /// `gamma / theta`: the flight path's first-order lag behind the pitch, or 1 where it is
+    /// not modelled (`a_gamma` 0).
+    fn flight_path(&self, s: C) -> C {
+        let a = self.model.a_gamma;
+        if a > 0.0 {
+            C::from(a) / (s + a)
+        } else {
+            C::from(1.0)
+        }
+    }
+
     /// The servo, `p / (s + p)`.
     fn servo(&self, s: C) -> C {
         C::from(self.servo_pole) / (s + self.servo_pole)
@@ -153,14 +164,16 @@ pub(super) enum Transfer {
     },
     /// Pitch attitude: PID on the elevator.
     Pitch(LoopGains),
-    /// Altitude: PI on the commanded pitch, through the pitch loop closed, fed back filtered.
+    /// Altitude: PI on the commanded pitch, through the pitch loop closed and the flight
+    /// path's lag, fed back filtered.
     Altitude {
         /// The altitude loop's gains.
         altitude: LoopGains,
         /// The pitch loop's gains.
         pitch: LoopGains,
     },
-    /// Airspeed: PI on the commanded pitch, through the pitch loop closed, fed back filtered.
+    /// Airspeed: PI on the commanded pitch, through the pitch loop closed and the flight
+    /// path's lag, fed back filtered.
     AirspeedPitch {
         /// The airspeed loop's gains.
         airspeed: LoopGains,
@@ -187,11 +200,12 @@ impl Transfer {
             Transfer::Pitch(g) => g.pid(s) * p.pitch(s) * p.servo(s),
             Transfer::Altitude { altitude, pitch } => {
                 let pitch = p.closed(pitch, p.pitch(s), s, p.delay(w));
-                altitude.pi(s) * pitch * p.model.va / s * p.filter(s)
+                altitude.pi(s) * pitch * p.flight_path(s) * p.model.va / s * p.filter(s)
             }
             Transfer::AirspeedPitch { airspeed, pitch } => {
                 let pitch = p.closed(pitch, p.pitch(s), s, p.delay(w));
-                airspeed.pi(s) * pitch * C::from(-p.model.g) / (s + p.model.a_v1) * p.filter(s)
+                let gamma = pitch * p.flight_path(s);
+                airspeed.pi(s) * gamma * C::from(-p.model.g) / (s + p.model.a_v1) * p.filter(s)
             }
             Transfer::AirspeedThrottle(g) => {
                 let engine = C::from(p.model.a_v2 * p.engine_pole)

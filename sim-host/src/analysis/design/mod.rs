@@ -312,6 +312,9 @@ fn design_loops(
         a_theta3: coefficients.a_theta3 as f32,
         a_v1: a_v1 as f32,
         a_v2: a_v2 as f32,
+        // The thesis's altitude and airspeed models, `h / theta = Va / s`: the computed set
+        // is the thesis's design; the flight path's lag is the identified model's.
+        a_gamma: 0.0,
         engine_pole: Some(engine_pole as f32),
         servo_bandwidth_hz: servo_bandwidth_hz as f32,
         g: g as f32,
