@@ -270,7 +270,11 @@ fn the_estimator_meets_its_targets_in_light_turbulence() {
 /// larger: a tenth of a 1-3 % overshoot is below what one turbulent flight resolves (one
 /// point of a 90 deg turn is 0.9 deg, about three times the RMS course wander light
 /// turbulence leaves in straight flight on the truth, 0.26 deg); the course error over the
-/// last 5 s before the next command within 0.5 deg of the truth's.
+/// last 5 s before the next command within 0.5 deg of the truth's. The settling times are
+/// compared only where both overshoots are clear of the 2 % settling band by more than that
+/// one point's tolerance: an overshoot on the band's edge (2.00 % against 1.90 % in one
+/// flight) settles at its first entry into the band or only after the overshoot's return,
+/// 0.6 s apart, for a difference the overshoot's own check allows.
 #[test]
 fn turns_flown_on_the_estimate_match_turns_flown_on_the_truth() {
     let cfg = estimator_flight();
@@ -310,12 +314,15 @@ fn turns_flown_on_the_estimate_match_turns_flown_on_the_truth() {
     for (e, t) in a.iter().zip(&b) {
         eprintln!("{}: est {:?} truth {:?}", e.what, e.metrics, t.metrics);
         within(e.metrics.rise_time_s, t.metrics.rise_time_s, "rise");
-        within(
-            e.metrics.settling_time_s,
-            t.metrics.settling_time_s,
-            "settling",
-        );
         let tol = (0.1 * t.metrics.overshoot_pct).max(1.0);
+        let clear = |o: f64| (o - SETTLING_BAND_PCT).abs() > tol;
+        if clear(e.metrics.overshoot_pct) && clear(t.metrics.overshoot_pct) {
+            within(
+                e.metrics.settling_time_s,
+                t.metrics.settling_time_s,
+                "settling",
+            );
+        }
         assert!(
             (e.metrics.overshoot_pct - t.metrics.overshoot_pct).abs() <= tol,
             "overshoot: estimate {:.2} truth {:.2}",
@@ -330,6 +337,9 @@ fn turns_flown_on_the_estimate_match_turns_flown_on_the_truth() {
         );
     }
 }
+
+/// The settling band of `analysis::metrics`, % of the step.
+const SETTLING_BAND_PCT: f64 = 2.0;
 
 /// Wraps the in-process pipe and spoils the simulator's bytes on the way to the autopilot.
 struct Tamper {

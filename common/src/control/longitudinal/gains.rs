@@ -152,7 +152,7 @@ pub const PARAMS: Group<LongitudinalGains> = Group {
                 -2.0,
                 0.0,
                 "s",
-                "Pitch-rate damper, elevator per pitch rate, applied as -kd*q",
+                "Pitch-rate damper, elevator per pitch rate beyond a coordinated turn's, applied as -kd*q",
             ),
             LongitudinalGains => pitch_rate_kd
         ),
