@@ -287,14 +287,14 @@ fn navigation_targets(m: &MissionSummary) -> Vec<(&'static str, bool)> {
 /// runway, Hold, autotune, then the default mission on the gains it applied, beside the same
 /// mission on the default gains. The default gains meet every calm-air target of
 /// docs/NAVIGATION.md; after the autotune (the design's inputs `DesignInputs::AUTOTUNE`: the
-/// outer loops at the flight-proven set's separations) the mission reaches every item, holds
-/// its altitude and airspeed closer than the default gains do, lands within 20 m under
-/// 1.5 m/s of sink, and flies the calm-air line within a tenth of its 0.5 m RMS target
-/// (measured 0.505 m against the default gains' 0.441). Every loop keeps its margins on the
+/// outer loops at the flight-proven set's separations) the mission meets every one of them
+/// too, and holds its altitude and airspeed closer than the default gains do (measured: the
+/// straight legs 0.497 m RMS against the 0.5 m target, 0.436 on the default gains; 0.505 m
+/// before the pitch damper left the turns' pitch rate alone). Every loop keeps its margins on the
 /// identified model, recomputed on the host from what the station read back, with the gains
 /// the vehicle applied.
 #[test]
-fn after_the_autotune_the_default_mission_holds_altitude_and_airspeed_closer_lands_within_20_m_and_flies_the_line_within_a_tenth_of_its_target(
+fn after_the_autotune_the_default_mission_meets_every_navigation_target_and_holds_altitude_and_airspeed_closer(
 ) {
     let a = aircraft();
     let plain_cfg = runway_mission(default_mission(ModelParams::new(&a).home));
@@ -321,11 +321,7 @@ fn after_the_autotune_the_default_mission_holds_altitude_and_airspeed_closer_lan
     }
     let (after, before) = (&m.after_autotune, &m.default_gains);
     for (what, met) in navigation_targets(after) {
-        if what.starts_with("straight-leg cross-track") {
-            assert!(after.xtrack_rms_m < 0.55, "{what}: {after:?}");
-        } else {
-            assert!(met, "after the autotune: {what}: {after:?}");
-        }
+        assert!(met, "after the autotune: {what}: {after:?}");
     }
     assert!(
         after.alt_rms_m <= before.alt_rms_m,
