@@ -289,7 +289,7 @@ fn navigation_targets(m: &MissionSummary) -> Vec<(&'static str, bool)> {
 /// docs/NAVIGATION.md; after the autotune (the design's inputs `DesignInputs::AUTOTUNE`: the
 /// outer loops at the flight-proven set's separations) the mission meets every one of them
 /// too, and holds its altitude and airspeed closer than the default gains do (measured: the
-/// straight legs 0.497 m RMS against the 0.5 m target, 0.436 on the default gains; 0.505 m
+/// straight legs 0.499 m RMS against the 0.5 m target, 0.437 on the default gains; 0.505 m
 /// before the pitch damper left the turns' pitch rate alone). Every loop keeps its margins on the
 /// identified model, recomputed on the host from what the station read back, with the gains
 /// the vehicle applied.
