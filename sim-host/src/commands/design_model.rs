@@ -106,7 +106,8 @@ pub fn read_model(path: &Path) -> anyhow::Result<ReducedModel> {
             a_v1: coefficient("airspeed", "a_V1")?,
             a_v2: coefficient("airspeed", "a_V2")?,
             a_v3: coefficient("airspeed", "a_V3")?,
-            a_gamma: f64::NAN,
+            // Logs identified before the flight path's fit have none: no lag, as the thesis.
+            a_gamma: r.coefficient("flight path", "a_gamma").unwrap_or(f64::NAN),
             a_beta1: f64::NAN,
             a_beta2: f64::NAN,
         },

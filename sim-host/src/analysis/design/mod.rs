@@ -76,6 +76,9 @@ pub struct Coefficients {
     pub a_v2: f64,
     /// Engine-speed pole `-A[Omega,Omega]`, 1/s.
     pub engine_pole: f64,
+    /// The flight path's pole behind the pitch, 1/s (0: none, the thesis's altitude and
+    /// airspeed models `h / theta = Va / s`, `Va / theta = -g / (s + a_V1)`).
+    pub a_gamma: f64,
 }
 
 /// Appendix C's roll numbers, and the phase margin they leave once servo and delay are in the
@@ -170,6 +173,9 @@ pub fn design_at(
         a_v1,
         a_v2,
         engine_pole,
+        // The thesis's altitude and airspeed models: the computed set is the thesis's
+        // design. The flight path's lag is the identified models' (`--model`, the autotune).
+        a_gamma: 0.0,
     };
     // Pitch: predicted on the linear short period.
     let q_de = &super::transfer::thesis_transfer_functions(&lin).q_over_de;
@@ -231,6 +237,13 @@ pub fn design_from_model(model: &ReducedModel, inputs: &DesignInputs) -> anyhow:
         engine_pole: model
             .engine_pole
             .unwrap_or(f64::from(QUASI_STEADY_ENGINE_POLE)),
+        // A model without the flight path's fit (or with a pole that is no lag) keeps the
+        // thesis's lag-free altitude model.
+        a_gamma: if m.a_gamma.is_finite() && m.a_gamma > 0.0 {
+            m.a_gamma
+        } else {
+            0.0
+        },
     };
     let theta_de = tf(&[m.a_theta3], &[1.0, m.a_theta1, m.a_theta2]);
     let plant = Plant {
@@ -297,6 +310,7 @@ fn design_loops(
         a_v1,
         a_v2,
         engine_pole,
+        a_gamma,
         ..
     } = coefficients;
     let z = decimal(inputs.zeta);
@@ -312,9 +326,7 @@ fn design_loops(
         a_theta3: coefficients.a_theta3 as f32,
         a_v1: a_v1 as f32,
         a_v2: a_v2 as f32,
-        // The thesis's altitude and airspeed models, `h / theta = Va / s`: the computed set
-        // is the thesis's design; the flight path's lag is the identified model's.
-        a_gamma: 0.0,
+        a_gamma: a_gamma as f32,
         engine_pole: Some(engine_pole as f32),
         servo_bandwidth_hz: servo_bandwidth_hz as f32,
         g: g as f32,
@@ -502,7 +514,13 @@ fn design_loops(
     // --- Altitude by pitch.
     let (alt_kp, alt_ki, _, wn_h) = pid(&onboard.altitude);
     let alt_pi = tf(&[alt_kp, alt_ki], &[1.0, 0.0]);
-    let climb = tf(&[va], &[1.0, 0.0]);
+    // The flight path per pitch, `a_gamma / (s + a_gamma)`, or 1 without its lag.
+    let path = if a_gamma > 0.0 {
+        tf(&[a_gamma], &[1.0, a_gamma])
+    } else {
+        tf(&[1.0], &[1.0])
+    };
+    let climb = path.series(&tf(&[va], &[1.0, 0.0]));
     let alt_fwd = alt_pi.series(&pitch_cl).series(&climb);
     loops.push(predict(
         "altitude (commanded pitch)",
@@ -519,7 +537,7 @@ fn design_loops(
 
     // --- Airspeed by pitch (climb and descent regimes).
     let (aspd_pitch_kp, aspd_pitch_ki, _, wn_v2) = pid(&onboard.airspeed_pitch);
-    let v_theta = tf(&[-g], &[1.0, a_v1]);
+    let v_theta = path.series(&tf(&[-g], &[1.0, a_v1]));
     let ap_pi = tf(&[aspd_pitch_kp, aspd_pitch_ki], &[1.0, 0.0]);
     let ap_fwd = ap_pi.series(&pitch_cl).series(&v_theta);
     loops.push(predict(
