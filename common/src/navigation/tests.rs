@@ -501,7 +501,7 @@ fn runway_takeoff() {
         wp(0.0, 1500.0, 60.0),
     ];
     let mut nav = navigator();
-    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    let mut plane = on_the_runway_east();
     plane.k.airspeed = 0.0;
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 120.0, |o| {
@@ -556,6 +556,11 @@ fn runway_takeoff() {
 }
 
 /// The runway take-off of [`runway_takeoff`]: heading east from home, to 40 m.
+/// A plane standing at home on the runway of [`takeoff_east`], nose east.
+fn on_the_runway_east() -> Plane {
+    Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians())
+}
+
 fn takeoff_east() -> [MissionItem; 2] {
     let mut t = item(NAV_TAKEOFF, [0.0, 0.0, 0.0, 90.0], 0.0, 0.0, 40.0);
     t.x = 0;
@@ -586,7 +591,7 @@ fn step_plane(
 fn a_take_off_given_up_on_its_roll_rolls_out_wings_level_with_the_throttle_closed_to_a_stop() {
     let items = takeoff_east();
     let mut nav = navigator();
-    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    let mut plane = on_the_runway_east();
     plane.k.airspeed = 0.0;
     nav.start_mission(0);
     while plane.k.airspeed < 8.0 {
@@ -633,7 +638,7 @@ fn a_take_off_roll_swung_past_nav_tko_hdg_deg_off_its_line_is_given_up_with_the_
         .set(&mut p, "NAV_TKO_HDG_DEG", 60.0)
         .expect("in range");
     nav.set_params(&p);
-    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    let mut plane = on_the_runway_east();
     plane.k.airspeed = 0.0;
     nav.start_mission(0);
     for _ in 0..20 {
@@ -663,7 +668,7 @@ fn by_default_a_take_off_roll_swung_120_deg_off_its_line_rolls_on() {
     let items = takeoff_east();
     let mut nav = navigator();
     assert_eq!(nav.params().takeoff_heading_max, 0.0);
-    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    let mut plane = on_the_runway_east();
     plane.k.airspeed = 0.0;
     nav.start_mission(0);
     step_plane(&mut nav, &mut plane, &items);
@@ -681,7 +686,7 @@ fn a_take_off_roll_short_of_its_rotation_airspeed_for_20_s_is_given_up() {
     let items = takeoff_east();
     let mut nav = navigator();
     assert_eq!(nav.params().takeoff_roll_max, 20.0);
-    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    let mut plane = on_the_runway_east();
     nav.start_mission(0);
     let mut t = 0.0;
     let out = loop {
@@ -729,7 +734,7 @@ fn past_the_rotation_a_take_off_goes_on_and_is_clear_for_a_failsafe_from_nav_tko
     let mut nav = navigator();
     let clear = nav.params().takeoff_clear;
     assert_eq!(clear, 10.0);
-    let mut plane = Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians());
+    let mut plane = on_the_runway_east();
     plane.k.airspeed = 0.0;
     nav.start_mission(0);
     let mut seen = Vec::new();

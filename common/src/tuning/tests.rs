@@ -92,14 +92,20 @@ fn flown(servo_tau: f32, seconds: f32) -> [Sample; 1500] {
     out
 }
 
-fn identified(samples: &[Sample], servo_tau: f32) -> Identifier {
-    let mut id = Identifier::new(IdentifyConfig {
+/// The models at the reference airspeed through a servo of time constant `servo_tau` (s), no
+/// rate limit, no pre-filters: the data here are clean.
+fn unfiltered(servo_tau: f32) -> IdentifyConfig {
+    IdentifyConfig {
         airspeed_ref: VA_REF,
         servo_tau_s: servo_tau,
         servo_rate_radps: 0.0,
         airspeed_filter_tau_s: 0.0,
         attitude_filter_tau_s: 0.0,
-    });
+    }
+}
+
+fn identified(samples: &[Sample], servo_tau: f32) -> Identifier {
+    let mut id = Identifier::new(unfiltered(servo_tau));
     for s in samples {
         id.push(0.02, s);
     }
@@ -237,13 +243,7 @@ fn an_aileron_held_still_is_named_as_the_missing_excitation() {
 fn bad_time_steps_and_values_start_a_new_stretch_and_leave_the_fit_as_it_was() {
     let data = flown(SERVO_TAU, 30.0);
     let clean = identified(&data, SERVO_TAU).fit(Axis::Roll).expect("roll");
-    let mut id = Identifier::new(IdentifyConfig {
-        airspeed_ref: VA_REF,
-        servo_tau_s: SERVO_TAU,
-        servo_rate_radps: 0.0,
-        airspeed_filter_tau_s: 0.0,
-        attitude_filter_tau_s: 0.0,
-    });
+    let mut id = Identifier::new(unfiltered(SERVO_TAU));
     for (k, s) in data.iter().enumerate() {
         match k {
             500 => id.push(f32::NAN, s),
@@ -271,13 +271,7 @@ fn bad_time_steps_and_values_start_a_new_stretch_and_leave_the_fit_as_it_was() {
 #[test]
 fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
     let (a1, a2, a3, ka) = (0.6f32, 8.0f32, GRAVITY, 2.0f32);
-    let mut id = Identifier::new(IdentifyConfig {
-        airspeed_ref: VA_REF,
-        servo_tau_s: SERVO_TAU,
-        servo_rate_radps: 0.0,
-        airspeed_filter_tau_s: 0.0,
-        attitude_filter_tau_s: 0.0,
-    });
+    let mut id = Identifier::new(unfiltered(SERVO_TAU));
     let mut va = VA_REF;
     for k in 0..3000 {
         let t = k as f32 * 0.02;
@@ -314,13 +308,7 @@ fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
 /// A coordinated turn's course rate is `g tan(phi) / Vg`: the kinematic gain comes out 1.
 #[test]
 fn the_course_kinematics_of_banked_turns_give_a_gain_of_one() {
-    let mut id = Identifier::new(IdentifyConfig {
-        airspeed_ref: VA_REF,
-        servo_tau_s: SERVO_TAU,
-        servo_rate_radps: 0.0,
-        airspeed_filter_tau_s: 0.0,
-        attitude_filter_tau_s: 0.0,
-    });
+    let mut id = Identifier::new(unfiltered(SERVO_TAU));
     let mut chi = 0.0f32;
     for k in 0..2000 {
         let t = k as f32 * 0.02;
@@ -348,11 +336,8 @@ fn the_course_kinematics_of_banked_turns_give_a_gain_of_one() {
 #[test]
 fn a_full_stick_command_moves_the_surface_at_the_rate_limit_and_a_small_one_on_its_lag() {
     let c = IdentifyConfig {
-        airspeed_ref: VA_REF,
-        servo_tau_s: SERVO_TAU,
         servo_rate_radps: 150.0 * DEG,
-        airspeed_filter_tau_s: 0.0,
-        attitude_filter_tau_s: 0.0,
+        ..unfiltered(SERVO_TAU)
     };
     let (end, mean) = super::identify::servo(&c, 0.0, 45.0 * DEG, 0.02);
     assert!((end - 3.0 * DEG).abs() < 1e-5 && (mean - 1.5 * DEG).abs() < 1e-5);
@@ -369,13 +354,7 @@ fn a_full_stick_command_moves_the_surface_at_the_rate_limit_and_a_small_one_on_i
 #[test]
 fn the_flight_path_s_lift_gives_the_heave_damping_back() {
     let a_gamma = 7.54f32;
-    let mut id = Identifier::new(IdentifyConfig {
-        airspeed_ref: VA_REF,
-        servo_tau_s: SERVO_TAU,
-        servo_rate_radps: 0.0,
-        airspeed_filter_tau_s: 0.0,
-        attitude_filter_tau_s: 0.0,
-    });
+    let mut id = Identifier::new(unfiltered(SERVO_TAU));
     let (alpha_0, h) = (0.05f32, 0.001f32);
     let at = |t: f32| {
         let va = VA_REF + 2.0 * libm::sinf(0.3 * t);

@@ -66,7 +66,12 @@ pub const PLATE_FROM: f64 = 40.0 * std::f64::consts::PI / 180.0;
 /// How far `angle` (rad) is past the linear model's envelope: 0 within [`LINEAR_LIMIT`], 1
 /// from [`PLATE_FROM`], a smooth step (continuous slope) between.
 pub fn beyond_linear(angle: f64) -> f64 {
-    let t = ((angle.abs() - LINEAR_LIMIT) / (PLATE_FROM - LINEAR_LIMIT)).clamp(0.0, 1.0);
+    smooth_step(angle.abs(), LINEAR_LIMIT, PLATE_FROM)
+}
+
+/// 0 up to `from`, 1 from `to`, a cubic between with no slope at either end.
+fn smooth_step(x: f64, from: f64, to: f64) -> f64 {
+    let t = ((x - from) / (to - from)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
 }
 
@@ -77,8 +82,7 @@ pub const SIDE_AXIS_FROM: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// How far the side force has turned from the wind axes to the body's: 0 within
 /// [`SIDE_AXIS_FROM`], 1 from [`LINEAR_LIMIT`], a smooth step between.
 fn side_axis_turned(beta: f64) -> f64 {
-    let t = ((beta.abs() - SIDE_AXIS_FROM) / (LINEAR_LIMIT - SIDE_AXIS_FROM)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
+    smooth_step(beta.abs(), SIDE_AXIS_FROM, LINEAR_LIMIT)
 }
 
 /// The blend of the linear model into the flat plate's at one angle of attack and sideslip.
@@ -117,6 +121,7 @@ impl Beyond {
         let s_a = beyond_linear(air.alpha);
         let s_b = beyond_linear(air.beta);
         let s_y = side_axis_turned(air.beta);
+        // `s_y` is 0 only within 15 deg of sideslip, where `s_b` is too.
         if s_a == 0.0 && s_y == 0.0 {
             // The hot path in flight: no trigonometry, and the linear model bit for bit.
             return Self {

@@ -403,6 +403,7 @@ impl Designer {
         let (x0, scan) = match loop_ {
             Loop::Roll => (self.rules.roll_kp_appendix_c(), 0),
             Loop::Pitch => (self.rules.pitch_kp_nominal(), 0),
+            // An outer loop's share of its rule's natural frequency.
             _ => (1.0, SCAN_STEPS),
         };
         let search = Search {
@@ -432,12 +433,11 @@ impl Designer {
     /// Whether `margins` keep `loop_`'s search going down: an attitude loop's phase margin
     /// under [`DesignInputs::inner_phase_margin_deg`], an outer loop's targets missed.
     fn keeps(&self, loop_: Loop, margins: &Margins) -> bool {
-        match loop_ {
-            Loop::Roll | Loop::Pitch => {
-                let pm_min = self.rules.inputs.inner_phase_margin_deg;
-                margins.phase_margin_deg.is_some_and(|pm| pm >= pm_min)
-            }
-            _ => judge(loop_, margins).is_ok(),
+        if loop_.is_inner() {
+            let pm_min = self.rules.inputs.inner_phase_margin_deg;
+            margins.phase_margin_deg.is_some_and(|pm| pm >= pm_min)
+        } else {
+            judge(loop_, margins).is_ok()
         }
     }
 
@@ -510,13 +510,10 @@ impl Designer {
         if let Err(reason) = judge(loop_, &margins) {
             self.missed = self.missed.or(Some(failure(loop_, reason)));
         }
-        match loop_ {
-            Loop::Roll => self.limit(Loop::Course),
-            Loop::Course => self.limit(Loop::Pitch),
-            Loop::Pitch => self.limit(Loop::Altitude),
-            Loop::Altitude => self.limit(Loop::AirspeedPitch),
-            Loop::AirspeedPitch => self.limit(Loop::AirspeedThrottle),
-            Loop::AirspeedThrottle => Stage::Finish,
+        // The next loop in the design's order, or the finish after the last.
+        match Loop::ALL.iter().skip_while(|l| **l != loop_).nth(1) {
+            Some(&next) => self.limit(next),
+            None => Stage::Finish,
         }
     }
 

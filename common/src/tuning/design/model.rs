@@ -56,9 +56,9 @@ impl PitchResponse {
 /// The flight path's lag behind the pitch is left out of the book's altitude and airspeed
 /// models (`h / theta = va / s`): the lift that turns the flight path is built by the angle of
 /// attack, which the pitch must first open. Its pole, `a_gamma = rho Va S (CL_alpha + CD) /
-/// (2 m)` (the heave damping, `-Z_w`), is some 8 rad/s on the 25e at 17 m/s and 3.5 on the
-/// Aerosonde at 25: within an octave of their altitude loops' crossover, whose margins it
-/// takes 15 to 30 degrees of.
+/// (2 m)` (the heave damping, `-Z_w`), is 7.5 1/s on the 25e at 17 m/s and 4.3 on the
+/// Aerosonde at 25 (their linearisations'): a decade or less above their outer loops'
+/// crossovers, whose phase it lowers.
 ///
 /// No sideslip model: the sideslip loop keeps the base set's gains.
 #[derive(Clone, Copy, Debug, PartialEq)]

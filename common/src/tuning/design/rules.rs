@@ -120,9 +120,10 @@ impl Rules {
         }
     }
 
-    /// Altitude on `h / theta = Va / s` (the flight path's lag left to the margins): `wn_h` the lower of `wn_theta / separation` and the
-    /// feedback pole over its separation (times `share`); `kp = 2 zeta wn_h / Va`, the
-    /// integrator's zero at the outer fraction of `2 zeta wn_h`. Gains and `wn_h`.
+    /// Altitude on `h / theta = Va / s` (the flight path's lag left to the margins): `wn_h` the
+    /// lower of `wn_theta / separation` and the feedback pole over its separation (times
+    /// `share`); `kp = 2 zeta wn_h / Va`, the integrator's zero at the outer fraction of
+    /// `2 zeta wn_h`. Gains and `wn_h`.
     pub fn altitude(&self, wn_theta: f32, share: f32) -> (LoopGains, f32) {
         let i = &self.inputs;
         let wn = share
