@@ -35,6 +35,7 @@ fn control_tick(c: &mut Criterion) {
                 altitude: 100.0 + wobble,
                 airspeed: 16.8 + wobble,
                 sideslip: 0.01,
+                ground_speed: 16.8 + wobble,
             };
             black_box(ap.step(black_box(&m), black_box(&cmd), black_box(0.02)))
         })

@@ -5,7 +5,7 @@ pub use super::inputs::{InputFlags, Measurements};
 use super::lateral::{self, Lateral, LateralGains, RollMode, YawMode};
 use super::longitudinal::tecs::{self, TecsGains};
 use super::longitudinal::{self, LonMode, Longitudinal, LongitudinalGains, Regime};
-use super::scaling::surface_scale;
+use super::scaling::{course_scale, surface_scale};
 use crate::actuators::Surfaces;
 use crate::param;
 use crate::params::{Group, ParamDef, ParamError, ParamStore};
@@ -41,7 +41,7 @@ pub const PARAMS: Group<GainSet> = Group {
                 0.0,
                 40.0,
                 "m/s",
-                "Airspeed the surface and altitude loops' gains hold at; scaled by this/airspeed elsewhere (0: off)",
+                "Airspeed the gains are designed at: the surface and altitude loops scaled by this/airspeed elsewhere, the course loop by ground speed/this below it (0: off)",
             ),
             GainSet => scaling_airspeed
         ),
@@ -375,6 +375,8 @@ impl Autopilot {
         let scale = surface_scale(m.airspeed, self.gains.scaling_airspeed);
         self.lat.set_surface_scale(scale);
         self.lon.set_surface_scale(scale);
+        self.lat
+            .set_course_scale(course_scale(m.ground_speed, self.gains.scaling_airspeed));
         let lat = self.lat.step(m, c.roll, c.yaw, dt_stage);
         let lon = self.lon.step(m, c.lon, dt_stage);
         let mut rejected = lat.rejected | lon.rejected;
@@ -441,6 +443,7 @@ mod tests {
             altitude: 100.0,
             airspeed: 16.5,
             sideslip: 0.01,
+            ground_speed: 16.5,
         }
     }
 
@@ -600,6 +603,7 @@ mod tests {
                     altitude: val(500.0),
                     airspeed: val(40.0),
                     sideslip: val(0.5),
+                    ground_speed: val(40.0),
                 };
                 let c = Commands {
                     roll: match k % 3 {

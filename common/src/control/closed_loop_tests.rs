@@ -100,8 +100,25 @@ fn fly_lateral(
     mode: impl Fn(f64) -> RollMode,
     secs: f64,
 ) -> (Vec<f64>, Vec<[f64; 3]>) {
+    fly_lateral_over_the_ground(g, mode, secs, VA, 1.0)
+}
+
+/// As [`fly_lateral`] at `vg` m/s over the ground (the turn `chi' = g / vg tan(phi)`), the
+/// course loop's error scaled by `course_scale` (1: the design's gains).
+fn fly_lateral_over_the_ground(
+    g: &GainSet,
+    mode: impl Fn(f64) -> RollMode,
+    secs: f64,
+    vg: f64,
+    course_scale: f32,
+) -> (Vec<f64>, Vec<[f64; 3]>) {
     let g = no_trim(*g);
     let mut lat = Lateral::new(&g.lateral, g.transfer_tc);
+    lat.set_course_scale(course_scale);
+    let plant = |x: &[f64; 3], da: f64| {
+        let [p, phi, _] = roll_plant(x, da);
+        [p, phi, G0 / vg * x[1].tan()]
+    };
     let mut x = [0.0f64; 3];
     let (mut ts, mut xs) = (Vec::new(), Vec::new());
     let n = (secs / DT as f64) as usize;
@@ -114,7 +131,7 @@ fn fly_lateral(
             ..Measurements::level(VA as f32, 100.0)
         };
         let o = lat.step(&m, mode(t), YawMode::Off, DT);
-        rk4(&mut x, o.aileron as f64, roll_plant);
+        rk4(&mut x, o.aileron as f64, plant);
         ts.push(t + DT as f64);
         xs.push(x);
     }
@@ -214,6 +231,35 @@ fn course_hold_follows_successive_loop_closure_prediction() {
         x[2] / D
     );
     assert!(min_roll > -0.5 * D, "never banked left");
+}
+
+/// A 5 deg course step at `vg` m/s over the ground, the course loop's error scaled by
+/// `course` (1: the design's gains).
+fn course_step_over_the_ground(vg: f64, course: f32) -> StepInfo {
+    let cmd = |t: f64| RollMode::Course(if t < 1.0 { 0.0 } else { (5.0 * D) as f32 });
+    let (t, x) = fly_lateral_over_the_ground(&DESIGNED, cmd, 16.0, vg, course);
+    let chi: Vec<f64> = x.iter().map(|x| x[2]).collect();
+    step_after(&t, &chi, 1.0, 0.0, 5.0 * D)
+}
+
+/// At 4 m/s over the ground (17 m/s of airspeed into 13 m/s of wind) the designed course loop
+/// crosses over at `g kp / Vg` = 9.9 rad/s, above the roll loop's own bandwidth, and rings;
+/// scaled by `Vg / Va` ([`super::scaling::course_scale`]) it answers as designed at 17 m/s
+/// (`tau = Va / (g kp)`, 0.43 s, as `course_hold_follows_successive_loop_closure_prediction`).
+#[test]
+fn into_a_headwind_the_scaled_course_loop_answers_as_designed_and_the_unscaled_one_rings() {
+    let vg = 4.0;
+    let tau = VA / (G0 * DESIGNED.lateral.course_kp as f64);
+    let scaled =
+        course_step_over_the_ground(vg, super::scaling::course_scale(vg as f32, VA as f32));
+    let unscaled = course_step_over_the_ground(vg, 1.0);
+    std::println!("course 5 deg at Vg {vg}: scaled {scaled:?}, unscaled {unscaled:?}");
+    assert!(
+        scaled.t_63 > 0.9 * tau && scaled.t_63 < tau + 0.25,
+        "{scaled:?}"
+    );
+    assert!(scaled.overshoot < 0.05, "{scaled:?}");
+    assert!(unscaled.overshoot > 0.15, "{unscaled:?}");
 }
 
 /// Throttle trim at trim I (Table 2.3).

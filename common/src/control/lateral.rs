@@ -377,6 +377,7 @@ pub struct Lateral {
     roll_resume: bool,
     yaw_resume: bool,
     surface_scale: f32,
+    course_scale: f32,
 }
 
 fn roll_gains(g: &LateralGains) -> PidGains {
@@ -423,6 +424,7 @@ impl Lateral {
             roll_resume: false,
             yaw_resume: false,
             surface_scale: 1.0,
+            course_scale: 1.0,
         }
     }
 
@@ -432,6 +434,14 @@ impl Lateral {
     pub fn set_surface_scale(&mut self, scale: f32) {
         if scale.is_finite() && scale > 0.0 {
             self.surface_scale = scale;
+        }
+    }
+
+    /// Sets the factor on the course loop's error ([`super::scaling::course_scale`]); 1 until
+    /// set. A factor that is not finite and positive is ignored.
+    pub fn set_course_scale(&mut self, scale: f32) {
+        if scale.is_finite() && scale > 0.0 {
+            self.course_scale = scale;
         }
     }
 
@@ -546,7 +556,8 @@ impl Lateral {
                 // The tighter limit clamps the loop's output, not its integrator: the course
                 // integral is slow (CRS_KI 0.01/s) and close to the ground lasts seconds.
                 let phi = clamp(
-                    self.course.step(e, Derivative::None, 0.0, dt),
+                    self.course
+                        .step(self.course_scale * e, Derivative::None, 0.0, dt),
                     -within,
                     within,
                 );

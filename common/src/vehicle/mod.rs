@@ -41,7 +41,7 @@ use crate::actuators::Surfaces;
 use crate::battery::{self, BatteryMonitor};
 use crate::control::autopilot::{Autopilot, GainSet};
 use crate::control::gains::NAMED;
-use crate::control::inputs::Measurements;
+use crate::control::inputs::{course_or_crabbed_heading, Measurements};
 use crate::estimator::{self, config as estimator_config, EstimatedState, Estimator};
 use crate::navigation::navigator::io::HeightOracle;
 use crate::navigation::navigator::Navigator;
@@ -141,6 +141,9 @@ pub struct Vehicle {
     tune_mode: FlightMode,
     /// The gains the last autotune replaced, for a revert.
     tuned_from: Option<GainSet>,
+    /// Course over the ground less heading at the last tick fast enough over the ground to
+    /// give a course, rad: slower, the course loop reads the heading turned by it.
+    crab: f32,
 }
 
 impl Default for Vehicle {
@@ -192,6 +195,7 @@ impl Vehicle {
             autotune: Autotune::new(),
             tune_mode: FlightMode::Manual,
             tuned_from: None,
+            crab: 0.0,
         }
     }
 
@@ -500,7 +504,7 @@ impl Vehicle {
         self.observe_autotune(dt);
     }
 
-    fn measurements(&self, e: &EstimatedState) -> Measurements {
+    fn measurements(&mut self, e: &EstimatedState) -> Measurements {
         if self.use_truth == TruthUse::Loops {
             if let Some(t) = self.truth {
                 return t.loops;
@@ -509,18 +513,21 @@ impl Vehicle {
         Measurements {
             roll: e.euler.phi,
             pitch: e.euler.theta,
-            // Course needs ground speed; on the ground or in a hover-like crawl use heading.
-            course: if e.ground_speed > crate::math::MIN_COURSE_SPEED_MPS {
-                e.course
-            } else {
-                e.euler.psi
-            },
+            // Course needs ground speed; on the ground or in a crawl into the wind, the
+            // heading as far off the course as it last was.
+            course: course_or_crabbed_heading(
+                e.course,
+                e.euler.psi,
+                e.ground_speed,
+                &mut self.crab,
+            ),
             roll_rate: e.body_rates.x,
             pitch_rate: e.body_rates.y,
             yaw_rate: e.body_rates.z,
             altitude: e.alt_amsl_m,
             airspeed: e.airspeed,
             sideslip: e.sideslip,
+            ground_speed: e.ground_speed,
         }
     }
 

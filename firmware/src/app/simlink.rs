@@ -240,6 +240,7 @@ fn truth_sample(d: &HIL_STATE_QUATERNION_DATA) -> Option<TruthSample> {
             altitude: d.alt as f32 / 1000.0,
             airspeed: f32::from(d.true_airspeed) / 100.0,
             sideslip: 0.0,
+            ground_speed: vg,
         },
         vel_down_mps: v.z,
     })

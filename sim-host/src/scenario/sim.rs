@@ -128,6 +128,7 @@ fn truth(plant: &Plant) -> Measurements {
         altitude: plant.alt_msl_m() as f32,
         airspeed: air.va as f32,
         sideslip: air.beta as f32,
+        ground_speed: plant.velocity_ned().xy().norm() as f32,
     }
 }
 

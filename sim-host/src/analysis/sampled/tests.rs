@@ -67,6 +67,8 @@ fn fly_flight_code(
             altitude: (h0 + d[out::HEIGHT]) as f32,
             airspeed: (va0 + d[out::AIRSPEED]) as f32,
             sideslip: d[out::SIDESLIP] as f32,
+            // Still air: the ground speed of the trim, which the linear model holds.
+            ground_speed: va0 as f32,
         };
         let s = ap.step(&m, &commands(k), 0.02).surfaces;
         let mut u = [0.0; cmd::N];
