@@ -678,6 +678,53 @@ fn by_default_a_take_off_roll_swung_120_deg_off_its_line_rolls_on() {
     assert!(out.warnings.is_empty());
 }
 
+/// A roll swung more than 135 deg off its line (beyond where it began) closes the throttle
+/// until the heading is back within 135 deg, then opens it again over `NAV_TKO_RAMP_S` (2 s):
+/// it is not given up for it (`NAV_TKO_HDG_DEG` is off by default). Swung 120 deg, it keeps
+/// full throttle.
+#[test]
+fn a_take_off_roll_swung_past_135_deg_closes_the_throttle_until_it_is_back_then_opens_it_again() {
+    let items = takeoff_east();
+    let mut nav = navigator();
+    let ramp = nav.params().takeoff_ramp;
+    assert_eq!(ramp, 2.0);
+    let mut plane = on_the_runway_east();
+    plane.k.airspeed = 0.0;
+    nav.start_mission(0);
+    let throttle = |out: &NavOutput| match out.commands.map(|c| c.lon) {
+        Some(LonMode::Pitch { throttle, .. }) => throttle,
+        other => panic!("{other:?}"),
+    };
+    // Three seconds on the line: full throttle.
+    let mut out = step_plane(&mut nav, &mut plane, &items).0;
+    for _ in 0..60 {
+        out = step_plane(&mut nav, &mut plane, &items).0;
+    }
+    assert_eq!(throttle(&out), 1.0);
+    // Swung 120 deg off: still full throttle.
+    plane.k.heading = (90.0 + 120.0f32).to_radians();
+    out = step_plane(&mut nav, &mut plane, &items).0;
+    assert_eq!(throttle(&out), 1.0);
+    // Swung 150 deg off: closed at once, still rolling.
+    plane.k.heading = (90.0 + 150.0f32).to_radians();
+    out = step_plane(&mut nav, &mut plane, &items).0;
+    assert_eq!(out.phase, Phase::TakeoffRoll);
+    assert_eq!(throttle(&out), 0.0);
+    assert!(out.warnings.is_empty());
+    // Back within 130 deg: opened again from closed, 50 ms of the 2 s ramp a step.
+    plane.k.heading = (90.0 + 130.0f32).to_radians();
+    out = step_plane(&mut nav, &mut plane, &items).0;
+    assert!(
+        (throttle(&out) - DT / ramp).abs() < 1e-6,
+        "{}",
+        throttle(&out)
+    );
+    for _ in 0..40 {
+        out = step_plane(&mut nav, &mut plane, &items).0;
+    }
+    assert_eq!(throttle(&out), 1.0);
+}
+
 /// A roll that never reaches the rotation airspeed (`NAV_TKO_VR`, here held at 5 m/s: a
 /// brake binding, a headwind the engine cannot beat, a wrong propeller) is given up once it
 /// has lasted `NAV_TKO_ROLL_S` (20 s), not before.
@@ -1608,6 +1655,41 @@ fn a_flare_floating_past_the_abort_distance_goes_around_and_lands_on_a_new_appro
         landed.2
     );
     assert!(log.reached.contains(&0));
+}
+
+/// A go-around that a gust puts back on the runway below the lift-off airspeed
+/// (`NAV_LIFTOFF_ASPD`) finishes the landing on the ground after `TOUCHDOWN_S` (1 s): the
+/// roll-out, throttle closed, not the climb's full throttle on the wheels. Above the lift-off
+/// airspeed, or off the ground, it keeps climbing away.
+#[test]
+fn a_go_around_put_back_on_the_runway_too_slow_to_lift_off_finishes_the_landing_on_the_ground() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+    assert!(nav.go_around());
+    let liftoff = nav.params().liftoff_airspeed;
+    plane.k.pos.z = 0.0;
+    plane.climb = 0.0;
+    // On the wheels at the lift-off airspeed: a take-off, climbing on (5 s of 50 ms steps).
+    plane.k.airspeed = liftoff + 0.5;
+    for _ in 0..100 {
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        assert_eq!(out.phase, Phase::GoAround);
+    }
+    // Slower than it for 0.95 s: still the climb.
+    plane.k.airspeed = liftoff - 2.0;
+    for _ in 0..19 {
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        assert_eq!(out.phase, Phase::GoAround);
+    }
+    // A second: the roll-out, throttle closed.
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.phase, Phase::Landed);
+    match out.commands.map(|c| c.lon) {
+        Some(LonMode::Pitch { throttle, .. }) => assert_eq!(throttle, 0.0),
+        other => panic!("roll-out's longitudinal mode {other:?}"),
+    }
+    assert!(!nav.go_around(), "went around from the roll-out");
 }
 
 /// A landing goes around at most twice: a flare lifted out of itself (above twice

@@ -287,6 +287,22 @@ impl Landing {
             let g = f.guidance.step(line, &state.pos_ned, state.ground_speed());
             out.guidance = Some(g);
             let hagl = state.height() + self.point.z;
+            // Put back on the runway by a gust below the lift-off airspeed, the aircraft cannot
+            // climb away: full throttle on the wheels at the climb's pitch rolled two of 2000
+            // campaign aircraft on their noses and round the field for minutes (seed 1's
+            // flight 971, seed 2's 150). After `TOUCHDOWN_S` so, the landing is finished on the
+            // ground instead: throttle closed, the roll-out.
+            if hagl < p.touchdown_alt && state.airspeed < p.liftoff_airspeed {
+                self.ground_time += f.dt;
+            } else {
+                self.ground_time = 0.0;
+            }
+            if self.ground_time >= TOUCHDOWN_S {
+                self.phase = LandPhase::Landed;
+                out.phase = Phase::Landed;
+                roll_out(f, g.path_course, &mut self.rollout_s, out);
+                return;
+            }
             out.commands = Some(Commands {
                 roll: course_near_runway(g.course, hagl, p.ground_roll_height, p),
                 yaw: RUDDER,

@@ -1,6 +1,7 @@
 //! Take-off: the runway roll, rotation and climb-out of a `NAV_TAKEOFF` item.
 //!
-//! Take-off is a runway take-off: the throttle opened to full over `NAV_TKO_RAMP_S`, wings
+//! Take-off is a runway take-off: the throttle opened to full over `NAV_TKO_RAMP_S` (closed
+//! again while the heading swings more than 135 deg off the line, and opened anew), wings
 //! level, pitch 0 until the rotation airspeed, then the thesis's take-off regime
 //! (`LonMode::TakeOff`: fixed pitch, full throttle to the clear height, then climb) to the
 //! item's altitude. The runway is the line
@@ -52,7 +53,21 @@ pub(super) struct Takeoff {
     /// How far off the runway's course the aircraft stood when the roll began, rad (0 but
     /// for a line to the item, `NAV_TKO_TO_ITEM`): a ground loop is a swing beyond it.
     start_off: f32,
+    /// Time the throttle has been opening since the roll began, or since the heading last
+    /// came back within [`SWING_CUT_RAD`] of the line, s.
+    power_s: f32,
 }
+
+/// Swing off the runway's line (beyond where the roll began) past which the take-off roll
+/// closes the throttle until the heading comes back within it, rad (135 deg), then opens it
+/// again over `NAV_TKO_RAMP_S`, as a pilot takes the power off to get a swinging tail-dragger
+/// straight. On full throttle at a walking pace in moderate turbulence the campaign's aircraft
+/// spun on the runway at 100-150 deg/s for seconds: one of seed 2 (flight 13) through three
+/// turns and over onto its nose; others spun out of it and flew (seed 1's flight 3, 971).
+/// Swings of 60 to 120 deg in quartering tailwinds are flown out on full throttle: cut at 90
+/// deg, the wind rose's 5 m/s towards 60 deg (seed 1, docs/NAVIGATION.md) lifted off 6 s
+/// later, finished its climb at the first corner and overshot it by 47 m.
+const SWING_CUT_RAD: f32 = 0.75 * core::f32::consts::PI;
 
 impl Takeoff {
     /// The take-off of an item whose position is `target` (NED from home): along the present
@@ -86,6 +101,7 @@ impl Takeoff {
             climbed: 0.0,
             aborted: None,
             start_off: wrap_pi(state.heading - course).abs(),
+            power_s: 0.0,
         }
     }
 
@@ -173,10 +189,19 @@ impl Takeoff {
             // opened at once from idle it rolled the aircraft 15 deg onto a wing tip before
             // the ailerons had any air (34 of 1000 dispersed take-offs).
             self.roll_s += f.dt;
-            let throttle = if p.takeoff_ramp > 0.0 {
-                (self.roll_s / p.takeoff_ramp).clamp(0.0, 1.0)
+            // Swung far off the line, power off until it is back (a heading that is not a
+            // number keeps the power as it was going).
+            if wrap_pi(state.heading - self.course).abs() > SWING_CUT_RAD + self.start_off {
+                self.power_s = 0.0;
             } else {
+                self.power_s += f.dt;
+            }
+            let throttle = if p.takeoff_ramp > 0.0 {
+                (self.power_s / p.takeoff_ramp).clamp(0.0, 1.0)
+            } else if self.power_s > 0.0 {
                 1.0
+            } else {
+                0.0
             };
             out.commands = Some(Commands {
                 roll: RollMode::Roll(0.0),
