@@ -16,7 +16,7 @@
 
 use heapless::Deque;
 
-use super::land_detector::{LandDetector, LandInputs, LandParams};
+use super::land_detector::{reported_state, LandDetector, LandInputs, LandParams};
 use super::modes::{Commanded, FlightMode, NavTask};
 use super::requests::VehicleRequests;
 use super::snapshot::{LandedState, MissionRunState};
@@ -316,18 +316,7 @@ impl Commander {
     /// In the air: airborne otherwise. On the ground: the detector's landed, outside a
     /// take-off.
     pub fn landed_state(&self) -> LandedState {
-        let phase = self.navigated_phase();
-        let takeoff = matches!(phase, Some(Phase::TakeoffRoll | Phase::TakeoffClimb));
-        let landing = matches!(
-            phase,
-            Some(Phase::Approach | Phase::Flare | Phase::Landed | Phase::TakeoffAbort)
-        );
-        match (self.land.landed(), takeoff, landing) {
-            (_, true, _) => LandedState::Takeoff,
-            (true, false, _) => LandedState::OnGround,
-            (false, false, true) => LandedState::Landing,
-            (false, false, false) => LandedState::InAir,
-        }
+        reported_state(self.land.landed(), self.navigated_phase())
     }
 
     /// The navigator has a plan and the flown mode is one it flies (armed or not).
@@ -512,7 +501,14 @@ impl Commander {
             i.navigator,
         );
         self.oracle = i.oracle;
+        let armed = self.armed;
         let (demand, home) = self.demand(i.now_us, i.dt, i.estimate, i.navigator, i.plan, i.gains);
+        if armed && !self.armed {
+            // Disarmed on this tick (the navigator's landing): the landed state it reports is
+            // the disarmed aircraft's.
+            let rolling_out = self.navigator_flies() && self.nav.phase.rolls_out();
+            self.land.disarmed(i.land, rolling_out);
+        }
         CommanderOutput { demand, home }
     }
 

@@ -25,8 +25,29 @@
 //!
 //! [`LandDetector::update`] is a pure step: explicit inputs and time step, no clock.
 
+use super::snapshot::LandedState;
+use crate::navigation::navigator::io::Phase;
 use crate::param;
 use crate::params::{Group, ParamDef};
+
+/// The landed state reported (`EXTENDED_SYS_STATE`) from the detector's `landed` and the
+/// navigator's `phase` while it flies the armed aircraft (`None` otherwise): taking off in the
+/// take-off roll or climb; landing when airborne on an approach or flare, or rolling out fast
+/// enough to count as moving (after a landing or a take-off given up); in the air when
+/// airborne otherwise; on the ground when landed, outside a take-off.
+pub fn reported_state(landed: bool, phase: Option<Phase>) -> LandedState {
+    let takeoff = matches!(phase, Some(Phase::TakeoffRoll | Phase::TakeoffClimb));
+    let landing = matches!(
+        phase,
+        Some(Phase::Approach | Phase::Flare | Phase::Landed | Phase::TakeoffAbort)
+    );
+    match (landed, takeoff, landing) {
+        (_, true, _) => LandedState::Takeoff,
+        (true, false, _) => LandedState::OnGround,
+        (false, false, true) => LandedState::Landing,
+        (false, false, false) => LandedState::InAir,
+    }
+}
 
 /// Time constant of the low-pass filters on the detector's inputs, s.
 pub const FILTER_TAU_S: f32 = 0.3;
@@ -167,6 +188,16 @@ struct Filtered {
     accel_dev: f32,
 }
 
+impl Filtered {
+    /// Moving as a flight or a take-off run moves: over the ground faster than `LND_VXY_MAX`
+    /// (but in the navigator's roll-out, `rolling_out`), or up or down faster than
+    /// `LND_VZ_MAX`.
+    fn moving(&self, p: &LandParams, rolling_out: bool) -> bool {
+        (self.ground_speed > p.vel_xy_max && !rolling_out)
+            || libm::fabsf(self.vel_down) > p.vel_z_max
+    }
+}
+
 /// The land detector's state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LandDetector {
@@ -194,6 +225,22 @@ impl LandDetector {
 
     /// On the ground.
     pub fn landed(&self) -> bool {
+        self.landed
+    }
+
+    /// The aircraft has just been disarmed: the disarmed rule (at rest over the ground with
+    /// the motor stopped, on the ground) on the inputs as last filtered, at once rather than at
+    /// the next step, so that the tick that disarms does not report a disarmed aircraft in the
+    /// air (a roll-out into a gusty headwind disarms at a walking pace over the ground with more
+    /// air over the wings than `LND_ASPD_MAX`: the campaign's flights ending on that tick read
+    /// "in air"). `rolling_out` as in [`LandInputs`]. Returns [`LandDetector::landed`].
+    pub fn disarmed(&mut self, p: &LandParams, rolling_out: bool) -> bool {
+        if let Some(f) = self.filtered {
+            if !f.moving(p, rolling_out) {
+                self.landed = true;
+                self.at_rest_s = p.trigger_s;
+            }
+        }
         self.landed
     }
 
@@ -225,8 +272,7 @@ impl LandDetector {
             },
         };
         self.filtered = Some(f);
-        let moving = (f.ground_speed > p.vel_xy_max && !i.rolling_out)
-            || libm::fabsf(f.vel_down) > p.vel_z_max;
+        let moving = f.moving(p, i.rolling_out);
         // Landed, only an airspeed near flying speed is a take-off: wind and its gusts over
         // the stopped aircraft are not (hysteresis between the two thresholds).
         let airspeed_max = if self.landed {
@@ -278,6 +324,15 @@ mod tests {
             airspeed: 0.0,
             specific_force: Some(G),
             rolling_out: false,
+        }
+    }
+
+    /// Armed and flying at 15 m/s.
+    fn cruising() -> LandInputs {
+        LandInputs {
+            ground_speed: 15.0,
+            airspeed: 15.0,
+            ..at_rest(true)
         }
     }
 
@@ -420,12 +475,7 @@ mod tests {
     fn a_bounce_or_a_bump_on_the_ground_does_not_land_it_early() {
         let mut d = LandDetector::new();
         let p = LandParams::default();
-        let fly = LandInputs {
-            ground_speed: 15.0,
-            airspeed: 15.0,
-            ..at_rest(true)
-        };
-        run(&mut d, &fly, 1.0);
+        run(&mut d, &cruising(), 1.0);
         let slow = LandInputs {
             ground_speed: 3.0,
             airspeed: 3.0,
@@ -449,12 +499,7 @@ mod tests {
     #[test]
     fn disarmed_at_rest_over_the_ground_in_a_wind_it_is_landed_at_once() {
         let mut d = LandDetector::new();
-        let fly = LandInputs {
-            ground_speed: 15.0,
-            airspeed: 15.0,
-            ..at_rest(true)
-        };
-        run(&mut d, &fly, 1.0);
+        run(&mut d, &cruising(), 1.0);
         // Stopped on the runway, 11 m/s of wind over the wings: armed, the airspeed keeps it
         // "flying"; disarmed, the wind is no evidence.
         let windy = LandInputs {
@@ -471,6 +516,34 @@ mod tests {
             },
             DT
         ));
+    }
+
+    /// The tick that disarms reads the aircraft as disarmed, before the next step: stopped
+    /// over the ground with 11 m/s of headwind over the wings (armed, "flying" by its airspeed
+    /// over `LND_ASPD_MAX`) it is on the ground at once; still sinking at 3 m/s (over `LND_VZ_MAX`) it
+    /// is not.
+    #[test]
+    fn the_tick_that_disarms_a_stopped_aircraft_reads_it_on_the_ground() {
+        let p = LandParams::default();
+        let mut d = LandDetector::new();
+        run(&mut d, &cruising(), 1.0);
+        let headwind = LandInputs {
+            ground_speed: 1.5,
+            airspeed: 11.0,
+            ..at_rest(true)
+        };
+        assert!(run(&mut d, &headwind, 3.0).iter().all(|&l| !l));
+        assert!(d.disarmed(&p, true));
+        let mut d = LandDetector::new();
+        run(&mut d, &cruising(), 1.0);
+        let sinking = LandInputs {
+            vel_down: 3.0,
+            ..headwind
+        };
+        run(&mut d, &sinking, 3.0);
+        assert!(!d.disarmed(&p, true));
+        // Before any input, as booted: on the ground.
+        assert!(LandDetector::new().disarmed(&p, false));
     }
 
     #[test]
@@ -635,11 +708,7 @@ mod tests {
             ..at_rest(true)
         };
         assert!(d.update(&p, &nan, DT));
-        let fly = LandInputs {
-            ground_speed: 15.0,
-            airspeed: 15.0,
-            ..at_rest(true)
-        };
+        let fly = cruising();
         assert!(!d.update(&p, &fly, DT));
         assert!(!d.update(&p, &nan, DT));
         assert!(!d.update(&p, &at_rest(true), f32::NAN));
