@@ -256,10 +256,9 @@ fn missions_from_other_runways_fly_well_in_calm_air_and_in_wind() {
 /// ground at the touchdown in the tailwind: the station reads ON_GROUND within 15 s of it
 /// (`landed_state_honest`), since ground speed is no evidence of flight in the navigator's
 /// roll-out (the land detector waited 20 s for the wheels to slow it under `LND_VXY_MAX`).
-/// The crosswind's flight meets every target of docs/NAVIGATION.md besides
-/// (`navigation::flies_well`). The tailwind's lands 20.3 m past the point, 0.3 m beyond the
-/// 20 m target, as the wind sweep there says (35 of 36; it moved between -2.7 and +20.3 m with
-/// changes far from the flare): it is held here to the campaign's 30 m and to the sink target.
+/// Both flights meet every target of docs/NAVIGATION.md besides (`navigation::flies_well`):
+/// the tailwind's lands 16.9 m past the point, near the 20 m target's edge (it moved between
+/// -2.7 and +20.3 m with changes far from the flare, docs/NAVIGATION.md).
 #[test]
 fn a_tailwind_or_a_crosswind_strikes_no_wing_tip_and_the_roll_out_reads_on_ground_within_15_s() {
     let a = Aircraft::ultrastick25e().expect("built-in aircraft");
@@ -272,12 +271,7 @@ fn a_tailwind_or_a_crosswind_strikes_no_wing_tip_and_the_roll_out_reads_on_groun
         if let Err(e) = landed_state_honest(&o.summary.landed_states, td.time_s, &o.samples) {
             panic!("wind towards {towards} deg: {e}");
         }
-        if towards == 0 {
-            assert!(
-                td.distance_m < 30.0 && td.sink_rate_mps < 1.5,
-                "tailwind: {td:?}"
-            );
-        } else if let Err(e) = navigation::flies_well(&o, false) {
+        if let Err(e) = navigation::flies_well(&o, false) {
             panic!("wind towards {towards} deg: {e}");
         }
     }
