@@ -42,10 +42,11 @@ impl Measurements {
 /// The course the course loop reads: the course over the ground `course` (rad) where the
 /// ground speed `ground_speed` (m/s) gives one (over `MIN_COURSE_SPEED_MPS`), and below it the
 /// heading `heading` turned by the crab angle of the last reading that did. `crab` (rad, the
-/// course less the heading) is kept up to date from each reading that gives one. The heading alone there read a step
-/// of the whole crab into the course error: on an approach into a 12 m/s gust the ground
-/// speed fell under 3 m/s with 11 deg of crab, the course loop asked 37 deg of bank at once
-/// and the aircraft was upset (seed 2's flight 418, docs/RESULTS-MONTECARLO.md).
+/// course less the heading) is kept up to date from each reading that gives one. The heading
+/// alone there read a step of the whole crab into the course error: on an approach into a
+/// 12 m/s gust the ground speed fell under 3 m/s with 11 deg of crab, the course loop asked
+/// 37 deg of bank at once and the aircraft was upset (seed 2's flight 418,
+/// docs/RESULTS-MONTECARLO.md).
 pub fn course_or_crabbed_heading(
     course: f32,
     heading: f32,

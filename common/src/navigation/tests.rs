@@ -555,12 +555,12 @@ fn runway_takeoff() {
     assert!(plane.k.airspeed >= vr);
 }
 
-/// The runway take-off of [`runway_takeoff`]: heading east from home, to 40 m.
 /// A plane standing at home on the runway of [`takeoff_east`], nose east.
 fn on_the_runway_east() -> Plane {
     Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians())
 }
 
+/// The runway take-off of [`runway_takeoff`]: heading east from home, to 40 m.
 fn takeoff_east() -> [MissionItem; 2] {
     let mut t = item(NAV_TAKEOFF, [0.0, 0.0, 0.0, 90.0], 0.0, 0.0, 40.0);
     t.x = 0;

@@ -303,8 +303,7 @@ impl Commander {
             vel_down: e.vel_ned.z,
             airspeed: e.airspeed,
             specific_force,
-            // The navigator stays in its roll-out once it disarms the aircraft.
-            rolling_out: self.navigator_flies() && self.nav.phase.rolls_out(),
+            rolling_out: self.rolling_out(),
         };
         self.land.update(p, &inputs, dt);
     }
@@ -317,6 +316,11 @@ impl Commander {
     /// take-off.
     pub fn landed_state(&self) -> LandedState {
         reported_state(self.land.landed(), self.navigated_phase())
+    }
+
+    /// In the navigator's roll-out, where it stays once it disarms the aircraft.
+    fn rolling_out(&self) -> bool {
+        self.navigator_flies() && self.nav.phase.rolls_out()
     }
 
     /// The navigator has a plan and the flown mode is one it flies (armed or not).
@@ -506,8 +510,7 @@ impl Commander {
         if armed && !self.armed {
             // Disarmed on this tick (the navigator's landing): the landed state it reports is
             // the disarmed aircraft's.
-            let rolling_out = self.navigator_flies() && self.nav.phase.rolls_out();
-            self.land.disarmed(i.land, rolling_out);
+            self.land.disarmed(i.land, self.rolling_out());
         }
         CommanderOutput { demand, home }
     }

@@ -520,8 +520,8 @@ mod tests {
 
     /// The tick that disarms reads the aircraft as disarmed, before the next step: stopped
     /// over the ground with 11 m/s of headwind over the wings (armed, "flying" by its airspeed
-    /// over `LND_ASPD_MAX`) it is on the ground at once; still sinking at 3 m/s (over `LND_VZ_MAX`) it
-    /// is not.
+    /// over `LND_ASPD_MAX`) it is on the ground at once; still sinking at 3 m/s (over
+    /// `LND_VZ_MAX`) it is not.
     #[test]
     fn the_tick_that_disarms_a_stopped_aircraft_reads_it_on_the_ground() {
         let p = LandParams::default();
