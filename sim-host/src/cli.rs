@@ -225,10 +225,12 @@ pub(crate) enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Fit the design's reduced models (roll, pitch, airspeed; the course and altitude
-    /// kinematics) from a simulator link's `.tlog` (`simlink.tlog` of `fly` and `sim`), with
-    /// each fit's quality and excitation, beside the aircraft file's linearisation at the
-    /// same airspeed. An axis the flight did not excite is an error naming it.
+    /// Fit the design's reduced models (roll, sideslip, pitch, airspeed; the course and
+    /// altitude kinematics) from a simulator link's `.tlog` (`simlink.tlog` of `fly` and
+    /// `sim`), with each fit's quality and excitation, beside the aircraft file's
+    /// linearisation at the same airspeed. An axis the flight did not excite is an error
+    /// naming it (the sideslip's is reported, not an error: without it a design keeps the
+    /// base set's sideslip gains).
     Identify {
         /// The log (`.tlog` of the simulator link, with its truth frames).
         file: PathBuf,

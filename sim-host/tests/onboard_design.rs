@@ -13,9 +13,9 @@ use sim_host::analysis::lti::margins;
 use sim_host::analysis::reduced::ReducedCoefficients;
 use sim_host::analysis::transfer::TransferFunction;
 
-/// The Ultra Stick 25e's reduced models at 18.5 m/s (the stick flight's airspeed): roll and
-/// pitch from its aero data, airspeed and the engine's pole from its linear model, as
-/// `sim-host design --airspeed 18.5` takes them; no sideslip model, as identified ones have.
+/// The Ultra Stick 25e's reduced models at 18.5 m/s (the stick flight's airspeed): roll,
+/// sideslip and pitch from its aero data, airspeed and the engine's pole from its linear
+/// model, as `sim-host design --airspeed 18.5` takes them.
 fn ultrastick_at_18_5() -> ReducedModel {
     let aircraft = Aircraft::ultrastick25e().expect("built-in aircraft");
     let c = design_at(&aircraft, &DesignInputs::default(), 18.5)
@@ -33,8 +33,8 @@ fn ultrastick_at_18_5() -> ReducedModel {
             a_v2: c.a_v2,
             a_gamma: f64::NAN,
             a_v3: f64::NAN,
-            a_beta1: f64::NAN,
-            a_beta2: f64::NAN,
+            a_beta1: c.a_beta1,
+            a_beta2: c.a_beta2,
         },
         engine_pole: Some(c.engine_pole),
         servo_bandwidth_hz: aircraft.actuators.bandwidth_Hz,
@@ -49,6 +49,17 @@ fn on_board(m: &ReducedModel) -> DesignModel {
         va: m.va as f32,
         a_phi1: c.a_phi1 as f32,
         a_phi2: c.a_phi2 as f32,
+        // NaN: no sideslip model, as the host reads it.
+        a_beta1: if c.a_beta1.is_finite() {
+            c.a_beta1 as f32
+        } else {
+            0.0
+        },
+        a_beta2: if c.a_beta2.is_finite() {
+            c.a_beta2 as f32
+        } else {
+            0.0
+        },
         a_theta1: c.a_theta1 as f32,
         a_theta2: c.a_theta2 as f32,
         a_theta3: c.a_theta3 as f32,
@@ -72,6 +83,7 @@ fn host_name(l: Loop) -> &'static str {
     match l {
         Loop::Roll => "roll attitude",
         Loop::Course => "course",
+        Loop::Sideslip => "sideslip",
         Loop::Pitch => "pitch attitude",
         Loop::Altitude => "altitude",
         Loop::AirspeedPitch => "airspeed (commanded pitch)",

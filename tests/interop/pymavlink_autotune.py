@@ -28,7 +28,7 @@ A_PHI1, A_PHI2, TOLERANCE = 16.09, -156.5, 0.15
 # PX4's main mode POSCTL: the autopilot's Hold.
 PX4_POSCTL = 3
 # Wall-clock bounds of each stage, s (the flight is paced several times faster).
-ARM_S, CLIMB_S, TUNE_S, MISSION_S = 60.0, 30.0, 40.0, 120.0
+ARM_S, CLIMB_S, TUNE_S, MISSION_S = 60.0, 30.0, 55.0, 120.0
 
 m = connect()
 # JSON has no NaN: a parameter left unset (NaN) is written null.

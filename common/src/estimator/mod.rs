@@ -660,6 +660,12 @@ impl Estimator {
         self.origin.home(self.baro_drift_m())
     }
 
+    /// The specific force of the last IMU sample taken in, body axes, m/s^2 (as measured: the
+    /// accelerometer's bias left in); `None` before the first.
+    pub fn specific_force(&self) -> Option<Vector3<f32>> {
+        self.last_accel
+    }
+
     /// The current estimate.
     pub fn state(&self) -> EstimatedState {
         let q = self.ins.attitude();

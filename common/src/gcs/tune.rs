@@ -128,6 +128,7 @@ pub fn words(r: &Report) -> (MavSeverity, Line<TEXT_MAX>) {
             l.str(match s {
                 Stage::Level => "level flight",
                 Stage::Roll => "roll doublets",
+                Stage::Yaw => "rudder doublets",
                 Stage::Pitch => "pitch doublets",
                 Stage::Throttle => "throttle steps",
             });

@@ -22,11 +22,24 @@
 //! pitch     q'  = -a_theta1 v q - a_theta2 v^2 alpha + a_theta3 v^2 de + k_t dt + c v^2
 //!                 + k_r r + k_pr p r + k_rr (r^2 - p^2)
 //!                                                                          v = Va / Va_ref
-//! airspeed  Va' = -a_V1 (Va - Va_ref) + a_V2 dt - a_V3 theta + k_alpha alpha + c
+//! sideslip  a_y = Va_ref v^2 (-a_beta1 beta + a_beta2 dr) + k_p v p + k_r v r + c v^2
+//! airspeed  Va' = -a_V1 (Va - Va_ref) + a_V2 dt - a_V3 theta + k_alpha alpha + k_beta v^2 beta^2 + c
 //! course    chi' = k_chi g tan(phi) / Vg + c                               (k_chi = 1 ideal)
 //! altitude  h'  = k_h Va theta + c                                         (k_h = 1 ideal)
 //! flight    Va gamma' + g cos(gamma) = v^2 cos(phi) (a_gamma Va_ref alpha + c)   gamma = h'/Va
 //! ```
+//!
+//! The sideslip's model is the book's side force, `beta' = -a_beta1 beta + a_beta2 dr` with
+//! `a_beta1 = -rho Va S CY_beta / (2 m)` and `a_beta2 = rho Va S CY_dr / (2 m)`: what the
+//! accelerometer measures across the body is that force per unit mass, `a_y = Va (-a_beta1 beta
+//! + a_beta2 dr)` at the airspeed flown, where both coefficients grow with `Va`, so no rate is
+//! differenced and a noisy accelerometer's noise falls on the measured side alone, where least
+//! squares averages it out. The rates' side force (`CY_p`, `CY_r`) and the trim's are the `k_p`,
+//! `k_r` and `c` terms. The ailerons' (`CY_da`, none on the 25e) is left out: on the rudder
+//! doublets the ailerons move only to hold the wings against the sideslip's roll, in step with
+//! the sideslip, and a term for them took `a_beta1` 12 % high on the 25e's truth, where without
+//! it both coefficients come within 6 %. The sideslip's drag slows the aircraft as its square
+//! (`k_beta`): left out, the rudder doublets took the airspeed fit's R^2 from 0.7 to 0.46.
 //!
 //! The flight path turns as the lift the angle of attack builds (the heave damping: `a_gamma =
 //! rho Va S (CL_alpha + CD) / (2 m)`); the altitude loop's design reads its lag behind the
@@ -66,6 +79,16 @@ pub struct Sample {
     /// roll term and put `a_phi1` 15 % high). Only its fitted coefficient's scale depends on
     /// which.
     pub ay: f32,
+    /// Sideslip of the velocity through the air, rad.
+    pub beta: f32,
+    /// The speed of that velocity, m/s, which the sideslip model's dynamic pressure is read
+    /// from (0 or less: `airspeed`'s). A pitot's low-passed airspeed lags the rudder doublets'
+    /// drag, which slows the 25e by 1-2 m/s within a second: through it the rudder's side
+    /// force came out 15 % high on average over six flights (+1 to +25 %); through the
+    /// velocity less the wind, -4 to +6 %.
+    pub air_speed: f32,
+    /// Lateral specific force, what an accelerometer's y axis reads, m/s^2.
+    pub accel_y: f32,
     /// Roll, rad.
     pub phi: f32,
     /// Pitch, rad.
@@ -84,6 +107,8 @@ pub struct Sample {
     pub aileron: f32,
     /// Elevator command, rad (positive pitches down).
     pub elevator: f32,
+    /// Rudder command, rad (Minnesota signs: positive raises the sideslip).
+    pub rudder: f32,
     /// Throttle, 0..1.
     pub throttle: f32,
 }
@@ -204,6 +229,7 @@ pub(super) fn servo(c: &IdentifyConfig, from: f32, cmd: f32, dt_s: f32) -> (f32,
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Axis {
     Roll,
+    Sideslip,
     Pitch,
     Airspeed,
     Course,
@@ -213,8 +239,9 @@ pub enum Axis {
 
 impl Axis {
     /// Every axis, in the order of the design (inner loops first).
-    pub const ALL: [Axis; 6] = [
+    pub const ALL: [Axis; 7] = [
         Axis::Roll,
+        Axis::Sideslip,
         Axis::Pitch,
         Axis::Airspeed,
         Axis::Course,
@@ -226,6 +253,7 @@ impl Axis {
     pub fn name(self) -> &'static str {
         match self {
             Axis::Roll => "roll",
+            Axis::Sideslip => "sideslip",
             Axis::Pitch => "pitch",
             Axis::Airspeed => "airspeed",
             Axis::Course => "course",
@@ -238,10 +266,11 @@ impl Axis {
     pub fn coefficients(self) -> &'static [&'static str] {
         match self {
             Axis::Roll => &["a_phi1", "a_phi2", "k_r", "k_ay", "k_t", "c_phi"],
+            Axis::Sideslip => &["a_beta1", "a_beta2", "k_p", "k_r", "c_beta"],
             Axis::Pitch => &[
                 "a_theta1", "a_theta2", "a_theta3", "k_t", "c_theta", "k_r", "k_pr", "k_rr",
             ],
-            Axis::Airspeed => &["a_V1", "a_V2", "a_V3", "k_alpha", "c_V"],
+            Axis::Airspeed => &["a_V1", "a_V2", "a_V3", "k_alpha", "c_V", "k_beta"],
             Axis::Course => &["k_chi", "c_chi"],
             Axis::Altitude => &["k_h", "c_h"],
             Axis::FlightPath => &["a_gamma", "c_gamma"],
@@ -255,6 +284,7 @@ impl Axis {
     pub fn input(self) -> (&'static str, f32) {
         match self {
             Axis::Roll => ("aileron", 0.25 * crate::math::DEG),
+            Axis::Sideslip => ("rudder", 0.25 * crate::math::DEG),
             Axis::Pitch => ("elevator", 0.25 * crate::math::DEG),
             Axis::Airspeed => ("throttle", 0.02),
             Axis::Course => ("bank", 2.0 * crate::math::DEG),
@@ -324,19 +354,22 @@ impl Spread {
 pub struct Identifier {
     config: IdentifyConfig,
     prev: Option<Sample>,
-    /// Where the servos hold the aileron and elevator at `prev`, rad.
-    surfaces: [f32; 2],
+    /// Where the servos hold the aileron, elevator and rudder at `prev`, rad.
+    surfaces: [f32; 3],
     roll: LeastSquares<6>,
+    sideslip: LeastSquares<5>,
     pitch: LeastSquares<8>,
-    speed: LeastSquares<5>,
+    speed: LeastSquares<6>,
     course: LeastSquares<2>,
     altitude: LeastSquares<2>,
     flight_path: LeastSquares<2>,
     roll_filter: Prefilter<6>,
     pitch_filter: Prefilter<8>,
-    speed_filter: Prefilter<5>,
+    speed_filter: Prefilter<6>,
     path_filter: Prefilter<2>,
-    inputs: [Spread; 5],
+    inputs: [Spread; 6],
+    /// Which models take the rows: the sideslip's, the others'.
+    rows: (bool, bool),
 }
 
 /// Longest interval two samples may be apart and still make a rate, s: longer is a gap in
@@ -349,8 +382,9 @@ impl Identifier {
         Self {
             config,
             prev: None,
-            surfaces: [0.0; 2],
+            surfaces: [0.0; 3],
             roll: LeastSquares::new(),
+            sideslip: LeastSquares::new(),
             pitch: LeastSquares::new(),
             speed: LeastSquares::new(),
             course: LeastSquares::new(),
@@ -360,8 +394,20 @@ impl Identifier {
             pitch_filter: Prefilter::new(),
             speed_filter: Prefilter::new(),
             path_filter: Prefilter::new(),
-            inputs: [Spread::default(); 5],
+            inputs: [Spread::default(); 6],
+            rows: (true, true),
         }
+    }
+
+    /// Which models take the next rows: the sideslip's (`sideslip`), the others' (`others`);
+    /// both from the start. A flight that excites each axis in a stage of its own fits each
+    /// model on its stage: the rudder doublets' sideslip is beyond what the other reduced
+    /// models hold (its drag and the lift it costs: the 25e's flight-path fit fell from R^2 0.7
+    /// to 0.35 with them), and the other stages' rudder moves only with the yaw damper (on its
+    /// truth, the 25e's autotune flight put `a_beta2` 15 % short with them, 1.4 % on the
+    /// rudder doublets alone).
+    pub fn take_rows(&mut self, sideslip: bool, others: bool) {
+        self.rows = (sideslip, others);
     }
 
     /// Forgets the previous sample: the next one starts a new stretch of data (the samples
@@ -377,12 +423,18 @@ impl Identifier {
     /// Takes in the sample `dt_s` after the previous one. An interval that is not a positive
     /// finite number under 0.1 s, or a sample with a value that is not finite, starts a new
     /// stretch instead of making a rate.
+    // Out of line: inlined into the vehicle's tick, the MCU image held two copies of it,
+    // 1.9 KB each.
+    #[inline(never)]
     pub fn push(&mut self, dt_s: f32, s: &Sample) {
         let finite = [
             s.p,
             s.q,
             s.r,
             s.ay,
+            s.beta,
+            s.air_speed,
+            s.accel_y,
             s.phi,
             s.theta,
             s.airspeed,
@@ -392,6 +444,7 @@ impl Identifier {
             s.ground_speed,
             s.aileron,
             s.elevator,
+            s.rudder,
             s.throttle,
         ]
         .iter()
@@ -403,15 +456,16 @@ impl Identifier {
         let Some(a) = self.prev.filter(|_| dt_s > 0.0 && dt_s <= MAX_INTERVAL_S) else {
             self.break_chain();
             self.prev = Some(*s);
-            self.surfaces = [s.aileron, s.elevator];
+            self.surfaces = [s.aileron, s.elevator, s.rudder];
             return;
         };
         // The servos move towards the command held since `a`, no faster than their rate
         // limit: over the interval each surface's mean is what the servo model gives.
-        let [ail, ele] = self.surfaces;
+        let [ail, ele, rud] = self.surfaces;
         let (ail_end, da) = servo(&self.config, ail, a.aileron, dt_s);
         let (ele_end, de) = servo(&self.config, ele, a.elevator, dt_s);
-        self.surfaces = [ail_end, ele_end];
+        let (rud_end, dr) = servo(&self.config, rud, a.rudder, dt_s);
+        self.surfaces = [ail_end, ele_end, rud_end];
         let mid = |f: fn(&Sample) -> f32| 0.5 * (f(&a) + f(s));
         let va = mid(|x| x.airspeed);
         let v = va / self.config.airspeed_ref;
@@ -421,12 +475,37 @@ impl Identifier {
         let (phi, theta, alpha) = (mid(|x| x.phi), mid(|x| x.theta), mid(|x| x.alpha));
         let (ay, thr) = (mid(|x| x.ay), a.throttle);
         let k = share(dt_s, self.config.attitude_filter_tau_s);
+        // The pre-filters run on every row, so that a model's rows pick up where its filter
+        // has followed the flight.
+        let (sideslip, others) = self.rows;
         let (row, y) = self.roll_filter.pass(
             k,
             SVector::from([-v * p, v2 * da, v * r, ay, thr, v2]),
             rate(|x| x.p),
         );
-        self.roll.push(&row, y);
+        if others {
+            self.roll.push(&row, y);
+        }
+        let vb = mid(|x| {
+            if x.air_speed > 0.0 {
+                x.air_speed
+            } else {
+                x.airspeed
+            }
+        }) / self.config.airspeed_ref;
+        let force = self.config.airspeed_ref * vb * vb;
+        if sideslip {
+            self.sideslip.push(
+                &SVector::from([
+                    -force * mid(|x| x.beta),
+                    force * dr,
+                    vb * p,
+                    vb * r,
+                    vb * vb,
+                ]),
+                mid(|x| x.accel_y),
+            );
+        }
         let (row, y) = self.pitch_filter.pass(
             k,
             SVector::from([
@@ -441,22 +520,35 @@ impl Identifier {
             ]),
             rate(|x| x.q),
         );
-        self.pitch.push(&row, y);
+        if others {
+            self.pitch.push(&row, y);
+        }
         let (row, y) = self.speed_filter.pass(
             share(dt_s, self.config.airspeed_filter_tau_s),
-            SVector::from([-(va - self.config.airspeed_ref), thr, -theta, alpha, 1.0]),
+            SVector::from([
+                -(va - self.config.airspeed_ref),
+                thr,
+                -theta,
+                alpha,
+                1.0,
+                v2 * mid(|x| x.beta * x.beta),
+            ]),
             rate(|x| x.airspeed),
         );
-        self.speed.push(&row, y);
+        if others {
+            self.speed.push(&row, y);
+        }
         let vg = mid(|x| x.ground_speed);
-        if vg > 1.0 {
+        if vg > 1.0 && others {
             self.course.push(
                 &SVector::from([GRAVITY * libm::tanf(phi) / vg, 1.0]),
                 wrap_pi(s.course - a.course) / dt_s,
             );
         }
-        self.altitude
-            .push(&SVector::from([va * theta, 1.0]), mid(|x| x.climb_rate));
+        if others {
+            self.altitude
+                .push(&SVector::from([va * theta, 1.0]), mid(|x| x.climb_rate));
+        }
         // The lift that turns the flight path, `Va gamma' + g cos(gamma) = (qbar S / m) CL
         // cos(phi)`, with `CL = CL_0 + CL_alpha alpha` and the dynamic pressure as `v^2`: the
         // angle of attack's coefficient is `a_gamma Va_ref`, the rest a constant per `v^2`.
@@ -474,10 +566,20 @@ impl Identifier {
                 SVector::from([lift * self.config.airspeed_ref * alpha, lift]),
                 va * (gamma_b - gamma_a) / dt_s + GRAVITY * libm::cosf(gamma),
             );
-            self.flight_path.push(&row, y);
+            if others {
+                self.flight_path.push(&row, y);
+            }
         }
-        for (spread, x) in self.inputs.iter_mut().zip([da, de, thr, phi, theta]) {
-            spread.push(x);
+        let taken = [others, others, others, others, others, sideslip];
+        for ((spread, x), taken) in self
+            .inputs
+            .iter_mut()
+            .zip([da, de, thr, phi, theta, dr])
+            .zip(taken)
+        {
+            if taken {
+                spread.push(x);
+            }
         }
         self.prev = Some(*s);
     }
@@ -491,6 +593,7 @@ impl Identifier {
             Axis::Airspeed => self.inputs[2],
             Axis::Course => self.inputs[3],
             Axis::Altitude | Axis::FlightPath => self.inputs[4],
+            Axis::Sideslip => self.inputs[5],
         };
         let sd = spread.sd();
         if sd.is_nan() || sd < needed {
@@ -498,6 +601,7 @@ impl Identifier {
         }
         let fit = match axis {
             Axis::Roll => self.roll.solve().map(widen),
+            Axis::Sideslip => self.sideslip.solve().map(widen),
             Axis::Pitch => self.pitch.solve().map(widen),
             Axis::Airspeed => self.speed.solve().map(widen),
             Axis::Course => self.course.solve().map(widen),

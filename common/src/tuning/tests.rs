@@ -267,10 +267,12 @@ fn bad_time_steps_and_values_start_a_new_stretch_and_leave_the_fit_as_it_was() {
     assert!(within(f.coef[1], A_PHI2, 0.02) && f.coef.iter().all(|c| c.is_finite()));
 }
 
-/// The airspeed model from throttle, pitch and angle-of-attack swings of different periods.
+/// The airspeed model from throttle, pitch, angle-of-attack and sideslip swings of different
+/// periods.
 #[test]
-fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
-    let (a1, a2, a3, ka) = (0.6f32, 8.0f32, GRAVITY, 2.0f32);
+fn the_airspeed_model_gives_its_damping_throttle_gravity_and_sideslip_drag_terms_back() {
+    // The sideslip's drag as the 25e's at 17 m/s: about 3 m/s^2 per rad^2.
+    let (a1, a2, a3, ka, kb) = (0.6f32, 8.0f32, GRAVITY, 2.0f32, -3.0f32);
     let mut id = Identifier::new(unfiltered(SERVO_TAU));
     let mut va = VA_REF;
     for k in 0..3000 {
@@ -278,6 +280,7 @@ fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
         let thr = 0.5 + 0.2 * three_two_one_one(t % 12.0, 1.0, 1.0);
         let theta = 0.05 * libm::sinf(0.4 * t);
         let alpha = 0.06 + 0.02 * libm::sinf(1.3 * t);
+        let beta = |t: f32| 0.08 * libm::sinf(0.9 * t);
         id.push(
             0.02,
             &Sample {
@@ -285,6 +288,7 @@ fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
                 throttle: thr,
                 theta,
                 alpha,
+                beta: beta(t),
                 ground_speed: va,
                 ..Sample::default()
             },
@@ -295,14 +299,19 @@ fn the_airspeed_model_gives_its_damping_throttle_and_gravity_terms_back() {
             0.05 * libm::sinf(0.4 * tm),
             0.06 + 0.02 * libm::sinf(1.3 * tm),
         );
+        let drag = kb * beta(tm) * beta(tm);
         for _ in 0..20 {
-            va += 0.001 * (-a1 * (va - VA_REF) + a2 * (thr - 0.5) - a3 * thm + ka * alm - 0.1);
+            let v = va / VA_REF;
+            va += 0.001
+                * (-a1 * (va - VA_REF) + a2 * (thr - 0.5) - a3 * thm + ka * alm - 0.1
+                    + drag * v * v);
         }
     }
     let f = id.fit(Axis::Airspeed).expect("airspeed");
     assert!(within(f.coef[0], a1, 0.03), "{f:?}");
     assert!(within(f.coef[1], a2, 0.03), "{f:?}");
     assert!(within(f.coef[2], a3, 0.03), "{f:?}");
+    assert!(within(f.coef[5], kb, 0.05), "{f:?}");
 }
 
 /// A coordinated turn's course rate is `g tan(phi) / Vg`: the kinematic gain comes out 1.
@@ -395,4 +404,63 @@ fn the_flight_path_s_lift_gives_the_heave_damping_back() {
     // The doublets' steps fall inside a sample's interval, where the trapezoid's mean angle
     // of attack is not the one the lift had: what the fit leaves is that, 2-3 %.
     assert!(f.r2 > 0.95, "{f:?}");
+}
+
+/// The side force of rudder 3-2-1-1s read by a noisy accelerometer (0.6 m/s^2, the 25e's): the
+/// sideslip flown by a Dutch roll, the rudder through its servo, the airspeed swinging as the
+/// `Va^2` scaling must follow. The book's coefficients at 17 m/s (`a_beta1` 0.796, `a_beta2`
+/// 0.312, the 25e's aero data) come back within three of the standard errors the fit gives
+/// (each under 5 % of its value: the noise's share) and the 1 % the trapezoid's means leave
+/// (without the noise: 0.9 % and 0.8 % low), the noise left unexplained.
+#[test]
+fn the_sideslip_model_gives_the_side_forces_coefficients_back_through_the_accelerometers_noise() {
+    const A_BETA1: f32 = 0.7963;
+    const A_BETA2: f32 = 0.3116;
+    let mut id = Identifier::new(unfiltered(SERVO_TAU));
+    let (mut beta, mut r, mut dr_s) = (0.0f32, 0.0f32, 0.0f32);
+    let mut seed = 777u32;
+    let mut uniform = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    };
+    let h = 0.000_25f32;
+    for k in 0..1500 {
+        let t = k as f32 * 0.02;
+        let va = VA_REF + 2.0 * libm::sinf(0.3 * t);
+        let v = va / VA_REF;
+        let p = 0.05 * libm::sinf(0.9 * t);
+        let cmd = three_two_one_one(t % 5.0, 0.3, 6.0 * DEG);
+        // A sum of twelve uniforms has unit variance: 0.6 m/s^2 of noise.
+        let noise = 0.6 * (0..12).map(|_| uniform()).sum::<f32>();
+        let force = VA_REF * v * v * (-A_BETA1 * beta + A_BETA2 * dr_s);
+        id.push(
+            0.02,
+            &Sample {
+                p,
+                r,
+                beta,
+                accel_y: force + 0.3 * v * r + 0.05 * v * v + noise,
+                rudder: cmd,
+                airspeed: va,
+                ground_speed: va,
+                ..Sample::default()
+            },
+        );
+        for _ in 0..80 {
+            dr_s += (1.0 - libm::expf(-h / SERVO_TAU)) * (cmd - dr_s);
+            let beta_dot = -A_BETA1 * v * beta + A_BETA2 * v * dr_s - r;
+            let r_dot = 20.0 * v * v * beta - 2.0 * v * r - 5.0 * v * v * dr_s;
+            beta += h * beta_dot;
+            r += h * r_dot;
+        }
+    }
+    let f = id.fit(Axis::Sideslip).expect("sideslip");
+    for (i, want) in [A_BETA1, A_BETA2].into_iter().enumerate() {
+        assert!(f.std_err[i] < 0.05 * want, "{f:?}");
+        assert!(
+            (f.coef[i] - want).abs() < 3.0 * f.std_err[i] + 0.01 * want,
+            "{f:?}"
+        );
+    }
+    assert!(f.r2 > 0.3 && f.r2 < 0.99, "{f:?}");
 }

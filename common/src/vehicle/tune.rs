@@ -124,7 +124,12 @@ impl Vehicle {
     pub(super) fn observe_autotune(&mut self, dt: f32) {
         if cfg!(feature = "autotune") && self.autotune.running() {
             let e = self.estimator.state();
-            let s = sample(&e, &self.surfaces);
+            let s = sample(
+                &e,
+                &self.surfaces,
+                self.estimator.specific_force(),
+                self.autotune.wind(),
+            );
             self.autotune.observe(dt, &s);
         }
     }

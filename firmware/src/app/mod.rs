@@ -395,8 +395,13 @@ pub(crate) mod tests {
     #[test]
     fn the_application_fits_the_stm32f405_ram_with_room_for_the_stack() {
         // 128 KiB of SRAM: the whole application state must leave most of it to the stack.
+        // The image builds it in `main`'s frame inside its 56 KiB stack region, whose painted
+        // peak measured 52,756 B with a 40,960 B bound here; the autotune's sideslip model
+        // (its fit, the rudder's servo state, the held wind) took the state to 41,168 B,
+        // which that region still holds with 3 KiB to spare (the budget test measures it:
+        // docs/PERFORMANCE.md).
         assert!(
-            core::mem::size_of::<App>() < 40 * 1024,
+            core::mem::size_of::<App>() < 41 * 1024 + 512,
             "{}",
             core::mem::size_of::<App>()
         );

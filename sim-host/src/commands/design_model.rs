@@ -108,8 +108,11 @@ pub fn read_model(path: &Path) -> anyhow::Result<ReducedModel> {
             a_v3: coefficient("airspeed", "a_V3")?,
             // Logs identified before the flight path's fit have none: no lag, as the thesis.
             a_gamma: r.coefficient("flight path", "a_gamma").unwrap_or(f64::NAN),
-            a_beta1: f64::NAN,
-            a_beta2: f64::NAN,
+            // A flight without rudder doublets has no sideslip model (the hand-flown
+            // Stabilized flight: its rudder is the yaw damper's): the sideslip loop keeps the
+            // base set's gains.
+            a_beta1: r.coefficient("sideslip", "a_beta1").unwrap_or(f64::NAN),
+            a_beta2: r.coefficient("sideslip", "a_beta2").unwrap_or(f64::NAN),
         },
         engine_pole: None,
         servo_bandwidth_hz: 1.0 / (2.0 * std::f64::consts::PI * tau),

@@ -112,10 +112,14 @@ impl IdentifyReport {
             .ok_or_else(|| format!("`{axis}.{name}` is missing or not a number"))
     }
 
-    /// The axes without a fit, with the reason.
+    /// The axes without a fit that a design needs, with the reason. The sideslip's is not
+    /// among them: without rudder doublets (a flight in Stabilized, whose rudder is the yaw
+    /// damper's) the report says why it has none, and a design keeps the base set's sideslip
+    /// gains.
     pub fn failures(&self) -> Vec<String> {
         self.axes
             .iter()
+            .filter(|a| a.axis != Axis::Sideslip.name())
             .filter_map(|a| a.error.as_ref().map(|e| format!("{}: {e}", a.axis)))
             .collect()
     }
@@ -162,6 +166,7 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                     theta: e.theta as f32,
                     airspeed: va as f32,
                     ay: (f64::from(d.yacc) * STANDARD_GRAVITY / 1000.0) as f32,
+                    accel_y: (f64::from(d.yacc) * STANDARD_GRAVITY / 1000.0) as f32,
                     climb_rate: climb as f32,
                     course: course as f32,
                     ground_speed: gs as f32,
@@ -194,6 +199,7 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
                     sample: Sample {
                         aileron: c.aileron,
                         elevator: c.elevator,
+                        rudder: c.rudder,
                         throttle: c.throttle,
                         ..t.sample
                     },
@@ -277,6 +283,8 @@ pub fn identify_log(
             Timed {
                 sample: Sample {
                     alpha: air.alpha as f32,
+                    beta: air.beta as f32,
+                    air_speed: air.va as f32,
                     ..t.sample
                 },
                 ..*t

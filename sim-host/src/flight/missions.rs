@@ -417,17 +417,19 @@ pub fn stick_doublets(throttle: f32) -> FlightConfig {
 pub const AUTOTUNE_AT_S: f64 = 10.0;
 
 /// Time the autotune flight leaves the autotune before the thesis's script, s: its timeline
-/// (48 s), the fit and the design, and some level flight.
-pub const AUTOTUNE_FOR_S: f64 = 70.0;
+/// (63 s), the fit and the design, and some level flight.
+pub const AUTOTUNE_FOR_S: f64 = 80.0;
 
 /// The gains the design sets, which the autotune flight's station reads before the autotune
 /// and after it, with the coefficients it identified (the `ATUN_A_*` parameters).
-pub const AUTOTUNE_GAINS: [&str; 15] = [
+pub const AUTOTUNE_GAINS: [&str; 17] = [
     "RLL_KP",
     "RLL_KI",
     "RLL_RATE_KD",
     "CRS_KP",
     "CRS_KI",
+    "SLIP_KP",
+    "SLIP_KI",
     "PTCH_KP",
     "PTCH_KI",
     "PTCH_RATE_KD",

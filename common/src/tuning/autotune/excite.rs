@@ -22,6 +22,10 @@ pub enum Stage {
     Pitch,
     /// Throttle steps, pitch held.
     Throttle,
+    /// 3-2-1-1s on the rudder, wings held level: last, as the wind estimate takes a share of
+    /// the sideslip for wind and gives it back over some seconds, and the other models read
+    /// their angle of attack through it.
+    Yaw,
 }
 
 /// Width of a 3-2-1-1's unit pulse, s: its energy sits between `1 / (6 T)` and `1 / (2 T)`
@@ -40,13 +44,15 @@ const SEQUENCES: f32 = 3.0;
 const THROTTLE_STEP_S: f32 = 4.0;
 
 /// The timeline, stage by stage, with each stage's length in s.
-pub const TIMELINE: [(Stage, f32); 7] = [
+pub const TIMELINE: [(Stage, f32); 9] = [
     (Stage::Level, 3.0),
     (Stage::Roll, SEQUENCES * SEQUENCE_S),
     (Stage::Level, 3.0),
     (Stage::Pitch, SEQUENCES * SEQUENCE_S),
     (Stage::Level, 3.0),
     (Stage::Throttle, 3.0 * THROTTLE_STEP_S),
+    (Stage::Level, 3.0),
+    (Stage::Yaw, SEQUENCES * SEQUENCE_S),
     (Stage::Level, 2.0),
 ];
 
@@ -86,7 +92,7 @@ fn sequence(t_s: f32) -> f32 {
     }
 }
 
-/// The roll or pitch stage's input, of unit height, `t_s` into the stage: three 3-2-1-1s, the
+/// The roll, yaw or pitch stage's input, of unit height, `t_s` into the stage: three 3-2-1-1s, the
 /// second mirrored.
 pub fn doublets(t_s: f32) -> f32 {
     let n = libm::floorf(t_s / SEQUENCE_S);

@@ -3,12 +3,13 @@
 //! them by successive loop closure and hands them over once every loop meets its margins.
 //!
 //! ```text
-//! Level ─► Roll ─► Level ─► Pitch ─► Level ─► Throttle ─► Level ─► fit ─► design ─► gains
-//!   └──────────── any limit, mode change, failsafe, the station: abort, gains kept ──────┘
+//! Level ─► Roll ─► Level ─► Pitch ─► Level ─► Throttle ─► Level ─► Yaw ─► Level ─► fit ─► design ─► gains
+//!   └──────────────────── any limit, mode change, failsafe, the station: abort, gains kept ───────────────┘
 //! ```
 //!
 //! It flies the aircraft itself: wings level at the altitude and airspeed it started at
-//! (the altitude-holding law), the roll excitation on the roll command, the pitch and throttle
+//! (the altitude-holding law), the roll excitation on the roll command, the rudder's on the
+//! rudder (its trim the level flight's, the yaw damper off), the pitch and throttle
 //! excitation on the pitch-attitude law with the level flight's pitch and throttle. Nothing
 //! here reads a clock or a sensor: the vehicle hands it the estimate and the surfaces each
 //! control tick and flies what it answers.
@@ -26,11 +27,13 @@ use super::identify::{
 };
 use crate::actuators::Surfaces;
 use crate::control::autopilot::{Commands, GainSet};
-use crate::control::lateral::{RollMode, RUDDER};
+use crate::control::lateral::{RollMode, YawMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::EstimatedState;
+use crate::math::frames::{ned_to_body, AirData};
 use crate::math::RAD2DEG;
 use excite::Stage;
+use nalgebra::Vector3;
 use params::{AutotuneParams, UNIDENTIFIED};
 
 /// Share of the abort limits the excitation uses: a 3-2-1-1 on a closed loop overshoots its
@@ -103,7 +106,8 @@ pub enum Status {
     #[default]
     Idle,
     /// Running: its progress, 0-99, in QGroundControl's bands (under 20 starting, 20-39 roll,
-    /// 40-59 pitch, 60-79 the third axis (here the throttle), 80-99 fitting and designing).
+    /// 40-59 pitch, 60-79 the third axis (here the throttle, 60-69, then the yaw, 70-79),
+    /// 80-99 fitting and designing).
     Running(u8),
     /// The last one applied its gains.
     Succeeded,
@@ -143,9 +147,15 @@ pub struct Tick {
 struct Start {
     alt_m: f32,
     airspeed: f32,
-    /// Pitch and throttle of level flight: followed (slowly) in the level stages.
+    /// Pitch, throttle and rudder of level flight: followed (slowly) in the level stages.
     pitch: f32,
     throttle: f32,
+    rudder: f32,
+    /// The wind estimate, NED, m/s, followed the same way and held through the excitation:
+    /// the wind filter takes a sideslip that lasts for its own wind (it assumes none), a third
+    /// of the rudder doublets' on the 25e, and the side-force fit read through it put
+    /// `a_beta2` 32 % short; the air mass does not move with the rudder.
+    wind: Vector3<f32>,
 }
 
 // The designer in place, not boxed: no heap, and one autotune per vehicle.
@@ -171,7 +181,13 @@ enum Phase {
 const DESIGN_STEPS: f32 = 200.0;
 
 /// The axes the design needs, in the order they are fitted.
-const FITTED: [Axis; 4] = [Axis::Roll, Axis::Pitch, Axis::Airspeed, Axis::FlightPath];
+const FITTED: [Axis; 5] = [
+    Axis::Roll,
+    Axis::Sideslip,
+    Axis::Pitch,
+    Axis::Airspeed,
+    Axis::FlightPath,
+];
 
 /// Time constant of the level pitch and throttle's average, s: longer than the altitude
 /// loop's oscillation, shorter than a level stage.
@@ -207,6 +223,8 @@ impl Autotune {
                 airspeed: 0.0,
                 pitch: 0.0,
                 throttle: 0.0,
+                rudder: 0.0,
+                wind: Vector3::zeros(),
             },
             stage: None,
             model: UNIDENTIFIED,
@@ -239,6 +257,8 @@ impl Autotune {
             airspeed,
             pitch: e.euler.theta,
             throttle: s.throttle,
+            rudder: s.rudder,
+            wind: e.wind_ned,
         };
         self.stage = None;
         self.model = DesignModel {
@@ -263,6 +283,12 @@ impl Autotune {
         self.phase = Phase::Idle;
         self.status = Status::Failed;
         Some(Report::Aborted(why))
+    }
+
+    /// The wind the sideslip is read against while it runs ([`sample`]'s `wind_ned`): the
+    /// estimate's, held through each stage of the excitation.
+    pub fn wind(&self) -> Vector3<f32> {
+        self.start.wind
     }
 
     /// What the tick flew: `sample` of the estimate at the tick's time with the surfaces the
@@ -295,7 +321,7 @@ impl Autotune {
         let phase = core::mem::replace(&mut self.phase, Phase::Idle);
         let (phase, mut tick) = match phase {
             Phase::Idle => (Phase::Idle, Tick::default()),
-            Phase::Flying { t_s, id } => self.fly(t_s, id, dt, e, s, p),
+            Phase::Flying { t_s, id } => self.fly(t_s, id, dt, e, s, p, base),
             Phase::Fitting { next, id } => self.fit(next, id, p, base),
             Phase::Designing(mut d) => match d.step() {
                 design::Step::Pending => {
@@ -371,6 +397,7 @@ impl Autotune {
     }
 
     /// A tick of the excitation's timeline.
+    #[allow(clippy::too_many_arguments)]
     fn fly(
         &mut self,
         t_s: f32,
@@ -379,6 +406,7 @@ impl Autotune {
         e: &EstimatedState,
         s: &Surfaces,
         p: &AutotuneParams,
+        base: &GainSet,
     ) -> (Phase, Tick) {
         let Some((stage, into_s, share)) = excite::at(t_s) else {
             self.status = Status::Running(80);
@@ -394,31 +422,56 @@ impl Autotune {
         } else {
             None
         };
-        // QGroundControl's bands: the stage in its 20-wide band, the level stages between.
-        let band = |first: f32| first + 19.0 * ((share * 80.0 - first) / 20.0).clamp(0.0, 1.0);
+        // QGroundControl's bands: the stage in its band, the level stages between.
+        let band = |first: f32, width: f32| {
+            first + (width - 1.0) * ((share * 80.0 - first) / width).clamp(0.0, 1.0)
+        };
         let progress = match stage {
             Stage::Level => share * 80.0,
-            Stage::Roll => band(20.0),
-            Stage::Pitch => band(40.0),
-            Stage::Throttle => band(60.0),
+            Stage::Roll => band(20.0, 20.0),
+            Stage::Pitch => band(40.0, 20.0),
+            Stage::Throttle => band(60.0, 10.0),
+            Stage::Yaw => band(70.0, 10.0),
         };
-        self.status = Status::Running((progress as u8).min(79));
+        // Never back: a level stage's share of the timeline can lie below the band of the
+        // stage before it.
+        let last = match self.status {
+            Status::Running(p) => p,
+            _ => 0,
+        };
+        // Not `clamp`: a panic site in the image, where `last` is not known to be under 79.
+        self.status = Status::Running((progress as u8).min(79).max(last));
         let pitch_cmd = |offset: f32| LonMode::Pitch {
             pitch: self.start.pitch + offset,
             throttle: self.start.throttle,
         };
+        // Each model on the stages that are its own: the sideslip's on the rudder doublets,
+        // the others on the rest ([`Identifier::take_rows`]).
+        let mut id = id;
+        id.take_rows(stage == Stage::Yaw, stage != Stage::Yaw);
         let commands = match stage {
             Stage::Level => {
                 // The level pitch and throttle, averaged, for the pitch-attitude stages.
                 let k = (dt / LEVEL_TC_S).clamp(0.0, 1.0);
-                if e.euler.theta.is_finite() && s.throttle.is_finite() {
+                if e.euler.theta.is_finite() && s.throttle.is_finite() && s.rudder.is_finite() {
                     self.start.pitch += k * (e.euler.theta - self.start.pitch);
                     self.start.throttle += k * (s.throttle - self.start.throttle);
+                    self.start.rudder += k * (s.rudder - self.start.rudder);
+                }
+                if e.wind_ned.iter().all(|w| w.is_finite()) {
+                    self.start.wind += (e.wind_ned - self.start.wind) * k;
                 }
                 self.level()
             }
             Stage::Roll => Commands {
                 roll: RollMode::Roll(EXCITATION_SHARE * p.bank_max * excite::doublets(into_s)),
+                ..self.level()
+            },
+            Stage::Yaw => Commands {
+                yaw: YawMode::Rudder(
+                    self.start.rudder
+                        + EXCITATION_SHARE * base.lateral.rudder_max * excite::doublets(into_s),
+                ),
                 ..self.level()
             },
             Stage::Pitch => Commands {
@@ -475,6 +528,7 @@ impl Autotune {
         let m = &mut self.model;
         match axis {
             Axis::Roll => (m.a_phi1, m.a_phi2) = (a, b),
+            Axis::Sideslip => (m.a_beta1, m.a_beta2) = (a, b),
             Axis::Pitch => (m.a_theta1, m.a_theta2, m.a_theta3) = (a, b, c),
             Axis::FlightPath => m.a_gamma = a,
             _ => (m.a_v1, m.a_v2) = (a, b),
@@ -496,11 +550,25 @@ impl Autotune {
     }
 }
 
-/// What the models read, from the estimate and the surfaces flown. The sideslip's lateral
-/// force is read through the estimated sideslip (`beta Va^2`, as the force goes), not the
-/// accelerometer, whose noise is larger than that force ([`Sample::ay`]).
-pub fn sample(e: &EstimatedState, s: &Surfaces) -> Sample {
+/// What the models read, from the estimate, the surfaces flown and the specific force
+/// measured (body axes, m/s^2; `None` before the first IMU sample, which no sample is made
+/// of). In the roll model the sideslip's lateral force is read through the estimated sideslip
+/// (`beta Va^2`, as the force goes), not the accelerometer, whose noise is larger than that
+/// force ([`Sample::ay`]); the sideslip model's side force is the accelerometer's own, on its
+/// measured side, and its sideslip the velocity's through the air against `wind_ned`
+/// ([`Autotune::wind`]).
+pub fn sample(
+    e: &EstimatedState,
+    s: &Surfaces,
+    specific_force: Option<Vector3<f32>>,
+    wind_ned: Vector3<f32>,
+) -> Sample {
+    let air = AirData::from_body_velocity(&ned_to_body(&e.attitude, &(e.vel_ned - wind_ned)));
     Sample {
+        beta: air.beta,
+        air_speed: air.va,
+        accel_y: specific_force.map_or(f32::NAN, |f| f.y),
+        rudder: s.rudder,
         p: e.body_rates.x,
         q: e.body_rates.y,
         r: e.body_rates.z,

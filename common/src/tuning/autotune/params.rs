@@ -13,6 +13,8 @@ pub const UNIDENTIFIED: DesignModel = DesignModel {
     va: 0.0,
     a_phi1: 0.0,
     a_phi2: 0.0,
+    a_beta1: 0.0,
+    a_beta2: 0.0,
     a_theta1: 0.0,
     a_theta2: 0.0,
     a_theta3: 0.0,
@@ -110,6 +112,14 @@ pub const IDENTIFIED: Group<DesignModel> = Group {
         param!(
             ParamDef::real("ATUN_A_PHI2", 0.0, -1e5, 1e5, "1/s^2", "Identified a_phi2"),
             DesignModel => a_phi2
+        ),
+        param!(
+            ParamDef::real("ATUN_A_BET1", 0.0, -1e4, 1e4, "1/s", "Identified a_beta1"),
+            DesignModel => a_beta1
+        ),
+        param!(
+            ParamDef::real("ATUN_A_BET2", 0.0, -1e4, 1e4, "1/s", "Identified a_beta2"),
+            DesignModel => a_beta2
         ),
         param!(
             ParamDef::real("ATUN_A_THT1", 0.0, -1e4, 1e4, "1/s", "Identified a_theta1"),

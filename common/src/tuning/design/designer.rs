@@ -2,7 +2,8 @@
 //! vehicle can run it between control ticks: [`Designer::step`] evaluates at most
 //! [`POINTS_PER_STEP`] points of a loop transfer.
 //!
-//! The loops are designed inner to outer ([`Loop::ALL`]). The attitude loops' gains start at
+//! The loops are designed inner to outer ([`Loop::ALL`]; the sideslip's only on a model that
+//! has one). The attitude loops' gains start at
 //! their rule's value and are lowered by 1 % steps ([`GAIN_STEP`], at most [`GAIN_STEPS`])
 //! until the phase margin with servo and delay is [`DesignInputs::inner_phase_margin_deg`].
 //! The host's design walked the steps down one by one (up to 400 margin computations); here
@@ -59,6 +60,8 @@ pub struct Loops<T> {
     pub roll: T,
     /// [`Loop::Course`]'s.
     pub course: T,
+    /// [`Loop::Sideslip`]'s.
+    pub sideslip: T,
     /// [`Loop::Pitch`]'s.
     pub pitch: T,
     /// [`Loop::Altitude`]'s.
@@ -75,6 +78,7 @@ impl<T> Loops<T> {
         match l {
             Loop::Roll => &self.roll,
             Loop::Course => &self.course,
+            Loop::Sideslip => &self.sideslip,
             Loop::Pitch => &self.pitch,
             Loop::Altitude => &self.altitude,
             Loop::AirspeedPitch => &self.airspeed_pitch,
@@ -86,6 +90,7 @@ impl<T> Loops<T> {
         match l {
             Loop::Roll => &mut self.roll,
             Loop::Course => &mut self.course,
+            Loop::Sideslip => &mut self.sideslip,
             Loop::Pitch => &mut self.pitch,
             Loop::Altitude => &mut self.altitude,
             Loop::AirspeedPitch => &mut self.airspeed_pitch,
@@ -284,6 +289,8 @@ fn check(model: &DesignModel, inputs: &DesignInputs, lp: f32) -> Result<(), Desi
         (Roll, "delay", i.delay_s(), NonNegative),
         (Course, "va", model.va, Positive),
         (Course, "g", model.g, Positive),
+        (Sideslip, "a_beta1", model.a_beta1, Finite),
+        (Sideslip, "a_beta2", model.a_beta2, Finite),
         (Pitch, "a_theta1", model.a_theta1, Finite),
         (Pitch, "a_theta2", model.a_theta2, Finite),
         (Pitch, "a_theta3", model.a_theta3, Finite),
@@ -364,8 +371,9 @@ impl Designer {
 
     /// `l` as designed, once it is (whether or not it met its margins).
     pub fn loop_design(&self, l: Loop) -> Option<&LoopDesign> {
+        let skipped = l == Loop::Sideslip && !self.rules.plant.model.has_sideslip();
         self.designed
-            .is_some_and(|last| l <= last)
+            .is_some_and(|last| l <= last && !skipped)
             .then(|| self.loops.get(l))
     }
 
@@ -387,6 +395,7 @@ impl Designer {
             Loop::Roll => (r.roll(x), r.roll_wn(x)),
             Loop::Pitch => (r.pitch(x), r.pitch_wn(x)),
             Loop::Course => r.course(l.roll.wn_radps, x),
+            Loop::Sideslip => r.sideslip(l.roll.wn_radps, x),
             Loop::Altitude => r.altitude(l.pitch.wn_radps, x),
             Loop::AirspeedPitch => r.airspeed_pitch(l.pitch.wn_radps, x),
             Loop::AirspeedThrottle => r.airspeed_throttle(x),
@@ -489,6 +498,7 @@ impl Designer {
                 course: design.gains,
                 roll: l.roll.gains,
             },
+            Loop::Sideslip => Transfer::Sideslip(design.gains),
             Loop::Pitch => Transfer::Pitch(design.gains),
             Loop::Altitude => Transfer::Altitude {
                 altitude: design.gains,
@@ -510,8 +520,15 @@ impl Designer {
         if let Err(reason) = judge(loop_, &margins) {
             self.missed = self.missed.or(Some(failure(loop_, reason)));
         }
-        // The next loop in the design's order, or the finish after the last.
-        match Loop::ALL.iter().skip_while(|l| **l != loop_).nth(1) {
+        // The next loop in the design's order (the sideslip's only where the model has
+        // one), or the finish after the last.
+        let has_sideslip = self.rules.plant.model.has_sideslip();
+        let mut next = Loop::ALL
+            .iter()
+            .skip_while(|l| **l != loop_)
+            .skip(1)
+            .filter(|l| has_sideslip || **l != Loop::Sideslip);
+        match next.next() {
             Some(&next) => self.limit(next),
             None => Stage::Finish,
         }
@@ -533,6 +550,10 @@ impl Designer {
         lat.roll_rate_kd = l.roll.gains.kd;
         lat.course_kp = l.course.gains.kp;
         lat.course_ki = l.course.gains.ki;
+        if self.rules.plant.model.has_sideslip() {
+            lat.slip_kp = l.sideslip.gains.kp;
+            lat.slip_ki = l.sideslip.gains.ki;
+        }
         let lon = &mut gains.longitudinal;
         lon.pitch_kp = l.pitch.gains.kp;
         lon.pitch_ki = l.pitch.gains.ki;

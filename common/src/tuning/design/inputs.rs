@@ -26,8 +26,7 @@ pub struct DesignInputs {
     pub roll_error_max_deg: f32,
     /// Bandwidth separation of course from roll (Appendix C: 10; 15 here).
     pub course_separation: f32,
-    /// Bandwidth separation of sideslip from roll (Appendix C: 20). The sideslip loop is
-    /// designed on the host only, where there is a sideslip model.
+    /// Bandwidth separation of sideslip from roll (Appendix C: 20).
     pub sideslip_separation: f32,
     /// Elevator deflection the pitch design may use, deg (the servo limit).
     pub pitch_elevator_max_deg: f32,

@@ -34,8 +34,11 @@
 //!   `Va / theta = -g / (s + a_V1)` and `Va / throttle = a_V2 / (s + a_V1)`, the engine's lag
 //!   in the throttle loop's margins.
 //!
-//! No sideslip loop: a reduced model has none (the 25e has no vane), so the base set's
-//! sideslip gains, and its trims, stay.
+//! - sideslip (PI on the rudder, Appendix C): `wn_beta = wn_phi / 20`, by pole placement on
+//!   `beta / dr = a_beta2 / (s + a_beta1)`, `kp = (2 zeta wn_beta - a_beta1) / a_beta2` (0
+//!   where the side force alone damps more), `ki = wn_beta^2 / a_beta2`; on a model without a
+//!   sideslip model (`a_beta2` 0) the base set's sideslip gains stay. The base set's trims
+//!   stay.
 //!
 //! Margins: every inner loop at least [`GAIN_MARGIN_MIN_DB`] and [`INNER_PHASE_MARGIN_MIN_DEG`],
 //! every outer loop [`GAIN_MARGIN_MIN_DB`] and [`OUTER_PHASE_MARGIN_MIN_DEG`] ([`judge`]),

@@ -45,6 +45,7 @@ impl PitchResponse {
 ///
 /// ```text
 /// roll      phi / da      = a_phi2 / (s (s + a_phi1))
+/// sideslip  beta / dr     = a_beta2 / (s + a_beta1)
 /// pitch     theta / de    = a_theta3 / (s^2 + a_theta1 s + a_theta2)   (or `pitch_response`)
 /// airspeed  Va / theta    = -g / (s + a_v1)
 ///           Va / throttle = a_v2 engine_pole / ((s + a_v1) (s + engine_pole))
@@ -60,7 +61,7 @@ impl PitchResponse {
 /// Aerosonde at 25 (their linearisations'): a decade or less above their outer loops'
 /// crossovers, whose phase it lowers.
 ///
-/// No sideslip model: the sideslip loop keeps the base set's gains.
+/// Without a sideslip model (`a_beta2` 0) the sideslip loop keeps the base set's gains.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DesignModel {
@@ -70,6 +71,11 @@ pub struct DesignModel {
     pub a_phi1: f32,
     /// Roll acceleration per radian of combined aileron, 1/s^2.
     pub a_phi2: f32,
+    /// Sideslip damping, the side force's per radian of sideslip, 1/s (0 with `a_beta2`:
+    /// no sideslip model).
+    pub a_beta1: f32,
+    /// Sideslip rate per radian of rudder, 1/s (0: no sideslip model).
+    pub a_beta2: f32,
     /// Pitch damping, 1/s.
     pub a_theta1: f32,
     /// Pitch stiffness, 1/s^2.
@@ -110,10 +116,12 @@ impl DesignModel {
 
     /// The coefficients a design takes from identification, under Beard and McLain's names
     /// (as the linearisation's reports name them), in the order of the design.
-    pub fn coefficients(&self) -> [(&'static str, f32); 8] {
+    pub fn coefficients(&self) -> [(&'static str, f32); 10] {
         [
             ("a_phi1", self.a_phi1),
             ("a_phi2", self.a_phi2),
+            ("a_beta1", self.a_beta1),
+            ("a_beta2", self.a_beta2),
             ("a_theta1", self.a_theta1),
             ("a_theta2", self.a_theta2),
             ("a_theta3", self.a_theta3),
@@ -121,6 +129,11 @@ impl DesignModel {
             ("a_V2", self.a_v2),
             ("a_gamma", self.a_gamma),
         ]
+    }
+
+    /// Whether it has a sideslip model to design the sideslip loop on.
+    pub fn has_sideslip(&self) -> bool {
+        self.a_beta2 != 0.0
     }
 
     /// The servo's pole, rad/s.

@@ -92,6 +92,19 @@ impl Rules {
         (LoopGains { kp, ki, kd: 0.0 }, wn)
     }
 
+    /// Sideslip on `beta / dr = a_beta2 / (s + a_beta1)` (Appendix C), by pole placement at
+    /// `wn_beta = wn_phi / separation` (times `share`): `kp = (2 zeta wn_beta - a_beta1) /
+    /// a_beta2`, `ki = wn_beta^2 / a_beta2`. Where the aircraft's own side force damps the
+    /// sideslip more than the placement asks (`a_beta1 > 2 zeta wn_beta`), `kp` is 0, not the
+    /// negative gain that would take damping away. Gains and `wn_beta`.
+    pub fn sideslip(&self, wn_phi: f32, share: f32) -> (LoopGains, f32) {
+        let m = &self.plant.model;
+        let wn = share * wn_phi / self.inputs.sideslip_separation;
+        let kp = ((2.0 * self.zeta() * wn - m.a_beta1) / m.a_beta2).max(0.0);
+        let ki = wn * wn / m.a_beta2;
+        (LoopGains { kp, ki, kd: 0.0 }, wn)
+    }
+
     /// The pitch rule's gain, `sign(a_theta3) de_max / e_theta_max`: where the limit by phase
     /// margin starts.
     pub fn pitch_kp_nominal(&self) -> f32 {

@@ -107,6 +107,11 @@ impl Plant {
         C::from(self.model.a_phi2) / (s * (s + self.model.a_phi1))
     }
 
+    /// `beta / dr = a_beta2 / (s + a_beta1)`.
+    fn sideslip(&self, s: C) -> C {
+        C::from(self.model.a_beta2) / (s + self.model.a_beta1)
+    }
+
     /// `theta / de`, by Horner's rule.
     fn pitch(&self, s: C) -> C {
         let [n1, n0] = self.pitch.num;
@@ -162,6 +167,8 @@ pub(super) enum Transfer {
         /// The roll loop's gains.
         roll: LoopGains,
     },
+    /// Sideslip: PI on the rudder.
+    Sideslip(LoopGains),
     /// Pitch attitude: PID on the elevator.
     Pitch(LoopGains),
     /// Altitude: PI on the commanded pitch, through the pitch loop closed and the flight
@@ -197,6 +204,7 @@ impl Transfer {
                 let roll = p.closed(roll, p.roll(s), s, p.delay(w));
                 course.pi(s) * roll * (p.model.g / p.model.va) / s
             }
+            Transfer::Sideslip(g) => g.pi(s) * p.sideslip(s) * p.servo(s),
             Transfer::Pitch(g) => g.pid(s) * p.pitch(s) * p.servo(s),
             Transfer::Altitude { altitude, pitch } => {
                 let pitch = p.closed(pitch, p.pitch(s), s, p.delay(w));

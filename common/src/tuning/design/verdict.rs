@@ -15,6 +15,9 @@ pub enum Loop {
     Roll,
     /// Course, PI on the commanded roll (`CRS_KP`, `CRS_KI`).
     Course,
+    /// Sideslip, PI on the rudder (`SLIP_KP`, `SLIP_KI`): designed where the model has a
+    /// sideslip model, else the base set's gains stay.
+    Sideslip,
     /// Pitch attitude, PID on the elevator (`PTCH_KP`, `PTCH_KI`, `PTCH_RATE_KD`).
     Pitch,
     /// Altitude, PI on the commanded pitch (`ALT_KP`, `ALT_KI`).
@@ -27,9 +30,10 @@ pub enum Loop {
 
 impl Loop {
     /// Every loop, in the order of the design.
-    pub const ALL: [Loop; 6] = [
+    pub const ALL: [Loop; 7] = [
         Loop::Roll,
         Loop::Course,
+        Loop::Sideslip,
         Loop::Pitch,
         Loop::Altitude,
         Loop::AirspeedPitch,
@@ -41,6 +45,7 @@ impl Loop {
         match self {
             Loop::Roll => "roll",
             Loop::Course => "course",
+            Loop::Sideslip => "sideslip",
             Loop::Pitch => "pitch",
             Loop::Altitude => "altitude",
             Loop::AirspeedPitch => "aspd-pitch",
@@ -68,6 +73,7 @@ impl Loop {
         match self {
             Loop::Roll => &["RLL_KP", "RLL_KI", "RLL_RATE_KD"],
             Loop::Course => &["CRS_KP", "CRS_KI"],
+            Loop::Sideslip => &["SLIP_KP", "SLIP_KI"],
             Loop::Pitch => &["PTCH_KP", "PTCH_KI", "PTCH_RATE_KD"],
             Loop::Altitude => &["ALT_KP", "ALT_KI"],
             Loop::AirspeedPitch => &["ASPD_PTCH_KP", "ASPD_PTCH_KI"],

@@ -313,7 +313,6 @@ fn design_loops(
         a_gamma,
         ..
     } = coefficients;
-    let z = decimal(inputs.zeta);
     let d = &DESIGNED;
 
     // The gains: the on-board design on this plant.
@@ -321,6 +320,18 @@ fn design_loops(
         va: va as f32,
         a_phi1: a_phi1 as f32,
         a_phi2: a_phi2 as f32,
+        // Without a sideslip model (an aircraft file without the side force's derivatives):
+        // none, and the sideslip loop keeps the base set's gains.
+        a_beta1: if a_beta1.is_finite() {
+            a_beta1 as f32
+        } else {
+            0.0
+        },
+        a_beta2: if a_beta2.is_finite() {
+            a_beta2 as f32
+        } else {
+            0.0
+        },
         a_theta1: coefficients.a_theta1 as f32,
         a_theta2: coefficients.a_theta2 as f32,
         a_theta3: coefficients.a_theta3 as f32,
@@ -445,23 +456,15 @@ fn design_loops(
         20.0,
     ));
 
-    // --- Sideslip (where there is a sideslip model; the on-board design has none).
-    let wn_beta = wn_phi / decimal(inputs.sideslip_separation);
-    let sideslip = a_beta1.is_finite() && a_beta2.is_finite();
-    let (slip_kp, slip_ki) = if sideslip {
-        (
-            (2.0 * z * wn_beta - a_beta1) / a_beta2,
-            wn_beta * wn_beta / a_beta2,
-        )
-    } else {
-        (f64::from(d.lateral.slip_kp), f64::from(d.lateral.slip_ki))
-    };
+    // --- Sideslip (where there is a sideslip model): the on-board design's.
+    let sideslip = model.has_sideslip();
+    let (slip_kp, slip_ki, _, wn_beta) = pid(&onboard.sideslip);
     if sideslip {
         let slip_plant = tf(&[a_beta2], &[1.0, a_beta1]);
         let slip_loop = tf(&[slip_kp, slip_ki], &[1.0, 0.0]).series(&slip_plant);
         loops.push(predict(
             "sideslip (rudder)",
-            None,
+            Some(Loop::Sideslip),
             vec![
                 gain("SLIP_KP", slip_kp, d.lateral.slip_kp),
                 gain("SLIP_KI", slip_ki, d.lateral.slip_ki),
@@ -577,11 +580,9 @@ fn design_loops(
         40.0,
     ));
 
-    // The on-board design's set (the base's with its loops' gains), with the sideslip loop
-    // and the trims where this design has them.
+    // The on-board design's set (the base's with its loops' gains), with the trims where this
+    // design has them.
     let mut gains = designed.gains;
-    gains.lateral.slip_kp = slip_kp as f32;
-    gains.lateral.slip_ki = slip_ki as f32;
     if let Some(trim) = trim {
         gains.lateral.trim_aileron = trim.aileron as f32;
         gains.lateral.trim_rudder = trim.rudder as f32;
