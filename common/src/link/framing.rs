@@ -207,14 +207,26 @@ impl<D: Dialect> FrameParser<D> {
     }
 
     /// As [`FrameParser::push`], and calls `on_undecoded` for every frame whose checksum
-    /// matched but whose payload did not decode. Not inlined: the framing stays a function
-    /// of its own in the MCU image's profile (one call per chunk of bytes).
-    #[inline(never)]
+    /// matched but whose payload did not decode.
     pub fn push_with(
         &mut self,
         bytes: &[u8],
         mut on_frame: impl FnMut(Frame),
         mut on_undecoded: impl FnMut(Undecoded<'_>),
+    ) {
+        self.push_dyn(bytes, &mut on_frame, &mut on_undecoded);
+    }
+
+    /// [`FrameParser::push_with`] with its callbacks called through their vtables: one copy
+    /// of the framing for all its callers (the MCU image's two links had a copy each, with
+    /// their handlers inlined into it, 1.5 KB), and a function of its own in the image's
+    /// profile (one call per chunk of bytes).
+    #[inline(never)]
+    fn push_dyn(
+        &mut self,
+        bytes: &[u8],
+        on_frame: &mut dyn FnMut(Frame),
+        on_undecoded: &mut dyn FnMut(Undecoded<'_>),
     ) {
         let mut rest = bytes;
         while let Some((&b, tail)) = rest.split_first() {
@@ -236,7 +248,7 @@ impl<D: Dialect> FrameParser<D> {
             }
             self.len = self.len.saturating_add(kept);
             rest = after;
-            self.drain(&mut on_frame, &mut on_undecoded);
+            self.drain(on_frame, on_undecoded);
         }
     }
 
@@ -254,6 +266,16 @@ impl<D: Dialect> FrameParser<D> {
         on_frame: &mut impl FnMut(Frame),
         on_undecoded: &mut impl FnMut(Undecoded<'_>),
     ) {
+        self.end_of_datagram_dyn(on_frame, on_undecoded);
+    }
+
+    /// [`FrameParser::end_of_datagram_with`] through the callbacks' vtables, as
+    /// [`FrameParser::push_dyn`].
+    fn end_of_datagram_dyn(
+        &mut self,
+        on_frame: &mut dyn FnMut(Frame),
+        on_undecoded: &mut dyn FnMut(Undecoded<'_>),
+    ) {
         while self.len > 0 {
             self.stats.cut_short = self.stats.cut_short.wrapping_add(1);
             self.resync();
@@ -264,8 +286,8 @@ impl<D: Dialect> FrameParser<D> {
     /// Checks the buffer until it needs more bytes.
     fn drain(
         &mut self,
-        on_frame: &mut impl FnMut(Frame),
-        on_undecoded: &mut impl FnMut(Undecoded<'_>),
+        on_frame: &mut dyn FnMut(Frame),
+        on_undecoded: &mut dyn FnMut(Undecoded<'_>),
     ) {
         loop {
             match self.check() {

@@ -154,6 +154,9 @@ impl<T: RealField + Copy> AirData<T> {
 }
 
 /// Wraps an angle into (-pi, pi].
+// Not inlined: its remainder and two compares were copied into some twenty callers (1 KB of
+// the MCU image).
+#[inline(never)]
 pub fn wrap_pi<T: RealField + Copy>(angle: T) -> T {
     let two_pi = T::two_pi();
     let mut a = angle % two_pi;
