@@ -145,7 +145,13 @@ pub struct Tick {
 /// Where the level flight it started from is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Start {
+    /// Where it started: the height lost is counted from here.
     alt_m: f32,
+    /// The height each level stage holds: where the stage began. The stages before leave the
+    /// aircraft some metres off (the Aerosonde's throttle steps, 11 m low), and climbing back
+    /// to the start took the Aerosonde's altitude loop to 17 deg of pitch, beyond the pitch
+    /// change that aborts it.
+    hold_alt_m: f32,
     airspeed: f32,
     /// Pitch, throttle and rudder of level flight: followed (slowly) in the level stages.
     pitch: f32,
@@ -193,6 +199,11 @@ const FITTED: [Axis; 5] = [
 /// loop's oscillation, shorter than a level stage.
 const LEVEL_TC_S: f32 = 1.0;
 
+/// Height from the one it holds within which a level stage's flight is level, m: outside it
+/// the altitude loop is climbing or diving back to it, and its pitch and throttle are not the
+/// level flight's.
+const LEVEL_BAND_M: f32 = 2.0;
+
 /// The autotune.
 #[derive(Clone, Debug)]
 pub struct Autotune {
@@ -220,6 +231,7 @@ impl Autotune {
             status: Status::Idle,
             start: Start {
                 alt_m: 0.0,
+                hold_alt_m: 0.0,
                 airspeed: 0.0,
                 pitch: 0.0,
                 throttle: 0.0,
@@ -254,6 +266,7 @@ impl Autotune {
         });
         self.start = Start {
             alt_m: e.alt_amsl_m,
+            hold_alt_m: e.alt_amsl_m,
             airspeed,
             pitch: e.euler.theta,
             throttle: s.throttle,
@@ -390,7 +403,7 @@ impl Autotune {
             roll: RollMode::Roll(0.0),
             yaw: RUDDER,
             lon: LonMode::Altitude {
-                altitude: self.start.alt_m,
+                altitude: self.start.hold_alt_m,
                 airspeed: self.start.airspeed,
             },
         }
@@ -414,6 +427,9 @@ impl Autotune {
         };
         let report = if self.stage != Some(stage) {
             self.stage = Some(stage);
+            if stage == Stage::Level && e.alt_amsl_m.is_finite() {
+                self.start.hold_alt_m = e.alt_amsl_m;
+            }
             Some(if t_s == 0.0 {
                 Report::Started
             } else {
@@ -452,7 +468,12 @@ impl Autotune {
         let commands = match stage {
             Stage::Level => {
                 // The level pitch and throttle, averaged, for the pitch-attitude stages.
-                let k = (dt / LEVEL_TC_S).clamp(0.0, 1.0);
+                let level = libm::fabsf(e.alt_amsl_m - self.start.hold_alt_m) < LEVEL_BAND_M;
+                let k = if level {
+                    (dt / LEVEL_TC_S).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 if e.euler.theta.is_finite() && s.throttle.is_finite() && s.rudder.is_finite() {
                     self.start.pitch += k * (e.euler.theta - self.start.pitch);
                     self.start.throttle += k * (s.throttle - self.start.throttle);
