@@ -48,7 +48,12 @@ fn write_metadata(out: &std::path::Path) {
          \"firmwareVersion\":\"{version}\",\"metadataTypes\":[{{\"type\":1,\
          \"uri\":\"mftp://{PARAMETERS}\",\"fileCrc\":{crc}}}]}}",
         vendor = env!("CARGO_PKG_NAME"),
-        model = "Ultra Stick 25e",
+        // The firmware's build, not an airframe: the aircraft is what its parameters make it.
+        model = if env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("none") {
+            "STM32F405"
+        } else {
+            "SITL"
+        },
         version = env!("CARGO_PKG_VERSION"),
         crc = file_crc(&xz),
     );
