@@ -372,8 +372,9 @@ pub(crate) struct FlyArgs {
     pub(crate) json: bool,
     /// Fly Stabilized from the hand launch as a pilot flies for identification, instead of the
     /// thesis's script: the simulator's radio (RC_CHANNELS) flies 3-2-1-1 doublets in roll,
-    /// then in pitch, three times each, then throttle steps, at the aircraft's level-trim
-    /// throttle; `sim-host identify OUT/simlink.tlog` fits the models (docs/AUTOTUNE.md).
+    /// then in pitch, three times each, then throttle steps, then doublets in yaw, at the
+    /// aircraft's level-trim throttle; `sim-host identify OUT/simlink.tlog` fits the models
+    /// (docs/AUTOTUNE.md).
     #[arg(long, conflicts_with = "mission")]
     pub(crate) stick_doublets: bool,
     /// Autotune in the air first, as QGroundControl's autotune button does

@@ -321,6 +321,9 @@ pub enum YawMode {
     Off,
     /// Yaw damper only.
     Damper,
+    /// Yaw damper with this rudder added to it, rad (UMN sign): a pilot's yaw stick in
+    /// Stabilized, as PX4's Stabilized passes the yaw stick to the rudder.
+    DamperPlus(f32),
     /// Hold this sideslip angle, rad (normally 0), with the yaw damper.
     Sideslip(f32),
     /// The rudder at this deflection, rad (UMN sign, limited to the rudder limit): ground
@@ -617,6 +620,7 @@ impl Lateral {
                 return false;
             }
             YawMode::Damper => (YawKind::Damper, 0.0),
+            YawMode::DamperPlus(_) => (YawKind::Damper, 0.0),
             YawMode::Sideslip(b) => (YawKind::Sideslip, b),
             YawMode::Rudder(d) => {
                 if !d.is_finite() {
@@ -639,7 +643,14 @@ impl Lateral {
             InputFlags::SIDESLIP,
             kind == YawKind::Sideslip && !m.sideslip.is_finite(),
         );
-        bad.set(InputFlags::COMMAND, !beta_c.is_finite());
+        let added = match mode {
+            YawMode::DamperPlus(d) => d,
+            _ => 0.0,
+        };
+        bad.set(
+            InputFlags::COMMAND,
+            !beta_c.is_finite() || !added.is_finite(),
+        );
         bad.set(InputFlags::DT, !dt_ok(dt));
         if !bad.is_empty() {
             *rejected |= bad;
@@ -671,7 +682,7 @@ impl Lateral {
         };
         self.rudder = self
             .slip
-            .step(k * e, Derivative::None, g.trim_rudder + damper, dt);
+            .step(k * e, Derivative::None, g.trim_rudder + damper + added, dt);
         self.yaw_kind = kind;
         self.yaw_resume = false;
         false
@@ -785,6 +796,29 @@ mod tests {
         lat.step(&m, RollMode::Course(0.0), YawMode::Off, DT);
         let o = lat.step(&m, RollMode::Course(5.0 * D), YawMode::Off, DT);
         assert!(o.roll_cmd > 0.0 && o.aileron < 0.0, "{o:?}");
+    }
+
+    /// A pilot's yaw stick in Stabilized: its rudder is added to the damper's, to the
+    /// radian, within the rudder's limit; a stick that is not a number is refused and the
+    /// last rudder kept.
+    #[test]
+    fn the_yaw_stick_s_rudder_adds_to_the_damper_s_within_the_limit_and_a_nan_keeps_the_last() {
+        let g = zero_trim();
+        let mut lat = Lateral::new(&g, 1.0);
+        let m = Measurements {
+            yaw_rate: 0.2,
+            ..Measurements::level(17.0, 100.0)
+        };
+        lat.step(&m, RollMode::Off, YawMode::Damper, DT);
+        let damped = lat.step(&m, RollMode::Off, YawMode::Damper, DT).rudder;
+        let o = lat.step(&m, RollMode::Off, YawMode::DamperPlus(-0.1), DT);
+        assert!((o.rudder - (damped - 0.1)).abs() < 1e-6, "{o:?} {damped}");
+        let o = lat.step(&m, RollMode::Off, YawMode::DamperPlus(-1.0), DT);
+        assert!((o.rudder + g.rudder_max).abs() < 1e-6, "{o:?}");
+        let held = o.rudder;
+        let o = lat.step(&m, RollMode::Off, YawMode::DamperPlus(f32::NAN), DT);
+        assert_eq!(o.rudder, held);
+        assert!(o.rejected.contains(InputFlags::COMMAND), "{o:?}");
     }
 
     #[test]

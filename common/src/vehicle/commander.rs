@@ -23,7 +23,7 @@ use super::snapshot::{LandedState, MissionRunState};
 use crate::actuators::Surfaces;
 use crate::battery::Warning;
 use crate::control::autopilot::{Commands, GainSet};
-use crate::control::lateral::{RollMode, RUDDER};
+use crate::control::lateral::{RollMode, YawMode, RUDDER};
 use crate::control::longitudinal::LonMode;
 use crate::estimator::{EstimatedState, Home};
 use crate::failsafe::{FailsafeConfig, FailsafeInputs, Failsafes, Reaction};
@@ -689,9 +689,13 @@ impl Commander {
         }
         let commands = match flown.commands() {
             Commanded::Attitude => Commands {
-                // Sticks command attitude within the loops' limits; centred: wings level.
+                // Sticks command attitude within the loops' limits; centred: wings level. The
+                // yaw stick moves the rudder over the damper (PX4's sense: right yaw, rudder
+                // right, which is negative here).
                 roll: RollMode::Roll(sticks.map_or(0.0, |s| s.roll * gains.lateral.roll_max)),
-                yaw: RUDDER,
+                yaw: sticks.map_or(RUDDER, |s| {
+                    YawMode::DamperPlus(-s.yaw * gains.lateral.rudder_max)
+                }),
                 lon: LonMode::Pitch {
                     pitch: sticks.map_or(0.0, |s| s.pitch * level.pitch_max),
                     throttle: sticks.map_or(level.trim_throttle, |s| s.throttle),

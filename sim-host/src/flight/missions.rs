@@ -376,7 +376,8 @@ fn three_two_one_one(from_s: f64, unit_s: f64, amp: f32) -> [(f64, f32); 5] {
 /// An identification flight as a pilot flies it with the simulator's radio (RC_CHANNELS):
 /// Stabilized from the hand launch at `throttle`, 3-2-1-1s of 0.3 stick on 0.3 s steps in
 /// roll, then in pitch, three times each, then full and idle power for 6 s each (the airspeed
-/// model's excitation), 95 s in all.
+/// model's excitation), then three 3-2-1-1s of 0.3 stick in yaw (the rudder over the yaw
+/// damper: the sideslip model's), 105 s in all.
 pub fn stick_doublets(throttle: f32) -> FlightConfig {
     let stick = |from_s, roll, pitch, throttle| RcSticks {
         from_s,
@@ -384,6 +385,10 @@ pub fn stick_doublets(throttle: f32) -> FlightConfig {
         pitch,
         throttle,
         yaw: 0.0,
+    };
+    let yaw = |from_s, yaw| RcSticks {
+        yaw,
+        ..stick(from_s, 0.0, 0.0, throttle)
     };
     let mut sticks = vec![stick(0.0, 0.0, 0.0, throttle)];
     for k in 0..3 {
@@ -398,8 +403,13 @@ pub fn stick_doublets(throttle: f32) -> FlightConfig {
     for (from_s, power) in [(72.0, 0.9), (78.0, 0.2), (84.0, throttle)] {
         sticks.push(stick(from_s, 0.0, 0.0, power));
     }
+    for t0 in [90.0, 95.0, 100.0] {
+        for (from_s, y) in three_two_one_one(t0, 0.3, 0.3) {
+            sticks.push(yaw(from_s, y));
+        }
+    }
     FlightConfig {
-        duration_s: 95.0,
+        duration_s: 105.0,
         script: Script {
             steps: vec![ScriptStep {
                 after_arm_s: 0.0,
