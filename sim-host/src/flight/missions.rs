@@ -427,7 +427,7 @@ pub fn stick_doublets(throttle: f32) -> FlightConfig {
 pub const AUTOTUNE_AT_S: f64 = 10.0;
 
 /// Time the autotune flight leaves the autotune before the thesis's script, s: its timeline
-/// (63 s), the fit and the design, and some level flight.
+/// (60 s), the fit and the design, and some level flight.
 pub const AUTOTUNE_FOR_S: f64 = 80.0;
 
 /// The gains the design sets, which the autotune flight's station reads before the autotune

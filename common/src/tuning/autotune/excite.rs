@@ -35,6 +35,15 @@ pub const PULSE_S: f32 = 0.3;
 /// A 3-2-1-1 lasts seven unit pulses; two seconds of level flight follow each.
 const SEQUENCE_S: f32 = 7.0 * PULSE_S + 2.0;
 
+/// Width of the rudder's 3-2-1-1 unit pulse, s: half the attitude stages'. The rudder yaws
+/// the aircraft for as long as it is held, and its three-unit pulse at 0.3 s (0.9 s) of 10 deg
+/// swung the 25e 30-40 deg off its heading and, in light turbulence, slowed it to 13 m/s;
+/// the side force it is fitted on answers the rudder at once.
+pub const YAW_PULSE_S: f32 = 0.5 * PULSE_S;
+
+/// A rudder 3-2-1-1 and the level flight after it.
+const YAW_SEQUENCE_S: f32 = 7.0 * YAW_PULSE_S + 2.0;
+
 /// Sequences flown per axis.
 const SEQUENCES: f32 = 3.0;
 
@@ -52,7 +61,7 @@ pub const TIMELINE: [(Stage, f32); 9] = [
     (Stage::Level, 3.0),
     (Stage::Throttle, 3.0 * THROTTLE_STEP_S),
     (Stage::Level, 3.0),
-    (Stage::Yaw, SEQUENCES * SEQUENCE_S),
+    (Stage::Yaw, SEQUENCES * YAW_SEQUENCE_S),
     (Stage::Level, 2.0),
 ];
 
@@ -74,9 +83,9 @@ pub fn at(t_s: f32) -> Option<(Stage, f32, f32)> {
     None
 }
 
-/// A 3-2-1-1 of unit height, `t_s` into it (0 after its end).
-fn sequence(t_s: f32) -> f32 {
-    let k = t_s / PULSE_S;
+/// A 3-2-1-1 of unit height on pulses of `pulse_s`, `t_s` into it (0 after its end).
+fn sequence(t_s: f32, pulse_s: f32) -> f32 {
+    let k = t_s / pulse_s;
     if k < 0.0 {
         0.0
     } else if k < 3.0 {
@@ -92,15 +101,25 @@ fn sequence(t_s: f32) -> f32 {
     }
 }
 
-/// The roll, yaw or pitch stage's input, of unit height, `t_s` into the stage: three 3-2-1-1s, the
+/// The roll or pitch stage's input, of unit height, `t_s` into the stage: three 3-2-1-1s, the
 /// second mirrored.
 pub fn doublets(t_s: f32) -> f32 {
-    let n = libm::floorf(t_s / SEQUENCE_S);
+    sequences(t_s, PULSE_S, SEQUENCE_S)
+}
+
+/// The yaw stage's input: the same on [`YAW_PULSE_S`].
+pub fn yaw_doublets(t_s: f32) -> f32 {
+    sequences(t_s, YAW_PULSE_S, YAW_SEQUENCE_S)
+}
+
+/// Three 3-2-1-1s on pulses of `pulse_s`, one every `every_s`, the second mirrored.
+fn sequences(t_s: f32, pulse_s: f32, every_s: f32) -> f32 {
+    let n = libm::floorf(t_s / every_s);
     let sign = if n == 1.0 { -1.0 } else { 1.0 };
     if !(0.0..SEQUENCES).contains(&n) {
         return 0.0;
     }
-    sign * sequence(t_s - n * SEQUENCE_S)
+    sign * sequence(t_s - n * every_s, pulse_s)
 }
 
 /// The throttle stage's step, of unit height, `t_s` into the stage: up, down, then back.

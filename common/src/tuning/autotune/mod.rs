@@ -491,7 +491,7 @@ impl Autotune {
             Stage::Yaw => Commands {
                 yaw: YawMode::Rudder(
                     self.start.rudder
-                        + EXCITATION_SHARE * base.lateral.rudder_max * excite::doublets(into_s),
+                        + EXCITATION_SHARE * base.lateral.rudder_max * excite::yaw_doublets(into_s),
                 ),
                 ..self.level()
             },
