@@ -464,3 +464,32 @@ fn the_sideslip_model_gives_the_side_forces_coefficients_back_through_the_accele
     }
     assert!(f.r2 > 0.3 && f.r2 < 0.99, "{f:?}");
 }
+
+/// Rows given to the other models only leave the sideslip model without any (its rudder
+/// unexcited), and rows given to it only leave the roll model without any: each fits on the
+/// stages that are its own.
+#[test]
+fn a_model_whose_rows_are_off_takes_none_and_says_its_input_was_not_excited() {
+    let data = flown(SERVO_TAU, 30.0);
+    let mut others = Identifier::new(unfiltered(SERVO_TAU));
+    let mut sideslip = Identifier::new(unfiltered(SERVO_TAU));
+    others.take_rows(false, true);
+    sideslip.take_rows(true, false);
+    for s in &data[..1500] {
+        let s = Sample {
+            rudder: 0.05 * s.aileron.signum(),
+            ..*s
+        };
+        others.push(0.02, &s);
+        sideslip.push(0.02, &s);
+    }
+    assert!(others.fit(Axis::Roll).is_ok());
+    assert!(matches!(
+        others.fit(Axis::Sideslip),
+        Err(AxisError::NotExcited { sd, .. }) if sd == 0.0
+    ));
+    assert!(matches!(
+        sideslip.fit(Axis::Roll),
+        Err(AxisError::NotExcited { sd, .. }) if sd == 0.0
+    ));
+}

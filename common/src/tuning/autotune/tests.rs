@@ -241,3 +241,46 @@ fn a_model_whose_design_fails_its_margins_hands_over_no_gains() {
     }
     assert_eq!(a.status(), Status::Failed);
 }
+
+/// A stage that leaves the aircraft 11 m low (the Aerosonde's throttle steps): the level
+/// stages after it hold the height they found, not the start's, so no climb back (the
+/// Aerosonde's took 17 deg of pitch and aborted the autotune); the height lost is still
+/// counted from the start.
+#[test]
+fn a_level_stage_holds_the_height_it_began_at_and_the_height_lost_counts_from_the_start() {
+    let (mut a, s) = started();
+    let p = p();
+    let g = GainSet::default();
+    let mut t_s = 0.0;
+    let mut held_after = 0;
+    while t_s < excite::timeline_s() {
+        let stage = excite::at(t_s).map(|x| x.0);
+        let mut e = level();
+        // From the throttle steps on: 11 m low.
+        let past_throttle = TIMELINE
+            .iter()
+            .take_while(|(st, _)| *st != Stage::Throttle)
+            .map(|(_, d)| d)
+            .sum::<f32>();
+        if t_s >= past_throttle {
+            e.alt_amsl_m -= 11.0;
+        }
+        let t = a.step(DT, &e, &s, &calm(), &p, &g);
+        if let (Some(Stage::Level), Some(c)) = (stage, t.commands) {
+            if let LonMode::Altitude { altitude, .. } = c.lon {
+                let after = t_s >= past_throttle;
+                let want = if after { 349.0 } else { 360.0 };
+                assert!((altitude - want).abs() < 1e-3, "{altitude} at {t_s} s");
+                held_after += usize::from(after);
+            }
+        }
+        t_s += DT;
+    }
+    assert!(matches!(a.status(), Status::Running(_)), "not aborted");
+    assert!(held_after > 0);
+    // 11 m below the start with 30 allowed: no abort; 31 m would be one.
+    let mut low = level();
+    low.alt_amsl_m -= 31.0;
+    let t = a.step(DT, &low, &s, &calm(), &p, &g);
+    assert_eq!(t.report, Some(Report::Aborted(Abort::HeightLoss(31.0))));
+}
