@@ -610,7 +610,8 @@ impl Lateral {
         rejected: &mut InputFlags,
     ) -> bool {
         let g = &self.gains;
-        let (kind, beta_c) = match mode {
+        // The sideslip commanded, and the rudder a pilot adds over the damper.
+        let (kind, beta_c, added) = match mode {
             YawMode::Off => {
                 self.slip.reset();
                 self.washout.reset();
@@ -619,9 +620,9 @@ impl Lateral {
                 self.rudder = g.trim_rudder;
                 return false;
             }
-            YawMode::Damper => (YawKind::Damper, 0.0),
-            YawMode::DamperPlus(_) => (YawKind::Damper, 0.0),
-            YawMode::Sideslip(b) => (YawKind::Sideslip, b),
+            YawMode::Damper => (YawKind::Damper, 0.0, 0.0),
+            YawMode::DamperPlus(d) => (YawKind::Damper, 0.0, d),
+            YawMode::Sideslip(b) => (YawKind::Sideslip, b, 0.0),
             YawMode::Rudder(d) => {
                 if !d.is_finite() {
                     rejected.set(InputFlags::COMMAND, true);
@@ -643,10 +644,6 @@ impl Lateral {
             InputFlags::SIDESLIP,
             kind == YawKind::Sideslip && !m.sideslip.is_finite(),
         );
-        let added = match mode {
-            YawMode::DamperPlus(d) => d,
-            _ => 0.0,
-        };
         bad.set(
             InputFlags::COMMAND,
             !beta_c.is_finite() || !added.is_finite(),

@@ -501,8 +501,7 @@ fn runway_takeoff() {
         wp(0.0, 1500.0, 60.0),
     ];
     let mut nav = navigator();
-    let mut plane = on_the_runway_east();
-    plane.k.airspeed = 0.0;
+    let mut plane = at_rest_on_the_runway_east();
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 120.0, |o| {
         o.reached == Some(0)
@@ -555,9 +554,17 @@ fn runway_takeoff() {
     assert!(plane.k.airspeed >= vr);
 }
 
-/// A plane standing at home on the runway of [`takeoff_east`], nose east.
+/// A plane at home on the runway of [`takeoff_east`], nose east, with the flying plane's
+/// airspeed.
 fn on_the_runway_east() -> Plane {
     Plane::flying(0.0, 0.0, 0.0, 90f32.to_radians())
+}
+
+/// [`on_the_runway_east`] standing still: no air over it.
+fn at_rest_on_the_runway_east() -> Plane {
+    let mut plane = on_the_runway_east();
+    plane.k.airspeed = 0.0;
+    plane
 }
 
 /// The runway take-off of [`runway_takeoff`]: heading east from home, to 40 m.
@@ -591,8 +598,7 @@ fn step_plane(
 fn a_take_off_given_up_on_its_roll_rolls_out_wings_level_with_the_throttle_closed_to_a_stop() {
     let items = takeoff_east();
     let mut nav = navigator();
-    let mut plane = on_the_runway_east();
-    plane.k.airspeed = 0.0;
+    let mut plane = at_rest_on_the_runway_east();
     nav.start_mission(0);
     while plane.k.airspeed < 8.0 {
         let (out, stage) = step_plane(&mut nav, &mut plane, &items);
@@ -638,8 +644,7 @@ fn a_take_off_roll_swung_past_nav_tko_hdg_deg_off_its_line_is_given_up_with_the_
         .set(&mut p, "NAV_TKO_HDG_DEG", 60.0)
         .expect("in range");
     nav.set_params(&p);
-    let mut plane = on_the_runway_east();
-    plane.k.airspeed = 0.0;
+    let mut plane = at_rest_on_the_runway_east();
     nav.start_mission(0);
     for _ in 0..20 {
         assert_eq!(
@@ -668,8 +673,7 @@ fn by_default_a_take_off_roll_swung_120_deg_off_its_line_rolls_on() {
     let items = takeoff_east();
     let mut nav = navigator();
     assert_eq!(nav.params().takeoff_heading_max, 0.0);
-    let mut plane = on_the_runway_east();
-    plane.k.airspeed = 0.0;
+    let mut plane = at_rest_on_the_runway_east();
     nav.start_mission(0);
     step_plane(&mut nav, &mut plane, &items);
     plane.k.heading = (90.0 + 120.0f32).to_radians();
@@ -688,8 +692,7 @@ fn a_take_off_roll_swung_past_135_deg_closes_the_throttle_until_it_is_back_then_
     let mut nav = navigator();
     let ramp = nav.params().takeoff_ramp;
     assert_eq!(ramp, 2.0);
-    let mut plane = on_the_runway_east();
-    plane.k.airspeed = 0.0;
+    let mut plane = at_rest_on_the_runway_east();
     nav.start_mission(0);
     let throttle = |out: &NavOutput| match out.commands.map(|c| c.lon) {
         Some(LonMode::Pitch { throttle, .. }) => throttle,
@@ -781,8 +784,7 @@ fn past_the_rotation_a_take_off_goes_on_and_is_clear_for_a_failsafe_from_nav_tko
     let mut nav = navigator();
     let clear = nav.params().takeoff_clear;
     assert_eq!(clear, 10.0);
-    let mut plane = on_the_runway_east();
-    plane.k.airspeed = 0.0;
+    let mut plane = at_rest_on_the_runway_east();
     nav.start_mission(0);
     let mut seen = Vec::new();
     for _ in 0..2000 {

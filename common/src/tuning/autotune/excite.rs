@@ -32,8 +32,11 @@ pub enum Stage {
 /// Hz, around the roll and pitch loops' 1-3 Hz.
 pub const PULSE_S: f32 = 0.3;
 
-/// A 3-2-1-1 lasts seven unit pulses; two seconds of level flight follow each.
-const SEQUENCE_S: f32 = 7.0 * PULSE_S + 2.0;
+/// Level flight after each 3-2-1-1, s.
+const REST_S: f32 = 2.0;
+
+/// A 3-2-1-1 lasts seven unit pulses; [`REST_S`] of level flight follow each.
+const SEQUENCE_S: f32 = 7.0 * PULSE_S + REST_S;
 
 /// Width of the rudder's 3-2-1-1 unit pulse, s: half the attitude stages'. The rudder yaws
 /// the aircraft for as long as it is held, and its three-unit pulse at 0.3 s (0.9 s) of 10 deg
@@ -42,7 +45,7 @@ const SEQUENCE_S: f32 = 7.0 * PULSE_S + 2.0;
 pub const YAW_PULSE_S: f32 = 0.5 * PULSE_S;
 
 /// A rudder 3-2-1-1 and the level flight after it.
-const YAW_SEQUENCE_S: f32 = 7.0 * YAW_PULSE_S + 2.0;
+const YAW_SEQUENCE_S: f32 = 7.0 * YAW_PULSE_S + REST_S;
 
 /// Sequences flown per axis.
 const SEQUENCES: f32 = 3.0;

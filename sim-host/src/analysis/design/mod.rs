@@ -17,9 +17,10 @@
 //! short period `q / de` (with its free integrator to `theta`); from identified models, on the
 //! reduced short period `a_theta3 / (s^2 + a_theta1 s + a_theta2)`.
 //!
-//! The host alone designs the sideslip loop (PI on rudder), where there is a sideslip model
-//! (the aircraft file's): `wn_beta = wn_phi / 20`, `kp = (2 zeta wn - a_beta1) / a_beta2`,
-//! `ki = wn^2 / a_beta2`.
+//! The sideslip loop (PI on rudder) is the on-board design's too, where there is a sideslip
+//! model (the aircraft file's, or an identified one): `wn_beta = wn_phi / 20`, `kp = (2 zeta
+//! wn - a_beta1) / a_beta2` (0 where that is negative), `ki = wn^2 / a_beta2`; here it is
+//! predicted.
 
 pub mod inputs;
 pub mod loops;
@@ -457,9 +458,8 @@ fn design_loops(
     ));
 
     // --- Sideslip (where there is a sideslip model): the on-board design's.
-    let sideslip = model.has_sideslip();
-    let (slip_kp, slip_ki, _, wn_beta) = pid(&onboard.sideslip);
-    if sideslip {
+    if model.has_sideslip() {
+        let (slip_kp, slip_ki, _, wn_beta) = pid(&onboard.sideslip);
         let slip_plant = tf(&[a_beta2], &[1.0, a_beta1]);
         let slip_loop = tf(&[slip_kp, slip_ki], &[1.0, 0.0]).series(&slip_plant);
         loops.push(predict(
