@@ -125,7 +125,7 @@ impl Hagl {
         let usable = quality_ok
             && s.distance_m > s.min_m
             && s.distance_m < s.max_m
-            && cos_tilt >= libm::cosf(c.tilt_max)
+            && cos_tilt >= crate::math::elementary::cos(c.tilt_max)
             && height_m.is_finite();
         if !usable {
             // Not a measurement of the ground: the window starts again, so no median ever

@@ -306,13 +306,16 @@ impl Ins {
         earth_ned: &Vector3<f32>,
         bias_sigma: f32,
     ) -> bool {
-        let horizontal_earth = libm::hypotf(earth_ned.x, earth_ned.y);
+        let horizontal_earth = crate::math::elementary::hypot(earth_ned.x, earth_ned.y);
         if gravity.norm() < 0.5 * GRAVITY || mag.norm() < 1e-3 || horizontal_earth < 1e-3 {
             return false;
         }
         // In steady flight or at rest the accelerometer reads -g rotated into the body.
         let phi = libm::atan2f(-gravity.y, -gravity.z);
-        let theta = libm::atan2f(gravity.x, libm::hypotf(gravity.y, gravity.z));
+        let theta = libm::atan2f(
+            gravity.x,
+            crate::math::elementary::hypot(gravity.y, gravity.z),
+        );
         let Some(psi) = mag_heading(phi, theta, mag, earth_ned) else {
             return false;
         };
@@ -671,7 +674,7 @@ pub fn mag_heading(
 ) -> Option<f32> {
     let tilt = Euler::new(phi, theta, 0.0).to_quaternion();
     let m_level = tilt.transform_vector(mag);
-    if libm::hypotf(m_level.x, m_level.y) < 1e-4 {
+    if crate::math::elementary::hypot(m_level.x, m_level.y) < 1e-4 {
         return None;
     }
     let psi = libm::atan2f(earth_ned.y, earth_ned.x) - libm::atan2f(m_level.y, m_level.x);

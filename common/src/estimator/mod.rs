@@ -35,7 +35,7 @@ pub use origin::Home;
 
 use crate::math::atmosphere::pressure_altitude;
 use crate::math::frames::{course_and_speed, AirData, Euler};
-use crate::math::geodetic::{offset_point, GeoPoint};
+use crate::math::geodetic::{flight_offset_point, GeoPoint};
 use crate::sensors::{BaroSample, GpsFix, ImuSample, MagSample, PitotSample, RangeSample};
 use air::{air_density, true_airspeed, AirspeedFilter, WindFilter, WindNoise};
 use ins::{Fusion, GpsNoise, Ins, Motion, ProcessNoise};
@@ -281,7 +281,11 @@ impl Estimator {
         } else if self.health.pitot.healthy {
             let va = self.airspeed.value();
             let a = self.alpha_memory;
-            Vector3::new(va * libm::cosf(a), 0.0, va * libm::sinf(a))
+            Vector3::new(
+                va * crate::math::elementary::cos(a),
+                0.0,
+                va * crate::math::elementary::sin(a),
+            )
         } else {
             Vector3::zeros()
         }
@@ -473,7 +477,11 @@ impl Estimator {
             // GPS lost: the air-data velocity (last angle of attack, frozen wind) keeps the
             // horizontal velocity, and so the position drift, bounded.
             let a = self.alpha_memory;
-            let body = Vector3::new(va * libm::cosf(a), 0.0, va * libm::sinf(a));
+            let body = Vector3::new(
+                va * crate::math::elementary::cos(a),
+                0.0,
+                va * crate::math::elementary::sin(a),
+            );
             let v = q.transform_vector(&body) + self.wind.wind();
             self.ins
                 .fuse_horizontal_velocity(self.t_us, v.x, v.y, c.dead_reckon_vel_noise);
@@ -704,7 +712,10 @@ impl Estimator {
         let (position, alt_amsl_m) = match home {
             Some(h) => match self.origin.frame_about(h.point) {
                 Some(f) => (f.offset_point(pos.x, pos.y), h.alt_amsl_m - pos.z),
-                None => (offset_point(h.point, pos.x, pos.y), h.alt_amsl_m - pos.z),
+                None => (
+                    flight_offset_point(h.point, pos.x, pos.y),
+                    h.alt_amsl_m - pos.z,
+                ),
             },
             None => (GeoPoint::default(), self.baro_alt.unwrap_or(0.0)),
         };

@@ -4,7 +4,7 @@
 //! was set.
 
 use super::ins::Ins;
-use crate::math::geodetic::{ned_offset, GeoPoint, LocalFrame};
+use crate::math::geodetic::{flight_ned_offset, GeoPoint, LocalFrame};
 use crate::sensors::limits;
 use nalgebra::Vector3;
 
@@ -78,7 +78,7 @@ impl Origin {
         // The origin and the altitude it is fused at move together, so the barometer's
         // offset, and with it the height above home, carry on from where they were.
         let up = home.alt_amsl_m - reported;
-        let (n, e): (f32, f32) = ned_offset(home.point, old.point);
+        let (n, e) = flight_ned_offset(home.point, old.point);
         ins.shift_origin(&Vector3::new(n, e, up));
         self.home = Some(Home {
             point: home.point,
@@ -99,7 +99,7 @@ impl Origin {
     pub fn ned_of(&self, origin: GeoPoint, p: GeoPoint) -> (f32, f32) {
         match self.frame.filter(|f| f.origin() == origin) {
             Some(f) => f.ned_offset(p),
-            None => ned_offset(origin, p),
+            None => flight_ned_offset(origin, p),
         }
     }
 

@@ -5,7 +5,7 @@ extern crate std;
 use super::truth::{Segment, SensorSim, Trajectory, Truth};
 use super::*;
 use crate::math::frames::wrap_pi;
-use crate::math::geodetic::ned_offset;
+use crate::math::geodetic::{ned_offset, offset_point};
 use std::println;
 
 const DT: f64 = 0.02;

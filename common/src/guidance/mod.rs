@@ -188,7 +188,7 @@ impl Path {
     /// less than 1 cm apart horizontally (no direction to follow).
     pub fn line_between(from: &Vector3<f32>, to: &Vector3<f32>, airspeed: f32) -> Option<Self> {
         let d = to - from;
-        let h = libm::hypotf(d.x, d.y);
+        let h = crate::math::elementary::hypot(d.x, d.y);
         if h.is_nan() || h <= 0.01 {
             return None;
         }
@@ -253,13 +253,13 @@ impl Guidance {
                 direction: q,
                 airspeed,
             } => {
-                let qh = libm::hypotf(q.x, q.y);
+                let qh = crate::math::elementary::hypot(q.x, q.y);
                 let chi_q = if qh > 1e-6 {
                     libm::atan2f(q.y, q.x)
                 } else {
                     0.0
                 };
-                let (s, c) = libm::sincosf(chi_q);
+                let (s, c) = crate::math::elementary::sin_cos(chi_q);
                 let e = pos - origin;
                 let e_py = -s * e.x + c * e.y;
                 let along = (c * e.x + s * e.y).max(0.0);
@@ -282,7 +282,7 @@ impl Guidance {
             } => {
                 let rho = radius.max(1.0);
                 let (dn, de) = (pos.x - center.x, pos.y - center.y);
-                let d = libm::hypotf(dn, de);
+                let d = crate::math::elementary::hypot(dn, de);
                 let phi = libm::atan2f(de, dn);
                 let lambda = direction.lambda();
                 let lead = if ground_speed.is_finite() {

@@ -3,6 +3,7 @@
 //! The plant takes air density from it and the barometer model its static pressure; the
 //! estimator inverts it to turn pressure into altitude. One set of constants serves all three.
 
+use super::elementary::Elementary;
 use nalgebra::RealField;
 
 /// Sea-level standard pressure, Pa.
@@ -34,11 +35,11 @@ pub struct AirState<T> {
 }
 
 /// The standard atmosphere at `alt_m` above mean sea level, clamped to 0..11 km.
-pub fn standard_atmosphere<T: RealField + Copy>(alt_m: T) -> AirState<T> {
+pub fn standard_atmosphere<T: Elementary>(alt_m: T) -> AirState<T> {
     let h = alt_m.clamp(c(-500.0), c(TROPOPAUSE_M));
     let temperature_k = c::<T>(T0_K) - c::<T>(LAPSE_K_PER_M) * h;
     let exponent = c::<T>(G0 / (R_AIR * LAPSE_K_PER_M));
-    let pressure_pa = c::<T>(P0_PA) * (temperature_k / c(T0_K)).powf(exponent);
+    let pressure_pa = c::<T>(P0_PA) * (temperature_k / c(T0_K)).powf_el(exponent);
     AirState {
         temperature_k,
         pressure_pa,
@@ -48,12 +49,12 @@ pub fn standard_atmosphere<T: RealField + Copy>(alt_m: T) -> AirState<T> {
 
 /// Pressure altitude (m above mean sea level) of a static pressure, the inverse of
 /// [`standard_atmosphere`]. Non-positive pressure returns `None`.
-pub fn pressure_altitude<T: RealField + Copy>(pressure_pa: T) -> Option<T> {
+pub fn pressure_altitude<T: Elementary>(pressure_pa: T) -> Option<T> {
     if pressure_pa <= T::zero() || !pressure_pa.is_finite() {
         return None;
     }
     let exponent = c::<T>(R_AIR * LAPSE_K_PER_M / G0);
-    let ratio = (pressure_pa / c(P0_PA)).powf(exponent);
+    let ratio = (pressure_pa / c(P0_PA)).powf_el(exponent);
     Some(c::<T>(T0_K / LAPSE_K_PER_M) * (T::one() - ratio))
 }
 

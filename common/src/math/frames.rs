@@ -1,6 +1,7 @@
 //! Rotations between the NED, body and wind frames, air-data angles and Euler kinematics.
 
-use nalgebra::{Matrix3, RealField, UnitQuaternion, Vector3};
+use super::elementary::Elementary;
+use nalgebra::{Matrix3, Quaternion, RealField, UnitQuaternion, Vector3};
 
 /// 3-2-1 Euler angles in radians: roll `phi`, pitch `theta`, yaw `psi`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -14,7 +15,7 @@ pub struct Euler<T> {
     pub psi: T,
 }
 
-impl<T: RealField + Copy> Euler<T> {
+impl<T: Elementary> Euler<T> {
     /// Builds the angles from roll, pitch and yaw.
     pub fn new(phi: T, theta: T, psi: T) -> Self {
         Self { phi, theta, psi }
@@ -22,8 +23,19 @@ impl<T: RealField + Copy> Euler<T> {
 
     /// The unit quaternion that rotates body vectors into NED.
     pub fn to_quaternion(self) -> UnitQuaternion<T> {
-        // nalgebra composes Rz(yaw) * Ry(pitch) * Rx(roll): exactly the 3-2-1 sequence.
-        UnitQuaternion::from_euler_angles(self.phi, self.theta, self.psi)
+        // Rz(yaw) * Ry(pitch) * Rx(roll), the 3-2-1 sequence, as nalgebra's
+        // `from_euler_angles` composes it (term for term, so the plant's `f64` is unchanged),
+        // with the half angles' sines and cosines of `Elementary`.
+        let half = T::one() / (T::one() + T::one());
+        let (sr, cr) = (self.phi * half).sin_cos_el();
+        let (sp, cp) = (self.theta * half).sin_cos_el();
+        let (sy, cy) = (self.psi * half).sin_cos_el();
+        UnitQuaternion::new_unchecked(Quaternion::new(
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        ))
     }
 
     /// The angles of a body-to-NED quaternion (pitch in [-pi/2, pi/2], roll and yaw in (-pi, pi]).
@@ -32,27 +44,28 @@ impl<T: RealField + Copy> Euler<T> {
     /// cosine of the pitch: the same angles while that cosine is positive, for a cosine and
     /// four divisions (on the MCU, f32 `cosf` runs a software f64 kernel: about 1,100
     /// instructions a call). They are taken from the matrix directly; the poles (where the
-    /// 3-2-1 sequence is singular) stay nalgebra's.
+    /// 3-2-1 sequence is singular) are nalgebra's: yaw zero, roll from the first row.
     pub fn from_quaternion(q: &UnitQuaternion<T>) -> Self {
         let r = q.to_rotation_matrix();
         let m = r.matrix();
         if m.m31.abs() < T::one() {
             Self {
                 phi: m.m32.atan2(m.m33),
-                theta: -m.m31.asin(),
+                theta: -m.m31.asin_el(),
                 psi: m.m21.atan2(m.m11),
             }
+        } else if m.m31 <= -T::one() {
+            Self::new(m.m12.atan2(m.m13), T::frac_pi_2(), T::zero())
         } else {
-            let (phi, theta, psi) = r.euler_angles();
-            Self { phi, theta, psi }
+            Self::new(-m.m12.atan2(-m.m13), -T::frac_pi_2(), T::zero())
         }
     }
 
     /// The direction cosine matrix that rotates body vectors into NED.
     pub fn body_to_ned(self) -> Matrix3<T> {
-        let (sf, cf) = self.phi.sin_cos();
-        let (st, ct) = self.theta.sin_cos();
-        let (sp, cp) = self.psi.sin_cos();
+        let (sf, cf) = self.phi.sin_cos_el();
+        let (st, ct) = self.theta.sin_cos_el();
+        let (sp, cp) = self.psi.sin_cos_el();
         Matrix3::new(
             ct * cp,
             sf * st * cp - cf * sp,
@@ -71,9 +84,9 @@ impl<T: RealField + Copy> Euler<T> {
     /// Singular at pitch +-90 deg, where the 3-2-1 sequence loses a degree of freedom; the plant
     /// integrates a quaternion for that reason and uses this only for reporting.
     pub fn rates_from_body(self, omega: &Vector3<T>) -> Vector3<T> {
-        let (sf, cf) = self.phi.sin_cos();
-        let tt = self.theta.tan();
-        let ct = self.theta.cos();
+        let (sf, cf) = self.phi.sin_cos_el();
+        let tt = self.theta.tan_el();
+        let ct = self.theta.sin_cos_el().1;
         let (p, q, r) = (omega.x, omega.y, omega.z);
         Vector3::new(
             p + (q * sf + r * cf) * tt,
@@ -97,9 +110,9 @@ pub fn ned_to_body<T: RealField + Copy>(q: &UnitQuaternion<T>, v_ned: &Vector3<T
 ///
 /// Wind axes: x along the air-relative velocity. Lift and drag are defined there, so the plant
 /// forms its aerodynamic force as `C_bw * q S [-CD, CY, -CL]`.
-pub fn wind_to_body<T: RealField + Copy>(alpha: T, beta: T) -> Matrix3<T> {
-    let (sa, ca) = alpha.sin_cos();
-    let (sb, cb) = beta.sin_cos();
+pub fn wind_to_body<T: Elementary>(alpha: T, beta: T) -> Matrix3<T> {
+    let (sa, ca) = alpha.sin_cos_el();
+    let (sb, cb) = beta.sin_cos_el();
     Matrix3::new(
         ca * cb,
         -ca * sb,
@@ -125,7 +138,7 @@ pub struct AirData<T> {
     pub beta: T,
 }
 
-impl<T: RealField + Copy> AirData<T> {
+impl<T: Elementary> AirData<T> {
     /// Air data of the body-frame velocity relative to the air mass.
     ///
     /// At zero airspeed the angles are zero rather than undefined.
@@ -143,7 +156,7 @@ impl<T: RealField + Copy> AirData<T> {
         Self {
             va,
             alpha,
-            beta: ratio.asin(),
+            beta: ratio.asin_el(),
         }
     }
 

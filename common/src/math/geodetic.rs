@@ -39,12 +39,12 @@ impl GeoPoint {
 
     /// Latitude in degrees.
     pub fn lat_deg(&self) -> f64 {
-        f64::from(self.lat_e7) / E7_PER_DEG
+        deg_of_e7(self.lat_e7)
     }
 
     /// Longitude in degrees.
     pub fn lon_deg(&self) -> f64 {
-        f64::from(self.lon_e7) / E7_PER_DEG
+        deg_of_e7(self.lon_e7)
     }
 
     /// True when latitude is within +-90 deg and longitude within +-180 deg.
@@ -53,17 +53,59 @@ impl GeoPoint {
     }
 }
 
+/// `e7 / 1e7`, rounded to the nearest `f64` (ties to even) as IEEE 754's division rounds it,
+/// in integers: the board's FPU has no `f64`, and a flight log's latitudes and longitudes are
+/// `f64` degrees (PX4's `vehicle_global_position`), which soft-float arithmetic would cost
+/// a kilobyte of flash for.
+pub fn deg_of_e7(e7: i32) -> f64 {
+    const D: u64 = 10_000_000;
+    let sign = u64::from(e7 < 0) << 63;
+    let x = u64::from(e7.unsigned_abs());
+    if x == 0 {
+        return f64::from_bits(sign);
+    }
+    // x scaled into [2^30, 2^31) (i32::MIN's 2^31 halves exactly), so that x / D lies in
+    // [107, 215) and floor(x 2^64 / D) has 71 or 72 bits: its top 53, a rounding bit and
+    // whether anything below is non-zero fix the result.
+    let up = 31 - i64::from(64 - x.leading_zeros());
+    let x = if up >= 0 { x << up } else { x >> 1 };
+    let q1 = (x << 32) / D;
+    let r1 = (x << 32) % D;
+    let q2 = (r1 << 32) / D;
+    let exact_below = (r1 << 32).is_multiple_of(D);
+    // floor(x 2^64 / D) >> 18, and the 18 bits shifted out.
+    let top = (q1 << 14) | (q2 >> 18);
+    let low = q2 & ((1 << 18) - 1);
+    let (mant, cut, round, rest_zero) = if top >> 53 != 0 {
+        (top >> 1, 19, top & 1 == 1, low == 0 && exact_below)
+    } else {
+        (
+            top,
+            18,
+            low >> 17 == 1,
+            low & ((1 << 17) - 1) == 0 && exact_below,
+        )
+    };
+    let mut mant = mant;
+    let mut exp = 1023 + 52 + cut - 64 - up;
+    if round && (!rest_zero || mant & 1 == 1) {
+        mant += 1;
+        if mant >> 53 != 0 {
+            mant >>= 1;
+            exp += 1;
+        }
+    }
+    f64::from_bits(sign | ((exp as u64) << 52) | (mant & ((1 << 52) - 1)))
+}
+
 fn round_e7(x: f64) -> i32 {
     let r = if x >= 0.0 { x + 0.5 } else { x - 0.5 };
     // Saturating cast: out-of-range input is caught by `is_valid`, never wrapped.
     r as i32
 }
 
-/// Sine and cosine of latitudes: on the MCU (and with `bounded-trig`) without `libm`'s
-/// reduction of large arguments ([`super::latitude`]).
-#[cfg(any(target_os = "none", feature = "bounded-trig"))]
-use super::latitude::{cos as lat_cos, sin as lat_sin};
-#[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
+// The `f64` conversions serve the plant and the host's tools; the board's flight code takes
+// [`LocalFrame`], in `f32`.
 use libm::{cos as lat_cos, sin as lat_sin};
 
 /// Meridian and prime-vertical radii of curvature (m) at a latitude.
@@ -141,6 +183,26 @@ pub fn offset_point<T: RealField + Copy>(origin: GeoPoint, north: T, east: T) ->
     }
 }
 
+/// North and east (m) of `p` from `origin` as the flight code takes them: on the board through
+/// a [`LocalFrame`] in `f32` (no software `f64`); on the host build the generic `f64`
+/// [`ned_offset`] unless `bounded-trig` (the two agree within 5 mm within 10 km of the origin:
+/// test below), as its flights and campaigns were computed.
+pub fn flight_ned_offset(origin: GeoPoint, p: GeoPoint) -> (f32, f32) {
+    #[cfg(any(target_os = "none", feature = "bounded-trig"))]
+    return LocalFrame::new(origin).ned_offset(p);
+    #[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
+    return ned_offset(origin, p);
+}
+
+/// The point `north`, `east` metres from `origin` as the flight code takes it (as
+/// [`flight_ned_offset`]: the board's [`LocalFrame`], the host's [`offset_point`]).
+pub fn flight_offset_point(origin: GeoPoint, north: f32, east: f32) -> GeoPoint {
+    #[cfg(any(target_os = "none", feature = "bounded-trig"))]
+    return LocalFrame::new(origin).offset_point(north, east);
+    #[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
+    return offset_point(origin, north, east);
+}
+
 /// Radians per 1e-7 degree.
 const RAD_PER_E7: f64 = core::f64::consts::PI / 180.0 / E7_PER_DEG;
 
@@ -161,8 +223,45 @@ pub struct LocalFrame {
 }
 
 impl LocalFrame {
-    /// The frame about `origin`.
+    /// The frame about `origin`: on the board [`Self::with_f32_radii`], on the host
+    /// [`Self::with_f64_radii`] (unless `bounded-trig`), which agree within millimetres.
     pub fn new(origin: GeoPoint) -> Self {
+        #[cfg(any(target_os = "none", feature = "bounded-trig"))]
+        return Self::with_f32_radii(origin);
+        #[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
+        return Self::with_f64_radii(origin);
+    }
+
+    /// The frame about `origin` with the radii and their first two derivatives in the
+    /// latitude worked out in `f32` (the meridian radius `M = a (1 - e^2) / W^3` with `W^2 =
+    /// 1 - e^2 sin^2`, so `M' = 3 e^2 M sin cos / W^2`; the parallel's radius `P = a cos / W`,
+    /// whose derivative is `-M sin`): the board's, which has no `f64` in hardware.
+    pub fn with_f32_radii(origin: GeoPoint) -> Self {
+        let lat0 = origin.lat_e7 as f32 * RAD_PER_E7 as f32;
+        let (s, c) = super::elementary::sin_cos(lat0);
+        let (a, e2) = (WGS84_A_M as f32, WGS84_E2 as f32);
+        let w2 = 1.0 - e2 * s * s;
+        let w = libm::sqrtf(w2);
+        let m = a * (1.0 - e2) / (w2 * w);
+        // M' = 3 e^2 M g with g = sin cos / W^2, g' = (cos^2 - sin^2) / W^2 + 2 e^2 g^2.
+        let g = s * c / w2;
+        let dm = 3.0 * e2 * m * g;
+        let dg = (c * c - s * s) / w2 + 2.0 * e2 * g * g;
+        let ddm = 3.0 * e2 * (dm * g + m * dg);
+        let p = a * c / w;
+        let dp = -m * s;
+        let ddp = -(dm * s + m * c);
+        Self {
+            origin,
+            m: [m, dm, 0.5 * ddm],
+            c: [p, dp, 0.5 * ddp],
+        }
+    }
+
+    /// The frame about `origin` with the radii's expansion from central differences of the
+    /// `f64` radii over 1 mrad (the third-order terms they leave are far below `f32`'s
+    /// resolution of the radii): the host build's, as its flights were first computed.
+    pub fn with_f64_radii(origin: GeoPoint) -> Self {
         let lat0 = f64::from(origin.lat_e7) * RAD_PER_E7;
         let h = 1e-3;
         let parallel = |lat: f64| {
@@ -170,8 +269,6 @@ impl LocalFrame {
             n * lat_cos(lat)
         };
         let meridian = |lat: f64| radii(lat).0;
-        // Central differences over 1 mrad: the third-order terms they leave are far below
-        // f32's resolution of the radii.
         let expand = |f: &dyn Fn(f64) -> f64| {
             let (lo, mid, hi) = (f(lat0 - h), f(lat0), f(lat0 + h));
             [
@@ -296,6 +393,35 @@ mod tests {
         .is_valid());
     }
 
+    /// Every 1e-7 degree from -180 to 180 deg in steps of 7,919 (a prime, so every last digit
+    /// is met), the ends and i32's extremes: bit for bit `f64`'s correctly rounded quotient.
+    #[test]
+    fn degrees_of_1e7_units_are_the_correctly_rounded_quotient_bit_for_bit() {
+        let check = |e7: i32| {
+            let want = f64::from(e7) / 1e7;
+            assert_eq!(deg_of_e7(e7).to_bits(), want.to_bits(), "{e7}: {want}");
+        };
+        let mut e7 = -1_800_000_000;
+        while e7 <= 1_800_000_000 {
+            check(e7);
+            e7 += 7_919;
+        }
+        for e7 in [
+            0,
+            1,
+            -1,
+            5,
+            10_000_000,
+            447_258_357,
+            -930_750_131,
+            i32::MAX,
+            i32::MIN,
+        ] {
+            check(e7);
+        }
+        assert!(deg_of_e7(0).to_bits() == 0 && deg_of_e7(-1) < 0.0);
+    }
+
     #[test]
     fn the_local_frame_agrees_with_the_generic_conversions_within_millimetres() {
         for (lat, lon) in [
@@ -305,29 +431,33 @@ mod tests {
             (80.0, 5.0),
         ] {
             let home = GeoPoint::from_deg(lat, lon);
-            let frame = LocalFrame::new(home);
-            for (n, e) in [
-                (1234.5_f64, -678.9_f64),
-                (-9000.0, 4000.0),
-                (7000.0, 7000.0),
-                (-300.0, -9900.0),
-                (0.0, 0.0),
+            for frame in [
+                LocalFrame::with_f32_radii(home),
+                LocalFrame::with_f64_radii(home),
             ] {
-                let p = offset_point(home, n, e);
-                let q = frame.offset_point(n as f32, e as f32);
-                // One 1e-7 deg step is ~1.1 cm: the points may differ by one rounding.
-                assert!(
-                    (p.lat_e7 - q.lat_e7).abs() <= 1 && (p.lon_e7 - q.lon_e7).abs() <= 1,
-                    "{lat} {n} {e}: {p:?} vs {q:?}"
-                );
-                let (gn, ge): (f64, f64) = ned_offset(home, p);
-                let (fn_, fe) = frame.ned_offset(p);
-                assert!(
-                    (f64::from(fn_) - gn).abs() < 5e-3 && (f64::from(fe) - ge).abs() < 5e-3,
-                    "{lat} {n} {e}: ({gn}, {ge}) vs ({fn_}, {fe})"
-                );
+                for (n, e) in [
+                    (1234.5_f64, -678.9_f64),
+                    (-9000.0, 4000.0),
+                    (7000.0, 7000.0),
+                    (-300.0, -9900.0),
+                    (0.0, 0.0),
+                ] {
+                    let p = offset_point(home, n, e);
+                    let q = frame.offset_point(n as f32, e as f32);
+                    // One 1e-7 deg step is ~1.1 cm: the points may differ by one rounding.
+                    assert!(
+                        (p.lat_e7 - q.lat_e7).abs() <= 1 && (p.lon_e7 - q.lon_e7).abs() <= 1,
+                        "{lat} {n} {e}: {p:?} vs {q:?}"
+                    );
+                    let (gn, ge): (f64, f64) = ned_offset(home, p);
+                    let (fn_, fe) = frame.ned_offset(p);
+                    assert!(
+                        (f64::from(fn_) - gn).abs() < 5e-3 && (f64::from(fe) - ge).abs() < 5e-3,
+                        "{lat} {n} {e}: ({gn}, {ge}) vs ({fn_}, {fe})"
+                    );
+                }
+                assert_eq!(frame.offset_point(f32::NAN, 1.0), home);
             }
-            assert_eq!(frame.offset_point(f32::NAN, 1.0), home);
         }
     }
 }

@@ -10,9 +10,9 @@
 //!   quaternion that rotates body vectors into NED.
 
 pub mod atmosphere;
+pub mod elementary;
 pub mod frames;
 pub mod geodetic;
-pub mod latitude;
 
 pub use frames::*;
 
@@ -51,11 +51,12 @@ const SERIES_MAX_ANGLE: f32 = 0.3;
 /// correction) are small: below 0.3 rad the half-angle's cosine and `sin(x)/x` are their
 /// Taylor series to the x^6 term, whose remainder (below 2e-11) lies far under `f32`'s
 /// resolution, in `f32` arithmetic; `libm`'s `sinf`/`cosf` evaluate in `f64`, which the
-/// Cortex-M4F does in software. Larger angles go to nalgebra.
+/// Cortex-M4F does in software. Larger angles take the half angle's sine and cosine
+/// ([`elementary`]; nalgebra's on the host).
 pub fn rotation_from_vector(v: &nalgebra::Vector3<f32>) -> nalgebra::UnitQuaternion<f32> {
     let theta2 = v.norm_squared();
     if theta2.is_nan() || theta2 >= SERIES_MAX_ANGLE * SERIES_MAX_ANGLE {
-        return nalgebra::UnitQuaternion::from_scaled_axis(*v);
+        return large_rotation(v, theta2);
     }
     // With h the half angle: cos h and sin(h) / (2 h), so the vector part is v sin(h) / theta.
     let h2 = 0.25 * theta2;
@@ -63,6 +64,22 @@ pub fn rotation_from_vector(v: &nalgebra::Vector3<f32>) -> nalgebra::UnitQuatern
     let sinc_half = 0.5 * (1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0)));
     let xyz = v * sinc_half;
     nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(cos_h, xyz.x, xyz.y, xyz.z))
+}
+
+/// The rotation by a rotation vector of squared length `theta2`, at least 0.3 rad long (or
+/// NaN), as nalgebra's `from_scaled_axis` builds it.
+#[cfg(any(target_os = "none", feature = "bounded-trig"))]
+fn large_rotation(v: &nalgebra::Vector3<f32>, theta2: f32) -> nalgebra::UnitQuaternion<f32> {
+    let theta = libm::sqrtf(theta2);
+    let (s, c) = elementary::sin_cos(0.5 * theta);
+    let k = s / theta;
+    nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(c, v.x * k, v.y * k, v.z * k))
+}
+
+/// The rotation by a rotation vector at least 0.3 rad long (or NaN): nalgebra's.
+#[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
+fn large_rotation(v: &nalgebra::Vector3<f32>, _theta2: f32) -> nalgebra::UnitQuaternion<f32> {
+    nalgebra::UnitQuaternion::from_scaled_axis(*v)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 use super::items::{FENCE_POLYGON_EXCLUSION, FENCE_POLYGON_INCLUSION};
 use super::plan::MissionItem;
 use crate::estimator::Home;
-use crate::math::geodetic::{ned_offset, GeoPoint};
+use crate::math::geodetic::{flight_ned_offset, GeoPoint};
 use crate::param;
 use crate::params::{independent, Group, ParamDef};
 use mavlink::dialects::common::{MavCmd, MavMissionResult};
@@ -112,7 +112,7 @@ fn zones(fence: &[MissionItem]) -> impl Iterator<Item = Result<Zone<'_>, usize>>
 }
 
 fn vertex(home: &Home, it: &MissionItem) -> (f32, f32) {
-    ned_offset(
+    flight_ned_offset(
         home.point,
         GeoPoint {
             lat_e7: it.x,
@@ -159,7 +159,10 @@ pub fn breached(
             Zone::Polygon(v, inc) => (inside_polygon(home, v, n, e), inc),
             Zone::Circle(c, inc) => {
                 let (cn, ce) = vertex(home, c);
-                (libm::hypotf(n - cn, e - ce) <= c.param(0), inc)
+                (
+                    crate::math::elementary::hypot(n - cn, e - ce) <= c.param(0),
+                    inc,
+                )
             }
         };
         if inclusion {

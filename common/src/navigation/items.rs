@@ -2,7 +2,7 @@
 
 use super::plan::MissionItem;
 use crate::estimator::Home;
-use crate::math::geodetic::{ned_offset, GeoPoint};
+use crate::math::geodetic::{flight_ned_offset, GeoPoint};
 use mavlink::dialects::common::{MavCmd, MavFrame};
 use nalgebra::Vector3;
 
@@ -153,7 +153,7 @@ impl Place {
     /// `here`'s when it gives none).
     pub fn ned(&self, home: &Home, here: &Vector3<f32>) -> Vector3<f32> {
         let (n, e) = match self.point {
-            Some(p) => ned_offset::<f32>(home.point, p),
+            Some(p) => flight_ned_offset(home.point, p),
             None => (here.x, here.y),
         };
         let h = self.height(home).unwrap_or(-here.z);

@@ -165,7 +165,7 @@ fn horizontal(v: &Vector3<f32>) -> Vector2<f32> {
 
 /// Unit vector and length of the horizontal part of `v`; `None` under 1 cm.
 fn unit(v: Vector2<f32>) -> Option<(Vector2<f32>, f32)> {
-    let n = libm::hypotf(v.x, v.y);
+    let n = crate::math::elementary::hypot(v.x, v.y);
     (n > 0.01).then(|| (v / n, n))
 }
 
@@ -216,8 +216,8 @@ impl PathManager {
     pub fn fillet_radius(&self, airspeed: f32, wind_speed: f32) -> f32 {
         let speed = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
         let over_ground = speed(airspeed) + speed(wind_speed);
-        let needed =
-            over_ground * over_ground / (crate::math::GRAVITY * libm::tanf(self.turn_bank));
+        let needed = over_ground * over_ground
+            / (crate::math::GRAVITY * crate::math::elementary::tan(self.turn_bank));
         self.turn_radius.max(needed.min(TURN_RADIUS_MAX))
     }
 
@@ -266,13 +266,13 @@ impl PathManager {
                 return None;
             }
             let half = 0.5 * rho;
-            let tan_half = libm::tanf(half);
+            let tan_half = crate::math::elementary::tan(half);
             let radius = self
                 .leg_radius
                 .min(0.5 * len_prev.min(len_next) * tan_half)
                 .max(0.01);
             let (dq, _) = unit(q_prev - q_next)?;
-            let center = w - radius / libm::sinf(half) * dq;
+            let center = w - radius / crate::math::elementary::sin(half) * dq;
             let cross = q_prev.x * q_next.y - q_prev.y * q_next.x;
             Some(Fillet {
                 z1: w - radius / tan_half * q_prev,
@@ -292,7 +292,8 @@ impl PathManager {
         });
 
         let Some(f) = fillet else {
-            let inside = libm::hypotf(p.x - w.x, p.y - w.y) <= to.accept_radius.max(0.0);
+            let inside =
+                crate::math::elementary::hypot(p.x - w.x, p.y - w.y) <= to.accept_radius.max(0.0);
             if inside || in_half_plane(p, w, q_prev) {
                 return Some(self.reached_step(to, next, pos));
             }

@@ -35,8 +35,8 @@ impl Kinematic {
     /// Velocity over ground, NED (horizontal).
     pub fn ground_velocity(&self) -> Vector3<f32> {
         Vector3::new(
-            self.airspeed * libm::cosf(self.heading),
-            self.airspeed * libm::sinf(self.heading),
+            self.airspeed * crate::math::elementary::cos(self.heading),
+            self.airspeed * crate::math::elementary::sin(self.heading),
             0.0,
         ) + self.wind
     }
@@ -48,7 +48,8 @@ impl Kinematic {
 
     /// Turns towards `course_cmd` and climbs or sinks towards `alt_cmd`.
     pub fn step(&mut self, course_cmd: f32, alt_cmd: f32, dt: f32) {
-        let max_rate = G * libm::tanf(45f32.to_radians()) / self.airspeed.max(1.0);
+        let max_rate =
+            G * crate::math::elementary::tan(45f32.to_radians()) / self.airspeed.max(1.0);
         let rate =
             (wrap_pi(course_cmd - self.course()) / self.tau_course).clamp(-max_rate, max_rate);
         self.heading = wrap_pi(self.heading + rate * dt);

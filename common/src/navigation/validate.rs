@@ -5,7 +5,7 @@ use super::items::{self, *};
 use super::navigator::params::NavParams;
 use super::plan::MissionItem;
 use crate::estimator::Home;
-use crate::math::geodetic::ned_offset;
+use crate::math::geodetic::flight_ned_offset;
 use crate::param;
 use crate::params::{Group, ParamDef};
 use mavlink::dialects::common::MavMissionResult;
@@ -183,9 +183,13 @@ pub fn validate_mission(
                 .filter(|p| p.command == NAV_WAYPOINT)
                 .and_then(|p| {
                     let (a, b) = (items::point(p)?, items::point(it)?);
-                    let (n, e): (f32, f32) = ned_offset(a, b);
+                    let (n, e) = flight_ned_offset(a, b);
                     let drop = items::height(p, &some_home)? - items::height(it, &some_home)?;
-                    Some(libm::hypotf(n, e) * libm::tanf(nav.glide_slope) < drop - nav.alt_accept)
+                    Some(
+                        crate::math::elementary::hypot(n, e)
+                            * crate::math::elementary::tan(nav.glide_slope)
+                            < drop - nav.alt_accept,
+                    )
                 });
             if short == Some(true) {
                 warn(ValidationWarning::ApproachTooShort { seq: s16 });

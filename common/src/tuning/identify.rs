@@ -541,7 +541,7 @@ impl Identifier {
         let vg = mid(|x| x.ground_speed);
         if vg > 1.0 && others {
             self.course.push(
-                &SVector::from([GRAVITY * libm::tanf(phi) / vg, 1.0]),
+                &SVector::from([GRAVITY * crate::math::elementary::tan(phi) / vg, 1.0]),
                 wrap_pi(s.course - a.course) / dt_s,
             );
         }
@@ -560,11 +560,11 @@ impl Identifier {
         let [gamma_a, gamma_b] = [&a, s].map(|x| x.climb_rate / x.airspeed.max(1.0));
         if va > 1.0 {
             let gamma = 0.5 * (gamma_a + gamma_b);
-            let lift = v2 * libm::cosf(phi);
+            let lift = v2 * crate::math::elementary::cos(phi);
             let (row, y) = self.path_filter.pass(
                 k,
                 SVector::from([lift * self.config.airspeed_ref * alpha, lift]),
-                va * (gamma_b - gamma_a) / dt_s + GRAVITY * libm::cosf(gamma),
+                va * (gamma_b - gamma_a) / dt_s + GRAVITY * crate::math::elementary::cos(gamma),
             );
             if others {
                 self.flight_path.push(&row, y);

@@ -193,7 +193,7 @@ fn rotate_in(r: &mut [f32], z: &mut [f32], x: &mut [f32], y: f32) -> f32 {
         if b == 0.0 {
             continue;
         }
-        let h = libm::hypotf(a, b);
+        let h = crate::math::elementary::hypot(a, b);
         let (c, s) = (a / h, b / h);
         if let Some(d) = r.get_mut(diag) {
             *d = h;

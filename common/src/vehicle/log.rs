@@ -12,12 +12,8 @@ use crate::math::atmosphere::pressure_altitude;
 use crate::math::geodetic::GeoPoint;
 use crate::sensors::SensorFrame;
 
-fn deg(e7: i32) -> f64 {
-    f64::from(e7) * 1e-7
-}
-
 fn lat_lon(p: GeoPoint) -> (f64, f64) {
-    (deg(p.lat_e7), deg(p.lon_e7))
+    (p.lat_deg(), p.lon_deg())
 }
 
 impl Vehicle {

@@ -186,7 +186,8 @@ pub fn turn_pitch_rate(roll: f32, airspeed: f32) -> f32 {
         return 0.0;
     }
     let phi = roll.clamp(-TURN_BANK_MAX, TURN_BANK_MAX);
-    crate::math::GRAVITY * libm::sinf(phi) * libm::tanf(phi) / airspeed
+    crate::math::GRAVITY * crate::math::elementary::sin(phi) * crate::math::elementary::tan(phi)
+        / airspeed
 }
 
 /// The largest bank a coordinated turn's pitch rate is reckoned at, rad (60 deg).
@@ -402,7 +403,7 @@ impl Longitudinal {
                 let ratio = climb_rate / airspeed;
                 if ratio.is_finite() {
                     pitch_ff = clamp(
-                        libm::asinf(ratio.clamp(-1.0, 1.0)),
+                        crate::math::elementary::asin(ratio.clamp(-1.0, 1.0)),
                         -g.pitch_max,
                         g.pitch_max,
                     );

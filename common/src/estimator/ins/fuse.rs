@@ -146,7 +146,7 @@ impl Ins {
             return out;
         }
         let m_ned = self.q.transform_vector(mag);
-        if libm::hypotf(m_ned.x, m_ned.y) < 1e-4 {
+        if crate::math::elementary::hypot(m_ned.x, m_ned.y) < 1e-4 {
             return out;
         }
         let innov = crate::math::wrap_pi(

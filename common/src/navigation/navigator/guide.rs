@@ -87,7 +87,7 @@ pub(super) fn course_near_runway(
 
 /// Distance between two points over the ground, m.
 pub(super) fn horizontal_dist(a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
-    libm::hypotf(a.x - b.x, a.y - b.y)
+    crate::math::elementary::hypot(a.x - b.x, a.y - b.y)
 }
 
 /// What a behaviour flies on in one step.

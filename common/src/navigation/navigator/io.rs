@@ -48,7 +48,7 @@ impl NavState {
             airspeed: s.airspeed,
             yaw_rate: s.body_rates.z,
             wind_speed: if s.wind_valid {
-                libm::hypotf(s.wind_ned.x, s.wind_ned.y)
+                crate::math::elementary::hypot(s.wind_ned.x, s.wind_ned.y)
             } else {
                 0.0
             },
@@ -64,7 +64,7 @@ impl NavState {
 
     /// Horizontal speed over ground, m/s.
     pub fn ground_speed(&self) -> f32 {
-        libm::hypotf(self.vel_ned.x, self.vel_ned.y)
+        crate::math::elementary::hypot(self.vel_ned.x, self.vel_ned.y)
     }
 }
 

@@ -178,7 +178,7 @@ pub(super) struct Landing {
 /// height `h_f` ([`flare_height`] at the slope's sink): height decays as `e^(-t/tau)` towards `-s_t tau` with `tau = h_f /
 /// (s_a - s_t)`, reaching the ground after `tau ln(s_a / s_t)`.
 fn flare_overrun(p: &NavParams, ground_speed: f32) -> f32 {
-    let tan_slope = libm::tanf(p.glide_slope);
+    let tan_slope = crate::math::elementary::tan(p.glide_slope);
     let s_a = ground_speed * tan_slope;
     let s_t = p.flare_sink;
     let h_f = flare_height(p, s_a);
@@ -256,7 +256,7 @@ impl Landing {
         let left = Vector3::new(d.y, -d.x, 0.0);
         let ground = -self.point.z;
         let height = (-self.origin.z).max(ground + GO_AROUND_MIN_M);
-        let tan_slope = libm::tanf(p.glide_slope).max(0.01);
+        let tan_slope = crate::math::elementary::tan(p.glide_slope).max(0.01);
         let turn = 2.0 * p.loiter_radius;
         let length =
             horizontal_dist(&self.origin, &self.point).max((height - ground) / tan_slope + turn);
@@ -395,7 +395,7 @@ impl Landing {
         };
         let to_go = signed_to_go.max(0.0);
         let start_h = -self.origin.z;
-        let tan_slope = libm::tanf(p.glide_slope);
+        let tan_slope = crate::math::elementary::tan(p.glide_slope);
         // The slope aims short of the point by as far as the flare carries past where the
         // slope meets the flare height, so that the wheels touch at the point.
         let along = if along_speed.is_finite() {

@@ -643,8 +643,9 @@ impl NavParams {
         if !(height.is_finite() && half_span > 0.0) {
             return None;
         }
-        let sin = 0.5 * (libm::sinf(self.tip_ground_bank) + height.max(0.0) / half_span);
-        (sin < 1.0).then(|| libm::asinf(sin))
+        let sin = 0.5
+            * (crate::math::elementary::sin(self.tip_ground_bank) + height.max(0.0) / half_span);
+        (sin < 1.0).then(|| crate::math::elementary::asin(sin))
     }
 }
 

@@ -102,10 +102,10 @@ impl Return {
                     // the aircraft is), starting where the glide slope meets the return
                     // altitude.
                     let course = runway.unwrap_or_else(|| libm::atan2f(-pos.y, -pos.x));
-                    let run = p.rtl_alt / libm::tanf(p.glide_slope);
+                    let run = p.rtl_alt / crate::math::elementary::tan(p.glide_slope);
                     let gate = Vector3::new(
-                        -libm::cosf(course) * run,
-                        -libm::sinf(course) * run,
+                        -crate::math::elementary::cos(course) * run,
+                        -crate::math::elementary::sin(course) * run,
                         -p.rtl_alt,
                     );
                     paths.reset();

@@ -173,7 +173,7 @@ impl Search {
 
     /// The gain or share `n` steps down.
     fn at(&self, n: u16) -> f32 {
-        self.x0 * libm::powf(GAIN_STEP, f32::from(n))
+        self.x0 * crate::math::elementary::powf(GAIN_STEP, f32::from(n))
     }
 }
 

@@ -128,7 +128,7 @@ impl Sweep {
             transfer,
             next: 0,
             w_next: W_MIN_RADPS,
-            ratio: libm::powf(10.0, 1.0 / f32::from(POINTS_PER_DECADE)),
+            ratio: crate::math::elementary::powf(10.0, 1.0 / f32::from(POINTS_PER_DECADE)),
             last: None,
             bracket: None,
             queued: None,
@@ -232,7 +232,7 @@ impl Sweep {
         } else {
             0.5
         };
-        let w = b.lo.w * libm::powf(b.hi.w / b.lo.w, t);
+        let w = b.lo.w * crate::math::elementary::powf(b.hi.w / b.lo.w, t);
         let at = |a: f32, b: f32| a + t * (b - a);
         let m = &mut self.margins;
         match b.crossing {
