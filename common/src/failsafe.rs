@@ -109,13 +109,13 @@ impl Default for FailsafeConfig {
 /// What the failsafes see at one tick.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FailsafeInputs {
-    /// Time, s (any monotonic clock).
-    pub t_s: f64,
+    /// Time, µs (any monotonic clock).
+    pub t_us: u64,
     /// Armed and off the ground: only then do failsafes change what the aircraft does.
     pub flying: bool,
-    /// When the ground station was last heard, s (`None`: never, then there is nothing to
+    /// When the ground station was last heard, µs (`None`: never, then there is nothing to
     /// lose).
-    pub gcs_heard_s: Option<f64>,
+    pub gcs_heard_us: Option<u64>,
     /// GPS healthy.
     pub gps_ok: bool,
     /// Airspeed sensor healthy.
@@ -247,7 +247,7 @@ pub type Events = heapless::Vec<Event, 5>;
 pub struct Failsafes {
     gcs_lost: bool,
     gcs_return: bool,
-    gps_lost_since: Option<f64>,
+    gps_lost_since_us: Option<u64>,
     gps_loiter: bool,
     airspeed_failed: bool,
     fence_breached: bool,
@@ -267,7 +267,7 @@ impl Failsafes {
     /// True while any failsafe is raised.
     pub fn active(&self) -> bool {
         self.gcs_lost
-            || self.gps_lost_since.is_some()
+            || self.gps_lost_since_us.is_some()
             || self.airspeed_failed
             || self.fence_breached
             || self.battery_level >= Warning::Critical
@@ -295,8 +295,8 @@ impl Failsafes {
             let _ = ev.push(e);
         };
         // Ground link.
-        let silent = match i.gcs_heard_s {
-            Some(t) => cfg.gcs_timeout_s > 0.0 && i.t_s - t > f64::from(cfg.gcs_timeout_s),
+        let silent = match i.gcs_heard_us {
+            Some(t) => cfg.gcs_timeout_s > 0.0 && seconds_since(i.t_us, t) > cfg.gcs_timeout_s,
             None => false,
         };
         if silent && !self.gcs_lost && i.flying {
@@ -308,19 +308,19 @@ impl Failsafes {
             push(Event::GcsRegained);
         }
         // GPS.
-        match (i.gps_ok, self.gps_lost_since) {
+        match (i.gps_ok, self.gps_lost_since_us) {
             (false, None) if i.flying => {
-                self.gps_lost_since = Some(i.t_s);
+                self.gps_lost_since_us = Some(i.t_us);
                 push(Event::GpsLost);
             }
             (false, Some(t0))
-                if !self.gps_loiter && i.t_s - t0 >= f64::from(cfg.gps_wings_level_s) =>
+                if !self.gps_loiter && seconds_since(i.t_us, t0) >= cfg.gps_wings_level_s =>
             {
                 self.gps_loiter = true;
                 push(Event::GpsLoiter);
             }
             (true, Some(_)) => {
-                self.gps_lost_since = None;
+                self.gps_lost_since_us = None;
                 self.gps_loiter = false;
                 push(Event::GpsRegained);
             }
@@ -359,7 +359,7 @@ impl Failsafes {
             self.battery_land |= act && level == Warning::Emergency;
         }
         // Without GPS there is no home to fly to: the GPS reaction comes first.
-        let reaction = if self.gps_lost_since.is_some() {
+        let reaction = if self.gps_lost_since_us.is_some() {
             if self.gps_loiter {
                 Reaction::Loiter
             } else {
@@ -376,15 +376,28 @@ impl Failsafes {
     }
 }
 
+/// Seconds from `then_us` to `now_us` (zero if the clock went back; past 71 minutes, 71
+/// minutes: longer than any failsafe waits), in the board's `f32` without software 64-bit
+/// arithmetic.
+fn seconds_since(now_us: u64, then_us: u64) -> f32 {
+    let us = u32::try_from(now_us.saturating_sub(then_us)).unwrap_or(u32::MAX);
+    us as f32 * 1e-6
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// Seconds on the failsafes' microsecond clock.
+    fn us(t_s: f64) -> u64 {
+        (t_s * 1e6) as u64
+    }
+
     fn flying(t_s: f64) -> FailsafeInputs {
         FailsafeInputs {
-            t_s,
+            t_us: us(t_s),
             flying: true,
-            gcs_heard_s: Some(t_s),
+            gcs_heard_us: Some(us(t_s)),
             gps_ok: true,
             airspeed_ok: true,
             fence_breached: false,
@@ -420,16 +433,16 @@ mod tests {
         let mut f = Failsafes::new();
         let mut i = flying(0.0);
         assert_eq!(f.update(&cfg, &i).0, Reaction::None);
-        i.t_s = 4.9;
-        i.gcs_heard_s = Some(0.0);
+        i.t_us = us(4.9);
+        i.gcs_heard_us = Some(0);
         assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
-        i.t_s = 5.1;
+        i.t_us = us(5.1);
         let (r, ev) = f.update(&cfg, &i);
         assert_eq!(r, Reaction::Return);
         assert_eq!(ev.as_slice(), &[Event::GcsLost]);
         // Heard again: reported, but the return stays until the pilot picks a mode.
-        i.gcs_heard_s = Some(5.2);
-        i.t_s = 5.3;
+        i.gcs_heard_us = Some(us(5.2));
+        i.t_us = us(5.3);
         let (r, ev) = f.update(&cfg, &i);
         assert_eq!(
             (r, ev.as_slice()),
@@ -444,10 +457,10 @@ mod tests {
         let cfg = FailsafeConfig::default();
         let mut f = Failsafes::new();
         let mut i = flying(100.0);
-        i.gcs_heard_s = None;
+        i.gcs_heard_us = None;
         assert_eq!(f.update(&cfg, &i).0, Reaction::None);
         i.flying = false;
-        i.gcs_heard_s = Some(0.0);
+        i.gcs_heard_us = Some(0);
         i.gps_ok = false;
         i.fence_breached = true;
         assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
@@ -461,10 +474,10 @@ mod tests {
         let mut i = flying(10.0);
         i.gps_ok = false;
         assert_eq!(f.update(&cfg, &i).0, Reaction::WingsLevel);
-        i.t_s = 19.9;
-        i.gcs_heard_s = Some(19.9);
+        i.t_us = us(19.9);
+        i.gcs_heard_us = Some(us(19.9));
         assert_eq!(f.update(&cfg, &i), (Reaction::WingsLevel, Events::new()));
-        i.t_s = 20.0;
+        i.t_us = us(20.0);
         let (r, ev) = f.update(&cfg, &i);
         assert_eq!(
             (r, ev.as_slice()),
@@ -594,8 +607,8 @@ mod tests {
         // An outside simulator that sends no BATTERY_STATUS.
         i.battery = None;
         for t in 0..100 {
-            i.t_s = f64::from(t);
-            i.gcs_heard_s = Some(i.t_s);
+            i.t_us = us(f64::from(t));
+            i.gcs_heard_us = Some(i.t_us);
             assert_eq!(f.update(&cfg, &i), (Reaction::None, Events::new()));
         }
         // An empty pack on the ground: the pre-arm check's business, not a failsafe.

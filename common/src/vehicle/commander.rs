@@ -543,9 +543,9 @@ impl Commander {
             None => false,
         };
         let inputs = FailsafeInputs {
-            t_s: now_us as f64 * 1e-6,
+            t_us: now_us,
             flying,
-            gcs_heard_s: gcs_heard_us.map(|t| t as f64 * 1e-6),
+            gcs_heard_us,
             gps_ok: e.health.gps.healthy,
             airspeed_ok: e.health.pitot.healthy,
             fence_breached,
