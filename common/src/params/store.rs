@@ -164,9 +164,7 @@ impl ParamStore {
     pub fn index_of(&self, name: &str) -> Option<usize> {
         let mut start = 0;
         for stage in self.registry.iter() {
-            if let Some(i) =
-                (0..stage.len()).find(|&i| stage.def(i).is_some_and(|d| d.name == name))
-            {
+            if let Some(i) = stage.position(name) {
                 return Some(start + i);
             }
             start += stage.len();
@@ -181,13 +179,21 @@ impl ParamStore {
         group.settings(self.group_values(first, group.params.len()))
     }
 
-    /// The `len` values of the group whose first parameter is called `first`. Apart from
-    /// [`ParamStore::load`] and not inlined: the search by name is the same for every
-    /// settings type, and the vehicle loads some fifteen of them in one function.
+    /// The `len` values of the group whose first parameter is called `first`: the stage
+    /// that begins with it, one name compared a stage. Apart from [`ParamStore::load`] and not
+    /// inlined: the search is the same for every settings type, and the vehicle loads some
+    /// fifteen of them in one function.
     #[inline(never)]
     fn group_values(&self, first: Option<&str>, len: usize) -> Option<&[f32]> {
-        let start = self.index_of(first?)?;
-        self.values.get(start..start.checked_add(len)?)
+        let first = first?;
+        let mut start: usize = 0;
+        for stage in self.registry.iter() {
+            if stage.def(0).is_some_and(|d| d.name == first) {
+                return self.values.get(start..start.checked_add(len)?);
+            }
+            start += stage.len();
+        }
+        None
     }
 
     /// Value at `index`.
@@ -237,9 +243,17 @@ impl ParamStore {
     ) -> Result<(), (&'a str, ParamError)> {
         let before = self.values.clone();
         let restore = |s: &mut Self| s.values.clone_from(&before);
+        // Sets come a group at a time, in the group's order: the parameter after the last one
+        // set is tried before the search by name.
+        let mut next = 0;
         for (name, v) in values.clone() {
-            let checked = self
-                .index_of(name)
+            let found = if self.def(next).is_some_and(|d| d.name == name) {
+                Some(next)
+            } else {
+                self.index_of(name)
+            };
+            next = found.map_or(0, |i| i + 1);
+            let checked = found
                 .ok_or(ParamError::Unknown)
                 .and_then(|i| Ok((i, self.def(i).ok_or(ParamError::Unknown)?.check(v)?)));
             match checked {

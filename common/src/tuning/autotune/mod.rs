@@ -183,6 +183,15 @@ enum Phase {
     Designing(Designer),
 }
 
+/// Where a tick takes the autotune ([`Autotune::advance`]).
+// The designer in place, as in `Phase`.
+#[allow(clippy::large_enum_variant)]
+enum Next {
+    Idle,
+    Fitting,
+    Designing(Designer),
+}
+
 /// About the steps a design takes (199 for the 25e), for the progress reported.
 const DESIGN_STEPS: f32 = 200.0;
 
@@ -331,36 +340,47 @@ impl Autotune {
                 ..Tick::default()
             };
         }
-        let phase = core::mem::replace(&mut self.phase, Phase::Idle);
-        let (phase, mut tick) = match phase {
-            Phase::Idle => (Phase::Idle, Tick::default()),
-            Phase::Flying { t_s, id } => self.fly(t_s, id, dt, e, s, p, base),
-            Phase::Fitting { next, id } => self.fit(next, id, p, base),
-            Phase::Designing(mut d) => match d.step() {
+        // The identifier and the designer stay where they are (some 1.2 KB each: moved out of
+        // the phase and back, they cost the MCU a few thousand instructions a tick): each arm
+        // takes what it needs of them, then the tick is worked out on the rest.
+        let (next, mut tick) = match &mut self.phase {
+            Phase::Idle => (None, Tick::default()),
+            Phase::Flying { t_s, .. } => {
+                let t = *t_s;
+                self.fly(t, dt, e, s, p, base)
+            }
+            Phase::Fitting { next, id } => {
+                let n = *next;
+                let fitted = FITTED.get(n).map(|&axis| (axis, id.fit(axis)));
+                self.fit(n, fitted, p, base)
+            }
+            Phase::Designing(d) => match d.step() {
                 design::Step::Pending => {
                     let share = d.steps() as f32 / DESIGN_STEPS;
                     self.status = Status::Running(85 + (share.min(1.0) * 14.0) as u8);
-                    (Phase::Designing(d), Tick::default())
+                    (None, Tick::default())
                 }
                 design::Step::Done(g) => {
-                    self.status = Status::Succeeded;
                     // Designed at the airspeed flown: where the loops scale with the airspeed,
                     // this is the one at which they hold as designed.
                     let mut gains = g.gains;
                     if gains.scaling_airspeed > 0.0 {
                         gains.scaling_airspeed = self.model.va;
                     }
+                    self.status = Status::Succeeded;
                     let tick = Tick {
                         report: Some(Report::Applied),
                         gains: Some(gains),
                         ..Tick::default()
                     };
-                    (Phase::Idle, tick)
+                    (Some(Next::Idle), tick)
                 }
                 design::Step::Failed(f) => self.fail(Failure::Design(f)),
             },
         };
-        self.phase = phase;
+        if let Some(next) = next {
+            self.advance(next);
+        }
         if self.running() && tick.commands.is_none() {
             tick.commands = Some(self.level());
         }
@@ -414,16 +434,15 @@ impl Autotune {
     fn fly(
         &mut self,
         t_s: f32,
-        id: Identifier,
         dt: f32,
         e: &EstimatedState,
         s: &Surfaces,
         p: &AutotuneParams,
         base: &GainSet,
-    ) -> (Phase, Tick) {
+    ) -> (Option<Next>, Tick) {
         let Some((stage, into_s, share)) = excite::at(t_s) else {
             self.status = Status::Running(80);
-            return (Phase::Fitting { next: 0, id }, Tick::default());
+            return (Some(Next::Fitting), Tick::default());
         };
         let report = if self.stage != Some(stage) {
             self.stage = Some(stage);
@@ -463,8 +482,10 @@ impl Autotune {
         };
         // Each model on the stages that are its own: the sideslip's on the rudder doublets,
         // the others on the rest ([`Identifier::take_rows`]).
-        let mut id = id;
-        id.take_rows(stage == Stage::Yaw, stage != Stage::Yaw);
+        if let Phase::Flying { t_s: at, id } = &mut self.phase {
+            id.take_rows(stage == Stage::Yaw, stage != Stage::Yaw);
+            *at = t_s + dt;
+        }
         let commands = match stage {
             Stage::Level => {
                 // The level pitch and throttle, averaged, for the pitch-attitude stages.
@@ -513,30 +534,36 @@ impl Autotune {
             report,
             ..Tick::default()
         };
-        (Phase::Flying { t_s: t_s + dt, id }, tick)
+        (None, tick)
     }
 
-    /// Fits the next axis; after the last, starts the design.
+    /// Takes axis `next`'s fit (`fitted`, none after the last axis); after the last, starts
+    /// the design.
     fn fit(
         &mut self,
         next: usize,
-        id: Identifier,
+        fitted: Option<(Axis, Result<AxisFit, AxisError>)>,
         p: &AutotuneParams,
         base: &GainSet,
-    ) -> (Phase, Tick) {
-        let Some(&axis) = FITTED.get(next) else {
-            let model = self.model;
-            self.status = Status::Running(85);
-            let tick = Tick {
-                identified: Some(model),
-                ..Tick::default()
-            };
-            return (
-                Phase::Designing(Designer::new(&model, &DesignInputs::AUTOTUNE, base)),
-                tick,
-            );
+    ) -> (Option<Next>, Tick) {
+        // After the last axis, the model to the parameters in one tick and the designer
+        // set up in the next: each is a share of a control period's budget.
+        let Some((axis, result)) = fitted else {
+            if next == FITTED.len() {
+                self.status = Status::Running(85);
+                if let Phase::Fitting { next: n, .. } = &mut self.phase {
+                    *n = next + 1;
+                }
+                let tick = Tick {
+                    identified: Some(self.model),
+                    ..Tick::default()
+                };
+                return (None, tick);
+            }
+            let designer = Designer::new(&self.model, &DesignInputs::AUTOTUNE, base);
+            return (Some(Next::Designing(designer)), Tick::default());
         };
-        let fit: AxisFit = match id.fit(axis) {
+        let fit: AxisFit = match result {
             Ok(f) => f,
             Err(AxisError::NotExcited { .. }) => return self.fail(Failure::NotExcited(axis)),
             Err(AxisError::Singular) => return self.fail(Failure::Singular(axis)),
@@ -558,16 +585,29 @@ impl Autotune {
             report: Some(Report::Fitted(axis, [a, b, c], fit.r2)),
             ..Tick::default()
         };
-        (Phase::Fitting { next: next + 1, id }, tick)
+        if let Phase::Fitting { next: n, .. } = &mut self.phase {
+            *n = next + 1;
+        }
+        (None, tick)
     }
 
-    fn fail(&mut self, why: Failure) -> (Phase, Tick) {
+    fn fail(&mut self, why: Failure) -> (Option<Next>, Tick) {
         self.status = Status::Failed;
         let tick = Tick {
             report: Some(Report::Failed(why)),
             ..Tick::default()
         };
-        (Phase::Idle, tick)
+        (Some(Next::Idle), tick)
+    }
+
+    /// Goes on to `next`: the identifier moves from the flight to the fits once, and the
+    /// designer takes its memory after them.
+    fn advance(&mut self, next: Next) {
+        self.phase = match (next, core::mem::replace(&mut self.phase, Phase::Idle)) {
+            (Next::Fitting, Phase::Flying { id, .. }) => Phase::Fitting { next: 0, id },
+            (Next::Designing(d), _) => Phase::Designing(d),
+            _ => Phase::Idle,
+        };
     }
 }
 
