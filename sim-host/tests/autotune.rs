@@ -296,7 +296,7 @@ fn navigation_targets(m: &MissionSummary) -> Vec<(&'static str, bool)> {
 /// mission on the default gains. The default gains meet every calm-air target of
 /// docs/NAVIGATION.md; after the autotune (the design's inputs `DesignInputs::AUTOTUNE`: the
 /// outer loops at the flight-proven set's separations) the mission meets every one of them
-/// too (straight legs 0.489 m RMS against 0.5, 0.436 on the default gains; 0.502 m before the
+/// too (straight legs 0.487 m RMS against 0.5, 0.436 on the default gains; 0.502 m before the
 /// autotune fitted each model on its own stage of the excitation), and holds its altitude and
 /// airspeed closer than the default gains do. Every loop, the sideslip's among them, keeps its
 /// margins on the identified model, recomputed on the host from what the station read back,

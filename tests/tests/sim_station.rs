@@ -12,7 +12,8 @@
 //!   given up, and the aircraft stops on the runway wings level and disarms.
 //! - The host build of the 25e's aircraft file (`sim-host --aircraft FILE sim`) and pymavlink's
 //!   station (`tests/interop/pymavlink_autotune.py`): take-off, Hold, the autotune polled as
-//!   QGroundControl polls it, then a mission uploaded and flown to its landing.
+//!   QGroundControl polls it, then a mission uploaded and flown to its landing; the same
+//!   script against the MCU image, whose autotune runs on board, to the mission's first leg.
 //! - The MCU image: `sim-host sim --link qemu` boots it, and the station speaks to its ground
 //!   bridge. The image answers at about the pace of real time, so the flight is not paced;
 //!   the station watches the take-off and the first leg, then stops the simulator as Ctrl-C
@@ -213,6 +214,15 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     let r = sim.join().expect("sim thread").expect("the flight");
     assert_eq!(gcs.log.reached, [0, 1]);
     assert!(gcs.log.heartbeats.iter().any(|h| h.0), "armed");
+    stopped_in_the_air(&r);
+    for f in ["simlink.tlog", "flight.csv", "summary.json", "mcu.defmt"] {
+        assert!(out.path().join(f).is_file(), "{f} written");
+    }
+}
+
+/// The MCU image's flight `r`, stopped by the station as by Ctrl-C, ended armed above 40 m
+/// with no simulator frame corrupted.
+fn stopped_in_the_air(r: &FlyReport) {
     let s = &r.outcome.summary;
     assert_eq!(s.ended, Ending::Stopped);
     let last = r.outcome.samples.last().expect("samples");
@@ -222,9 +232,6 @@ fn a_station_flies_the_mcu_image_through_sim_host_sim_over_its_ground_bridge() {
     );
     assert!(last.armed && last.alt > 40.0, "{last:?}");
     assert_eq!(s.sim_rx.crc_errors, 0);
-    for f in ["simlink.tlog", "flight.csv", "summary.json", "mcu.defmt"] {
-        assert!(out.path().join(f).is_file(), "{f} written");
-    }
 }
 
 /// A flight of the MCU image: `sim-host sim --link qemu` on the runway heading north for at
@@ -568,28 +575,20 @@ const PYMAVLINK_FLIGHT_S: f64 = 800.0;
 /// Wall-clock bound of the station's script, s.
 const PYMAVLINK_WALL_S: u64 = 150;
 
-/// The autotune as a user flies it from a ground station, three programs apart: `sim-host
-/// --aircraft sim-host/aircraft/ultrastick25e.toml sim` on the runway, the autopilot's host
-/// build on its TCP port (both the code of those commands, on this test's threads) and
-/// pymavlink over the autopilot's UDP ground link (`tests/interop/pymavlink_autotune.py`: its
-/// docstring lists the checks). The station takes off, switches to Hold in the air, starts
-/// the autotune and polls it each second of the vehicle's clock until the final ACCEPTED,
-/// reads the roll model back within 15 % of docs/AUTOTUNE.md's linearisation, uploads the
-/// default mission and flies it to the landing and the disarm; the simulator's truth puts the
-/// touchdown on the runway's centre line at under 1.5 m/s of sink. (The MCU image is built without the autotune, cargo feature
-/// `autotune` of `common` off for flash; once it has it, the same script runs against
-/// `start_mcu_flight`'s ground bridge.)
-#[test]
-fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_sim_and_the_host_build(
+/// The 25e's default mission as a planner would write it for pymavlink's station (a JSON file
+/// in `dir`), the mission, its home and the GPS latency the station sets.
+fn autotune_plan(
+    dir: &std::path::Path,
+) -> (
+    std::path::PathBuf,
+    Vec<MISSION_ITEM_INT_DATA>,
+    GeoPoint,
+    f64,
 ) {
-    if !system_tests::pymavlink_available() {
-        return;
-    }
     let file = system_tests::workspace_root().join("sim-host/aircraft/ultrastick25e.toml");
     let a = Aircraft::from_file(&file).expect("the 25e's aircraft file");
     let home = ModelParams::new(&a).home;
     let mission = default_mission(home);
-    let out = tempfile::tempdir().expect("tempdir");
     let items: Vec<serde_json::Value> = mission
         .iter()
         .map(|i| {
@@ -601,33 +600,41 @@ fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_s
             })
         })
         .collect();
-    let plan = out.path().join("mission.json");
+    let plan = dir.join("mission.json");
     std::fs::write(&plan, serde_json::to_string(&items).expect("json")).expect("written");
-    let gps_delay = a.sensors.gps.latency_s;
+    (plan, mission, home, a.sensors.gps.latency_s)
+}
 
-    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
-    let (ground, sim, autopilot) = start_host_flight_of(
-        a,
-        PYMAVLINK_FLIGHT_S,
-        PYMAVLINK_SPEED,
-        Some(out.path()),
-        Some(stop),
-    );
+/// `tests/interop/pymavlink_autotune.py` on the ground link at `ground` with `plan`, the GPS
+/// latency and `extra` arguments, until it exits, `wall_s` pass or the flight ends; then the
+/// flight is stopped (as by Ctrl-C). Returns the script's status (None: it did not finish) and
+/// what it said.
+fn run_autotune_station(
+    ground: SocketAddr,
+    plan: &std::path::Path,
+    gps_delay: f64,
+    extra: &[&str],
+    wall_s: u64,
+    sim: &JoinHandle<anyhow::Result<FlyReport>>,
+    stop: &AtomicBool,
+) -> (Option<std::process::ExitStatus>, String) {
     let script = system_tests::workspace_root().join("tests/interop/pymavlink_autotune.py");
     // To a file, not a pipe: nothing here reads a pipe while the script runs.
-    let said = out.path().join("station.txt");
+    let dir = plan.parent().expect("the plan's folder");
+    let said = dir.join("station.txt");
     let said_to = std::fs::File::create(&said).expect("station's output");
     let child = std::process::Command::new("python3")
         .arg(script)
         .arg(ground.port().to_string())
-        .arg(&plan)
+        .arg(plan)
         .arg(gps_delay.to_string())
+        .args(extra)
         .stdout(said_to.try_clone().expect("file"))
         .stderr(said_to)
         .spawn()
         .expect("python3 runs");
     let mut station = system_tests::Kill(child);
-    let deadline = std::time::Instant::now() + Duration::from_secs(PYMAVLINK_WALL_S);
+    let deadline = std::time::Instant::now() + Duration::from_secs(wall_s);
     let status = loop {
         if let Some(s) = station.0.try_wait().expect("the station's status") {
             break Some(s);
@@ -639,7 +646,38 @@ fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_s
     };
     stop.store(true, Ordering::Relaxed);
     drop(station);
-    let output = std::fs::read_to_string(&said).unwrap_or_default();
+    (status, std::fs::read_to_string(&said).unwrap_or_default())
+}
+
+/// The autotune as a user flies it from a ground station, three programs apart: `sim-host
+/// --aircraft sim-host/aircraft/ultrastick25e.toml sim` on the runway, the autopilot's host
+/// build on its TCP port (both the code of those commands, on this test's threads) and
+/// pymavlink over the autopilot's UDP ground link (`tests/interop/pymavlink_autotune.py`: its
+/// docstring lists the checks). The station takes off, switches to Hold in the air, starts
+/// the autotune and polls it each second of the vehicle's clock until the final ACCEPTED,
+/// reads the roll model back within 15 % of docs/AUTOTUNE.md's linearisation, uploads the
+/// default mission and flies it to the landing and the disarm; the simulator's truth puts the
+/// touchdown on the runway's centre line at under 1.5 m/s of sink.
+#[test]
+fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_sim_and_the_host_build(
+) {
+    if !system_tests::pymavlink_available() {
+        return;
+    }
+    let out = tempfile::tempdir().expect("tempdir");
+    let (plan, mission, home, gps_delay) = autotune_plan(out.path());
+    let file = system_tests::workspace_root().join("sim-host/aircraft/ultrastick25e.toml");
+    let a = Aircraft::from_file(&file).expect("the 25e's aircraft file");
+    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+    let (ground, sim, autopilot) = start_host_flight_of(
+        a,
+        PYMAVLINK_FLIGHT_S,
+        PYMAVLINK_SPEED,
+        Some(out.path()),
+        Some(stop),
+    );
+    let (status, output) =
+        run_autotune_station(ground, &plan, gps_delay, &[], PYMAVLINK_WALL_S, &sim, stop);
     let r = sim.join().expect("sim thread").expect("the flight");
     let _ = autopilot.join();
     eprintln!("{output}");
@@ -664,4 +702,43 @@ fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_s
         "{td:?}, {distance:.1} m from the point, {across:.1} m off the centre line"
     );
     assert!(!r.outcome.samples.last().expect("samples").armed);
+}
+
+/// Wall-clock bounds of the MCU image's pymavlink autotune against the host build's: the
+/// image in QEMU answers at about real time, the host build's flight ten times faster.
+const MCU_WALL_SCALE: u64 = 12;
+/// Mission items the station watches the image fly after its autotune: the take-off item
+/// (reached at once in the air) and the first leg.
+const MCU_ITEMS_WATCHED: u32 = 2;
+
+/// The same station and script against the MCU image (`sim-host sim --link qemu`, the
+/// STM32F405 image in QEMU, which runs the autotune's identification and design on board):
+/// take-off, Hold, the autotune polled to its final ACCEPTED, the roll model read back within
+/// 15 % of the linearisation, the default mission uploaded and its first leg flown; the
+/// simulator's truth has the aircraft still armed and above 40 m when the station stops it.
+#[test]
+fn pymavlink_autotunes_the_mcu_image_in_hold_then_flies_the_first_leg() {
+    if !system_tests::pymavlink_available() || !tool_available("qemu-system-arm") {
+        return;
+    }
+    let out = tempfile::tempdir().expect("tempdir");
+    let (plan, _, _, gps_delay) = autotune_plan(out.path());
+    let (ground, sim, stop) = start_mcu_flight(PYMAVLINK_FLIGHT_S, out.path(), None);
+    let (scale, watch) = (MCU_WALL_SCALE.to_string(), MCU_ITEMS_WATCHED.to_string());
+    let (status, output) = run_autotune_station(
+        ground,
+        &plan,
+        gps_delay,
+        &[&scale, &watch],
+        PYMAVLINK_WALL_S * MCU_WALL_SCALE,
+        &sim,
+        stop,
+    );
+    let r = sim.join().expect("sim thread").expect("the flight");
+    eprintln!("{output}");
+    assert!(
+        status.is_some_and(|s| s.success()),
+        "pymavlink's checks ({status:?}):\n{output}"
+    );
+    stopped_in_the_air(&r);
 }
