@@ -42,8 +42,8 @@ impl<T: Elementary> Euler<T> {
     ///
     /// nalgebra's `euler_angles` divides both arguments of the roll and yaw `atan2` by the
     /// cosine of the pitch: the same angles while that cosine is positive, for a cosine and
-    /// four divisions (on the MCU, f32 `cosf` runs a software f64 kernel: about 1,100
-    /// instructions a call). They are taken from the matrix directly; the poles (where the
+    /// four divisions (a cosine that, as `libm`'s `f32` `cosf`, had cost the MCU about 1,100
+    /// instructions of software `f64`). They are taken from the matrix directly; the poles (where the
     /// 3-2-1 sequence is singular) are nalgebra's: yaw zero, roll from the first row.
     pub fn from_quaternion(q: &UnitQuaternion<T>) -> Self {
         let r = q.to_rotation_matrix();

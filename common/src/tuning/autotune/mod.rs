@@ -175,7 +175,8 @@ enum Phase {
         id: Identifier,
     },
     /// Fitting axis `next` of [`FITTED`] (one a tick: a solve is a few thousand
-    /// instructions, the design's steps follow).
+    /// instructions), then the model handed to the parameters (`next` one past the last
+    /// axis) and the designer set up (two past), the design's steps following.
     Fitting {
         next: usize,
         id: Identifier,
@@ -361,13 +362,13 @@ impl Autotune {
                     (None, Tick::default())
                 }
                 design::Step::Done(g) => {
+                    self.status = Status::Succeeded;
                     // Designed at the airspeed flown: where the loops scale with the airspeed,
                     // this is the one at which they hold as designed.
                     let mut gains = g.gains;
                     if gains.scaling_airspeed > 0.0 {
                         gains.scaling_airspeed = self.model.va;
                     }
-                    self.status = Status::Succeeded;
                     let tick = Tick {
                         report: Some(Report::Applied),
                         gains: Some(gains),
@@ -537,8 +538,8 @@ impl Autotune {
         (None, tick)
     }
 
-    /// Takes axis `next`'s fit (`fitted`, none after the last axis); after the last, starts
-    /// the design.
+    /// Takes axis `next`'s fit (`fitted`, none after the last axis); after the last, hands
+    /// the model to the parameters, and in the tick after that starts the design.
     fn fit(
         &mut self,
         next: usize,
