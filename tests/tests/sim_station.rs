@@ -575,16 +575,20 @@ const PYMAVLINK_FLIGHT_S: f64 = 800.0;
 /// Wall-clock bound of the station's script, s.
 const PYMAVLINK_WALL_S: u64 = 150;
 
-/// The 25e's default mission as a planner would write it for pymavlink's station (a JSON file
-/// in `dir`), the mission, its home and the GPS latency the station sets.
-fn autotune_plan(
-    dir: &std::path::Path,
-) -> (
-    std::path::PathBuf,
-    Vec<MISSION_ITEM_INT_DATA>,
-    GeoPoint,
-    f64,
-) {
+/// What pymavlink's autotune station flies: the 25e's aircraft file and its default mission.
+struct AutotunePlan {
+    /// The 25e as its aircraft file gives it.
+    aircraft: Aircraft,
+    /// The mission as a planner wrote it for the station (a JSON file).
+    file: std::path::PathBuf,
+    mission: Vec<MISSION_ITEM_INT_DATA>,
+    home: GeoPoint,
+    /// The GPS latency the station sets, s.
+    gps_delay_s: f64,
+}
+
+/// [`AutotunePlan`], its mission file written in `dir`.
+fn autotune_plan(dir: &std::path::Path) -> AutotunePlan {
     let file = system_tests::workspace_root().join("sim-host/aircraft/ultrastick25e.toml");
     let a = Aircraft::from_file(&file).expect("the 25e's aircraft file");
     let home = ModelParams::new(&a).home;
@@ -602,7 +606,13 @@ fn autotune_plan(
         .collect();
     let plan = dir.join("mission.json");
     std::fs::write(&plan, serde_json::to_string(&items).expect("json")).expect("written");
-    (plan, mission, home, a.sensors.gps.latency_s)
+    AutotunePlan {
+        gps_delay_s: a.sensors.gps.latency_s,
+        aircraft: a,
+        file: plan,
+        mission,
+        home,
+    }
 }
 
 /// `tests/interop/pymavlink_autotune.py` on the ground link at `ground` with `plan`, the GPS
@@ -665,12 +675,16 @@ fn pymavlink_autotunes_in_hold_then_flies_the_default_mission_through_sim_host_s
         return;
     }
     let out = tempfile::tempdir().expect("tempdir");
-    let (plan, mission, home, gps_delay) = autotune_plan(out.path());
-    let file = system_tests::workspace_root().join("sim-host/aircraft/ultrastick25e.toml");
-    let a = Aircraft::from_file(&file).expect("the 25e's aircraft file");
+    let AutotunePlan {
+        aircraft,
+        file: plan,
+        mission,
+        home,
+        gps_delay_s: gps_delay,
+    } = autotune_plan(out.path());
     let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
     let (ground, sim, autopilot) = start_host_flight_of(
-        a,
+        aircraft,
         PYMAVLINK_FLIGHT_S,
         PYMAVLINK_SPEED,
         Some(out.path()),
@@ -722,7 +736,11 @@ fn pymavlink_autotunes_the_mcu_image_in_hold_then_flies_the_first_leg() {
         return;
     }
     let out = tempfile::tempdir().expect("tempdir");
-    let (plan, _, _, gps_delay) = autotune_plan(out.path());
+    let AutotunePlan {
+        file: plan,
+        gps_delay_s: gps_delay,
+        ..
+    } = autotune_plan(out.path());
     let (ground, sim, stop) = start_mcu_flight(PYMAVLINK_FLIGHT_S, out.path(), None);
     let (scale, watch) = (MCU_WALL_SCALE.to_string(), MCU_ITEMS_WATCHED.to_string());
     let (status, output) = run_autotune_station(

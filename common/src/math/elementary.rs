@@ -133,6 +133,11 @@ pub mod bounded {
     }
 }
 
+/// Whether this build computes as the board does: the MCU image, or a host build with
+/// `common`'s `bounded-trig` feature. The one switch of the functions here, the local frame's
+/// radii and the flight code's geodetic offsets (`geodetic::flight_ned_offset`).
+pub const BOARD_ARITHMETIC: bool = cfg!(any(target_os = "none", feature = "bounded-trig"));
+
 #[cfg(any(target_os = "none", feature = "bounded-trig"))]
 pub use bounded::{asin, cos, hypot, powf, sin, sin_cos, tan};
 

@@ -108,6 +108,8 @@ fn round_e7(x: f64) -> i32 {
 // [`LocalFrame`], in `f32`.
 use libm::{cos as lat_cos, sin as lat_sin};
 
+use super::elementary::BOARD_ARITHMETIC;
+
 /// Meridian and prime-vertical radii of curvature (m) at a latitude.
 fn radii(lat_rad: f64) -> (f64, f64) {
     let s = lat_sin(lat_rad);
@@ -188,19 +190,21 @@ pub fn offset_point<T: RealField + Copy>(origin: GeoPoint, north: T, east: T) ->
 /// [`ned_offset`] unless `bounded-trig` (the two agree within 5 mm within 10 km of the origin:
 /// test below), as its flights and campaigns were computed.
 pub fn flight_ned_offset(origin: GeoPoint, p: GeoPoint) -> (f32, f32) {
-    #[cfg(any(target_os = "none", feature = "bounded-trig"))]
-    return LocalFrame::new(origin).ned_offset(p);
-    #[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
-    return ned_offset(origin, p);
+    if BOARD_ARITHMETIC {
+        LocalFrame::new(origin).ned_offset(p)
+    } else {
+        ned_offset(origin, p)
+    }
 }
 
 /// The point `north`, `east` metres from `origin` as the flight code takes it (as
 /// [`flight_ned_offset`]: the board's [`LocalFrame`], the host's [`offset_point`]).
 pub fn flight_offset_point(origin: GeoPoint, north: f32, east: f32) -> GeoPoint {
-    #[cfg(any(target_os = "none", feature = "bounded-trig"))]
-    return LocalFrame::new(origin).offset_point(north, east);
-    #[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
-    return offset_point(origin, north, east);
+    if BOARD_ARITHMETIC {
+        LocalFrame::new(origin).offset_point(north, east)
+    } else {
+        offset_point(origin, north, east)
+    }
 }
 
 /// Radians per 1e-7 degree.
@@ -226,10 +230,11 @@ impl LocalFrame {
     /// The frame about `origin`: on the board [`Self::with_f32_radii`], on the host
     /// [`Self::with_f64_radii`] (unless `bounded-trig`), which agree within millimetres.
     pub fn new(origin: GeoPoint) -> Self {
-        #[cfg(any(target_os = "none", feature = "bounded-trig"))]
-        return Self::with_f32_radii(origin);
-        #[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
-        return Self::with_f64_radii(origin);
+        if BOARD_ARITHMETIC {
+            Self::with_f32_radii(origin)
+        } else {
+            Self::with_f64_radii(origin)
+        }
     }
 
     /// The frame about `origin` with the radii and their first two derivatives in the

@@ -67,19 +67,15 @@ pub fn rotation_from_vector(v: &nalgebra::Vector3<f32>) -> nalgebra::UnitQuatern
 }
 
 /// The rotation by a rotation vector of squared length `theta2`, at least 0.3 rad long (or
-/// NaN), as nalgebra's `from_scaled_axis` builds it.
-#[cfg(any(target_os = "none", feature = "bounded-trig"))]
+/// NaN), as nalgebra's `from_scaled_axis` builds it (nalgebra's own on the host).
 fn large_rotation(v: &nalgebra::Vector3<f32>, theta2: f32) -> nalgebra::UnitQuaternion<f32> {
+    if !elementary::BOARD_ARITHMETIC {
+        return nalgebra::UnitQuaternion::from_scaled_axis(*v);
+    }
     let theta = libm::sqrtf(theta2);
     let (s, c) = elementary::sin_cos(0.5 * theta);
     let k = s / theta;
     nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(c, v.x * k, v.y * k, v.z * k))
-}
-
-/// The rotation by a rotation vector at least 0.3 rad long (or NaN): nalgebra's.
-#[cfg(not(any(target_os = "none", feature = "bounded-trig")))]
-fn large_rotation(v: &nalgebra::Vector3<f32>, _theta2: f32) -> nalgebra::UnitQuaternion<f32> {
-    nalgebra::UnitQuaternion::from_scaled_axis(*v)
 }
 
 #[cfg(test)]
