@@ -102,6 +102,23 @@ pub struct McuProfile {
     pub instr_per_period: f64,
     /// Every function that ran, costliest first.
     pub functions: Vec<FunctionCost>,
+    /// The window's costliest pass of work (from one wake of the image to its return to
+    /// waiting), by function: where a single heavy tick spends what the averages spread.
+    pub costliest_pass: Option<PassCost>,
+}
+
+/// One pass of the image's work, by function.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PassCost {
+    /// Which pass of the window, from 0.
+    pub index: u64,
+    /// Its instructions.
+    pub instructions: u64,
+    /// Every function that ran in it, costliest first (`instr_per_period` here: in the pass).
+    pub functions: Vec<FunctionCost>,
+    /// The memory routines' instructions (`memcpy`, `memcmp`, `memset` and their `__aeabi_`
+    /// entries), charged to the function that called them, costliest first.
+    pub memory_callers: Vec<FunctionCost>,
 }
 
 impl McuProfile {
@@ -118,16 +135,45 @@ impl McuProfile {
                 f.function, f.instr_per_period, f.percent
             ));
         }
-        let rest: f64 = self.functions.iter().skip(n).map(|f| f.percent).sum();
-        if self.functions.len() > n {
+        push_rest(&mut s, &self.functions, n, self.instr_per_period);
+        if let Some(c) = &self.costliest_pass {
             s.push_str(&format!(
-                "| {} other functions | {:.0} | {:.1} % |\n",
-                self.functions.len() - n,
-                rest / 100.0 * self.instr_per_period,
-                rest
+                "\nThe costliest pass of work, pass {} of the window: {} instructions.\n\n\
+                 | function | instructions | share |\n|---|---:|---:|\n",
+                c.index, c.instructions
             ));
+            for f in c.functions.iter().take(n) {
+                s.push_str(&format!(
+                    "| `{}` | {:.0} | {:.1} % |\n",
+                    f.function, f.instr_per_period, f.percent
+                ));
+            }
+            push_rest(&mut s, &c.functions, n, c.instructions as f64);
+            s.push_str(
+                "\nIts memory routines by caller:\n\n\
+                 | caller | instructions | share of the pass |\n|---|---:|---:|\n",
+            );
+            for f in c.memory_callers.iter().take(n) {
+                s.push_str(&format!(
+                    "| `{}` | {:.0} | {:.1} % |\n",
+                    f.function, f.instr_per_period, f.percent
+                ));
+            }
         }
         s
+    }
+}
+
+/// The table's last row: the functions after the `n` costliest, of `total` instructions.
+fn push_rest(s: &mut String, functions: &[FunctionCost], n: usize, total: f64) {
+    let rest: f64 = functions.iter().skip(n).map(|f| f.percent).sum();
+    if functions.len() > n {
+        s.push_str(&format!(
+            "| {} other functions | {:.0} | {:.1} % |\n",
+            functions.len() - n,
+            rest / 100.0 * total,
+            rest
+        ));
     }
 }
 
@@ -410,6 +456,8 @@ struct Counts {
     pass: Option<Vec<u64>>,
     by_pc: HashMap<u64, u64>,
     passes: u64,
+    /// The longest pass so far and its index.
+    longest: (u64, Vec<u64>),
 }
 
 impl Counts {
@@ -420,6 +468,7 @@ impl Counts {
             pass: None,
             by_pc: HashMap::new(),
             passes: 0,
+            longest: (0, Vec::new()),
         }
     }
 
@@ -438,8 +487,11 @@ impl Counts {
             self.pass = Some(Vec::new());
         } else if pc == self.end {
             if let Some(p) = self.pass.take() {
-                for a in p {
-                    *self.by_pc.entry(a).or_insert(0) += 1;
+                for a in &p {
+                    *self.by_pc.entry(*a).or_insert(0) += 1;
+                }
+                if p.len() > self.longest.1.len() {
+                    self.longest = (self.passes, p);
                 }
                 self.passes += 1;
             }
@@ -450,36 +502,95 @@ impl Counts {
     }
 
     fn profile(self, symbols: &Symbols, window: ProfileWindow) -> McuProfile {
-        let mut by_fn: HashMap<String, u64> = HashMap::new();
-        let mut total = 0u64;
-        for (pc, n) in &self.by_pc {
-            let name = symbols
-                .function_at(*pc)
-                .map_or_else(|| format!("0x{pc:08x}"), str::to_string);
-            *by_fn.entry(name).or_insert(0) += n;
-            total += n;
-        }
         let periods = f64::from(window.periods.max(1));
-        let mut functions: Vec<FunctionCost> = by_fn
-            .into_iter()
-            .map(|(function, n)| FunctionCost {
-                function,
-                instr_per_period: n as f64 / periods,
-                percent: 100.0 * n as f64 / (total.max(1) as f64),
-            })
-            .collect();
-        functions.sort_by(|a, b| {
-            b.instr_per_period
-                .total_cmp(&a.instr_per_period)
-                .then_with(|| a.function.cmp(&b.function))
+        let (functions, total) =
+            by_function(self.by_pc.iter().map(|(a, n)| (*a, *n)), symbols, periods);
+        let (index, longest) = self.longest;
+        let costliest_pass = (!longest.is_empty()).then(|| {
+            let mut by_pc: HashMap<u64, u64> = HashMap::new();
+            for a in &longest {
+                *by_pc.entry(*a).or_insert(0) += 1;
+            }
+            let (functions, instructions) = by_function(by_pc.into_iter(), symbols, 1.0);
+            PassCost {
+                index,
+                instructions,
+                functions,
+                memory_callers: memory_callers(&longest, symbols),
+            }
         });
         McuProfile {
             start_frame: window.start_frame,
             periods: window.periods,
             instr_per_period: total as f64 / periods,
             functions,
+            costliest_pass,
         }
     }
+}
+
+/// The instructions of the memory routines in `pass` (executed addresses in order), charged to
+/// the last other function that ran before each entry into them; as a share of the pass.
+fn memory_callers(pass: &[u64], symbols: &Symbols) -> Vec<FunctionCost> {
+    let is_memory = |f: &str| {
+        let f = f.trim_start_matches("compiler_builtins::mem::");
+        ["memcpy", "memcmp", "memset", "memmove", "__aeabi_mem"]
+            .iter()
+            .any(|m| f.starts_with(m))
+    };
+    let mut by_caller: HashMap<String, u64> = HashMap::new();
+    let mut caller = "";
+    for pc in pass {
+        let f = symbols.function_at(*pc).unwrap_or("");
+        if is_memory(f) {
+            *by_caller.entry(caller.to_string()).or_insert(0) += 1;
+        } else {
+            caller = f;
+        }
+    }
+    let total = pass.len().max(1) as f64;
+    let mut callers: Vec<FunctionCost> = by_caller
+        .into_iter()
+        .map(|(function, n)| FunctionCost {
+            function,
+            instr_per_period: n as f64,
+            percent: 100.0 * n as f64 / total,
+        })
+        .collect();
+    callers.sort_by(|a, b| b.instr_per_period.total_cmp(&a.instr_per_period));
+    callers
+}
+
+/// Counts of executed addresses gathered by function, costliest first, each divided by
+/// `periods`; and their total.
+fn by_function(
+    by_pc: impl Iterator<Item = (u64, u64)>,
+    symbols: &Symbols,
+    periods: f64,
+) -> (Vec<FunctionCost>, u64) {
+    let mut by_fn: HashMap<String, u64> = HashMap::new();
+    let mut total = 0u64;
+    for (pc, n) in by_pc {
+        let name = symbols
+            .function_at(pc)
+            .map_or_else(|| format!("0x{pc:08x}"), str::to_string);
+        *by_fn.entry(name).or_insert(0) += n;
+        total += n;
+    }
+    let mut functions: Vec<FunctionCost> = by_fn
+        .into_iter()
+        .map(|(function, n)| FunctionCost {
+            function,
+            instr_per_period: n as f64 / periods,
+            percent: 100.0 * n as f64 / (total.max(1) as f64),
+        })
+        .collect();
+    functions.sort_by(|a, b| {
+        b.instr_per_period
+            .total_cmp(&a.instr_per_period)
+            .then_with(|| a.function.cmp(&b.function))
+    });
+    (functions, total)
 }
 
 /// The guest address of a `Trace` line: the second field of its bracket.
@@ -541,6 +652,7 @@ mod tests {
         c.line(&t(0x52));
         let total: u64 = c.by_pc.values().sum();
         assert_eq!((total, c.passes), (3, 1));
+        assert_eq!(c.longest, (0, vec![0x100, 0x300, 0x302]));
         assert_eq!(trace_pc(&t(0x0800_ebd8)), Some(0x0800_ebd8));
         assert_eq!(trace_pc("cpu_io_recompile: x"), None);
     }
