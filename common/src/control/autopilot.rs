@@ -8,7 +8,7 @@ use super::longitudinal::{self, LonMode, Longitudinal, LongitudinalGains, Regime
 use super::scaling::{course_scale, surface_scale};
 use crate::actuators::Surfaces;
 use crate::param;
-use crate::params::{Group, ParamDef, ParamError, ParamStore};
+use crate::params::{Group, ParamDef, ParamError, ParamStore, Stage};
 use serde::{Deserialize, Serialize};
 
 /// Time constant with which a bumpless-transfer offset fades by default, s (not in the thesis:
@@ -187,6 +187,14 @@ impl GainSet {
             (_, None) => GainError::Unknown,
         })
     }
+
+    /// The stages of the store a set is made of, in the order of [`GainSet::params`]'s values.
+    pub const STAGES: [&'static dyn Stage; 4] = [
+        &lateral::PARAMS,
+        &longitudinal::PARAMS,
+        &tecs::gains::PARAMS,
+        &PARAMS,
+    ];
 
     /// The set the store holds (consistent by the store's own checks).
     pub fn from_store(store: &ParamStore) -> GainSet {

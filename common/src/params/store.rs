@@ -185,11 +185,16 @@ impl ParamStore {
     /// fifteen of them in one function.
     #[inline(never)]
     fn group_values(&self, first: Option<&str>, len: usize) -> Option<&[f32]> {
-        let first = first?;
+        let start = self.stage_start(first?)?;
+        self.values.get(start..start.checked_add(len)?)
+    }
+
+    /// Where the values of the stage whose first parameter is called `first` start.
+    fn stage_start(&self, first: &str) -> Option<usize> {
         let mut start: usize = 0;
         for stage in self.registry.iter() {
             if stage.def(0).is_some_and(|d| d.name == first) {
-                return self.values.get(start..start.checked_add(len)?);
+                return Some(start);
             }
             start += stage.len();
         }
@@ -233,48 +238,51 @@ impl ParamStore {
         }
     }
 
-    /// Sets several parameters at once, as one change: each value is checked against its
-    /// definition and each stage touched against its rule only when all are written, so a set
-    /// that is consistent as a whole is taken whatever its order. Refused as a whole (the
-    /// store unchanged) with the first offending name.
-    pub fn set_all<'a>(
+    /// Writes whole stages at once, as one change: each of `stages` in turn takes the next
+    /// values of `values`, one a parameter in its declared order (the order of the settings'
+    /// own `params` and of the registry). Each value is checked against its definition and
+    /// each stage's values against its rule; no parameter is looked up by name, no other stage
+    /// is asked. Refused as a whole (the store unchanged) with the first offending name.
+    pub fn set_stages(
         &mut self,
-        values: impl Iterator<Item = (&'a str, f32)> + Clone,
-    ) -> Result<(), (&'a str, ParamError)> {
+        stages: &[&dyn Stage],
+        mut values: impl Iterator<Item = f32>,
+    ) -> Result<(), (&'static str, ParamError)> {
         let before = self.values.clone();
-        let restore = |s: &mut Self| s.values.clone_from(&before);
-        // Sets come a group at a time, in the group's order: the parameter after the last one
-        // set is tried before the search by name.
-        let mut next = 0;
-        for (name, v) in values.clone() {
-            let found = if self.def(next).is_some_and(|d| d.name == name) {
-                Some(next)
-            } else {
-                self.index_of(name)
-            };
-            next = found.map_or(0, |i| i + 1);
-            let checked = found
-                .ok_or(ParamError::Unknown)
-                .and_then(|i| Ok((i, self.def(i).ok_or(ParamError::Unknown)?.check(v)?)));
-            match checked {
-                Ok((i, v)) => self.put(i, v),
-                Err(e) => {
-                    restore(self);
-                    return Err((name, e));
+        match self.write_stages(stages, &mut values) {
+            Ok(()) => {
+                if self.values != before {
+                    self.changes = self.changes.wrapping_add(1);
                 }
+                Ok(())
+            }
+            Err(e) => {
+                self.values.clone_from(&before);
+                Err(e)
             }
         }
-        let mut start = 0;
-        for stage in self.registry.iter() {
-            let values = self.values.get(start..start + stage.len()).unwrap_or(&[]);
-            start += stage.len();
-            if let Err(at) = stage.check(values) {
-                restore(self);
-                return Err((at, ParamError::Inconsistent));
+    }
+
+    /// [`ParamStore::set_stages`]'s writes and checks, the store left as they leave it.
+    fn write_stages(
+        &mut self,
+        stages: &[&dyn Stage],
+        values: &mut dyn Iterator<Item = f32>,
+    ) -> Result<(), (&'static str, ParamError)> {
+        for stage in stages {
+            let first = stage.def(0).map_or(stage.name(), |d| d.name);
+            let start = self
+                .stage_start(first)
+                .ok_or((first, ParamError::Unknown))?;
+            for i in 0..stage.len() {
+                let d = stage.def(i).ok_or((first, ParamError::Unknown))?;
+                let v = values.next().ok_or((d.name, ParamError::Unknown))?;
+                self.put(start + i, d.check(v).map_err(|e| (d.name, e))?);
             }
-        }
-        if self.values != before {
-            self.changes = self.changes.wrapping_add(1);
+            let now = self.values.get(start..start + stage.len()).unwrap_or(&[]);
+            stage
+                .check(now)
+                .map_err(|at| (at, ParamError::Inconsistent))?;
         }
         Ok(())
     }
@@ -542,6 +550,40 @@ mod tests {
         assert_eq!((r.loaded, r.rejected), (1, 2));
         assert_eq!((s.get("B_LOW"), s.get("B_HIGH")), (Some(4.0), Some(4.5)));
         assert_eq!(s.get("A_MODE"), Some(3.0));
+    }
+
+    #[test]
+    fn whole_stages_are_written_in_order_checked_by_their_own_rules_and_refused_as_a_whole() {
+        let mut s = ParamStore::new(REG);
+        // B_LOW above the present B_HIGH would be refused alone; written with its stage, whose
+        // values are consistent, it is taken.
+        let both = [7.0, 1.0, 4.0, 4.5];
+        assert_eq!(s.set_stages(&[&GA, &GB], both.into_iter()), Ok(()));
+        assert_eq!((s.load(&GA).gain, s.load(&GA).mode), (7.0, 1));
+        assert_eq!((s.load(&GB).low, s.load(&GB).high), (4.0, 4.5));
+        assert_eq!(s.change_count(), 1);
+        // The same values again: nothing moved, no change counted.
+        assert_eq!(s.set_stages(&[&GB], [4.0, 4.5].into_iter()), Ok(()));
+        assert_eq!(s.change_count(), 1);
+        // The second stage inconsistent: the first is not written either.
+        let bad = [2.0, 3.0, 1.0, 0.5];
+        assert_eq!(
+            s.set_stages(&[&GA, &GB], bad.into_iter()),
+            Err(("B_LOW", ParamError::Inconsistent))
+        );
+        assert_eq!(
+            s.set_stages(&[&GA], [2.0, 9.0].into_iter()),
+            Err(("A_MODE", ParamError::OutOfBounds))
+        );
+        assert_eq!(
+            s.set_stages(&[&GA], [2.0].into_iter()),
+            Err(("A_MODE", ParamError::Unknown))
+        );
+        // A stage the store does not hold.
+        let unknown = ParamStore::new(&[&GB]).set_stages(&[&GA], [1.0, 1.0].into_iter());
+        assert_eq!(unknown, Err(("A_GAIN", ParamError::Unknown)));
+        assert_eq!(s.load(&GA).gain, 7.0);
+        assert_eq!(s.change_count(), 1);
     }
 
     #[test]

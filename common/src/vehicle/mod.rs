@@ -531,6 +531,17 @@ impl Vehicle {
         }
     }
 
+    /// Hands the store's gains to the control laws.
+    pub(super) fn apply_gains(&mut self) {
+        let gains = GainSet::from_store(&self.params);
+        if self.autopilot.set_gains(&gains).is_err() {
+            self.commander.notify(Notice::Text(
+                Severity::Warning,
+                "Gains refused: inconsistent set, previous kept",
+            ));
+        }
+    }
+
     /// Hands changed parameters to the stages.
     pub fn apply_params(&mut self) {
         let count = self.params.change_count();
@@ -543,19 +554,14 @@ impl Vehicle {
         if sys.gain_set != self.gain_set_seen {
             self.gain_set_seen = sys.gain_set;
             if let Some((_, g, _)) = NAMED.get(usize::from(sys.gain_set)) {
-                if self.params.set_all(g.params()).is_err() {
+                let values = g.params().map(|(_, v)| v);
+                if self.params.set_stages(&GainSet::STAGES, values).is_err() {
                     self.commander
                         .notify(Notice::Text(Severity::Warning, "Gain set refused"));
                 }
             }
         }
-        let gains = GainSet::from_store(&self.params);
-        if self.autopilot.set_gains(&gains).is_err() {
-            self.commander.notify(Notice::Text(
-                Severity::Warning,
-                "Gains refused: inconsistent set, previous kept",
-            ));
-        }
+        self.apply_gains();
         let p = &self.params;
         self.estimator.set_config(p.load(&estimator_config::PARAMS));
         self.estimator

@@ -102,10 +102,12 @@ impl Vehicle {
             self.commander.notify(Notice::Tune(r));
         }
         if let Some(identified) = tick.identified {
-            let names = params::IDENTIFIED.params.iter();
-            let values = names.map(|q| (q.def.name, (q.get)(&identified)));
+            let values = params::IDENTIFIED
+                .params
+                .iter()
+                .map(|q| (q.get)(&identified));
             // Out of the parameters' bounds only for a model the design then refuses.
-            let _ = self.params.set_all(values);
+            let _ = self.params.set_stages(&[&params::IDENTIFIED], values);
         }
         if let Some(gains) = tick.gains {
             if self.set_gains(&gains, "Autotune: gains applied") {
@@ -137,10 +139,20 @@ impl Vehicle {
     /// Writes `gains` into the parameters (saved with them, as a station's would be) and says
     /// `done`; false, and a warning, when the store refuses them.
     fn set_gains(&mut self, gains: &GainSet, done: &'static str) -> bool {
-        match self.params.set_all(gains.params()) {
+        // The store's other changes are applied at the start of each tick: when none is
+        // pending, the gains are all that moved, and only the control laws re-read theirs (the
+        // MCU's costliest control period was the whole reload).
+        let applied = self.params_seen == Some(self.params.change_count());
+        let values = gains.params().map(|(_, v)| v);
+        match self.params.set_stages(&GainSet::STAGES, values) {
             Ok(()) => {
                 self.commander.notify(Notice::Text(Severity::Info, done));
-                self.apply_params();
+                if applied {
+                    self.params_seen = Some(self.params.change_count());
+                    self.apply_gains();
+                } else {
+                    self.apply_params();
+                }
                 true
             }
             Err(_) => {
