@@ -227,12 +227,14 @@ pub(crate) enum Command {
     },
     /// Fit the design's reduced models (roll, sideslip, pitch, airspeed; the course and
     /// altitude kinematics) from a simulator link's `.tlog` (`simlink.tlog` of `fly` and
-    /// `sim`), with each fit's quality and excitation, beside the aircraft file's
+    /// `sim`) or the autopilot's own flight log at `SDLOG_PROFILE 9`, with each fit's quality
+    /// and excitation, beside the aircraft file's
     /// linearisation at the same airspeed. An axis the flight did not excite is an error
     /// naming it (the sideslip's is reported, not an error: without it a design keeps the
     /// base set's sideslip gains).
     Identify {
-        /// The log (`.tlog` of the simulator link, with its truth frames).
+        /// The log: a `.tlog` of the simulator link, with its truth frames, or the autopilot's
+        /// flight log (`.ulg`) written with `SDLOG_PROFILE 9` (100 Hz).
         file: PathBuf,
         /// Airspeed the coefficients are given at, m/s (default: the flown samples' mean).
         #[arg(long, value_name = "M/S", value_parser = positive_airspeed, allow_negative_numbers = true)]

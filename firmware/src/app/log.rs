@@ -112,6 +112,8 @@ impl FlightLog {
         if self.params_seen != Some(changes) {
             self.params_seen = Some(changes);
             self.when = v.params().load(&common::logger::params::PARAMS);
+            let high_rate = self.when.profile & common::logger::params::PROFILE_HIGH_RATE != 0;
+            self.logger.set_high_rate(high_rate);
         }
         let when = self.when;
         // A log starts once the last one is drained (the board empties the ring after each

@@ -12,6 +12,15 @@
 //! wind: the flight's steady wind is read from it (the ground velocity less the airspeed
 //! along the nose, averaged), and the angle of attack is the velocity's through it. Gusts are
 //! not: in turbulence the angle of attack carries them as noise.
+//!
+//! Or the log is the autopilot's own flight log (a `.ulg`, as the board writes it and a station
+//! downloads it), written with `SDLOG_PROFILE`'s system-identification bit (8) so that its
+//! attitude, rates, accelerations, surfaces, velocity and airspeed come at every 100 Hz sensor
+//! frame: the same samples from the autopilot's estimate instead of the truth, each taken at
+//! an `actuator_outputs` sample with the latest of the other topics, fitted through the
+//! pre-filters the vehicle fits its own sensors through. A flight log at the default
+//! profile's 25 Hz is refused with the parameter to set: its 40 ms between samples do not
+//! resolve the 25e's 60 ms roll mode.
 
 use crate::aircraft::Aircraft;
 use crate::commands::linearize::linearize_report_at;
@@ -24,7 +33,10 @@ use common::gcs::{COMPONENT_ID, SYSTEM_ID};
 use common::link::framing::FrameParser;
 use common::math::frames::{body_to_ned, course_and_speed, ned_to_body, AirData, Euler};
 use common::math::{RAD2DEG, STANDARD_GRAVITY};
-use common::tuning::identify::{Axis, AxisError, Identifier, IdentifyConfig, Sample};
+use common::tuning::identify::{
+    Axis, AxisError, Identifier, IdentifyConfig, Sample, AIRSPEED_FILTER_TAU_S,
+    ATTITUDE_FILTER_TAU_S,
+};
 use mavlink::dialects::common::MavMessage;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -212,6 +224,143 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
     out
 }
 
+/// A ULog file's first bytes ("ULog", then 0x01 0x12 0x35).
+const ULOG_MAGIC: &[u8] = b"ULog\x01\x12\x35";
+
+/// Longest median interval between a flight log's surface samples that the fits take, s: the
+/// control rate's 20 ms and some room (the default profile's 40 ms does not resolve a 60 ms
+/// roll mode).
+const ULOG_INTERVAL_MAX_S: f64 = 0.03;
+
+/// The samples of the autopilot's flight log: each `actuator_outputs` sample with the latest
+/// attitude, inertial sample, velocity and airspeed at or before it.
+fn ulog_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Vec<Timed>> {
+    let log =
+        crate::ulog_read::parse(bytes).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let topic = |name: &str| {
+        log.dataset(name)
+            .filter(|d| !d.is_empty())
+            .with_context(|| format!("{}: no `{name}` in the flight log", path.display()))
+    };
+    let fields = |name: &str, keys: &[&str]| -> anyhow::Result<(Vec<u64>, Vec<Vec<f64>>)> {
+        let d = topic(name)?;
+        let columns = keys
+            .iter()
+            .map(|k| {
+                d.field(k)
+                    .with_context(|| format!("{}: no `{name}.{k}`", path.display()))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok((d.timestamps_us().to_vec(), columns))
+    };
+    let (t_out, out) = fields(
+        "actuator_outputs",
+        &["output[0]", "output[1]", "output[2]", "output[3]"],
+    )?;
+    let mut gaps: Vec<u64> = t_out
+        .windows(2)
+        .map(|w| w[1].saturating_sub(w[0]))
+        .collect();
+    gaps.sort_unstable();
+    let median_s = gaps
+        .get(gaps.len() / 2)
+        .map_or(f64::INFINITY, |g| *g as f64 * 1e-6);
+    if median_s > ULOG_INTERVAL_MAX_S {
+        bail!(
+            "{}: surfaces logged every {} ms: too far apart to resolve the fast modes; fly with \
+             SDLOG_PROFILE's system-identification bit (`SDLOG_PROFILE 9`) for 100 Hz",
+            path.display(),
+            sig(median_s * 1e3, 2)
+        );
+    }
+    let att = fields("vehicle_attitude", &["q[0]", "q[1]", "q[2]", "q[3]"])?;
+    let imu = fields(
+        "sensor_combined",
+        &[
+            "gyro_rad[0]",
+            "gyro_rad[1]",
+            "gyro_rad[2]",
+            "accelerometer_m_s2[1]",
+        ],
+    )?;
+    let pos = fields("vehicle_local_position", &["vx", "vy", "vz", "z"])?;
+    let air = fields("airspeed_validated", &["true_airspeed_m_s"])?;
+    // The latest sample of a topic at or before `t`, by a cursor that only moves forward.
+    struct Latest<'a> {
+        times: &'a [u64],
+        columns: &'a [Vec<f64>],
+        at: Option<usize>,
+    }
+    impl Latest<'_> {
+        fn at(&mut self, t: u64) -> Option<Vec<f64>> {
+            let mut i = self.at;
+            while self
+                .times
+                .get(i.map_or(0, |i| i + 1))
+                .is_some_and(|n| *n <= t)
+            {
+                i = Some(i.map_or(0, |i| i + 1));
+            }
+            self.at = i;
+            let i = i?;
+            self.columns.iter().map(|c| c.get(i).copied()).collect()
+        }
+    }
+    fn latest((times, columns): &(Vec<u64>, Vec<Vec<f64>>)) -> Latest<'_> {
+        Latest {
+            times,
+            columns,
+            at: None,
+        }
+    }
+    let (mut att, mut imu, mut pos, mut air) =
+        (latest(&att), latest(&imu), latest(&pos), latest(&air));
+    let mut samples = Vec::new();
+    for (k, &t) in t_out.iter().enumerate() {
+        let controls: Option<Vec<f64>> = out.iter().map(|c| c.get(k).copied()).collect();
+        let (Some(u), Some(q), Some(w), Some(v), Some(va)) =
+            (controls, att.at(t), imu.at(t), pos.at(t), air.at(t))
+        else {
+            continue;
+        };
+        let Some(q) = UnitQuaternion::try_new(Quaternion::new(q[0], q[1], q[2], q[3]), 1e-3) else {
+            continue;
+        };
+        let e = Euler::from_quaternion(&q);
+        let v_ned = Vector3::new(v[0], v[1], v[2]);
+        let (course, gs) = course_and_speed(&v_ned);
+        let c = Surfaces::from_px4_controls([u[0], u[1], u[2], u[3]].map(|x| x as f32));
+        samples.push(Timed {
+            time_us: t,
+            alt_m: -v[3],
+            // A flight log is written from arming (or from boot: the runway's samples are
+            // then left out by their height).
+            armed: true,
+            attitude: q,
+            v_ned,
+            sample: Sample {
+                p: w[0] as f32,
+                q: w[1] as f32,
+                r: w[2] as f32,
+                phi: e.phi as f32,
+                theta: e.theta as f32,
+                airspeed: va[0] as f32,
+                ay: w[3] as f32,
+                accel_y: w[3] as f32,
+                climb_rate: -v_ned.z as f32,
+                course: course as f32,
+                ground_speed: gs as f32,
+                aileron: c.aileron,
+                elevator: c.elevator,
+                rudder: c.rudder,
+                throttle: c.throttle,
+                ..Sample::default()
+            },
+        });
+    }
+    Ok(samples)
+}
+
 /// The flight's steady horizontal wind, NED, m/s: the mean of the ground velocity less the
 /// airspeed along the body's nose. The log holds no wind, and the angle of attack is read from
 /// the velocity through the air; the nose's direction leaves out the angle of attack's and
@@ -240,7 +389,12 @@ pub fn identify_log(
     window: Option<(f64, f64)>,
 ) -> anyhow::Result<IdentifyReport> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    let all = samples(&bytes);
+    let flight_log = bytes.starts_with(ULOG_MAGIC);
+    let all = if flight_log {
+        ulog_samples(path, &bytes)?
+    } else {
+        samples(&bytes)
+    };
     if all.is_empty() {
         bail!(
             "{}: no HIL_STATE_QUATERNION answered by an HIL_ACTUATOR_CONTROLS of the autopilot \
@@ -303,8 +457,18 @@ pub fn identify_log(
         airspeed_ref: va_ref as f32,
         servo_tau_s: servo_tau as f32,
         servo_rate_radps: aircraft.actuators.rate_limit_radps as f32,
-        airspeed_filter_tau_s: 0.0,
-        attitude_filter_tau_s: 0.0,
+        // The autopilot's estimate carries its sensors' noise: fitted through the pre-filters
+        // the vehicle fits its own through; the truth needs none.
+        airspeed_filter_tau_s: if flight_log {
+            AIRSPEED_FILTER_TAU_S
+        } else {
+            0.0
+        },
+        attitude_filter_tau_s: if flight_log {
+            ATTITUDE_FILTER_TAU_S
+        } else {
+            0.0
+        },
     });
     let mut last: Option<u64> = None;
     for s in &flown {
