@@ -253,3 +253,21 @@ fn nothing_is_taken_before_the_start_or_after_the_stop() {
     assert_eq!(log.pending_len(), n);
     assert!(!log.recording());
 }
+
+/// `SDLOG_PROFILE`'s identification bits put the identification's topics at every 100 Hz
+/// frame and leave the others at their own rates; a board's cap still bounds them all.
+#[test]
+fn the_identification_profile_logs_its_topics_every_frame_under_the_boards_cap() {
+    let mut log = Logger::new(INFO);
+    assert_eq!(log.rate_hz(VehicleAttitude::ID), Some(25));
+    log.set_high_rate(true);
+    for id in [VehicleAttitude::ID, SensorCombined::ID, ActuatorOutputs::ID] {
+        assert_eq!(log.rate_hz(id), Some(100));
+    }
+    assert_eq!(log.rate_hz(VehicleLocalPosition::ID), Some(100));
+    assert_eq!(log.rate_hz(AirspeedValidated::ID), Some(100));
+    assert_eq!(log.rate_hz(BatteryStatus::ID), Some(1));
+    log.set_rate_cap(4);
+    assert_eq!(log.rate_hz(VehicleAttitude::ID), Some(4));
+    assert_eq!(log.rate_hz(BatteryStatus::ID), Some(1));
+}
