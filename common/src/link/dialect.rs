@@ -29,9 +29,21 @@ pub trait Dialect {
     /// own decoding error (an enum value it does not know, ...).
     fn decode(version: MavlinkVersion, id: u32, payload: &[u8]) -> Result<MavMessage, ParserError>;
 
-    /// Encodes `message` as a MAVLink 2 frame with `header`; `None` for a message this side
-    /// does not write.
-    fn encode(header: MavHeader, message: &MavMessage) -> Option<MAVLinkV2MessageRaw>;
+    /// Encodes `message` as a MAVLink 2 frame with `header` into `raw` (a fresh buffer);
+    /// `None` for a message this side does not write. Into the caller's buffer: a frame
+    /// returned by value is a copy of some 290 bytes per message on the board.
+    fn encode_into(
+        header: MavHeader,
+        message: &MavMessage,
+        raw: &mut MAVLinkV2MessageRaw,
+    ) -> Option<()>;
+
+    /// [`Dialect::encode_into`] a new buffer.
+    fn encode(header: MavHeader, message: &MavMessage) -> Option<MAVLinkV2MessageRaw> {
+        let mut raw = MAVLinkV2MessageRaw::new();
+        Self::encode_into(header, message, &mut raw)?;
+        Some(raw)
+    }
 }
 
 /// The whole common dialect, as the `mavlink` crate has it: the host's tools (simulator,
@@ -48,10 +60,13 @@ impl Dialect for Common {
         MavMessage::parse(version, id, payload)
     }
 
-    fn encode(header: MavHeader, message: &MavMessage) -> Option<MAVLinkV2MessageRaw> {
-        let mut raw = MAVLinkV2MessageRaw::new();
+    fn encode_into(
+        header: MavHeader,
+        message: &MavMessage,
+        raw: &mut MAVLinkV2MessageRaw,
+    ) -> Option<()> {
         raw.serialize_message(header, message);
-        Some(raw)
+        Some(())
     }
 }
 
@@ -157,14 +172,17 @@ macro_rules! autopilot_dialect {
                 }
             }
 
-            fn encode(header: MavHeader, message: &MavMessage) -> Option<MAVLinkV2MessageRaw> {
-                let mut raw = MAVLinkV2MessageRaw::new();
+            fn encode_into(
+                header: MavHeader,
+                message: &MavMessage,
+                raw: &mut MAVLinkV2MessageRaw,
+            ) -> Option<()> {
                 let payload = match message {
-                    $(MavMessage::$w(d) => write_payload(&mut raw, d),)*
+                    $(MavMessage::$w(d) => write_payload(raw, d),)*
                     _ => None,
                 }?;
-                finish_v2(&mut raw, header, payload)?;
-                Some(raw)
+                finish_v2(raw, header, payload)?;
+                Some(())
             }
         }
     };

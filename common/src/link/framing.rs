@@ -585,23 +585,43 @@ impl<D: Dialect> Sender<D> {
     /// Encodes `message` as the next MAVLink 2 frame of this sender; `None` (and no sequence
     /// number spent) for a message its dialect does not write.
     pub fn try_encode(&mut self, message: &MavMessage) -> Option<MAVLinkV2MessageRaw> {
-        let raw = D::encode(self.header(), message)?;
-        self.sequence = self.sequence.wrapping_add(1);
+        let mut raw = MAVLinkV2MessageRaw::new();
+        self.try_encode_into(message, &mut raw)?;
         Some(raw)
+    }
+
+    /// [`Sender::try_encode`] into `raw` (a fresh buffer): no frame copied on its way out.
+    pub fn try_encode_into(
+        &mut self,
+        message: &MavMessage,
+        raw: &mut MAVLinkV2MessageRaw,
+    ) -> Option<()> {
+        D::encode_into(self.header(), message, raw)?;
+        self.sequence = self.sequence.wrapping_add(1);
+        Some(())
     }
 
     /// Encodes one message's data (a type of the dialect's, or one written for a case the
     /// dialect's types cannot express) as the next MAVLink 2 frame of this sender.
     pub fn encode_data<M: mavlink::MessageData>(&mut self, data: &M) -> MAVLinkV2MessageRaw {
         let mut raw = MAVLinkV2MessageRaw::new();
+        self.encode_data_into(data, &mut raw);
+        raw
+    }
+
+    /// [`Sender::encode_data`] into `raw` (a fresh buffer).
+    pub fn encode_data_into<M: mavlink::MessageData>(
+        &mut self,
+        data: &M,
+        raw: &mut MAVLinkV2MessageRaw,
+    ) {
         let header = self.next_header();
         // The dialect's writer, not the crate's `serialize_message_data`, whose bounds checks
         // inlined into the board's code would be panic sites of ours (its system id is a u8:
         // the writer never refuses it).
-        if let Some(p) = super::dialect::write_payload(&mut raw, data) {
-            let _ = super::dialect::finish_v2(&mut raw, header, p);
+        if let Some(p) = super::dialect::write_payload(raw, data) {
+            let _ = super::dialect::finish_v2(raw, header, p);
         }
-        raw
     }
 }
 

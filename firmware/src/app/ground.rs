@@ -299,7 +299,8 @@ impl GroundPort {
     pub fn send(&mut self, msg: &MavMessage) {
         // Encoded from the borrowed message: no copy of it (a clone of `MavMessage` is a match
         // over the whole common dialect in the image).
-        if let Some(raw) = self.tx.try_encode(msg) {
+        let mut raw = mavlink::MAVLinkV2MessageRaw::new();
+        if self.tx.try_encode_into(msg, &mut raw).is_some() {
             let (out, dropped) = (&mut self.out, &mut self.bytes_dropped);
             push_frame(out, dropped, self.link.signing_mut(), Dest::All, &raw);
         }
@@ -335,14 +336,16 @@ fn queue(
     dest: Dest,
     msg: &Outgoing,
 ) {
-    let raw = match msg {
-        Outgoing::Message(m) => match tx.try_encode(m) {
-            Some(raw) => raw,
+    let mut raw = mavlink::MAVLinkV2MessageRaw::new();
+    match msg {
+        Outgoing::Message(m) => {
             // Not in the autopilot's dialect: nothing to send.
-            None => return,
-        },
-        Outgoing::Ack(a) => tx.encode_data(a),
-    };
+            if tx.try_encode_into(m, &mut raw).is_none() {
+                return;
+            }
+        }
+        Outgoing::Ack(a) => tx.encode_data_into(a, &mut raw),
+    }
     push_frame(buf, dropped, signing, dest, &raw);
 }
 

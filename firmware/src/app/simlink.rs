@@ -162,7 +162,8 @@ impl Answers {
                     armed: vehicle.armed(),
                 };
                 let msg = MavMessage::HIL_ACTUATOR_CONTROLS(simlink::encode_actuators(&answer));
-                if let Some(raw) = self.tx.try_encode(&msg) {
+                let mut raw = mavlink::MAVLinkV2MessageRaw::new();
+                if self.tx.try_encode_into(&msg, &mut raw).is_some() {
                     out(raw.raw_bytes());
                 }
             }
