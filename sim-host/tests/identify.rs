@@ -64,6 +64,27 @@ fn coefficient(report: &serde_json::Value, axis: &str, name: &str) -> (f64, f64)
     )
 }
 
+/// Each `(axis, coefficient, share)` of `report` within `share` of the linearisation.
+fn assert_near_linearisation(report: &serde_json::Value, coefficients: &[(&str, &str, f64)]) {
+    for &(axis, name, within) in coefficients {
+        let (v, r) = coefficient(report, axis, name);
+        assert!(((v - r) / r).abs() < within, "{name}: {v} against {r}");
+    }
+}
+
+/// The roll and sideslip models within 15 %, the pitch model within `pitch_within`.
+fn attitude_models(pitch_within: f64) -> [(&'static str, &'static str, f64); 7] {
+    [
+        ("roll", "a_phi1", 0.15),
+        ("roll", "a_phi2", 0.15),
+        ("sideslip", "a_beta1", 0.15),
+        ("sideslip", "a_beta2", 0.15),
+        ("pitch", "a_theta1", pitch_within),
+        ("pitch", "a_theta2", pitch_within),
+        ("pitch", "a_theta3", pitch_within),
+    ]
+}
+
 /// Roll damping and aileron power from the closed-loop turns and corrections of an ordinary
 /// flight: within 15 % of the linearisation (measured: -6.2 % and -3.6 %), the fit explaining
 /// over 95 % of the roll acceleration.
@@ -159,18 +180,7 @@ fn stick_doublets_flown_in_stabilized_give_the_roll_sideslip_and_pitch_models_wi
         "{}",
         sim_host::commands::render(&r.tables, sim_host::commands::Format::Markdown)
     );
-    for (axis, name) in [
-        ("roll", "a_phi1"),
-        ("roll", "a_phi2"),
-        ("sideslip", "a_beta1"),
-        ("sideslip", "a_beta2"),
-        ("pitch", "a_theta1"),
-        ("pitch", "a_theta2"),
-        ("pitch", "a_theta3"),
-    ] {
-        let (v, r) = coefficient(&report, axis, name);
-        assert!(((v - r) / r).abs() < 0.15, "{name}: {v} against {r}");
-    }
+    assert_near_linearisation(&report, &attitude_models(0.15));
 }
 
 /// The same stick flight's own flight log, written with `SDLOG_PROFILE`'s system
@@ -217,18 +227,7 @@ fn the_autopilots_own_flight_log_at_the_identification_profile_gives_the_models(
             sim_host::commands::render(&r.tables, sim_host::commands::Format::Markdown)
         );
         let report = serde_json::to_value(&r).expect("json");
-        for (axis, name, within) in [
-            ("roll", "a_phi1", 0.15),
-            ("roll", "a_phi2", 0.15),
-            ("sideslip", "a_beta1", 0.15),
-            ("sideslip", "a_beta2", 0.15),
-            ("pitch", "a_theta1", 0.35),
-            ("pitch", "a_theta2", 0.35),
-            ("pitch", "a_theta3", 0.35),
-        ] {
-            let (v, r) = coefficient(&report, axis, name);
-            assert!(((v - r) / r).abs() < within, "{name}: {v} against {r}");
-        }
+        assert_near_linearisation(&report, &attitude_models(0.35));
     }
 }
 

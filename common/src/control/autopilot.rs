@@ -196,6 +196,12 @@ impl GainSet {
         &PARAMS,
     ];
 
+    /// Writes the set into `store`'s [`GainSet::STAGES`], as one change (the inverse of
+    /// [`GainSet::from_store`]); refused as a whole with the first offending name.
+    pub fn to_store(&self, store: &mut ParamStore) -> Result<(), (&'static str, ParamError)> {
+        store.set_stages(&Self::STAGES, self.params().map(|(_, v)| v))
+    }
+
     /// The set the store holds (consistent by the store's own checks).
     pub fn from_store(store: &ParamStore) -> GainSet {
         let own = store.load(&PARAMS);

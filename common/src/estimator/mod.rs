@@ -280,12 +280,8 @@ impl Estimator {
             q.inverse_transform_vector(&(self.ins.velocity() - self.wind.wind()))
         } else if self.health.pitot.healthy {
             let va = self.airspeed.value();
-            let a = self.alpha_memory;
-            Vector3::new(
-                va * crate::math::elementary::cos(a),
-                0.0,
-                va * crate::math::elementary::sin(a),
-            )
+            let (s, c) = crate::math::elementary::sin_cos(self.alpha_memory);
+            Vector3::new(va * c, 0.0, va * s)
         } else {
             Vector3::zeros()
         }
@@ -476,12 +472,8 @@ impl Estimator {
         } else if self.wind.is_initialized() {
             // GPS lost: the air-data velocity (last angle of attack, frozen wind) keeps the
             // horizontal velocity, and so the position drift, bounded.
-            let a = self.alpha_memory;
-            let body = Vector3::new(
-                va * crate::math::elementary::cos(a),
-                0.0,
-                va * crate::math::elementary::sin(a),
-            );
+            let (sa, ca) = crate::math::elementary::sin_cos(self.alpha_memory);
+            let body = Vector3::new(va * ca, 0.0, va * sa);
             let v = q.transform_vector(&body) + self.wind.wind();
             self.ins
                 .fuse_horizontal_velocity(self.t_us, v.x, v.y, c.dead_reckon_vel_noise);

@@ -34,11 +34,8 @@ impl Kinematic {
 
     /// Velocity over ground, NED (horizontal).
     pub fn ground_velocity(&self) -> Vector3<f32> {
-        Vector3::new(
-            self.airspeed * crate::math::elementary::cos(self.heading),
-            self.airspeed * crate::math::elementary::sin(self.heading),
-            0.0,
-        ) + self.wind
+        let (s, c) = crate::math::elementary::sin_cos(self.heading);
+        Vector3::new(self.airspeed * c, self.airspeed * s, 0.0) + self.wind
     }
 
     pub fn course(&self) -> f32 {

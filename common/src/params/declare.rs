@@ -333,6 +333,12 @@ impl<C: 'static> Group<C> {
         self.settings(Some(values))
     }
 
+    /// The values of `c`'s fields in parameter units, in parameter order: what
+    /// [`Group::load`] takes back.
+    pub fn values<'a>(&'a self, c: &'a C) -> impl Iterator<Item = f32> + 'a {
+        self.params.iter().map(move |p| (p.get)(c))
+    }
+
     /// [`Group::load`] of `values`, or [`Group::defaults`] if there are none: one loop for
     /// both, so that a caller that may take either (the parameter store) has one copy of it
     /// for each settings type, not two.
@@ -399,9 +405,7 @@ pub trait Stage: Sync {
     /// Definition of parameter `i` of the stage.
     fn def(&self, i: usize) -> Option<&'static ParamDef>;
     /// Index in the stage of the parameter called `name`.
-    fn position(&self, name: &str) -> Option<usize> {
-        (0..self.len()).find(|&i| self.def(i).is_some_and(|d| d.name == name))
-    }
+    fn position(&self, name: &str) -> Option<usize>;
     /// The group's rule over its values (in parameter order); `Err` names the parameter.
     fn check(&self, values: &[f32]) -> Result<(), &'static str>;
 }

@@ -263,6 +263,12 @@ impl ParamStore {
         }
     }
 
+    /// Writes a stage's settings `c` (the inverse of [`ParamStore::load`]), as
+    /// [`ParamStore::set_stages`] writes a stage.
+    pub fn save<C>(&mut self, group: &Group<C>, c: &C) -> Result<(), (&'static str, ParamError)> {
+        self.set_stages(&[group], group.values(c))
+    }
+
     /// [`ParamStore::set_stages`]'s writes and checks, the store left as they leave it.
     fn write_stages(
         &mut self,
@@ -584,6 +590,13 @@ mod tests {
         assert_eq!(unknown, Err(("A_GAIN", ParamError::Unknown)));
         assert_eq!(s.load(&GA).gain, 7.0);
         assert_eq!(s.change_count(), 1);
+        // A stage's settings saved are what it loads back.
+        let b = B {
+            low: -1.0,
+            high: 2.0,
+        };
+        assert_eq!(s.save(&GB, &b), Ok(()));
+        assert_eq!((s.load(&GB).low, s.load(&GB).high), (-1.0, 2.0));
     }
 
     #[test]

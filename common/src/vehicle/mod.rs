@@ -554,8 +554,7 @@ impl Vehicle {
         if sys.gain_set != self.gain_set_seen {
             self.gain_set_seen = sys.gain_set;
             if let Some((_, g, _)) = NAMED.get(usize::from(sys.gain_set)) {
-                let values = g.params().map(|(_, v)| v);
-                if self.params.set_stages(&GainSet::STAGES, values).is_err() {
+                if g.to_store(&mut self.params).is_err() {
                     self.commander
                         .notify(Notice::Text(Severity::Warning, "Gain set refused"));
                 }

@@ -102,12 +102,8 @@ impl Vehicle {
             self.commander.notify(Notice::Tune(r));
         }
         if let Some(identified) = tick.identified {
-            let values = params::IDENTIFIED
-                .params
-                .iter()
-                .map(|q| (q.get)(&identified));
             // Out of the parameters' bounds only for a model the design then refuses.
-            let _ = self.params.set_stages(&[&params::IDENTIFIED], values);
+            let _ = self.params.save(&params::IDENTIFIED, &identified);
         }
         if let Some(gains) = tick.gains {
             if self.set_gains(&gains, "Autotune: gains applied") {
@@ -143,8 +139,7 @@ impl Vehicle {
         // pending, the gains are all that moved, and only the control laws re-read theirs (the
         // MCU's costliest control period was the whole reload).
         let applied = self.params_seen == Some(self.params.change_count());
-        let values = gains.params().map(|(_, v)| v);
-        match self.params.set_stages(&GainSet::STAGES, values) {
+        match gains.to_store(&mut self.params) {
             Ok(()) => {
                 self.commander.notify(Notice::Text(Severity::Info, done));
                 if applied {

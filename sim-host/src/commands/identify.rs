@@ -285,41 +285,16 @@ fn ulog_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Vec<Timed>> {
     )?;
     let pos = fields("vehicle_local_position", &["vx", "vy", "vz", "z"])?;
     let air = fields("airspeed_validated", &["true_airspeed_m_s"])?;
-    // The latest sample of a topic at or before `t`, by a cursor that only moves forward.
-    struct Latest<'a> {
-        times: &'a [u64],
-        columns: &'a [Vec<f64>],
-        at: Option<usize>,
-    }
-    impl Latest<'_> {
-        fn at(&mut self, t: u64) -> Option<Vec<f64>> {
-            let mut i = self.at;
-            while self
-                .times
-                .get(i.map_or(0, |i| i + 1))
-                .is_some_and(|n| *n <= t)
-            {
-                i = Some(i.map_or(0, |i| i + 1));
-            }
-            self.at = i;
-            let i = i?;
-            self.columns.iter().map(|c| c.get(i).copied()).collect()
-        }
-    }
-    fn latest((times, columns): &(Vec<u64>, Vec<Vec<f64>>)) -> Latest<'_> {
-        Latest {
-            times,
-            columns,
-            at: None,
-        }
-    }
-    let (mut att, mut imu, mut pos, mut air) =
-        (latest(&att), latest(&imu), latest(&pos), latest(&air));
+    // The latest sample of a topic at or before `t`.
+    let at = |(times, columns): &(Vec<u64>, Vec<Vec<f64>>), t: u64| -> Option<Vec<f64>> {
+        let i = times.partition_point(|n| *n <= t).checked_sub(1)?;
+        columns.iter().map(|c| c.get(i).copied()).collect()
+    };
     let mut samples = Vec::new();
     for (k, &t) in t_out.iter().enumerate() {
         let controls: Option<Vec<f64>> = out.iter().map(|c| c.get(k).copied()).collect();
         let (Some(u), Some(q), Some(w), Some(v), Some(va)) =
-            (controls, att.at(t), imu.at(t), pos.at(t), air.at(t))
+            (controls, at(&att, t), at(&imu, t), at(&pos, t), at(&air, t))
         else {
             continue;
         };

@@ -129,45 +129,35 @@ impl McuProfile {
              | function | instructions per period | share |\n|---|---:|---:|\n",
             self.periods, self.start_frame, self.instr_per_period
         );
-        for f in self.functions.iter().take(n) {
-            s.push_str(&format!(
-                "| `{}` | {:.0} | {:.1} % |\n",
-                f.function, f.instr_per_period, f.percent
-            ));
-        }
-        push_rest(&mut s, &self.functions, n, self.instr_per_period);
+        push_rows(&mut s, &self.functions, n, Some(self.instr_per_period));
         if let Some(c) = &self.costliest_pass {
             s.push_str(&format!(
                 "\nThe costliest pass of work, pass {} of the window: {} instructions.\n\n\
                  | function | instructions | share |\n|---|---:|---:|\n",
                 c.index, c.instructions
             ));
-            for f in c.functions.iter().take(n) {
-                s.push_str(&format!(
-                    "| `{}` | {:.0} | {:.1} % |\n",
-                    f.function, f.instr_per_period, f.percent
-                ));
-            }
-            push_rest(&mut s, &c.functions, n, c.instructions as f64);
+            push_rows(&mut s, &c.functions, n, Some(c.instructions as f64));
             s.push_str(
                 "\nIts memory routines by caller:\n\n\
                  | caller | instructions | share of the pass |\n|---|---:|---:|\n",
             );
-            for f in c.memory_callers.iter().take(n) {
-                s.push_str(&format!(
-                    "| `{}` | {:.0} | {:.1} % |\n",
-                    f.function, f.instr_per_period, f.percent
-                ));
-            }
+            push_rows(&mut s, &c.memory_callers, n, None);
         }
         s
     }
 }
 
-/// The table's last row: the functions after the `n` costliest, of `total` instructions.
-fn push_rest(s: &mut String, functions: &[FunctionCost], n: usize, total: f64) {
+/// The rows of the `n` costliest of `functions`, then, with the `total` instructions they
+/// share, one row for the rest.
+fn push_rows(s: &mut String, functions: &[FunctionCost], n: usize, total: Option<f64>) {
+    for f in functions.iter().take(n) {
+        s.push_str(&format!(
+            "| `{}` | {:.0} | {:.1} % |\n",
+            f.function, f.instr_per_period, f.percent
+        ));
+    }
     let rest: f64 = functions.iter().skip(n).map(|f| f.percent).sum();
-    if functions.len() > n {
+    if let Some(total) = total.filter(|_| functions.len() > n) {
         s.push_str(&format!(
             "| {} other functions | {:.0} | {:.1} % |\n",
             functions.len() - n,

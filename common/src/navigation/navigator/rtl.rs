@@ -103,11 +103,8 @@ impl Return {
                     // altitude.
                     let course = runway.unwrap_or_else(|| libm::atan2f(-pos.y, -pos.x));
                     let run = p.rtl_alt / crate::math::elementary::tan(p.glide_slope);
-                    let gate = Vector3::new(
-                        -crate::math::elementary::cos(course) * run,
-                        -crate::math::elementary::sin(course) * run,
-                        -p.rtl_alt,
-                    );
+                    let (s, c) = crate::math::elementary::sin_cos(course);
+                    let gate = Vector3::new(-c * run, -s * run, -p.rtl_alt);
                     paths.reset();
                     ReturnPhase::ToFinal { origin: pos, gate }
                 } else {

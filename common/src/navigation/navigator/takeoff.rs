@@ -159,10 +159,7 @@ impl Takeoff {
         if self.rolling && self.aborted.is_none() && state.airspeed >= p.takeoff_vr {
             self.rolling = false;
         }
-        let (dn, de) = (
-            crate::math::elementary::cos(self.course),
-            crate::math::elementary::sin(self.course),
-        );
+        let (de, dn) = crate::math::elementary::sin_cos(self.course);
         let far = self.start + Vector3::new(dn, de, 0.0) * 1000.0;
         let line = Path::line_between(&self.start, &far, f.cruise);
         out.target = Some(far);
