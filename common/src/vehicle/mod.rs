@@ -275,6 +275,11 @@ impl Vehicle {
         self.commander.armed()
     }
 
+    /// The angles the outer loops last asked the roll and pitch loops for.
+    pub fn loop_commands(&self) -> LoopCommands {
+        self.loops
+    }
+
     /// What the autopilot is holding: the guided modes' set points, or in a navigation mode
     /// what guidance commands (its altitude as AMSL).
     pub fn setpoints(&self) -> Setpoints {

@@ -8,6 +8,7 @@ use common::estimator::EstimatedState;
 use common::gcs::modes::FlightMode;
 use common::math::{course_and_speed, Euler};
 use common::navigation::Phase;
+use common::vehicle::LoopCommands;
 use firmware::app::Setpoints;
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -70,6 +71,10 @@ pub struct Sample {
     pub sp_alt: f64,
     /// Setpoint airspeed, m/s.
     pub sp_airspeed: f64,
+    /// Bank angle the course loop asked the roll loop for, rad (NaN: the loop is off).
+    pub sp_roll: f64,
+    /// Pitch angle the outer loops asked the pitch loop for, rad (NaN: the loop is off).
+    pub sp_pitch: f64,
     /// Commanded surfaces (UMN signs), rad, and throttle 0..1.
     pub elevator: f64,
     /// Commanded aileron, rad.
@@ -166,6 +171,8 @@ pub struct AutopilotView {
     pub est_ne: (f64, f64),
     /// What the autopilot holds.
     pub setpoints: Setpoints,
+    /// The angles its outer loops asked the inner loops for.
+    pub loops: LoopCommands,
     /// The mode flown.
     pub mode: FlightMode,
     /// The navigator.
@@ -244,6 +251,8 @@ impl Sample {
             sp_course: nan,
             sp_alt: nan,
             sp_airspeed: nan,
+            sp_roll: nan,
+            sp_pitch: nan,
             xtrack: nan,
             est_xtrack: nan,
             nav_phase: Phase::Idle as u8,
@@ -286,6 +295,8 @@ impl Sample {
         self.sp_course = f64::from(sp.course);
         self.sp_alt = f64::from(sp.alt_amsl_m);
         self.sp_airspeed = f64::from(sp.airspeed);
+        self.sp_roll = f64::from(v.loops.roll_cmd);
+        self.sp_pitch = f64::from(v.loops.pitch_cmd);
         self.est_xtrack = nav.xtrack;
         self.nav_phase = nav.phase as u8;
         self.mission_seq = nav.seq.map_or(-1, i32::from);
@@ -330,6 +341,8 @@ pub fn csv_headers() -> Vec<String> {
         "sp_course_deg",
         "sp_alt_amsl_m",
         "sp_airspeed_mps",
+        "sp_roll_deg",
+        "sp_pitch_deg",
         "elevator_deg",
         "aileron_deg",
         "rudder_deg",
@@ -383,6 +396,8 @@ pub fn csv_row(s: &Sample) -> Vec<f64> {
         s.sp_course * DEG,
         s.sp_alt,
         s.sp_airspeed,
+        s.sp_roll * DEG,
+        s.sp_pitch * DEG,
         s.elevator * DEG,
         s.aileron * DEG,
         s.rudder * DEG,

@@ -361,6 +361,7 @@ pub fn fly<T: Transport, O: Onboard<T>>(
                         ),
                         estimate,
                         setpoints: app.setpoints(),
+                        loops: app.vehicle().loop_commands(),
                         mode: app.mode(),
                     },
                     monitor.present.then_some(monitor.remaining),
