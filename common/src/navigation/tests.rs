@@ -1237,14 +1237,14 @@ fn warning_texts_fit_one_statustext() {
 /// A landing begun high above the glide slope closes the gap along a capture path, not in a
 /// dive: the altitude command starts at the aircraft's height (no step), never sinks faster
 /// than twice the slope's own rate at the ground speed, and the aircraft, following it, is on
-/// the slope within 1 m before the flare (10 m above it 500 m out: `NAV_APP_CAPT_S` 8 s
-/// leaves e^(-3.5), 0.3 m, of the gap after the 28 s approach).
+/// the slope within 1 m before the flare (some 9 m above it 800 m out: `NAV_APP_CAPT_S`
+/// leaves e^(-46 s / 12 s), 0.2 m, of the gap after the approach).
 #[test]
 fn a_high_approach_closes_on_the_slope_along_a_path_no_steeper_than_twice_the_slope() {
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
     let mut nav = navigator();
     let tan_slope = libm::tanf(nav.params().glide_slope);
-    let mut plane = Plane::flying(500.0, 0.0, 60.0, core::f32::consts::PI);
+    let mut plane = Plane::flying(800.0, 0.0, 90.0, core::f32::consts::PI);
     nav.start_mission(0);
     let log = fly(&mut nav, &mut plane, &items, 120.0, |o| {
         o.phase == Phase::Flare

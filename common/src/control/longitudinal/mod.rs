@@ -76,9 +76,7 @@ pub enum LonMode {
     /// As [`LonMode::Altitude`] for an altitude command that moves at `climb_rate` (a glide
     /// slope): in the hold regime the pitch command carries the flight-path angle that rate
     /// asks for, `asin(climb_rate / airspeed)`, so the altitude loop no longer lags the ramp
-    /// by the error its proportional gain needs to make that pitch; and the command is led by
-    /// `climb_rate / pole` of the altitude's feedback filter, which lags a ramp by as much
-    /// (read through it, an aircraft on a 1.3 m/s slope seems 0.65 m above it at 2 rad/s).
+    /// by the error its proportional gain needs to make that pitch.
     Glide {
         /// Altitude, m (same datum as the measured altitude).
         altitude: f32,
@@ -416,12 +414,6 @@ impl Longitudinal {
                     );
                 }
                 let floor = alt_f.map(|h| h - dive).filter(|f| f.is_finite());
-                let lead = -climb_rate / g.feedback_lpf_pole;
-                let altitude = if lead.is_finite() {
-                    altitude + lead
-                } else {
-                    altitude
-                };
                 (floor.map_or(altitude, |f| altitude.max(f)), airspeed, None)
             }
             LonMode::TakeOff {
@@ -781,97 +773,80 @@ mod tests {
         assert!(saw_hold);
     }
 
-    /// The glide of `rate` m/s flown exactly for ten seconds (the measured altitude on the
-    /// command all along) and, beside it, the altitude held exactly: their last outputs.
-    fn glide_flown_on_the_command(
-        rate: f32,
-        dive: f32,
-    ) -> (LongitudinalOutput, LongitudinalOutput) {
-        let g = THESIS;
-        let mut lon = Longitudinal::new(&g, 1.0);
-        let mut glide = LongitudinalOutput::default();
+    /// The last of ten seconds' outputs of a fresh law in `mode`, the measured altitude at
+    /// `altitude(t)`, 15 m/s.
+    fn ten_seconds(mode: LonMode, altitude: impl Fn(f32) -> f32) -> LongitudinalOutput {
+        let mut lon = Longitudinal::new(&THESIS, 1.0);
+        let mut o = LongitudinalOutput::default();
+        // Ten seconds: the engagement's bumpless offset has faded.
         for k in 0..500 {
-            let h = 40.0 + rate * k as f32 * DT;
-            let mode = LonMode::Glide {
-                altitude: h,
-                airspeed: 15.0,
-                climb_rate: rate,
-                dive,
-            };
-            glide = lon.step(&meas(0.0, h, 15.0), mode, DT);
+            o = lon.step(&meas(0.0, altitude(k as f32 * DT), 15.0), mode, DT);
         }
-        let mut lon = Longitudinal::new(&g, 1.0);
-        let mut hold = LongitudinalOutput::default();
-        for _ in 0..500 {
-            let mode = LonMode::Altitude {
-                altitude: 40.0,
-                airspeed: 15.0,
-            };
-            hold = lon.step(&meas(0.0, 40.0, 15.0), mode, DT);
-        }
-        (glide, hold)
+        o
     }
 
-    /// On a glide slope flown exactly, the pitch command is the hold's plus the flight-path
-    /// angle of the command's rate, `asin(climb_rate / airspeed)`: the command is led by the
-    /// altitude filter's lag on a ramp (`climb_rate / pole`), so the loop sees no error there
-    /// (unled, 1.3 m/s over the 2 rad/s pole read 0.65 m under the slope, 2.2 deg of pitch
-    /// at `ALT_KP` 0.06); a rate that is not a number loses only the feed-forward.
+    /// On a glide slope the pitch command carries the flight-path angle of the command's
+    /// rate, `asin(climb_rate / airspeed)`, on top of what the altitude loop asks for; a rate
+    /// that is not a number loses only that feed-forward.
     #[test]
-    fn a_glide_flown_on_its_slope_asks_the_holds_pitch_plus_the_slopes_flight_path_angle() {
-        let (down, hold) = glide_flown_on_the_command(-1.3, f32::INFINITY);
+    fn glide_feeds_the_flight_path_angle_forward() {
+        let hold = ten_seconds(
+            LonMode::Altitude {
+                altitude: 41.0,
+                airspeed: 15.0,
+            },
+            |_| 40.0,
+        );
+        let glide = |climb_rate| {
+            let mode = LonMode::Glide {
+                altitude: 41.0,
+                airspeed: 15.0,
+                climb_rate,
+                dive: 1.0,
+            };
+            ten_seconds(mode, |_| 40.0)
+        };
+        let down = glide(-1.3);
         assert_eq!(hold.regime, Some(Regime::AltitudeHold));
         assert_eq!(down.regime, Some(Regime::AltitudeHold));
         let gamma = libm::asinf(-1.3 / 15.0);
-        // The filter's zero-order hold lags a ramp by one period more than 1 / pole (0.013 m
-        // here, 0.8 mrad of pitch).
         assert!(
-            (down.pitch_cmd - hold.pitch_cmd - gamma).abs() < 2e-3,
+            (down.pitch_cmd - hold.pitch_cmd - gamma).abs() < 1e-4,
             "{} vs {} + {gamma}",
             down.pitch_cmd,
             hold.pitch_cmd
         );
-        let mut lon = Longitudinal::new(&THESIS, 1.0);
-        let mut bad = LongitudinalOutput::default();
-        for _ in 0..500 {
-            let mode = LonMode::Glide {
-                altitude: 40.0,
-                airspeed: 15.0,
-                climb_rate: f32::NAN,
-                dive: f32::INFINITY,
-            };
-            bad = lon.step(&meas(0.0, 40.0, 15.0), mode, DT);
-        }
+        let bad = glide(f32::NAN);
         assert!((bad.pitch_cmd - hold.pitch_cmd).abs() < 1e-6);
         assert!(bad.rejected.is_empty());
     }
 
     /// High above a slope, the command may lie no deeper than `dive` under the altitude the
-    /// loop flies by, whatever the aircraft's sink: the pitch command is the hold's plus the
-    /// slope's flight-path angle less `ALT_KP` times `dive`, at 1 m/s of sink as at 4. Taken
-    /// under the measured height instead, the filter's lag (sink / pole) added to it and the
-    /// dive fed itself: `gamma (1 - ALT_KP Va / pole) = gamma_slope - ALT_KP dive`, without
-    /// bound once `ALT_KP Va` reaches the pole.
+    /// loop flies by, whatever the aircraft's sink: the pitch command is that of a hold 1 m
+    /// under the aircraft plus the slope's flight-path angle, at 1 m/s of sink as at 4.
+    /// Taken under the measured height instead, the filter's lag (sink over its 2 rad/s pole)
+    /// deepened it, and the dive fed itself: the flight path settled at `(gamma_slope -
+    /// ALT_KP dive) / (1 - ALT_KP Va / pole)`, without bound once `ALT_KP Va` reaches the pole.
     #[test]
     fn above_the_slope_the_dive_floor_holds_the_loops_error_whatever_the_sink() {
-        let g = THESIS;
         let gamma = libm::asinf(-1.3 / 15.0);
-        let (_, hold) = glide_flown_on_the_command(-1.3, f32::INFINITY);
+        let hold = ten_seconds(
+            LonMode::Altitude {
+                altitude: 39.0,
+                airspeed: 15.0,
+            },
+            |_| 40.0,
+        );
         for sink in [1.0_f32, 4.0] {
-            let mut lon = Longitudinal::new(&g, 1.0);
-            let mut o = LongitudinalOutput::default();
-            for k in 0..500 {
-                let h = 80.0 - sink * k as f32 * DT;
-                let mode = LonMode::Glide {
-                    altitude: 20.0,
-                    airspeed: 15.0,
-                    climb_rate: -1.3,
-                    dive: 1.0,
-                };
-                o = lon.step(&meas(0.0, h, 15.0), mode, DT);
-            }
+            let mode = LonMode::Glide {
+                altitude: 20.0,
+                airspeed: 15.0,
+                climb_rate: -1.3,
+                dive: 1.0,
+            };
+            let o = ten_seconds(mode, |t| 80.0 - sink * t);
             assert_eq!(o.regime, Some(Regime::AltitudeHold));
-            let expected = hold.pitch_cmd + gamma - g.alt_kp * 1.0;
+            let expected = hold.pitch_cmd + gamma;
             assert!(
                 (o.pitch_cmd - expected).abs() < 1e-4,
                 "sinking {sink} m/s: {} vs {expected}",
