@@ -1615,6 +1615,23 @@ fn a_landed_aircraft_lifted_by_a_gust_flares_again_and_does_not_go_around() {
     assert_ne!(out.phase, Phase::GoAround);
 }
 
+/// An approach still above the flare's height past the land point goes around once it is
+/// `NAV_LND_ABORT_M` (20 m) past, as a floating flare does: not 19 m past, at 21 m.
+#[test]
+fn an_approach_still_high_past_the_abort_distance_goes_around() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
+    nav.start_mission(0);
+    let _ = fly(&mut nav, &mut plane, &items, 2.0, |_| false);
+    // Held 10 m up (over the flare's 4 m) down the runway's line, heading south.
+    for (north, phase) in [(-19.0, Phase::Approach), (-21.0, Phase::GoAround)] {
+        plane.k.pos = Vector3::new(north, 0.0, -10.0);
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        assert_eq!(out.phase, phase, "{north} m north of the point");
+    }
+}
+
 /// A flare still in the air 20 m past the land point (`NAV_LND_ABORT_M`) goes around: it
 /// climbs away on the runway's line at full throttle (the take-off regime) to the approach's
 /// start height (30 m here), flies back on a leg parallel to the runway two loiter radii

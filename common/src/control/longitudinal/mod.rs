@@ -413,8 +413,15 @@ impl Longitudinal {
                         g.pitch_max,
                     );
                 }
-                let floor = alt_f.map(|h| h - dive).filter(|f| f.is_finite());
-                (floor.map_or(altitude, |f| altitude.max(f)), airspeed, None)
+                // A bad command stays bad (refused below); `max` passes over a floor that is
+                // not a number (no altitude yet, or a bad `dive`).
+                let floor = alt_f.unwrap_or(f32::NAN) - dive;
+                let altitude = if altitude.is_finite() {
+                    altitude.max(floor)
+                } else {
+                    altitude
+                };
+                (altitude, airspeed, None)
             }
             LonMode::TakeOff {
                 altitude,
@@ -851,6 +858,26 @@ mod tests {
                 (o.pitch_cmd - expected).abs() < 1e-4,
                 "sinking {sink} m/s: {} vs {expected}",
                 o.pitch_cmd
+            );
+        }
+    }
+
+    /// A glide's altitude command that is not a finite number is refused as the hold's is,
+    /// the dive floor notwithstanding (a floor taken over it would fly a command nobody
+    /// gave).
+    #[test]
+    fn a_bad_glide_command_is_refused_whatever_its_floor() {
+        for altitude in [f32::NAN, f32::NEG_INFINITY, f32::INFINITY] {
+            let mode = LonMode::Glide {
+                altitude,
+                airspeed: 15.0,
+                climb_rate: -1.3,
+                dive: 1.0,
+            };
+            let o = ten_seconds(mode, |_| 40.0);
+            assert!(
+                o.rejected.contains(InputFlags::COMMAND),
+                "{altitude}: {o:?}"
             );
         }
     }

@@ -435,6 +435,13 @@ impl Landing {
             self.touched = false;
             self.ground_time = 0.0;
         }
+        // Floated or bounced past the point by more than the landing may be long, or lifted
+        // by a gust out of the flare: go around. Still on the approach, above the flare's
+        // height, that far past the point, the runway left is too short for a flare from
+        // there (a glide pulled up from under the slope floated one aircraft 230 m down the
+        // runway at 3-5 m): go around as well.
+        let long = p.land_abort > 0.0 && -signed_to_go > p.land_abort;
+        let mut abort = self.phase == LandPhase::Approach && long;
         if self.phase == LandPhase::Flare {
             let sink = sink_now;
             let on_ground = hagl < p.touchdown_alt || state.ground_speed() < ROLLING_SPEED;
@@ -453,23 +460,19 @@ impl Landing {
             if self.ground_time >= TOUCHDOWN_S {
                 self.phase = LandPhase::Landed;
             }
-            // Floated or bounced past the point by more than the landing may be long, or
-            // lifted by a gust out of the flare: go around.
-            let long = p.land_abort > 0.0 && -signed_to_go > p.land_abort;
             let airborne = hagl > p.touchdown_alt;
             // From `NAV_LIFTOFF_ASPD` up the wing lifts the weight even at the attitude on
             // the wheels, so the aircraft can climb away; slower, it is rolling (an estimated
             // height tenths of a metre off may say otherwise), and full throttle there put one
             // aircraft of 1000 on its nose.
             let flying = state.airspeed >= p.liftoff_airspeed;
-            if flying
+            abort = flying
                 && self.rollout_s == 0.0
-                && (long && airborne || hagl > BALLOON_FLARES * flare_top)
-                && self.go_around()
-            {
-                self.step_circuit(f, &line, out);
-                return;
-            }
+                && (long && airborne || hagl > BALLOON_FLARES * flare_top);
+        }
+        if abort && self.go_around() {
+            self.step_circuit(f, &line, out);
+            return;
         }
         match self.phase {
             LandPhase::Approach => {
@@ -486,16 +489,12 @@ impl Landing {
                 if self.capture.is_nan() {
                     self.capture = (state.height() - slope).max(0.0);
                 }
-                let close = (self.capture / p.approach_capture_s)
-                    .min(tan_slope * along)
-                    .max(0.0);
-                let close = if close.is_finite() { close } else { 0.0 };
+                // Finite and not negative: `along` and the slope are, the height left is not
+                // (the `max` below passes over a NaN), and `min` passes over a NaN.
+                let close = (self.capture / p.approach_capture_s).min(tan_slope * along);
                 self.capture = (self.capture - close * dt).max(0.0);
                 let climb_rate = climb_rate - close;
                 let slope = slope + self.capture;
-                if let Some(shown) = out.guidance.as_mut() {
-                    shown.altitude = slope + self.slope_trim - self.range_excess;
-                }
                 let err = slope - state.height();
                 if climb_rate != 0.0 && libm::fabsf(err) < SLOPE_TRIM_MAX_M {
                     self.slope_trim = (self.slope_trim + p.approach_i * err * dt)
