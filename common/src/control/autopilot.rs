@@ -649,7 +649,6 @@ mod tests {
                             altitude: val(300.0),
                             airspeed: val(30.0),
                             climb_rate: val(5.0),
-                            dive: val(10.0),
                         },
                         _ => LonMode::Altitude {
                             altitude: val(300.0),

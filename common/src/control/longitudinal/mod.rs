@@ -84,10 +84,6 @@ pub enum LonMode {
         airspeed: f32,
         /// Rate at which `altitude` moves, m/s, up positive.
         climb_rate: f32,
-        /// Deepest the command may lie below the altitude the loop flies by (its filtered
-        /// feedback), m: above the slope the aircraft closes on it at the altitude loop's
-        /// gain times this, not in a dive (infinite: no floor).
-        dive: f32,
     },
     /// As [`LonMode::Altitude`], starting in the take-off regime while below `clear_altitude`.
     TakeOff {
@@ -400,7 +396,6 @@ impl Longitudinal {
                 altitude,
                 airspeed,
                 climb_rate,
-                dive,
             } => {
                 // A bad rate or airspeed only loses the feed-forward; the loop still holds
                 // the altitude command.
@@ -413,14 +408,6 @@ impl Longitudinal {
                         g.pitch_max,
                     );
                 }
-                // A bad command stays bad (refused below); `max` passes over a floor that is
-                // not a number (no altitude yet, or a bad `dive`).
-                let floor = alt_f.unwrap_or(f32::NAN) - dive;
-                let altitude = if altitude.is_finite() {
-                    altitude.max(floor)
-                } else {
-                    altitude
-                };
                 (altitude, airspeed, None)
             }
             LonMode::TakeOff {
@@ -780,38 +767,31 @@ mod tests {
         assert!(saw_hold);
     }
 
-    /// The last of ten seconds' outputs of a fresh law in `mode`, the measured altitude at
-    /// `altitude(t)`, 15 m/s.
-    fn ten_seconds(mode: LonMode, altitude: impl Fn(f32) -> f32) -> LongitudinalOutput {
-        let mut lon = Longitudinal::new(&THESIS, 1.0);
-        let mut o = LongitudinalOutput::default();
-        // Ten seconds: the engagement's bumpless offset has faded.
-        for k in 0..500 {
-            o = lon.step(&meas(0.0, altitude(k as f32 * DT), 15.0), mode, DT);
-        }
-        o
-    }
-
     /// On a glide slope the pitch command carries the flight-path angle of the command's
     /// rate, `asin(climb_rate / airspeed)`, on top of what the altitude loop asks for; a rate
     /// that is not a number loses only that feed-forward.
     #[test]
     fn glide_feeds_the_flight_path_angle_forward() {
-        let hold = ten_seconds(
-            LonMode::Altitude {
-                altitude: 41.0,
-                airspeed: 15.0,
-            },
-            |_| 40.0,
-        );
+        let g = THESIS;
+        let run = |mode: LonMode| {
+            let mut lon = Longitudinal::new(&g, 1.0);
+            let mut o = LongitudinalOutput::default();
+            // Ten seconds: the engagement's bumpless offset has faded.
+            for _ in 0..500 {
+                o = lon.step(&meas(0.0, 40.0, 15.0), mode, DT);
+            }
+            o
+        };
+        let hold = run(LonMode::Altitude {
+            altitude: 41.0,
+            airspeed: 15.0,
+        });
         let glide = |climb_rate| {
-            let mode = LonMode::Glide {
+            run(LonMode::Glide {
                 altitude: 41.0,
                 airspeed: 15.0,
                 climb_rate,
-                dive: 1.0,
-            };
-            ten_seconds(mode, |_| 40.0)
+            })
         };
         let down = glide(-1.3);
         assert_eq!(hold.regime, Some(Regime::AltitudeHold));
@@ -828,53 +808,17 @@ mod tests {
         assert!(bad.rejected.is_empty());
     }
 
-    /// High above a slope, the command may lie no deeper than `dive` under the altitude the
-    /// loop flies by, whatever the aircraft's sink: the pitch command is that of a hold 1 m
-    /// under the aircraft plus the slope's flight-path angle, at 1 m/s of sink as at 4.
-    /// Taken under the measured height instead, the filter's lag (sink over its 2 rad/s pole)
-    /// deepened it, and the dive fed itself: the flight path settled at `(gamma_slope -
-    /// ALT_KP dive) / (1 - ALT_KP Va / pole)`, without bound once `ALT_KP Va` reaches the pole.
+    /// A glide's altitude command that is not a finite number is refused as the hold's is.
     #[test]
-    fn above_the_slope_the_dive_floor_holds_the_loops_error_whatever_the_sink() {
-        let gamma = libm::asinf(-1.3 / 15.0);
-        let hold = ten_seconds(
-            LonMode::Altitude {
-                altitude: 39.0,
-                airspeed: 15.0,
-            },
-            |_| 40.0,
-        );
-        for sink in [1.0_f32, 4.0] {
-            let mode = LonMode::Glide {
-                altitude: 20.0,
-                airspeed: 15.0,
-                climb_rate: -1.3,
-                dive: 1.0,
-            };
-            let o = ten_seconds(mode, |t| 80.0 - sink * t);
-            assert_eq!(o.regime, Some(Regime::AltitudeHold));
-            let expected = hold.pitch_cmd + gamma;
-            assert!(
-                (o.pitch_cmd - expected).abs() < 1e-4,
-                "sinking {sink} m/s: {} vs {expected}",
-                o.pitch_cmd
-            );
-        }
-    }
-
-    /// A glide's altitude command that is not a finite number is refused as the hold's is,
-    /// the dive floor notwithstanding (a floor taken over it would fly a command nobody
-    /// gave).
-    #[test]
-    fn a_bad_glide_command_is_refused_whatever_its_floor() {
+    fn a_bad_glide_command_is_refused() {
         for altitude in [f32::NAN, f32::NEG_INFINITY, f32::INFINITY] {
+            let mut lon = Longitudinal::new(&THESIS, 1.0);
             let mode = LonMode::Glide {
                 altitude,
                 airspeed: 15.0,
                 climb_rate: -1.3,
-                dive: 1.0,
             };
-            let o = ten_seconds(mode, |_| 40.0);
+            let o = lon.step(&meas(0.0, 40.0, 15.0), mode, DT);
             assert!(
                 o.rejected.contains(InputFlags::COMMAND),
                 "{altitude}: {o:?}"
@@ -1110,7 +1054,6 @@ mod tests {
             altitude: 90.0,
             airspeed: 15.0,
             climb_rate: -1.0,
-            dive: 1.0,
         };
         let mut prev = lon.step(&meas(0.0, 100.0, 15.0), mode, DT);
         let mut o = prev;

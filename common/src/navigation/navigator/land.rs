@@ -154,10 +154,6 @@ pub(super) struct Landing {
     ground_time: f32,
     /// The approach's integral of the height error, m (added to the altitude command).
     slope_trim: f32,
-    /// Height above the glide slope the approach still closes, m: where the approach began
-    /// above the slope (the last turn ended over it), decaying over `NAV_APP_CAPT_S`;
-    /// NaN until the approach's first step.
-    capture: f32,
     /// The wheels have touched (low and rising again): the flare is over and the pitch
     /// is held at 0 (a taildragger's main wheels, ahead of the centre of gravity, pitch it up
     /// as they touch; holding the flare's attitude there lifts it off again).
@@ -221,7 +217,6 @@ impl Landing {
             phase: LandPhase::Approach,
             ground_time: 0.0,
             slope_trim: 0.0,
-            capture: f32::NAN,
             touched: false,
             rollout_s: 0.0,
             go_arounds: 0,
@@ -438,8 +433,8 @@ impl Landing {
         // Floated or bounced past the point by more than the landing may be long, or lifted
         // by a gust out of the flare: go around. Still on the approach, above the flare's
         // height, that far past the point, the runway left is too short for a flare from
-        // there (a glide pulled up from under the slope floated one aircraft 230 m down the
-        // runway at 3-5 m): go around as well.
+        // there (a glide pulled up from under the slope has floated an aircraft 230 m down
+        // the runway at 3-5 m): go around as well.
         let long = p.land_abort > 0.0 && -signed_to_go > p.land_abort;
         let mut abort = self.phase == LandPhase::Approach && long;
         if self.phase == LandPhase::Flare {
@@ -477,24 +472,10 @@ impl Landing {
         match self.phase {
             LandPhase::Approach => {
                 out.phase = Phase::Approach;
-                // The altitude loop is proportional: on the slope it settles off it by what
-                // its gain needs for the pitch the slope's feed-forward misses (the approach
-                // flies slower, on less throttle, than the trim). A slow integral of the
-                // height error takes that out.
+                // The altitude loop is proportional: on the slope it settles below it by what
+                // its gain needs to make the pitch the slower approach flies at (a metre on
+                // the Ultra Stick). A slow integral of the height error takes that out.
                 let slope = g.altitude + self.range_excess;
-                // Found above the slope (the turn onto the final leg ends over it), the
-                // approach closes that height along a path that joins the slope with no kink,
-                // at most as steep again as the slope: a command that steps onto the slope
-                // asks the altitude loop for a dive it then overshoots.
-                if self.capture.is_nan() {
-                    self.capture = (state.height() - slope).max(0.0);
-                }
-                // Finite and not negative: `along` and the slope are, the height left is not
-                // (the `max` below passes over a NaN), and `min` passes over a NaN.
-                let close = (self.capture / p.approach_capture_s).min(tan_slope * along);
-                self.capture = (self.capture - close * dt).max(0.0);
-                let climb_rate = climb_rate - close;
-                let slope = slope + self.capture;
                 let err = slope - state.height();
                 if climb_rate != 0.0 && libm::fabsf(err) < SLOPE_TRIM_MAX_M {
                     self.slope_trim = (self.slope_trim + p.approach_i * err * dt)
@@ -502,15 +483,14 @@ impl Landing {
                 }
                 // Caught high by a gust near the ground, the aircraft is not dived back onto
                 // the slope (that arrives at the flare sinking fast): the command stays within
-                // `NAV_APP_DIVE_M` below the height the altitude loop flies by, and the
-                // landing is long instead.
+                // `NAV_APP_DIVE_M` below the present height, and the landing is long instead.
+                let cmd = (slope + self.slope_trim).max(state.height() - p.approach_dive);
                 out.commands = Some(Commands {
                     roll: course_near_runway(g.course, hagl, p.ground_roll_height, p),
                     lon: LonMode::Glide {
-                        altitude: slope + self.slope_trim,
+                        altitude: cmd,
                         airspeed: g.airspeed,
                         climb_rate,
-                        dive: p.approach_dive,
                     },
                     ..follow(&g)
                 });

@@ -347,17 +347,6 @@ pub const PARAMS: Group<NavParams> = Group {
         ),
         param!(
             ParamDef::real(
-                "NAV_APP_CAPT_S",
-                8.0,
-                0.5,
-                60.0,
-                "s",
-                "Approach: time constant closing the height above the slope found at its start (sinking at most twice the slope's rate)",
-            ),
-            NavParams => approach_capture_s
-        ),
-        param!(
-            ParamDef::real(
                 "NAV_APP_I",
                 0.1,
                 0.0,
@@ -564,8 +553,6 @@ pub struct NavParams {
     pub approach_i: f32,
     /// Largest height the approach's command lies below the present height, m.
     pub approach_dive: f32,
-    /// Approach: time constant of the capture onto the slope from above, s.
-    pub approach_capture_s: f32,
     /// Flare's sink aim per metre past the land point, 1/s.
     pub flare_past_k: f32,
     /// Flare throttle at the flare height, 0..1.
@@ -612,7 +599,6 @@ const ZERO: NavParams = NavParams {
     liftoff_airspeed: 0.0,
     approach_i: 0.0,
     approach_dive: 0.0,
-    approach_capture_s: 0.0,
     flare_past_k: 0.0,
     flare_throttle: 0.0,
 };
