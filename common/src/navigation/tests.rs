@@ -1613,9 +1613,7 @@ fn a_landed_aircraft_lifted_by_a_gust_flares_again_and_does_not_go_around() {
 fn an_approach_still_high_past_the_abort_distance_goes_around() {
     let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
     let mut nav = navigator();
-    let mut plane = Plane::flying(300.0, 0.0, 30.0, core::f32::consts::PI);
-    nav.start_mission(0);
-    let _ = fly(&mut nav, &mut plane, &items, 2.0, |_| false);
+    let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
     // Held 10 m up (over the flare's 4 m) down the runway's line, heading south.
     for (north, phase) in [(-19.0, Phase::Approach), (-21.0, Phase::GoAround)] {
         plane.k.pos = Vector3::new(north, 0.0, -10.0);

@@ -224,9 +224,6 @@ fn samples(bytes: &[u8]) -> Vec<Timed> {
     out
 }
 
-/// A ULog file's first bytes ("ULog", then 0x01 0x12 0x35).
-const ULOG_MAGIC: &[u8] = b"ULog\x01\x12\x35";
-
 /// Longest median interval between a flight log's surface samples that the fits take, s: the
 /// control rate's 20 ms and some room (the default profile's 40 ms does not resolve a 60 ms
 /// roll mode).
@@ -364,7 +361,7 @@ pub fn identify_log(
     window: Option<(f64, f64)>,
 ) -> anyhow::Result<IdentifyReport> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    let flight_log = bytes.starts_with(ULOG_MAGIC);
+    let flight_log = bytes.starts_with(&common::ulog::MAGIC);
     let all = if flight_log {
         ulog_samples(path, &bytes)?
     } else {
@@ -428,22 +425,19 @@ pub fn identify_log(
             / flown.len() as f64
     });
     let servo_tau = 1.0 / (2.0 * std::f64::consts::PI * aircraft.actuators.bandwidth_Hz);
+    // The autopilot's estimate carries its sensors' noise: fitted through the pre-filters the
+    // vehicle fits its own through; the truth needs none.
+    let (airspeed_filter_tau_s, attitude_filter_tau_s) = if flight_log {
+        (AIRSPEED_FILTER_TAU_S, ATTITUDE_FILTER_TAU_S)
+    } else {
+        (0.0, 0.0)
+    };
     let mut id = Identifier::new(IdentifyConfig {
         airspeed_ref: va_ref as f32,
         servo_tau_s: servo_tau as f32,
         servo_rate_radps: aircraft.actuators.rate_limit_radps as f32,
-        // The autopilot's estimate carries its sensors' noise: fitted through the pre-filters
-        // the vehicle fits its own through; the truth needs none.
-        airspeed_filter_tau_s: if flight_log {
-            AIRSPEED_FILTER_TAU_S
-        } else {
-            0.0
-        },
-        attitude_filter_tau_s: if flight_log {
-            ATTITUDE_FILTER_TAU_S
-        } else {
-            0.0
-        },
+        airspeed_filter_tau_s,
+        attitude_filter_tau_s,
     });
     let mut last: Option<u64> = None;
     for s in &flown {
