@@ -69,11 +69,69 @@ impl Surfaces {
         }
         .saturated()
     }
+
+    /// The outputs as `SERVO_OUTPUT_RAW` reports them, µs, in the order of
+    /// [`Surfaces::to_px4_controls`]: a surface's -1..1 on 1000..2000 (1500 neutral), the
+    /// throttle's 0..1 on 1000..2000, as PX4's outputs map the same controls.
+    pub fn to_pwm_us(self) -> [u16; 4] {
+        let c = self.to_px4_controls();
+        let us = |x: f32, centre: f32, half_span: f32| (centre + half_span * x + 0.5) as u16;
+        [
+            us(c[0], PWM_CENTRE_US, PWM_HALF_SPAN_US),
+            us(c[1], PWM_CENTRE_US, PWM_HALF_SPAN_US),
+            us(c[2], PWM_CENTRE_US, PWM_HALF_SPAN_US),
+            us(c[3], PWM_MIN_US, 2.0 * PWM_HALF_SPAN_US),
+        ]
+    }
+
+    /// The inverse of [`Surfaces::to_pwm_us`] (to its 1 µs steps); out-of-range values are
+    /// clamped.
+    pub fn from_pwm_us(us: [u16; 4]) -> Self {
+        let surface = |x: u16| (f32::from(x) - PWM_CENTRE_US) / PWM_HALF_SPAN_US;
+        Self::from_px4_controls([
+            surface(us[0]),
+            surface(us[1]),
+            surface(us[2]),
+            (f32::from(us[3]) - PWM_MIN_US) / (2.0 * PWM_HALF_SPAN_US),
+        ])
+    }
 }
+
+/// A surface's neutral pulse, µs.
+const PWM_CENTRE_US: f32 = 1500.0;
+/// The pulse of no throttle, µs.
+const PWM_MIN_US: f32 = 1000.0;
+/// Half the pulses' span, µs (a surface's full travel either way).
+const PWM_HALF_SPAN_US: f32 = 500.0;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_pulses_carry_the_outputs_to_a_microsecond() {
+        let s = Surfaces {
+            elevator: -0.1,
+            aileron: 0.2,
+            rudder: 0.05,
+            throttle: 0.37,
+        };
+        // +0.2 rad of aileron rolls left: -0.458 of PX4's roll control, 1500 - 229 us.
+        assert_eq!(s.to_pwm_us(), [1271, 1615, 1443, 1370]);
+        let back = Surfaces::from_pwm_us(s.to_pwm_us());
+        // One microsecond is 0.05 deg of surface and 0.1 % of throttle.
+        let step = SURFACE_LIMIT_RAD / 500.0;
+        assert!((back.aileron - s.aileron).abs() <= step / 2.0 + 1e-6);
+        assert!((back.elevator - s.elevator).abs() <= step / 2.0 + 1e-6);
+        assert!((back.rudder - s.rudder).abs() <= step / 2.0 + 1e-6);
+        assert!((back.throttle - s.throttle).abs() <= 0.0005 + 1e-6);
+        // Out of range, clamped to the travel.
+        assert_eq!(Surfaces::from_pwm_us([0, 3000, 1500, 2500]).throttle, 1.0);
+        assert_eq!(
+            Surfaces::from_pwm_us([0, 3000, 1500, 2500]).aileron,
+            SURFACE_LIMIT_RAD
+        );
+    }
 
     #[test]
     fn px4_sense_is_opposite_to_umn_surfaces() {

@@ -404,6 +404,39 @@ pub(crate) struct FlyArgs {
     /// QGroundControl's "Load from file" does; `--param` values follow them.
     #[arg(long = "params", value_name = "FILE.params", value_parser = parse_params_file)]
     pub(crate) params_file: Option<ParamsFile>,
+    /// Ask the autopilot for a message at a rate before arming (MAV_CMD_SET_MESSAGE_INTERVAL,
+    /// as QGroundControl's MAVLink Inspector or MAVProxy sends it); repeatable:
+    /// `--message-rate SERVO_OUTPUT_RAW=50`. The ground link's `.tlog` (OUT/flight.tlog)
+    /// then carries it (`sim-host identify` reads ATTITUDE, SERVO_OUTPUT_RAW,
+    /// GLOBAL_POSITION_INT and VFR_HUD at 50 Hz; docs/AUTOTUNE.md).
+    #[arg(long = "message-rate", value_name = "MESSAGE=HZ", value_parser = parse_message_rate)]
+    pub(crate) message_rates: Vec<(u32, f32)>,
+}
+
+/// A message of the common dialect and a rate: `SERVO_OUTPUT_RAW=50`.
+fn parse_message_rate(s: &str) -> Result<(u32, f32), String> {
+    use mavlink::Message;
+    let (name, hz) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}`: expected MESSAGE=HZ"))?;
+    let id = mavlink::dialects::common::MavMessage::message_id_from_name(name.trim()).ok_or_else(
+        || {
+            format!(
+                "`{s}`: no message `{}` in MAVLink's common set",
+                name.trim()
+            )
+        },
+    )?;
+    let hz: f32 = hz
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: rate `{hz}`: {e}"))?;
+    if !(hz.is_finite() && hz > 0.0 && hz <= 1000.0) {
+        return Err(format!(
+            "`{s}`: rate {hz} Hz: expected over 0 and at most 1000 Hz"
+        ));
+    }
+    Ok((id, hz))
 }
 
 /// The parameters of a `.params` file, in its order.
@@ -459,6 +492,7 @@ impl FlyArgs {
             mission: self.mission,
             stick_doublets: self.stick_doublets,
             autotune: self.autotune,
+            message_rates: self.message_rates,
             params: self
                 .params_file
                 .map(|f| f.0)

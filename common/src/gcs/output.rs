@@ -62,6 +62,7 @@ pub(crate) fn stream_message(s: Stream, src: &Sources<'_, '_>) -> Option<MavMess
         Stream::HomePosition => telemetry::home_position(v, now_us)?,
         Stream::ExtendedSysState => telemetry::extended_sys_state(v),
         Stream::CurrentMode => telemetry::current_mode(v, src.intended),
+        Stream::ServoOutputRaw => telemetry::servo_output_raw(v, now_us),
     })
 }
 

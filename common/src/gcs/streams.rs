@@ -6,7 +6,7 @@
 use mavlink::dialects::common::{
     ATTITUDE_DATA, BATTERY_STATUS_DATA, CURRENT_MODE_DATA, EXTENDED_SYS_STATE_DATA,
     GLOBAL_POSITION_INT_DATA, GPS_RAW_INT_DATA, HOME_POSITION_DATA, MISSION_CURRENT_DATA,
-    NAV_CONTROLLER_OUTPUT_DATA, SYS_STATUS_DATA, VFR_HUD_DATA,
+    NAV_CONTROLLER_OUTPUT_DATA, SERVO_OUTPUT_RAW_DATA, SYS_STATUS_DATA, VFR_HUD_DATA,
 };
 use mavlink::MessageData;
 
@@ -36,10 +36,13 @@ pub enum Stream {
     ExtendedSysState,
     /// `CURRENT_MODE` (436).
     CurrentMode,
+    /// `SERVO_OUTPUT_RAW` (36): the surfaces and the throttle flown, as PWM (what a station
+    /// logs for identification from the ground link: `sim-host identify`).
+    ServoOutputRaw,
 }
 
 /// Number of streams.
-pub const STREAM_COUNT: usize = 11;
+pub const STREAM_COUNT: usize = 12;
 
 impl Stream {
     /// Every stream, in the order they are emitted when due together.
@@ -55,6 +58,7 @@ impl Stream {
         Stream::HomePosition,
         Stream::ExtendedSysState,
         Stream::CurrentMode,
+        Stream::ServoOutputRaw,
     ];
 
     /// MAVLink message id.
@@ -71,6 +75,7 @@ impl Stream {
             Stream::HomePosition => HOME_POSITION_DATA::ID,
             Stream::ExtendedSysState => EXTENDED_SYS_STATE_DATA::ID,
             Stream::CurrentMode => CURRENT_MODE_DATA::ID,
+            Stream::ServoOutputRaw => SERVO_OUTPUT_RAW_DATA::ID,
         }
     }
 
@@ -81,7 +86,7 @@ impl Stream {
 
     /// Default interval, µs (PX4 normal-mode rates: ATTITUDE 15 Hz, GLOBAL_POSITION_INT 5 Hz,
     /// VFR_HUD 4 Hz, SYS_STATUS/GPS_RAW_INT/NAV_CONTROLLER_OUTPUT/EXTENDED_SYS_STATE/
-    /// MISSION_CURRENT 1 Hz, BATTERY_STATUS/HOME_POSITION/CURRENT_MODE 0.5 Hz).
+    /// MISSION_CURRENT/SERVO_OUTPUT_RAW 1 Hz, BATTERY_STATUS/HOME_POSITION/CURRENT_MODE 0.5 Hz).
     pub const fn default_interval_us(self) -> u32 {
         match self {
             Stream::Attitude => 66_667,
@@ -91,7 +96,8 @@ impl Stream {
             | Stream::GpsRawInt
             | Stream::NavControllerOutput
             | Stream::ExtendedSysState
-            | Stream::MissionCurrent => 1_000_000,
+            | Stream::MissionCurrent
+            | Stream::ServoOutputRaw => 1_000_000,
             Stream::BatteryStatus | Stream::HomePosition | Stream::CurrentMode => 2_000_000,
         }
     }
@@ -101,7 +107,7 @@ impl Stream {
     }
 }
 
-/// Time between the first emissions of two streams, µs (see [`Scheduler::new`]): the eleven
+/// Time between the first emissions of two streams, µs (see [`Scheduler::new`]): the twelve
 /// places 90 ms apart lie within the first second, each in a 20 ms control period of its own.
 pub const FIRST_DUE_STEP_US: u64 = 90_000;
 

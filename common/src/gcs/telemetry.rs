@@ -306,7 +306,22 @@ pub fn vfr_hud(v: &VehicleSnapshot) -> MavMessage {
         alt: v.alt_amsl_m,
         climb: -v.vel_d,
         heading: heading_deg(v.yaw) as i16,
-        throttle: (v.throttle.clamp(0.0, 1.0) * 100.0) as u16,
+        throttle: (v.outputs.throttle.clamp(0.0, 1.0) * 100.0) as u16,
+    })
+}
+
+/// `SERVO_OUTPUT_RAW` of output port 0: aileron, elevator, rudder and throttle on servos 1-4
+/// as [`crate::actuators::Surfaces::to_pwm_us`] maps them; `time_usec` the boot clock (µs,
+/// wrapping with its 32 bits every 71 min, as the message has it).
+pub fn servo_output_raw(v: &VehicleSnapshot, now_us: u64) -> MavMessage {
+    let [servo1_raw, servo2_raw, servo3_raw, servo4_raw] = v.outputs.to_pwm_us();
+    MavMessage::SERVO_OUTPUT_RAW(SERVO_OUTPUT_RAW_DATA {
+        time_usec: now_us as u32,
+        servo1_raw,
+        servo2_raw,
+        servo3_raw,
+        servo4_raw,
+        ..Default::default()
     })
 }
 

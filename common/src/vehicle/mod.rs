@@ -302,7 +302,7 @@ impl Vehicle {
         let extras = report::Extras {
             time_us: self.clock.now_us(),
             gps: self.last_gps,
-            throttle: self.surfaces.throttle,
+            outputs: self.surfaces,
             clock: self.clock.stats(),
             battery: self.battery.report(self.clock.now_us()),
             airspeed_range_m_s: {

@@ -16,8 +16,8 @@ pub struct Extras {
     pub time_us: Option<u64>,
     /// The last accepted GPS fix.
     pub gps: Option<GpsFix>,
-    /// Throttle commanded, 0..1.
-    pub throttle: f32,
+    /// The surfaces and throttle commanded.
+    pub outputs: crate::actuators::Surfaces,
     /// The clock's counters.
     pub clock: super::clock::ClockStats,
     /// The battery monitor's report.
@@ -106,7 +106,10 @@ pub fn snapshot(e: &EstimatedState, c: &Commander, x: &Extras) -> VehicleSnapsho
         vel_d: e.vel_ned.z,
         airspeed: e.airspeed,
         airspeed_range_m_s: x.airspeed_range_m_s,
-        throttle: if c.armed() { x.throttle } else { 0.0 },
+        outputs: crate::actuators::Surfaces {
+            throttle: if c.armed() { x.outputs.throttle } else { 0.0 },
+            ..x.outputs
+        },
         home,
         gps,
         battery: x.battery,

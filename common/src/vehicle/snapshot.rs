@@ -175,8 +175,8 @@ pub struct VehicleSnapshot {
     pub airspeed: f32,
     /// Airspeeds the vehicle may be asked to hold, m/s (`NAV_ASPD_MIN`, `NAV_ASPD_MAX`).
     pub airspeed_range_m_s: (f32, f32),
-    /// Throttle command, 0..1.
-    pub throttle: f32,
+    /// The surfaces and throttle commanded (the throttle 0 while disarmed).
+    pub outputs: crate::actuators::Surfaces,
     /// Home position.
     pub home: HomeReport,
     /// GPS receiver solution.

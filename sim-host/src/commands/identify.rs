@@ -13,6 +13,12 @@
 //! along the nose, averaged), and the angle of attack is the velocity's through it. Gusts are
 //! not: in turbulence the angle of attack carries them as noise.
 //!
+//! Or the log is a ground link's `.tlog`, as a station records the autopilot's telemetry, with
+//! `ATTITUDE`, `SERVO_OUTPUT_RAW`, `GLOBAL_POSITION_INT` and `VFR_HUD` asked for at 50 Hz: the
+//! same samples from the autopilot's estimate, its surfaces from the servo pulses, without the
+//! sideslip model (no accelerometer among those messages). At slower rates it is refused with
+//! the messages named.
+//!
 //! Or the log is the autopilot's own flight log (a `.ulg`, as the board writes it and a station
 //! downloads it), written with `SDLOG_PROFILE`'s system-identification bit (8) so that its
 //! attitude, rates, accelerations, surfaces, velocity and airspeed come at every 100 Hz sensor
@@ -24,21 +30,16 @@
 
 use crate::aircraft::Aircraft;
 use crate::commands::linearize::linearize_report_at;
-use crate::link::tlog::read_tlog;
 use crate::report::sig;
 use crate::report::table::Table;
 use anyhow::{bail, Context};
-use common::actuators::Surfaces;
-use common::gcs::{COMPONENT_ID, SYSTEM_ID};
-use common::link::framing::FrameParser;
-use common::math::frames::{body_to_ned, course_and_speed, ned_to_body, AirData, Euler};
-use common::math::{RAD2DEG, STANDARD_GRAVITY};
+use common::math::frames::{body_to_ned, ned_to_body, AirData};
+use common::math::RAD2DEG;
 use common::tuning::identify::{
     Axis, AxisError, Identifier, IdentifyConfig, Sample, AIRSPEED_FILTER_TAU_S,
     ATTITUDE_FILTER_TAU_S,
 };
-use mavlink::dialects::common::MavMessage;
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -137,201 +138,8 @@ impl IdentifyReport {
     }
 }
 
-/// One sample of the log with its time and height, and the attitude and ground velocity its
-/// angle of attack is read from once the wind is known.
-#[derive(Clone, Copy)]
-struct Timed {
-    time_us: u64,
-    alt_m: f64,
-    armed: bool,
-    attitude: UnitQuaternion<f64>,
-    v_ned: Vector3<f64>,
-    sample: Sample,
-}
-
-/// The samples of a simulator-link `.tlog`: each truth frame joined with the autopilot's
-/// answer to it.
-fn samples(bytes: &[u8]) -> Vec<Timed> {
-    let mut parser = FrameParser::new();
-    // The last truth frame, waiting for the autopilot's answer to it.
-    let mut truth: Option<Timed> = None;
-    let mut out = Vec::new();
-    for (_, frame) in read_tlog(bytes) {
-        parser.push(&frame, |f| match f.message {
-            MavMessage::HIL_STATE_QUATERNION(d) => {
-                let q = d.attitude_quaternion.map(f64::from);
-                let Some(q) =
-                    UnitQuaternion::try_new(Quaternion::new(q[0], q[1], q[2], q[3]), 1e-6)
-                else {
-                    return;
-                };
-                let e = Euler::from_quaternion(&q);
-                let v = Vector3::new(f64::from(d.vx), f64::from(d.vy), f64::from(d.vz)) / 100.0;
-                let (course, gs) = course_and_speed(&v);
-                let va = f64::from(d.true_airspeed) / 100.0;
-                let climb = -v.z;
-                let s = Sample {
-                    p: d.rollspeed,
-                    q: d.pitchspeed,
-                    r: d.yawspeed,
-                    phi: e.phi as f32,
-                    theta: e.theta as f32,
-                    airspeed: va as f32,
-                    ay: (f64::from(d.yacc) * STANDARD_GRAVITY / 1000.0) as f32,
-                    accel_y: (f64::from(d.yacc) * STANDARD_GRAVITY / 1000.0) as f32,
-                    climb_rate: climb as f32,
-                    course: course as f32,
-                    ground_speed: gs as f32,
-                    ..Sample::default()
-                };
-                truth = Some(Timed {
-                    time_us: d.time_usec,
-                    alt_m: f64::from(d.alt) / 1000.0,
-                    armed: false,
-                    attitude: q,
-                    v_ned: v,
-                    sample: s,
-                });
-            }
-            MavMessage::HIL_ACTUATOR_CONTROLS(d)
-                if (f.header.system_id, f.header.component_id)
-                    == (u32::from(SYSTEM_ID), COMPONENT_ID) =>
-            {
-                let Some(t) = truth.filter(|t| t.time_us == d.time_usec) else {
-                    return;
-                };
-                let c = Surfaces::from_px4_controls([
-                    d.controls[0],
-                    d.controls[1],
-                    d.controls[2],
-                    d.controls[3],
-                ]);
-                out.push(Timed {
-                    armed: d.mode.bits() & 128 != 0,
-                    sample: Sample {
-                        aileron: c.aileron,
-                        elevator: c.elevator,
-                        rudder: c.rudder,
-                        throttle: c.throttle,
-                        ..t.sample
-                    },
-                    ..t
-                });
-            }
-            _ => {}
-        });
-    }
-    out
-}
-
-/// Longest median interval between a flight log's surface samples that the fits take, s: the
-/// control rate's 20 ms and some room (the default profile's 40 ms does not resolve a 60 ms
-/// roll mode).
-const ULOG_INTERVAL_MAX_S: f64 = 0.03;
-
-/// The samples of the autopilot's flight log: each `actuator_outputs` sample with the latest
-/// attitude, inertial sample, velocity and airspeed at or before it.
-fn ulog_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Vec<Timed>> {
-    let log =
-        crate::ulog_read::parse(bytes).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let topic = |name: &str| {
-        log.dataset(name)
-            .filter(|d| !d.is_empty())
-            .with_context(|| format!("{}: no `{name}` in the flight log", path.display()))
-    };
-    let fields = |name: &str, keys: &[&str]| -> anyhow::Result<(Vec<u64>, Vec<Vec<f64>>)> {
-        let d = topic(name)?;
-        let columns = keys
-            .iter()
-            .map(|k| {
-                d.field(k)
-                    .with_context(|| format!("{}: no `{name}.{k}`", path.display()))
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        Ok((d.timestamps_us().to_vec(), columns))
-    };
-    let (t_out, out) = fields(
-        "actuator_outputs",
-        &["output[0]", "output[1]", "output[2]", "output[3]"],
-    )?;
-    let mut gaps: Vec<u64> = t_out
-        .windows(2)
-        .map(|w| w[1].saturating_sub(w[0]))
-        .collect();
-    gaps.sort_unstable();
-    let median_s = gaps
-        .get(gaps.len() / 2)
-        .map_or(f64::INFINITY, |g| *g as f64 * 1e-6);
-    if median_s > ULOG_INTERVAL_MAX_S {
-        bail!(
-            "{}: surfaces logged every {} ms: too far apart to resolve the fast modes; fly with \
-             SDLOG_PROFILE's system-identification bit (`SDLOG_PROFILE 9`) for 100 Hz",
-            path.display(),
-            sig(median_s * 1e3, 2)
-        );
-    }
-    let att = fields("vehicle_attitude", &["q[0]", "q[1]", "q[2]", "q[3]"])?;
-    let imu = fields(
-        "sensor_combined",
-        &[
-            "gyro_rad[0]",
-            "gyro_rad[1]",
-            "gyro_rad[2]",
-            "accelerometer_m_s2[1]",
-        ],
-    )?;
-    let pos = fields("vehicle_local_position", &["vx", "vy", "vz", "z"])?;
-    let air = fields("airspeed_validated", &["true_airspeed_m_s"])?;
-    // The latest sample of a topic at or before `t`.
-    let at = |(times, columns): &(Vec<u64>, Vec<Vec<f64>>), t: u64| -> Option<Vec<f64>> {
-        let i = times.partition_point(|n| *n <= t).checked_sub(1)?;
-        columns.iter().map(|c| c.get(i).copied()).collect()
-    };
-    let mut samples = Vec::new();
-    for (k, &t) in t_out.iter().enumerate() {
-        let controls: Option<Vec<f64>> = out.iter().map(|c| c.get(k).copied()).collect();
-        let (Some(u), Some(q), Some(w), Some(v), Some(va)) =
-            (controls, at(&att, t), at(&imu, t), at(&pos, t), at(&air, t))
-        else {
-            continue;
-        };
-        let Some(q) = UnitQuaternion::try_new(Quaternion::new(q[0], q[1], q[2], q[3]), 1e-3) else {
-            continue;
-        };
-        let e = Euler::from_quaternion(&q);
-        let v_ned = Vector3::new(v[0], v[1], v[2]);
-        let (course, gs) = course_and_speed(&v_ned);
-        let c = Surfaces::from_px4_controls([u[0], u[1], u[2], u[3]].map(|x| x as f32));
-        samples.push(Timed {
-            time_us: t,
-            alt_m: -v[3],
-            // A flight log is written from arming (or from boot: the runway's samples are
-            // then left out by their height).
-            armed: true,
-            attitude: q,
-            v_ned,
-            sample: Sample {
-                p: w[0] as f32,
-                q: w[1] as f32,
-                r: w[2] as f32,
-                phi: e.phi as f32,
-                theta: e.theta as f32,
-                airspeed: va[0] as f32,
-                ay: w[3] as f32,
-                accel_y: w[3] as f32,
-                climb_rate: -v_ned.z as f32,
-                course: course as f32,
-                ground_speed: gs as f32,
-                aileron: c.aileron,
-                elevator: c.elevator,
-                rudder: c.rudder,
-                throttle: c.throttle,
-                ..Sample::default()
-            },
-        });
-    }
-    Ok(samples)
-}
+mod logs;
+use logs::{ground_samples, samples, ulog_samples, Timed};
 
 /// The flight's steady horizontal wind, NED, m/s: the mean of the ground velocity less the
 /// airspeed along the body's nose. The log holds no wind, and the angle of attack is read from
@@ -362,15 +170,22 @@ pub fn identify_log(
 ) -> anyhow::Result<IdentifyReport> {
     let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
     let flight_log = bytes.starts_with(&common::ulog::MAGIC);
-    let all = if flight_log {
-        ulog_samples(path, &bytes)?
+    let ground = if flight_log {
+        None
     } else {
-        samples(&bytes)
+        ground_samples(path, &bytes)?
+    };
+    let ground_link = ground.is_some();
+    let all = match ground {
+        Some(g) => g,
+        None if flight_log => ulog_samples(path, &bytes)?,
+        None => samples(&bytes),
     };
     if all.is_empty() {
         bail!(
             "{}: no HIL_STATE_QUATERNION answered by an HIL_ACTUATOR_CONTROLS of the autopilot \
-             (a simulator link's .tlog with the truth frames is needed)",
+             (a simulator link's .tlog with the truth frames), nor a ground link's \
+             SERVO_OUTPUT_RAW with its ATTITUDE, GLOBAL_POSITION_INT and VFR_HUD",
             path.display()
         );
     }
@@ -379,7 +194,7 @@ pub fn identify_log(
     let on_runway = all
         .iter()
         .any(|s| s.armed && s.sample.airspeed < STANDING_MPS);
-    let ground = if on_runway {
+    let runway = if on_runway {
         all.iter()
             .filter(|s| s.armed)
             .map(|s| s.alt_m)
@@ -392,7 +207,7 @@ pub fn identify_log(
     };
     let flown: Vec<&Timed> = all
         .iter()
-        .filter(|s| s.armed && s.alt_m >= ground + AIRBORNE_M && within(s))
+        .filter(|s| s.armed && s.alt_m >= runway + AIRBORNE_M && within(s))
         .collect();
     if flown.len() < 50 {
         bail!(
@@ -406,11 +221,19 @@ pub fn identify_log(
         .into_iter()
         .map(|t| {
             let air = AirData::from_body_velocity(&ned_to_body(&t.attitude, &(t.v_ned - wind)));
+            // A ground link's roll model reads the sideslip's lateral force, as the vehicle's
+            // autotune does.
+            let ay = if ground_link {
+                (air.beta * f64::from(t.sample.airspeed).powi(2)) as f32
+            } else {
+                t.sample.ay
+            };
             Timed {
                 sample: Sample {
                     alpha: air.alpha as f32,
                     beta: air.beta as f32,
                     air_speed: air.va as f32,
+                    ay,
                     ..t.sample
                 },
                 ..*t
@@ -427,7 +250,7 @@ pub fn identify_log(
     let servo_tau = 1.0 / (2.0 * std::f64::consts::PI * aircraft.actuators.bandwidth_Hz);
     // The autopilot's estimate carries its sensors' noise: fitted through the pre-filters the
     // vehicle fits its own through; the truth needs none.
-    let (airspeed_filter_tau_s, attitude_filter_tau_s) = if flight_log {
+    let (airspeed_filter_tau_s, attitude_filter_tau_s) = if flight_log || ground_link {
         (AIRSPEED_FILTER_TAU_S, ATTITUDE_FILTER_TAU_S)
     } else {
         (0.0, 0.0)
@@ -439,6 +262,7 @@ pub fn identify_log(
         airspeed_filter_tau_s,
         attitude_filter_tau_s,
     });
+    id.take_rows(!ground_link, true);
     let mut last: Option<u64> = None;
     for s in &flown {
         let dt = last.map_or(0.0, |l| s.time_us.saturating_sub(l) as f32 * 1e-6);
@@ -464,6 +288,15 @@ pub fn identify_log(
         let (input, _) = axis.input();
         let scale = if axis == Axis::Airspeed { 1.0 } else { RAD2DEG };
         let report = match id.fit(axis) {
+            _ if ground_link && axis == Axis::Sideslip => AxisReport {
+                axis: axis.name().into(),
+                input: input.into(),
+                input_sd: None,
+                r2: None,
+                rows: 0,
+                coefficients: Vec::new(),
+                error: Some("no accelerometer (the side force) in a ground link's messages".into()),
+            },
             Ok(f) => AxisReport {
                 axis: axis.name().into(),
                 input: input.into(),

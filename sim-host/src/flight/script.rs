@@ -87,6 +87,10 @@ pub struct ScriptStep {
 pub struct Script {
     /// Parameters set (PARAM_SET) at the first frame, before arming.
     pub params: Vec<(String, f32)>,
+    /// Streams asked for at the first frame, after the parameters
+    /// (`MAV_CMD_SET_MESSAGE_INTERVAL`, as QGroundControl's MAVLink Inspector and MAVProxy's
+    /// `long` command send it): message id and rate, Hz.
+    pub message_rates: Vec<(u32, f32)>,
     /// First arming attempt, s of simulated time.
     pub first_arm_s: f64,
     /// Retry period while arming is refused, s.
@@ -111,6 +115,7 @@ impl Script {
         };
         Self {
             params: Vec::new(),
+            message_rates: Vec::new(),
             first_arm_s: 1.0,
             arm_retry_s: 1.0,
             steps: vec![
@@ -268,6 +273,18 @@ impl GroundStation {
                 });
                 let mut done = |m: &MavMessage| matches!(m, MavMessage::PARAM_VALUE(v) if v.param_id.to_str().is_ok_and(|id| id == name));
                 self.exchange(t_s, link, onboard, &msg, Await::Answer(&mut done));
+            }
+            for (id, hz) in self.script.message_rates.clone() {
+                let msg = command(
+                    MavCmd::MAV_CMD_SET_MESSAGE_INTERVAL,
+                    [id as f32, (1e6 / f64::from(hz)) as f32, 0.0, 0.0],
+                );
+                let name = <MavMessage as mavlink::Message>::default_message_from_id(id)
+                    .map_or_else(
+                        || id.to_string(),
+                        |m| mavlink::Message::message_name(&m).to_string(),
+                    );
+                self.command(t_s, &format!("{name} at {hz} Hz"), link, onboard, &msg);
             }
         }
         if !self.silent && t_s >= self.next_heartbeat_s {

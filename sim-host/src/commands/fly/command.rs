@@ -73,6 +73,8 @@ pub struct FlyCommand {
     pub autotune: bool,
     /// Parameters set before arming, name and value.
     pub params: Vec<(String, f32)>,
+    /// Messages asked for before arming: id and rate, Hz.
+    pub message_rates: Vec<(u32, f32)>,
 }
 
 /// The flight configuration of `--mission`: the built-in default mission, a built-in mission
@@ -153,6 +155,9 @@ pub fn fly_command(
             cfg.duration_s = d;
         }
         cfg.script.params.extend(a.params.iter().cloned());
+        cfg.script
+            .message_rates
+            .extend(a.message_rates.iter().copied());
         cfg
     };
     let cfg = configure(base);
