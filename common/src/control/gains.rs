@@ -127,6 +127,18 @@ pub const NAMED: &[(&str, GainSet, &str)] = &[
     ),
 ];
 
+/// The sets of [`NAMED`], in its order, as the vehicle loads them by `SYS_GAIN_SET`'s index:
+/// without the sources, which only the host's tools print (in the MCU image they were some
+/// 300 bytes).
+pub const SETS: [GainSet; 6] = [
+    FLIGHT,
+    DESIGNED,
+    DESIGNED_T310,
+    DESIGNED_APPE,
+    MINNESOTA,
+    MINNESOTA_APPE,
+];
+
 /// Names of the sets in [`NAMED`].
 pub const NAMES: &[&str] = &[
     "flight",
@@ -185,8 +197,10 @@ mod tests {
             assert!(text.contains(n), "{text}");
         }
         assert_eq!(NAMED.len(), NAMES.len());
-        for ((n, _, _), m) in NAMED.iter().zip(NAMES) {
+        assert_eq!(NAMED.len(), SETS.len());
+        for (((n, g, _), m), set) in NAMED.iter().zip(NAMES).zip(&SETS) {
             assert_eq!(n, m);
+            assert_eq!(g, set, "{n}");
         }
     }
 

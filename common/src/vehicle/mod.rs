@@ -40,7 +40,7 @@ mod tests;
 use crate::actuators::Surfaces;
 use crate::battery::{self, BatteryMonitor};
 use crate::control::autopilot::{Autopilot, GainSet};
-use crate::control::gains::NAMED;
+use crate::control::gains::SETS;
 use crate::control::inputs::{course_or_crabbed_heading, Measurements};
 use crate::estimator::{self, config as estimator_config, EstimatedState, Estimator};
 use crate::navigation::navigator::io::HeightOracle;
@@ -558,7 +558,7 @@ impl Vehicle {
         // A new gain set overwrites the control parameters with its values.
         if sys.gain_set != self.gain_set_seen {
             self.gain_set_seen = sys.gain_set;
-            if let Some((_, g, _)) = NAMED.get(usize::from(sys.gain_set)) {
+            if let Some(g) = SETS.get(usize::from(sys.gain_set)) {
                 if g.to_store(&mut self.params).is_err() {
                     self.commander
                         .notify(Notice::Text(Severity::Warning, "Gain set refused"));
