@@ -65,7 +65,7 @@ pub const PARAMS: Group<PathParams> = Group {
                 5.0,
                 80.0,
                 "deg",
-                "Bank a corner's turn is laid out for (LIM_ROLL_DEG less room for gusts)",
+                "Bank a corner's turn and the narrowest loiter are laid out for (LIM_ROLL_DEG less room for gusts)",
             ),
             PathParams => turn_bank, scale RAD2DEG
         ),
@@ -219,6 +219,20 @@ impl PathManager {
         let needed = over_ground * over_ground
             / (crate::math::GRAVITY * crate::math::elementary::tan(self.turn_bank));
         self.turn_radius.max(needed.min(TURN_RADIUS_MAX))
+    }
+
+    /// The narrowest circle flown at `airspeed` (m/s) at `NAV_TURN_BNK_DEG` in still air, m:
+    /// `airspeed^2 / (g tan bank)` (at most [`TURN_RADIUS_MAX`]; 0 for a speed that is not a
+    /// positive number). A loiter narrower than it is widened to it (ArduPlane's
+    /// `NAVL1_LIM_BANK`): the bank between it and the roll limit is left for the wind.
+    pub fn circle_radius(&self, airspeed: f32) -> f32 {
+        let v = if airspeed.is_finite() {
+            airspeed.max(0.0)
+        } else {
+            0.0
+        };
+        (v * v / (crate::math::GRAVITY * crate::math::elementary::tan(self.turn_bank)))
+            .min(TURN_RADIUS_MAX)
     }
 
     /// One step from the position `pos` (NED from home, m) along the window `[from, to,

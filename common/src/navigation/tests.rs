@@ -80,6 +80,7 @@ impl Plane {
             pos_ned: self.k.pos,
             vel_ned: Vector3::new(v.x, v.y, -self.climb),
             heading: self.k.heading,
+            roll: 0.0,
             airspeed: self.k.airspeed,
             yaw_rate: 0.0,
             wind_speed: self.k.wind.xy().norm(),
@@ -442,6 +443,36 @@ fn loiter_turns_counted() {
     }
     let turns = swept / core::f32::consts::TAU;
     assert!((turns + 2.0).abs() < 0.05, "turns {turns}");
+}
+
+/// A loiter narrower than the turn at `NAV_TURN_BNK_DEG` (35 deg) allows at the cruise
+/// airspeed is flown on that turn's circle: 30 m asked at 17 m/s becomes
+/// `17^2 / (g tan 35 deg)` = 42.1 m (ArduPlane's loiter radius at its bank limit), while a
+/// wider one (80 m, above) is flown as asked.
+#[test]
+fn a_loiter_narrower_than_the_turn_bank_allows_is_widened_to_it() {
+    let items = [
+        item(NAV_LOITER_TURNS, [2.0, 0.0, 30.0, 0.0], 300.0, 0.0, 80.0),
+        wp(500.0, 600.0, 80.0),
+    ];
+    let mut nav = navigator();
+    let mut plane = Plane::flying(0.0, 0.0, 80.0, 0.0);
+    nav.start_mission(0);
+    let log = fly(&mut nav, &mut plane, &items, 400.0, |o| {
+        o.reached == Some(0)
+    });
+    assert_eq!(log.reached, [0]);
+    let c = log.outs[0].1.target.unwrap();
+    let expected = 17.0 * 17.0 / (crate::math::GRAVITY * libm::tanf(35f32.to_radians()));
+    assert!((expected - 42.1).abs() < 0.1, "{expected}");
+    // The second turn, well on the circle.
+    let half = log.outs.len() / 2;
+    let radii: Vec<f32> = log.outs[half..]
+        .iter()
+        .map(|(_, _, p)| libm::hypotf(p.x - c.x, p.y - c.y))
+        .collect();
+    let mean = radii.iter().sum::<f32>() / radii.len() as f32;
+    assert!((mean - expected).abs() < 2.0, "mean radius {mean} m");
 }
 
 #[test]
@@ -1147,6 +1178,7 @@ fn garbage_items_and_state_do_not_panic() {
             pos_ned: Vector3::new(f32::NAN, 1e30, f32::INFINITY),
             vel_ned: Vector3::new(f32::NAN, 0.0, 0.0),
             heading: f32::NAN,
+            roll: f32::NAN,
             airspeed: f32::NAN,
             yaw_rate: f32::NAN,
             wind_speed: f32::NAN,

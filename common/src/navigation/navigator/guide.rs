@@ -42,6 +42,25 @@ impl Orbit {
     }
 }
 
+/// The largest bank a turn's airspeed floor is reckoned at, rad (60 deg: a load factor of 2).
+const TURN_FLOOR_BANK_MAX: f32 = core::f32::consts::FRAC_PI_3;
+
+/// The airspeed of the legs and circles at bank `roll` (rad): `cruise`, but no slower than
+/// `NAV_ASPD_MIN` raised by the turn's load factor, `NAV_ASPD_MIN sqrt(1 / cos(roll))` (the
+/// stall speed grows with the square root of the load factor: PX4's and ArduPlane's floor), nor
+/// faster than `NAV_ASPD_MAX`. A mission's `DO_CHANGE_SPEED` to the minimum holds it on the
+/// legs; in a 40 deg turn the wing needs 14 % more (the Aerosonde's elevator reached its stop
+/// in such turns at its 20 m/s minimum). The bank is counted to 60 deg; one that is not a
+/// number leaves `cruise` as it is.
+pub(super) fn turn_airspeed(cruise: f32, p: &NavParams, roll: f32) -> f32 {
+    if !roll.is_finite() {
+        return cruise;
+    }
+    let bank = roll.abs().min(TURN_FLOOR_BANK_MAX);
+    let floor = p.airspeed_min / libm::sqrtf(crate::math::elementary::cos(bank));
+    cruise.max(floor.min(p.airspeed_max))
+}
+
 /// The autopilot's commands that follow a guidance output: course, and altitude and airspeed.
 pub(super) fn follow(g: &GuidanceOutput) -> Commands {
     Commands {
@@ -102,12 +121,27 @@ pub(super) struct Flight<'a> {
     pub cruise: f32,
     /// The airspeed's gust level, m/s (its standard deviation about its slow mean).
     pub gust: f32,
+    /// The narrowest circle flown at `cruise`, m
+    /// ([`crate::navigation::path_manager::PathManager::circle_radius`]).
+    pub circle_min: f32,
 }
 
 impl Flight<'_> {
+    /// `orbit` as a path flown at `airspeed` (m/s), widened to [`Flight::circle_min`] where it
+    /// is narrower.
+    // Out of line: inlined at its seven sites, it cost the MCU image some 200 bytes.
+    #[inline(never)]
+    pub fn circle(&self, orbit: &Orbit, airspeed: f32) -> Path {
+        Orbit {
+            radius: orbit.radius.max(self.circle_min),
+            ..*orbit
+        }
+        .path(airspeed)
+    }
+
     /// Follows `path`: its guidance and commands into `out`, with the point flown to and the
     /// phase; the bank limited near the ground ([`course_near_ground`], the height above
-    /// home).
+    /// home), the airspeed no slower than the bank flown needs ([`turn_airspeed`]).
     pub fn emit(
         &self,
         path: &Path,
@@ -118,6 +152,10 @@ impl Flight<'_> {
         let g = self
             .guidance
             .step(path, &self.state.pos_ned, self.state.ground_speed());
+        let g = GuidanceOutput {
+            airspeed: turn_airspeed(g.airspeed, self.params, self.state.roll),
+            ..g
+        };
         out.guidance = Some(g);
         // Whatever brought the aircraft this low (a failsafe's return or circle just after
         // the take-off's climb, a go-around's circuit), its wing tips keep off the ground.
@@ -163,6 +201,29 @@ mod tests {
     /// turn); at rest the error alone steers, as before, the same wheel for any error beyond
     /// its reach.
     #[test]
+    fn a_turns_airspeed_floor_is_the_minimum_times_the_root_of_its_load_factor() {
+        let p = NavParams {
+            airspeed_min: 20.0,
+            airspeed_max: 32.0,
+            ..NavParams::default()
+        };
+        let deg = |d: f32| d.to_radians();
+        // 40 deg: a load factor of 1.305, 20 m/s becomes 22.85.
+        assert!((turn_airspeed(20.0, &p, deg(-40.0)) - 22.85).abs() < 0.01);
+        // Level, or a cruise above the floor: the cruise.
+        assert_eq!(turn_airspeed(20.0, &p, 0.0), 20.0);
+        assert_eq!(turn_airspeed(25.0, &p, deg(40.0)), 25.0);
+        // Counted to 60 deg (a load factor of 2), never over the maximum.
+        assert!((turn_airspeed(20.0, &p, deg(80.0)) - 28.28).abs() < 0.01);
+        let low_max = NavParams {
+            airspeed_max: 22.0,
+            ..p
+        };
+        assert_eq!(turn_airspeed(20.0, &low_max, deg(60.0)), 22.0);
+        assert_eq!(turn_airspeed(20.0, &p, f32::NAN), 20.0);
+    }
+
+    #[test]
     fn a_spinning_aircraft_s_tail_wheel_stays_against_the_spin_at_the_half_turn() {
         let p = NavParams::default();
         let g = crate::guidance::Guidance::default();
@@ -179,6 +240,7 @@ mod tests {
                 dt: 0.02,
                 cruise: 17.0,
                 gust: 0.0,
+                circle_min: 0.0,
             };
             match f.steer(heading_err_deg.to_radians()) {
                 YawMode::Rudder(r) => r,

@@ -15,6 +15,8 @@ pub struct NavState {
     pub vel_ned: Vector3<f32>,
     /// Heading (yaw), rad.
     pub heading: f32,
+    /// Bank (roll), rad.
+    pub roll: f32,
     /// Airspeed, m/s.
     pub airspeed: f32,
     /// Yaw rate about the body's z axis, rad/s (the heading's rate on the runway).
@@ -45,6 +47,7 @@ impl NavState {
             pos_ned: s.pos_ned,
             vel_ned: s.vel_ned,
             heading: s.euler.psi,
+            roll: s.euler.phi,
             airspeed: s.airspeed,
             yaw_rate: s.body_rates.z,
             wind_speed: if s.wind_valid {

@@ -1,7 +1,8 @@
 //! Loiter items: circling a point until the item's goal is met.
 //!
 //! Loiters orbit their point (the item's radius, or `NAV_LOIT_RAD` when it gives none; see
-//! [`crate::navigation::item`]). `LOITER_TURNS` counts the angle swept
+//! [`crate::navigation::item`]), widened to the narrowest circle `NAV_TURN_BNK_DEG` allows at
+//! the airspeed ([`super::guide::Flight::circle`]). `LOITER_TURNS` counts the angle swept
 //! round the centre once on the circle; `LOITER_TIME` the time on the circle;
 //! `LOITER_TO_ALT` waits for the altitude. `LOITER_UNLIM` is reported reached on arrival and
 //! never ends.
@@ -74,7 +75,7 @@ impl Loiter {
         let p = f.params;
         let pos = f.state.pos_ned;
         let orbit = self.orbit;
-        let path = orbit.path(f.cruise);
+        let path = f.circle(&orbit, f.cruise);
         let g = f.emit(&path, Some(orbit.center), Phase::Loiter, out);
         let on_circle = g.cross_track.abs() <= p.accept_radius.max(0.1 * orbit.radius);
         let mut done = false;

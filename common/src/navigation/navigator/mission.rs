@@ -315,7 +315,7 @@ impl Leg {
         let reached = step.as_ref().and_then(|s| s.reached).is_some();
         let path = step
             .map(|s| s.path)
-            .unwrap_or(Orbit::loiter(self.target, f.params).path(self.airspeed));
+            .unwrap_or(f.circle(&Orbit::loiter(self.target, f.params), self.airspeed));
         f.emit(&path, Some(self.target), Phase::Waypoint, out);
         // Turning onto the leg is no straight flight.
         out.straight &= !self.joining;

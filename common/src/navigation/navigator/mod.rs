@@ -377,6 +377,7 @@ impl Navigator {
             dt,
             cruise: self.mission.cruise(&self.params),
             gust: self.gust.sigma(),
+            circle_min: self.paths.circle_radius(self.mission.cruise(&self.params)),
         };
         let seq = self.mission.seq;
         match self.active {
@@ -428,10 +429,15 @@ impl Navigator {
                 self.active = Active::Return(r);
             }
             Active::Hold(o) => {
-                f.emit(&o.path(f.cruise), Some(o.center), Phase::Hold, out);
+                f.emit(&f.circle(&o, f.cruise), Some(o.center), Phase::Hold, out);
             }
             Active::Complete(o) => {
-                f.emit(&o.path(f.cruise), Some(o.center), Phase::Complete, out);
+                f.emit(
+                    &f.circle(&o, f.cruise),
+                    Some(o.center),
+                    Phase::Complete,
+                    out,
+                );
             }
         }
     }

@@ -78,7 +78,7 @@ impl Return {
         self.phase = match self.phase {
             ReturnPhase::Home { origin } => {
                 let path = Path::line_between(&origin, &home_ned, f.cruise)
-                    .unwrap_or(circle.path(f.cruise));
+                    .unwrap_or(f.circle(&circle, f.cruise));
                 f.emit(&path, Some(home_ned), Phase::Return, out);
                 if horizontal_dist(&pos, &home_ned) <= p.loiter_radius {
                     // A mission's return item counts as reached at home.
@@ -90,7 +90,7 @@ impl Return {
             }
             ReturnPhase::Circle => {
                 let g = f.emit(
-                    &circle.path(f.cruise),
+                    &f.circle(&circle, f.cruise),
                     Some(home_ned),
                     Phase::ReturnLoiter,
                     out,
@@ -122,7 +122,7 @@ impl Return {
                 let window = [mk(0, origin), mk(1, gate), mk(2, Vector3::zeros())];
                 let step = paths.step(&pos, &window, f.state.wind_speed);
                 let reached = step.as_ref().and_then(|s| s.reached).is_some();
-                let path = step.map(|s| s.path).unwrap_or(circle.path(airspeed));
+                let path = step.map(|s| s.path).unwrap_or(f.circle(&circle, airspeed));
                 f.emit(&path, Some(gate), Phase::Return, out);
                 if reached {
                     ReturnPhase::Land(Landing::new(gate, Vector3::zeros()))
