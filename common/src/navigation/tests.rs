@@ -1654,6 +1654,27 @@ fn an_approach_still_high_past_the_abort_distance_goes_around() {
     }
 }
 
+/// An approach that begins more than twice the glide slope's height above the point (6 deg in
+/// these tests: under 21 m at 200 m, the flare's overrun taken off) flies the circuit instead
+/// of diving onto the slope, and lands from it; one that begins at 30 m flies the approach.
+#[test]
+fn an_approach_begun_over_twice_the_slopes_height_flies_the_circuit() {
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    for (height, phase) in [(30.0, Phase::Approach), (45.0, Phase::GoAround)] {
+        let mut nav = navigator();
+        let plane = Plane::flying(200.0, 0.0, height, core::f32::consts::PI);
+        nav.start_mission(0);
+        let out = nav.step(&items, &home(), &plane.state(), DT);
+        assert_eq!(out.phase, phase, "begun {height} m up");
+        if phase == Phase::GoAround {
+            let log = fly(&mut nav, &mut { plane }, &items, 600.0, |o| {
+                o.phase == Phase::Landed
+            });
+            assert_eq!(log.outs.last().map(|o| o.1.phase), Some(Phase::Landed));
+        }
+    }
+}
+
 /// A flare still in the air 20 m past the land point (`NAV_LND_ABORT_M`) goes around: it
 /// climbs away on the runway's line at full throttle (the take-off regime) to the approach's
 /// start height (30 m here), flies back on a leg parallel to the runway two loiter radii

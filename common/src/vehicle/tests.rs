@@ -745,10 +745,10 @@ fn land_at_home() -> MissionStore {
     plan
 }
 
-/// `h` m up, 40 m short of home on a northbound final at 13 m/s, sinking 0.5 m/s.
-fn on_final(h: f32) -> EstimatedState {
+/// `h` m up, `short_m` m short of home on a northbound final at 13 m/s, sinking 0.5 m/s.
+fn on_final(h: f32, short_m: f32) -> EstimatedState {
     let mut e = flying();
-    e.pos_ned = Vector3::new(-40.0, 0.0, -h);
+    e.pos_ned = Vector3::new(-short_m, 0.0, -h);
     e.alt_amsl_m = 300.0 + h;
     e.airspeed = 13.0;
     e.ground_speed = 13.0;
@@ -757,14 +757,14 @@ fn on_final(h: f32) -> EstimatedState {
     e
 }
 
-/// Armed in Mission on the final of [`on_final`] at `h` m, its landing item at home flown for
-/// one tick; then the ground link silent for more than `FS_GCS_TOUT_S`. Returns the commander
-/// and the phase before the loss.
-fn loss_on_final(h: f32) -> (Commander, crate::navigation::navigator::io::Phase) {
+/// Armed in Mission on the final of [`on_final`] at `h` m, `short_m` m out, its landing item at
+/// home flown for one tick; then the ground link silent for more than `FS_GCS_TOUT_S`. Returns
+/// the commander and the phase before the loss.
+fn loss_on_final(h: f32, short_m: f32) -> (Commander, crate::navigation::navigator::io::Phase) {
     let plan = land_at_home();
     let mut c = Commander::new();
     let mut n = Navigator::default();
-    let e = on_final(h);
+    let e = on_final(h, short_m);
     c.apply(&arm(), &e, &mut n);
     c.apply(&mode(FlightMode::Mission), &e, &mut n);
     tick_at(&mut c, &mut n, &e, &plan, 0);
@@ -777,7 +777,7 @@ fn loss_on_final(h: f32) -> (Commander, crate::navigation::navigator::io::Phase)
 #[test]
 fn a_ground_link_loss_in_the_flare_lets_the_landing_finish_and_one_on_the_approach_returns() {
     use crate::navigation::navigator::io::Phase;
-    let (mut c, before) = loss_on_final(1.0);
+    let (mut c, before) = loss_on_final(1.0, 40.0);
     assert_eq!(before, Phase::Flare);
     assert_eq!(c.flown_mode(), FlightMode::Mission);
     assert_eq!(c.navigation().phase, Phase::Flare);
@@ -785,8 +785,8 @@ fn a_ground_link_loss_in_the_flare_lets_the_landing_finish_and_one_on_the_approa
         texts(&mut c),
         [crate::failsafe::Event::GcsLost.text(), TEXT_LANDING_FIRST]
     );
-    // The same loss higher on the approach returns.
-    let (c, before) = loss_on_final(20.0);
+    // The same loss higher on the approach (300 m out, under its slope) returns.
+    let (c, before) = loss_on_final(20.0, 300.0);
     assert_eq!(before, Phase::Approach);
     assert_eq!(c.flown_mode(), FlightMode::Return);
 }

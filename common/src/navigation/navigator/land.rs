@@ -123,6 +123,9 @@ const GO_AROUNDS_MAX: u8 = 2;
 const BALLOON_FLARES: f32 = 2.0;
 /// Least height above the land point a go-around climbs to, m.
 const GO_AROUND_MIN_M: f32 = 15.0;
+/// How many times the glide slope's height above the point an approach may begin at; higher,
+/// it flies the circuit instead ([`Landing::step`]).
+const APPROACH_HIGH: f32 = 2.0;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum LandPhase {
@@ -170,6 +173,8 @@ pub(super) struct Landing {
     /// Height the flare began at, m: `NAV_FLR_ALT`, or higher when the sink rate brought the
     /// ground within `NAV_FLR_TIME` first (0 before a flare).
     flare_top: f32,
+    /// The approach's start has been judged ([`APPROACH_HIGH`]).
+    judged: bool,
 }
 
 /// How far past the point where the glide slope meets the flare height the flare carries
@@ -222,6 +227,7 @@ impl Landing {
             go_arounds: 0,
             range_excess: 0.0,
             flare_top: 0.0,
+            judged: false,
         }
     }
 
@@ -412,6 +418,24 @@ impl Landing {
         } else {
             0.0
         };
+        // An approach that begins more than `APPROACH_HIGH` times the slope's height above the
+        // point is not dived onto the slope (the dive feeds on the altitude filter's lag:
+        // docs/NAVIGATION.md) but flown again from the circuit, whose final is long enough:
+        // a final laid out for an aircraft that turns tighter, its last corner's wider fillet
+        // cut short (an Aerosonde 25 m above its slope 230 m out, which dived to the ground at
+        // 6 m/s), as ArduPlane aborts a landing whose slope steepens past `LAND_ABORT_DEG`.
+        if !self.judged {
+            self.judged = true;
+            let above = state.height() + self.point.z;
+            let slope_above = (on_slope + self.point.z).max(p.flare_alt);
+            if self.phase == LandPhase::Approach
+                && above > APPROACH_HIGH * slope_above
+                && self.go_around()
+            {
+                self.step_circuit(f, &line, out);
+                return;
+            }
+        }
         out.guidance = Some(g);
         out.target = Some(self.point);
         // On the slope's sink at the present ground speed, not the measured sink: a 0.2 s
