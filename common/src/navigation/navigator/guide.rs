@@ -195,11 +195,8 @@ impl Flight<'_> {
 mod tests {
     use super::*;
 
-    /// The tail wheel in a ground loop: swinging right at 150 deg/s, the wheel stays against
-    /// the swing whether the course lies just left or just right of the tail (the
-    /// heading error's size, clamped to the wheel's reach, no longer flips it at the half
-    /// turn); at rest the error alone steers, as before, the same wheel for any error beyond
-    /// its reach.
+    /// `NAV_ASPD_MIN` times the root of the load factor, the bank counted to 60 deg, within
+    /// `NAV_ASPD_MAX`; a bank that is not a number leaves the cruise.
     #[test]
     fn a_turns_airspeed_floor_is_the_minimum_times_the_root_of_its_load_factor() {
         let p = NavParams {
@@ -223,6 +220,11 @@ mod tests {
         assert_eq!(turn_airspeed(20.0, &p, f32::NAN), 20.0);
     }
 
+    /// The tail wheel in a ground loop: swinging right at 150 deg/s, the wheel stays against
+    /// the swing whether the course lies just left or just right of the tail (the
+    /// heading error's size, clamped to the wheel's reach, no longer flips it at the half
+    /// turn); at rest the error alone steers, as before, the same wheel for any error beyond
+    /// its reach.
     #[test]
     fn a_spinning_aircraft_s_tail_wheel_stays_against_the_spin_at_the_half_turn() {
         let p = NavParams::default();
