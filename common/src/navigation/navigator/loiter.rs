@@ -2,10 +2,10 @@
 //!
 //! Loiters orbit their point (the item's radius, or `NAV_LOIT_RAD` when it gives none; see
 //! [`crate::navigation::item`]), widened to the narrowest circle `NAV_TURN_BNK_DEG` allows at
-//! the airspeed ([`super::guide::Flight::circle`]). `LOITER_TURNS` counts the angle swept
-//! round the centre once on the circle; `LOITER_TIME` the time on the circle;
-//! `LOITER_TO_ALT` waits for the altitude. `LOITER_UNLIM` is reported reached on arrival and
-//! never ends.
+//! the airspeed ([`crate::navigation::path_manager::PathManager::circle_radius`]).
+//! `LOITER_TURNS` counts the angle swept round the centre once on the circle; `LOITER_TIME`
+//! the time on the circle; `LOITER_TO_ALT` waits for the altitude. `LOITER_UNLIM` is reported
+//! reached on arrival and never ends.
 
 use super::guide::{Flight, Orbit};
 use super::io::{NavOutput, Phase};
