@@ -84,6 +84,8 @@ pub fn run(data: &[u8]) {
     nav.start_mission(0);
     let mut pos = Vector3::new(0.0f32, 0.0, -50.0);
     let mut heading = 0.0f32;
+    // The bank of the turn the aircraft last flew, rad (the navigator's turn airspeed floor).
+    let mut roll = 0.0f32;
     let airspeed = 18.0f32;
     let dt = 0.02;
     for e in input.events.iter().take(64) {
@@ -95,6 +97,7 @@ pub fn run(data: &[u8]) {
                         pos_ned: pos,
                         vel_ned: vel,
                         heading,
+                        roll,
                         airspeed,
                         yaw_rate: 0.0,
                         wind_speed: airspeed - 17.0,
@@ -116,7 +119,9 @@ pub fn run(data: &[u8]) {
                         }
                         // A first-order turn and climb towards what guidance asks.
                         let err = common::math::wrap_pi(g.course - heading);
-                        heading = common::math::wrap_pi(heading + err.clamp(-0.5, 0.5) * dt * 2.0);
+                        let rate = err.clamp(-0.5, 0.5) * 2.0;
+                        heading = common::math::wrap_pi(heading + rate * dt);
+                        roll = (airspeed * rate / 9.81).atan();
                         pos.z += (-g.altitude - pos.z).clamp(-3.0, 3.0) * dt;
                     }
                     // NaN and infinities print as such in the commands' fields.
