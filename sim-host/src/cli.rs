@@ -227,14 +227,17 @@ pub(crate) enum Command {
     },
     /// Fit the design's reduced models (roll, sideslip, pitch, airspeed; the course and
     /// altitude kinematics) from a simulator link's `.tlog` (`simlink.tlog` of `fly` and
-    /// `sim`) or the autopilot's own flight log at `SDLOG_PROFILE 9`, with each fit's quality
+    /// `sim`), a ground station's `.tlog` (`flight.tlog`) with the messages at 50 Hz, or the
+    /// autopilot's own flight log at `SDLOG_PROFILE 9`, with each fit's quality
     /// and excitation, beside the aircraft file's
     /// linearisation at the same airspeed. An axis the flight did not excite is an error
     /// naming it (the sideslip's is reported, not an error: without it a design keeps the
     /// base set's sideslip gains).
     Identify {
-        /// The log: a `.tlog` of the simulator link, with its truth frames, or the autopilot's
-        /// flight log (`.ulg`) written with `SDLOG_PROFILE 9` (100 Hz).
+        /// The log: a `.tlog` of the simulator link, with its truth frames; a ground station's
+        /// `.tlog` with ATTITUDE, SERVO_OUTPUT_RAW, GLOBAL_POSITION_INT and VFR_HUD at 50 Hz
+        /// (`fly --message-rate`); or the autopilot's flight log (`.ulg`) written with
+        /// `SDLOG_PROFILE 9` (100 Hz).
         file: PathBuf,
         /// Airspeed the coefficients are given at, m/s (default: the flown samples' mean).
         #[arg(long, value_name = "M/S", value_parser = positive_airspeed, allow_negative_numbers = true)]
