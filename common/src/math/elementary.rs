@@ -8,8 +8,9 @@
 //! angles are attitudes, courses and slopes, within a few turns of zero; here they are reduced
 //! by three parts of pi/2 (Cody and Waite's method: exact below 12,868 rad, the 8,192nd
 //! quarter turn) and the kernels are the Taylor series that reach below `f32`'s resolution
-//! within a quarter turn, all in `f32`. The arcsine and the hypotenuse are `libm`'s `f32`-only `atan2f` and `sqrtf` over exact or scaled arguments; the power is
-//! `libm`'s `expf` of `y ln x`. The tests state each one's largest difference from `f64`.
+//! within a quarter turn, all in `f32`. The arcsine and the hypotenuse are `libm`'s
+//! `f32`-only `atan2f` and `sqrtf` over exact or scaled arguments; the power is `libm`'s
+//! `expf` of `y ln x`. The tests state each one's largest difference from `f64`.
 //!
 //! The MCU image takes these ([`sin_cos`], [`sin`], [`cos`], [`tan`], [`asin`], [`hypot`],
 //! [`powf`], and [`Elementary`] in code generic over the float); the host build keeps `libm`'s

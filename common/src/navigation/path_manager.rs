@@ -215,10 +215,8 @@ impl PathManager {
     /// [`TURN_RADIUS_MAX`]). A non-finite or negative speed counts as none.
     pub fn fillet_radius(&self, airspeed: f32, wind_speed: f32) -> f32 {
         let speed = |v: f32| if v.is_finite() { v.max(0.0) } else { 0.0 };
-        let over_ground = speed(airspeed) + speed(wind_speed);
-        let needed = over_ground * over_ground
-            / (crate::math::GRAVITY * crate::math::elementary::tan(self.turn_bank));
-        self.turn_radius.max(needed.min(TURN_RADIUS_MAX))
+        self.turn_radius
+            .max(self.circle_radius(speed(airspeed) + speed(wind_speed)))
     }
 
     /// The narrowest circle flown at `airspeed` (m/s) at `NAV_TURN_BNK_DEG` in still air, m:

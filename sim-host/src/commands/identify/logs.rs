@@ -148,17 +148,9 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
     let mut parser = FrameParser::new();
     let mut latest = GroundLatest::default();
     let mut out = Vec::new();
-    let mut seen = [false; 4];
-    let mut intervals: [Vec<u64>; 4] = Default::default();
-    let mut last = [None::<u64>; 4];
-    // A message's boot time, µs: its own stamp, or (VFR_HUD has none) the attitude's.
-    let mut note = |k: usize, t: u64, seen: &mut [bool; 4]| {
-        seen[k] = true;
-        if let Some(l) = last[k].filter(|l| t > *l) {
-            intervals[k].push(t - l);
-        }
-        last[k] = Some(t);
-    };
+    // Each of `GROUND_MESSAGES`' boot times, µs: its own stamp, or (VFR_HUD has none) the
+    // attitude's.
+    let mut stamps: [Vec<u64>; 4] = Default::default();
     for (_, frame) in read_tlog(bytes) {
         parser.push(&frame, |f| {
             if (f.header.system_id, f.header.component_id) != (u32::from(SYSTEM_ID), COMPONENT_ID) {
@@ -172,24 +164,23 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
                 }
                 MavMessage::ATTITUDE(a) => {
                     let t = u64::from(a.time_boot_ms) * 1000;
-                    note(0, t, &mut seen);
+                    stamps[0].push(t);
                     latest.attitude = Some((t, a));
                 }
                 MavMessage::GLOBAL_POSITION_INT(p) => {
                     let t = u64::from(p.time_boot_ms) * 1000;
-                    note(2, t, &mut seen);
+                    stamps[2].push(t);
                     latest.position = Some((t, p));
                 }
                 MavMessage::VFR_HUD(h) => {
                     let t = latest.attitude.as_ref().map_or(0, |a| a.0);
-                    note(3, t, &mut seen);
+                    stamps[3].push(t);
                     latest.hud = Some((t, h.airspeed));
                 }
                 MavMessage::SERVO_OUTPUT_RAW(s) => {
                     // The 32-bit microseconds wrap every 71 min: unwrapped against the
                     // attitude's milliseconds of the same period.
                     let Some((t_att, a)) = latest.attitude.clone() else {
-                        seen[1] = true;
                         return;
                     };
                     let wrap = 1u64 << 32;
@@ -199,7 +190,7 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
                         .map(|b| b.wrapping_add(u64::from(s.time_usec)))
                         .min_by_key(|t| t.abs_diff(t_att))
                         .unwrap_or(t_att);
-                    note(1, t, &mut seen);
+                    stamps[1].push(t);
                     let fresh = |x: u64| t.abs_diff(x) as f64 * 1e-6 <= ULOG_INTERVAL_MAX_S;
                     let (Some((t_pos, p)), Some((t_hud, va))) =
                         (latest.position.clone(), latest.hud)
@@ -243,23 +234,16 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
             }
         });
     }
-    if !seen[1] {
+    if stamps[1].is_empty() {
         return Ok(None);
     }
     let slow: Vec<String> = GROUND_MESSAGES
         .iter()
-        .zip(intervals.iter_mut())
-        .zip(seen)
-        .filter_map(|((name, gaps), seen)| {
-            gaps.sort_unstable();
-            let median_s = gaps
-                .get(gaps.len() / 2)
-                .map_or(f64::INFINITY, |g| *g as f64 * 1e-6);
-            match (seen, median_s > ULOG_INTERVAL_MAX_S) {
-                (false, _) => Some(format!("{name} (absent)")),
-                (true, true) => Some(format!("{name} (every {} ms)", sig(median_s * 1e3, 2))),
-                _ => None,
-            }
+        .zip(&stamps)
+        .filter_map(|(name, t)| match median_interval_s(t) {
+            _ if t.is_empty() => Some(format!("{name} (absent)")),
+            m if m > ULOG_INTERVAL_MAX_S => Some(format!("{name} (every {} ms)", sig(m * 1e3, 2))),
+            _ => None,
         })
         .collect();
     if !slow.is_empty() {
@@ -273,6 +257,18 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
         );
     }
     Ok(Some(out))
+}
+
+/// The median interval between consecutive times (µs) that move forward, s; infinite with
+/// none.
+fn median_interval_s(times_us: &[u64]) -> f64 {
+    let mut gaps: Vec<u64> = times_us
+        .windows(2)
+        .filter_map(|w| w[1].checked_sub(w[0]).filter(|g| *g > 0))
+        .collect();
+    gaps.sort_unstable();
+    gaps.get(gaps.len() / 2)
+        .map_or(f64::INFINITY, |g| *g as f64 * 1e-6)
 }
 
 /// Longest median interval between a flight log's surface samples that the fits take, s: the
@@ -305,14 +301,7 @@ pub(super) fn ulog_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Vec<Time
         "actuator_outputs",
         &["output[0]", "output[1]", "output[2]", "output[3]"],
     )?;
-    let mut gaps: Vec<u64> = t_out
-        .windows(2)
-        .map(|w| w[1].saturating_sub(w[0]))
-        .collect();
-    gaps.sort_unstable();
-    let median_s = gaps
-        .get(gaps.len() / 2)
-        .map_or(f64::INFINITY, |g| *g as f64 * 1e-6);
+    let median_s = median_interval_s(&t_out);
     if median_s > ULOG_INTERVAL_MAX_S {
         bail!(
             "{}: surfaces logged every {} ms: too far apart to resolve the fast modes; fly with \
