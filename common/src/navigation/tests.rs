@@ -847,6 +847,57 @@ fn past_the_rotation_a_take_off_goes_on_and_is_clear_for_a_failsafe_from_nav_tko
     );
 }
 
+/// The take-off regime's climb from the runway, the take-off's and the go-around's, holds its
+/// course within a bank that widens from `NAV_GND_RLL_DEG` (5 deg) on the ground to 90 deg at
+/// `NAV_TKO_CLR_M` (10 m), the regime's end: 22 deg at 2 m, where `NAV_GND_RLL_M` (3 m) alone
+/// allowed 61.7 deg; the Ultra Stick's wing-tip clearance is the wider limit all the way up.
+#[test]
+fn a_climb_from_the_runway_banks_no_more_than_the_ground_allows_up_to_nav_tko_clr_m() {
+    let expected = |h: f32| (5.0 + 85.0 * (h / 10.0).clamp(0.0, 1.0)).to_radians();
+    let check = |out: &NavOutput, h: f32| match out.commands.map(|c| c.roll) {
+        Some(RollMode::CourseWithin { roll_max, .. }) => assert!(
+            (roll_max - expected(h)).abs() < 1e-4,
+            "{:?} at {h} m: {} deg",
+            out.phase,
+            roll_max.to_degrees()
+        ),
+        other => panic!("{:?} at {h} m: {other:?}", out.phase),
+    };
+    // The take-off: every step of its climb up to 12 m.
+    let items = takeoff_east();
+    let mut nav = navigator();
+    assert_eq!(nav.params().takeoff_clear, 10.0);
+    assert_eq!(nav.params().ground_roll_height, 3.0);
+    let mut plane = at_rest_on_the_runway_east();
+    nav.start_mission(0);
+    let mut heights = Vec::new();
+    for _ in 0..4000 {
+        let h = plane.height();
+        let (out, _) = step_plane(&mut nav, &mut plane, &items);
+        if out.phase == Phase::TakeoffClimb {
+            check(&out, h);
+            heights.push(h);
+        }
+        if h > 12.0 {
+            break;
+        }
+    }
+    assert!(
+        heights.iter().any(|h| (1.0..3.0).contains(h)) && heights.iter().any(|&h| h > 10.0),
+        "climb seen at {heights:?}"
+    );
+    // The go-around's climb, from 2 m over the land point.
+    let items = [item(NAV_LAND, [0.0; 4], 0.0, 0.0, 0.0)];
+    let mut nav = navigator();
+    let mut plane = land_here_until(&mut nav, &items, Phase::Approach);
+    assert!(nav.go_around());
+    plane.k.pos.z = -2.0;
+    let out = nav.step(&items, &home(), &plane.state(), DT);
+    assert_eq!(out.phase, Phase::GoAround);
+    check(&out, 2.0);
+    assert!((expected(2.0).to_degrees() - 22.0).abs() < 1e-4);
+}
+
 /// A return begun on the runway (a failsafe's, before any height was gained) turns for home
 /// within the bank the ground allows: `NAV_GND_RLL_DEG` (5 deg) on it, 47.5 deg at 1.5 m,
 /// the roll limit alone from `NAV_GND_RLL_M` (3 m) up.

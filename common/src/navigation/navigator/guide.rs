@@ -104,6 +104,17 @@ pub(super) fn course_near_runway(
     }
 }
 
+/// Holding `course` (rad) at `height` (m) in the take-off regime's climb from the runway (the
+/// take-off's and the go-around's: fixed pitch, full throttle, up to `NAV_TKO_CLR_M`): the bank
+/// allowed widens over that height rather than `NAV_GND_RLL_M` alone, as PX4 holds the wings
+/// level to `RWTO_NAV_ALT` and ArduPlane to `TKOFF_LVL_ALT`. At the regime's fixed pitch a
+/// bank costs the climb its lift's vertical part: nine aircraft of the campaign's 1000 that
+/// lifted off into a gust's swing, or 90 deg off the line after a ground loop, turned back
+/// at 30-45 deg a metre or two up, sank, and put a wing tip on the runway.
+pub(super) fn climb_from_runway(course: f32, height: f32, p: &NavParams) -> RollMode {
+    course_near_runway(course, height, p.ground_roll_height.max(p.takeoff_clear), p)
+}
+
 /// Distance between two points over the ground, m.
 pub(super) fn horizontal_dist(a: &Vector3<f32>, b: &Vector3<f32>) -> f32 {
     crate::math::elementary::hypot(a.x - b.x, a.y - b.y)

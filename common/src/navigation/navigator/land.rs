@@ -30,7 +30,7 @@
 //! height. A ground station asks for the same with `MAV_CMD_DO_GO_AROUND`. After
 //! `GO_AROUNDS_MAX` go-arounds the landing lands whatever its flare brings.
 
-use super::guide::{course_near_runway, follow, horizontal_dist, Flight};
+use super::guide::{climb_from_runway, course_near_runway, follow, horizontal_dist, Flight};
 use super::gust::approach_airspeed;
 use super::io::{NavOutput, Phase};
 use super::params::NavParams;
@@ -310,7 +310,7 @@ impl Landing {
                 return;
             }
             out.commands = Some(Commands {
-                roll: course_near_runway(g.course, hagl, p.ground_roll_height, p),
+                roll: climb_from_runway(g.course, hagl, p),
                 yaw: RUDDER,
                 lon: LonMode::TakeOff {
                     altitude: c.height,

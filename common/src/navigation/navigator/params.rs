@@ -123,7 +123,7 @@ pub const PARAMS: Group<NavParams> = Group {
                 1.0,
                 100.0,
                 "m",
-                "Take-off regime (fixed pitch, full throttle) ends at this height; a failsafe past the rotation waits, wings level, until the climb reaches it",
+                "Take-off regime (fixed pitch, full throttle) ends at this height; the bank allowed in its climb (take-off, go-around) widens to 90 deg over it; a failsafe past the rotation waits, wings level, until the climb reaches it",
             ),
             NavParams => takeoff_clear
         ),
@@ -404,7 +404,7 @@ pub const PARAMS: Group<NavParams> = Group {
                 0.5,
                 50.0,
                 "m",
-                "Height at which the bank allowed near the ground has widened from NAV_GND_RLL_DEG to 90 deg",
+                "Height at which the bank allowed near the ground has widened from NAV_GND_RLL_DEG to 90 deg (NAV_TKO_CLR_M in the take-off's and the go-around's climb, 10 m in the flare, when higher)",
             ),
             NavParams => ground_roll_height
         ),

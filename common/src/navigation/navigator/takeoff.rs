@@ -20,7 +20,7 @@
 //! stood when the roll began. Past the rotation the aircraft is committed: a failsafe waits
 //! until the climb has reached `NAV_TKO_CLR_M` (`Takeoff::ground_stage`).
 
-use super::guide::{course_near_runway, horizontal_dist, Flight, Orbit};
+use super::guide::{climb_from_runway, horizontal_dist, Flight, Orbit};
 use super::io::{GroundStage, NavOutput, NavState, NavWarning, Phase};
 use super::land::roll_out;
 use super::params::NavParams;
@@ -217,7 +217,7 @@ impl Takeoff {
             out.guidance = g;
             let height = self.climbed;
             let roll = match g {
-                Some(g) => course_near_runway(g.course, height, p.ground_roll_height, p),
+                Some(g) => climb_from_runway(g.course, height, p),
                 None => RollMode::Roll(0.0),
             };
             // Rotated but still on its wheels, the aircraft is steered as on the roll: a
