@@ -461,7 +461,7 @@ fn the_mcu_image_stays_within_its_flash_ram_and_instruction_budget() {
 /// closure's design run on board, spread over control periods, and every period since boot,
 /// the autotune's included, stays within the budget: at most 100,000 instructions on average
 /// and 150,000 in any period. The image identifies the 25e, meets every loop's margins and
-/// applies the gains. (Measured 2026-12-07: 82,810 / 122,895, docs/PERFORMANCE.md's last
+/// applies the gains. (Measured 2026-12-08: 82,833 / 122,579, docs/PERFORMANCE.md's last
 /// row; the gains' application, 118 k in one pass of work before it wrote whole stages by
 /// position and re-read the gains alone, was the costliest period.) The scripted
 /// station's reads of the autotune's forty parameters are left out: each is an exchange in
