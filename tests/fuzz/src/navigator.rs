@@ -121,7 +121,7 @@ pub fn run(data: &[u8]) {
                         let err = common::math::wrap_pi(g.course - heading);
                         let rate = err.clamp(-0.5, 0.5) * 2.0;
                         heading = common::math::wrap_pi(heading + rate * dt);
-                        roll = (airspeed * rate / 9.81).atan();
+                        roll = (airspeed * rate / common::math::GRAVITY).atan();
                         pos.z += (-g.altitude - pos.z).clamp(-3.0, 3.0) * dt;
                     }
                     // NaN and infinities print as such in the commands' fields.

@@ -151,6 +151,9 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
     // Each of `GROUND_MESSAGES`' boot times, µs: its own stamp, or (VFR_HUD has none) the
     // attitude's.
     let mut stamps: [Vec<u64>; 4] = Default::default();
+    // A SERVO_OUTPUT_RAW makes it a ground-link log, stamped or not (one before any ATTITUDE
+    // cannot be placed in time): such a log is refused for its missing messages, by name.
+    let mut servo_seen = false;
     for (_, frame) in read_tlog(bytes) {
         parser.push(&frame, |f| {
             if (f.header.system_id, f.header.component_id) != (u32::from(SYSTEM_ID), COMPONENT_ID) {
@@ -178,6 +181,7 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
                     latest.hud = Some((t, h.airspeed));
                 }
                 MavMessage::SERVO_OUTPUT_RAW(s) => {
+                    servo_seen = true;
                     // The 32-bit microseconds wrap every 71 min: unwrapped against the
                     // attitude's milliseconds of the same period.
                     let Some((t_att, a)) = latest.attitude.clone() else {
@@ -234,7 +238,7 @@ pub(super) fn ground_samples(path: &Path, bytes: &[u8]) -> anyhow::Result<Option
             }
         });
     }
-    if stamps[1].is_empty() {
+    if !servo_seen {
         return Ok(None);
     }
     let slow: Vec<String> = GROUND_MESSAGES
